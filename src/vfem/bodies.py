@@ -1,0 +1,295 @@
+"""A deformable body: mesh, material, supports and loads, with its own stiffness and factorization.
+
+Bodies never share a matrix. Contact reaches a body only as nodal forces on its contact surface,
+so for a linear body the whole response the contact algorithm needs is
+
+    u = load_factor * u_load + platen_displacement * u_platen + K^-1 f_contact
+
+where ``u_load`` is the solution under the body's loads and prescribed displacements at load factor
+1, ``u_platen`` the solution for a unit motion of its force-controlled platen (if any), and
+``K^-1`` is applied with the body's own factorization, supports kept.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementQuad1,
+    ElementTriP1,
+    ElementVector,
+    FacetBasis,
+    LinearForm,
+    MeshQuad,
+    MeshTri,
+    asm,
+)
+from skfem.helpers import sym_grad, trace
+from skfem.models.elasticity import linear_elasticity
+
+from .errors import InputError
+from .linalg import factorize
+from .materials import LinearElastic
+
+log = logging.getLogger(__name__)
+
+COMPONENTS = {"x": 0, "y": 1}
+
+
+@dataclass(frozen=True)
+class Support:
+    """Fixed displacement components (``"x"``, ``"y"``) on a named boundary."""
+
+    boundary: str
+    components: tuple[str, ...] = ("x", "y")
+
+
+@dataclass(frozen=True)
+class PrescribedDisplacement:
+    """A displacement component prescribed on a named boundary; ``value`` at load factor 1."""
+
+    boundary: str
+    component: str
+    value: float
+
+
+@dataclass(frozen=True)
+class Traction:
+    """A distributed load (force per unit undeformed length) on a named boundary, at factor 1."""
+
+    boundary: str
+    value: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Platen:
+    """A rigid, force-controlled platen on a named boundary.
+
+    Every node of the boundary moves by the same (unknown) displacement along ``component``; the
+    solver finds it so that the platen's reaction equals ``force`` times the load factor. This is
+    how a body held only by the load (the Hertz cylinder) is loaded without a singular stiffness.
+    ``force`` is the total force on the platen along ``component`` (negative: towards -x or -y).
+    """
+
+    boundary: str
+    component: str
+    force: float
+
+
+@dataclass
+class Body:
+    """One deformable body of a contact model.
+
+    Args:
+        name: unique name, used in messages and output files.
+        mesh: a scikit-fem ``MeshTri`` or ``MeshQuad`` with named boundaries.
+        material: its material.
+        supports, prescribed, tractions: boundary conditions on named boundaries.
+        platen: an optional force-controlled rigid platen.
+        contact_boundaries: boundaries that may touch other bodies; default: every exterior facet
+            on which no displacement is prescribed (symmetry planes and supports cannot touch).
+    """
+
+    name: str
+    mesh: MeshTri | MeshQuad
+    material: LinearElastic
+    supports: tuple[Support, ...] = ()
+    prescribed: tuple[PrescribedDisplacement, ...] = ()
+    tractions: tuple[Traction, ...] = ()
+    platen: Platen | None = None
+    contact_boundaries: tuple[str, ...] | None = None
+    _ready: bool = field(default=False, init=False, repr=False)
+
+    # -- set-up ---------------------------------------------------------------------------------
+
+    def setup(self, backend: str = "superlu") -> None:
+        """Validate, assemble the stiffness, factorize it and solve the unit load cases."""
+        self._validate()
+        elem = ElementTriP1() if isinstance(self.mesh, MeshTri) else ElementQuad1()
+        self.basis = Basis(self.mesh, ElementVector(elem))
+        lam, mu = self.material.lame()
+        self.K = asm(linear_elasticity(lam, mu), self.basis).tocsr()
+        self.ndofs = self.K.shape[0]
+
+        fixed: dict[int, float] = {}  # dof -> prescribed value at factor 1
+        for s in self.supports:
+            for c in s.components:
+                fixed.update(dict.fromkeys(self._boundary_dofs(s.boundary, c).tolist(), 0.0))
+        for pd in self.prescribed:
+            fixed.update(dict.fromkeys(self._boundary_dofs(pd.boundary, pd.component).tolist(),
+                                       float(pd.value)))
+        platen_dofs = np.array([], dtype=int)
+        if self.platen is not None:
+            platen_dofs = self._boundary_dofs(self.platen.boundary, self.platen.component)
+        self.platen_dofs = platen_dofs
+        self.fixed_dofs = np.array(sorted(set(fixed) | set(platen_dofs.tolist())), dtype=int)
+        self._check_supported()
+
+        self.free_dofs = np.setdiff1d(np.arange(self.ndofs), self.fixed_dofs)
+        self.K_ff = self.K[self.free_dofs][:, self.free_dofs].tocsc()
+        self.factor = factorize(self.K_ff, backend)
+
+        f = np.zeros(self.ndofs)
+        for tr in self.tractions:
+            f += self._traction_vector(tr)
+        u_fixed = np.zeros(self.ndofs)
+        for dof, value in fixed.items():
+            u_fixed[dof] = value
+        self.u_load = self._solve_with(f, u_fixed)
+        if self.platen is not None:
+            u_unit = np.zeros(self.ndofs)
+            u_unit[platen_dofs] = 1.0
+            self.u_platen = self._solve_with(np.zeros(self.ndofs), u_unit)
+        else:
+            self.u_platen = np.zeros(self.ndofs)
+        self._ready = True
+        log.info("body %s: %d nodes, %d dofs (%d fixed)", self.name, self.mesh.nvertices,
+                 self.ndofs, len(self.fixed_dofs))
+
+    def _validate(self) -> None:
+        where = f"body {self.name!r}"
+        if not isinstance(self.mesh, (MeshTri, MeshQuad)) or type(self.mesh).__name__ not in (
+            "MeshTri1", "MeshQuad1"
+        ):
+            raise InputError(f"{where}: mesh must be linear triangles or quadrilaterals, "
+                             f"got {type(self.mesh).__name__}")
+        self.material.validate(f"{where}, material")
+        names = set((self.mesh.boundaries or {}).keys())
+        for bc in (*self.supports, *self.prescribed, *self.tractions,
+                   *((self.platen,) if self.platen else ()), *(self.contact_boundaries or ())):
+            name = bc if isinstance(bc, str) else bc.boundary
+            if name not in names:
+                raise InputError(f"{where}: no boundary named {name!r}; the mesh has "
+                                 f"{', '.join(sorted(names)) or 'no named boundaries'}")
+        comps = [c for s in self.supports for c in s.components]
+        comps += [pd.component for pd in self.prescribed]
+        comps += [self.platen.component] if self.platen else []
+        for c in comps:
+            if c not in COMPONENTS:
+                raise InputError(f"{where}: component must be 'x' or 'y', got {c!r}")
+        values = [pd.value for pd in self.prescribed] + [v for t in self.tractions for v in t.value]
+        values += [self.platen.force] if self.platen else []
+        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
+            raise InputError(f"{where}: loads and prescribed displacements must be finite numbers")
+
+    def _boundary_dofs(self, boundary: str, component: str) -> np.ndarray:
+        facets = self.mesh.boundaries[boundary]
+        return self.basis.get_dofs(facets).nodal[f"u^{COMPONENTS[component] + 1}"]
+
+    def _check_supported(self) -> None:
+        """Refuse a body that can move as a rigid body: its stiffness would be singular."""
+        x, y = self.mesh.p
+        modes = {"translation in x": np.column_stack([np.ones_like(x), 0 * y]),
+                 "translation in y": np.column_stack([0 * x, np.ones_like(y)]),
+                 "rotation": np.column_stack([-(y - y.mean()), x - x.mean()])}
+        R = np.column_stack([m.ravel() for m in modes.values()])  # interleaved dofs
+        Rc = R[self.fixed_dofs]
+        if np.linalg.matrix_rank(Rc, tol=1e-10 * max(1.0, np.abs(R).max())) < 3:
+            # name a free motion: the null space of the constrained rows
+            _, _, vt = np.linalg.svd(Rc if len(Rc) else np.zeros((1, 3)))
+            v = vt[-1]
+            free = max(zip(np.abs(v), modes), key=lambda t: t[0])[1]
+            raise InputError(
+                f"body {self.name!r} is not supported: it can move freely as a rigid body "
+                f"({free}), so its stiffness is singular; add supports or a platen"
+            )
+
+    def _traction_vector(self, tr: Traction) -> np.ndarray:
+        fb = FacetBasis(self.mesh, self.basis.elem, facets=self.mesh.boundaries[tr.boundary])
+        t = np.asarray(tr.value, dtype=float)
+
+        @LinearForm
+        def load(v, w):
+            return t[0] * v[0] + t[1] * v[1]
+
+        return asm(load, fb)
+
+    def _solve_with(self, f: np.ndarray, u_fixed: np.ndarray) -> np.ndarray:
+        """Displacement for load ``f`` with the fixed dofs at ``u_fixed``."""
+        u = u_fixed.copy()
+        rhs = f - self.K @ u_fixed
+        u[self.free_dofs] = self.factor.solve(rhs[self.free_dofs])
+        return u
+
+    # -- what the contact algorithm uses ---------------------------------------------------------
+
+    def response(self, nodal_force: np.ndarray) -> np.ndarray:
+        """Displacement due to nodal forces (ndofs), supports kept at zero: K^-1 f."""
+        return self._solve_with(np.asarray(nodal_force, dtype=float), np.zeros(self.ndofs))
+
+    def flexibility_columns(self, dofs: np.ndarray, chunk: int = 256) -> np.ndarray:
+        """Columns of K^-1 (supports kept) for the given dofs, shape (ndofs, len(dofs)).
+
+        One back-substitution per dof; constrained dofs give zero columns.
+        """
+        dofs = np.asarray(dofs, dtype=int)
+        out = np.zeros((self.ndofs, len(dofs)))
+        pos = np.searchsorted(self.free_dofs, dofs)
+        is_free = (pos < len(self.free_dofs)) & (
+            self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == dofs)
+        cols = np.flatnonzero(is_free)
+        for start in range(0, len(cols), chunk):
+            c = cols[start:start + chunk]
+            rhs = np.zeros((len(self.free_dofs), len(c)))
+            rhs[pos[c], np.arange(len(c))] = 1.0
+            out[np.ix_(self.free_dofs, c)] = self.factor.solve(rhs)
+        return out
+
+    def displacement(self, load_factor: float, platen_displacement: float,
+                     contact_force: np.ndarray) -> np.ndarray:
+        """Full displacement vector (ndofs) for the given state."""
+        return (load_factor * self.u_load + platen_displacement * self.u_platen
+                + self.response(contact_force))
+
+    def platen_reaction(self, u: np.ndarray, load_factor: float) -> float:
+        """Reaction on the platen dofs for displacement ``u`` (external loads subtracted)."""
+        if self.platen is None:
+            return 0.0
+        r = self.K @ u
+        return float(r[self.platen_dofs].sum())
+
+    def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
+        """Element-average stresses: sxx, syy, sxy, szz and von Mises (per element)."""
+        lam, mu = self.material.lame()
+        ui = self.basis.interpolate(u)
+        eps = sym_grad(ui)
+        tr = trace(eps)
+        sig = 2 * mu * eps
+        sig[0, 0] += lam * tr
+        sig[1, 1] += lam * tr
+        w = self.basis.dx
+        avg = {key: (sig[i, j] * w).sum(axis=1) / w.sum(axis=1)
+               for key, (i, j) in {"sxx": (0, 0), "syy": (1, 1), "sxy": (0, 1)}.items()}
+        nu = self.material.poissons_ratio
+        avg["szz"] = (nu * (avg["sxx"] + avg["syy"]) if self.material.plane == "strain"
+                      else np.zeros_like(avg["sxx"]))
+        sxx, syy, sxy, szz = avg["sxx"], avg["syy"], avg["sxy"], avg["szz"]
+        avg["von_mises"] = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
+                                   + 3 * sxy**2)
+        return avg
+
+
+def boundary_mass_matrix(mesh, facets: np.ndarray) -> sp.csr_matrix:
+    """Scalar boundary "consistent mass" matrix N = sum over facets of int phi phi^T (eq. 4.4.10).
+
+    Integrated on the undeformed facets, so a traction obtained from ``N q = Q`` is nominal
+    (force per undeformed length). Returns an (nvertices x nvertices) matrix.
+    """
+    elem = ElementTriP1() if isinstance(mesh, MeshTri) else ElementQuad1()
+    fb = FacetBasis(mesh, elem, facets=facets)
+
+    @BilinearForm
+    def mass(u, v, w):
+        return u * v
+
+    return asm(mass, fb).tocsr()
+
+
+__all__ = ["Body", "Support", "PrescribedDisplacement", "Traction", "Platen",
+           "boundary_mass_matrix"]

@@ -1,0 +1,246 @@
+"""A body's contact surface: candidate facets and nodes, their rind, and the flexibility on them.
+
+The contact algorithm never sees a body's full mesh. It sees, per body:
+
+* the **candidate facets** — exterior facets that may touch another body (within the search
+  distance in the undeformed configuration), oriented so that ``(t_y, -t_x)`` of the facet
+  tangent is the outward normal;
+* the **candidate nodes** — the nodes of those facets, where contact forces may act;
+* the **rind** — the outer layer of elements (every element with a node on the candidate surface),
+  in which embedded nodes of other bodies are located (thesis §5.6);
+* the **flexibility** ``G = K^-1`` restricted to rows (candidate + rind nodes) and columns
+  (candidate dofs), computed once with the body's own factorization (linear bodies). Its square
+  block on the candidate dofs is ``C`` of vfem-method §3.3: static condensation and Castigliano
+  reduction in one object (reduced stiffness of dof i = 1 / C_ii).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+from skfem import BilinearForm, ElementLineP1, ElementQuad1, ElementTriP1, FacetBasis, MeshTri, asm
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefLine
+
+from ..bodies import Body
+
+log = logging.getLogger(__name__)
+
+
+def exterior_facets(body: Body) -> np.ndarray:
+    """Facets of the body that may take part in contact (indices into ``mesh.facets``)."""
+    mesh = body.mesh
+    if body.contact_boundaries is not None:
+        return np.unique(np.concatenate([mesh.boundaries[b] for b in body.contact_boundaries]))
+    bnd = mesh.boundary_facets()
+    excluded = [mesh.boundaries[s.boundary] for s in body.supports]
+    excluded += [mesh.boundaries[p.boundary] for p in body.prescribed]
+    if body.platen is not None:
+        excluded.append(mesh.boundaries[body.platen.boundary])
+    if excluded:
+        bnd = np.setdiff1d(bnd, np.concatenate(excluded))
+    return bnd
+
+
+@dataclass
+class ContactSurface:
+    """Everything about one body that contact needs; arrays are indexed by *local* node number.
+
+    Attributes:
+        body: the body.
+        facet_ids: (nf,) indices of the candidate facets in ``mesh.facets``.
+        facets: (nf, 2) local node numbers, ordered so the outward normal is (t_y, -t_x).
+        nodes: (nt,) mesh node numbers of the tracked nodes; the first ``nc`` are the candidate
+            nodes (on candidate facets), the rest the other nodes of the rind elements.
+        nc: number of candidate nodes.
+        X: (nt, 2) undeformed coordinates of the tracked nodes.
+        lengths: (nf,) undeformed facet lengths.
+        tributary: (nc,) undeformed tributary length of each candidate node (half of each
+            adjacent candidate facet), which turns nodal forces into nominal pressures.
+        rind: (ne, 3) triangles of the rind (quadrilaterals split in two), local node numbers.
+        G: (2 nt, 2 nc) flexibility rows of the tracked dofs for the candidate dofs.
+        platen_row: (2 nc,) the platen reaction per unit contact force on the candidate dofs.
+    """
+
+    body: Body
+    facet_ids: np.ndarray
+    facets: np.ndarray
+    nodes: np.ndarray
+    nc: int
+    X: np.ndarray
+    lengths: np.ndarray
+    tributary: np.ndarray
+    rind: np.ndarray
+    G: np.ndarray | None = None
+    platen_row: np.ndarray | None = None
+
+    @classmethod
+    def build(cls, body: Body, facet_ids: np.ndarray) -> ContactSurface:
+        mesh = body.mesh
+        fn = mesh.facets[:, facet_ids].T.copy()  # (nf, 2) mesh node numbers
+        # Orient each facet so that (t_y, -t_x) points away from its element.
+        elem = mesh.f2t[0, facet_ids]
+        centroid = mesh.p[:, mesh.t[:, elem]].mean(axis=1).T
+        a, b = mesh.p[:, fn[:, 0]].T, mesh.p[:, fn[:, 1]].T
+        t = b - a
+        normal = np.column_stack([t[:, 1], -t[:, 0]])
+        flip = np.einsum("ij,ij->i", normal, 0.5 * (a + b) - centroid) < 0
+        fn[flip] = fn[flip][:, ::-1]
+
+        cand = np.unique(fn)
+        rind_elems = np.flatnonzero(np.isin(mesh.t, cand).any(axis=0))
+        rind_nodes = np.setdiff1d(np.unique(mesh.t[:, rind_elems]), cand)
+        nodes = np.concatenate([cand, rind_nodes])
+        local = np.full(mesh.nvertices, -1)
+        local[nodes] = np.arange(len(nodes))
+        t_rind = mesh.t[:, rind_elems]
+        if t_rind.shape[0] == 4:  # quadrilaterals: two triangles each, for point location
+            t_rind = np.hstack([t_rind[[0, 1, 3]], t_rind[[1, 2, 3]]])
+        X = mesh.p[:, nodes].T.copy()
+        facets = local[fn]
+        lengths = np.linalg.norm(X[facets[:, 1]] - X[facets[:, 0]], axis=1)
+        tributary = np.zeros(len(cand))
+        np.add.at(tributary, facets.ravel(), np.repeat(0.5 * lengths, 2))
+        return cls(body=body, facet_ids=np.asarray(facet_ids), facets=facets, nodes=nodes,
+                   nc=len(cand), X=X, lengths=lengths, tributary=tributary,
+                   rind=local[t_rind].T.copy())
+
+    # -- dofs -----------------------------------------------------------------------------------
+
+    @property
+    def candidate_dofs(self) -> np.ndarray:
+        """Mesh dofs (interleaved x, y) of the candidate nodes."""
+        n = self.nodes[: self.nc]
+        return np.column_stack([2 * n, 2 * n + 1]).ravel()
+
+    @property
+    def tracked_dofs(self) -> np.ndarray:
+        n = self.nodes
+        return np.column_stack([2 * n, 2 * n + 1]).ravel()
+
+    def compute_flexibility(self) -> None:
+        """Solve for the flexibility columns of the candidate dofs (one back-substitution each)."""
+        cols = self.body.flexibility_columns(self.candidate_dofs)
+        self.G = cols[self.tracked_dofs]
+        if self.body.platen is not None:
+            self.platen_row = (self.body.K[self.body.platen_dofs] @ cols).sum(axis=0)
+            # the unit force itself, where a candidate dof is a platen dof, is not a reaction
+            self.platen_row -= np.isin(self.candidate_dofs, self.body.platen_dofs)
+        else:
+            self.platen_row = np.zeros(2 * self.nc)
+
+    @property
+    def C(self) -> np.ndarray:
+        """Flexibility on the candidate dofs, (2 nc, 2 nc)."""
+        return self.G[: 2 * self.nc]
+
+    def normal_stiffness(self, nodes: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        """Castigliano stiffness of candidate nodes along unit normals: 1 / (n^T C_jj n).
+
+        The force per unit displacement of that node along ``n`` with every other dof of the body
+        free (vfem-method §3.3). A node whose motion along ``n`` is fully prevented by supports
+        gets an infinite stiffness.
+        """
+        C = self.C
+        i0, i1 = 2 * nodes, 2 * nodes + 1
+        nx, ny = normal[:, 0], normal[:, 1]
+        c = C[i0, i0] * nx * nx + 2 * C[i0, i1] * nx * ny + C[i1, i1] * ny * ny
+        with np.errstate(divide="ignore"):
+            return np.where(c > 0, 1.0 / np.maximum(c, 1e-300), np.inf)
+
+    # -- geometry -------------------------------------------------------------------------------
+
+    def segments(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Start and end points of the candidate facets for tracked positions ``x``."""
+        return x[self.facets[:, 0]], x[self.facets[:, 1]]
+
+    def locate(self, x_tracked: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """Rind element containing each point (current configuration), or -1.
+
+        Uses scikit-fem's affine mapping of the rind triangles in their current position: the
+        inverse map gives a point's local coordinates in a triangle. Nearby triangles (by
+        centroid) are tried first; points they do not contain are tried against every rind
+        triangle, since the rind's elements may be long and thin.
+        """
+        found = np.full(len(points), -1)
+        if len(points) == 0 or len(self.rind) == 0:
+            return found
+        mesh = MeshTri(x_tracked.T.copy(), self.rind.T.copy(), sort_t=False, validate=False)
+        mapping = mesh._mapping()
+
+        def inside(tind, pts):
+            loc = mapping.invF(pts.T[:, :, None], tind=tind)[:, :, 0]
+            eps = 1e-12
+            return (loc[0] >= -eps) & (loc[1] >= -eps) & (1 - loc[0] - loc[1] >= -eps)
+
+        k = min(6, len(self.rind))
+        _, near = cKDTree(x_tracked[self.rind].mean(axis=1)).query(points, k)
+        near = near.reshape(len(points), k)
+        for j in range(k):
+            hit = inside(near[:, j], points) & (found < 0)
+            found[hit] = near[hit, j]
+        for i in np.flatnonzero(found < 0):
+            tind = np.arange(len(self.rind))
+            hit = np.flatnonzero(inside(tind, np.repeat(points[i:i + 1], len(tind), axis=0)))
+            if len(hit):
+                found[i] = hit[0]
+        return found
+
+    def quadrature(self, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Gauss points of the virtual elements on each candidate facet.
+
+        Returns (xi, phi, w): local coordinates (nq,), shape function values (2, nq) of the
+        facet's own 2-node element, and weights per facet (nf, nq) times the undeformed length.
+        """
+        X, W = get_quadrature(RefLine, order)
+        e = ElementLineP1()
+        phi = np.vstack([e.lbasis(X, i)[0] for i in range(2)])
+        return X[0], phi, self.lengths[:, None] * W[None, :]
+
+    def mass_matrix(self, facet_weight: np.ndarray):
+        """Redistribution matrix N* over the facets with nonzero weight (eq. 4.4.10), (nc, nc).
+
+        Built by scikit-fem on the undeformed candidate facets; the weight (1 for a facet that
+        takes part, 0 otherwise) is a per-facet field, so leaving facets out of the assembly
+        (the thesis's N*) needs no new basis.
+        """
+        fb = self._facet_basis()
+
+        @BilinearForm
+        def mass(u, v, w):
+            return w["active"] * u * v
+
+        active = np.repeat(facet_weight[:, None], fb.X.shape[1], axis=1)
+        N = asm(mass, fb, active=active).tocsr()
+        cand = self.nodes[: self.nc]
+        return N[cand][:, cand]
+
+    def _facet_basis(self):
+        if not hasattr(self, "_fb"):
+            elem = ElementTriP1() if isinstance(self.body.mesh, MeshTri) else ElementQuad1()
+            self._fb = FacetBasis(self.body.mesh, elem, facets=self.facet_ids)
+        return self._fb
+
+
+def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
+                            search_distance: float) -> list[np.ndarray]:
+    """Per body, the exterior facets within ``search_distance`` of a body it may touch."""
+    ext = [exterior_facets(b) for b in bodies]
+    mids, half = [], []
+    for b, f in zip(bodies, ext):
+        a, c = b.mesh.p[:, b.mesh.facets[0, f]].T, b.mesh.p[:, b.mesh.facets[1, f]].T
+        mids.append(0.5 * (a + c))
+        half.append(0.5 * np.linalg.norm(c - a, axis=1))
+    out = []
+    for i in range(len(bodies)):
+        keep = np.zeros(len(ext[i]), dtype=bool)
+        for j in range(len(bodies)):
+            if i == j or frozenset((i, j)) not in pairs or len(ext[j]) == 0 or len(ext[i]) == 0:
+                continue
+            d, _ = cKDTree(mids[j]).query(mids[i])
+            keep |= d <= search_distance + half[i] + half[j].max()
+        out.append(ext[i][keep])
+    return out

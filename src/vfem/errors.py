@@ -1,0 +1,26 @@
+"""Errors that vfem reports to its users.
+
+Two families: :class:`InputError` for a model that cannot be analysed as given (the CLI prints the
+message and exits with status 2, no traceback), and :class:`AnalysisError` for an analysis that was
+set up correctly but could not be completed (a step that would not converge, a node pushed through
+the outer layer of elements of another body).
+"""
+
+
+class VfemError(Exception):
+    """Base of every error vfem raises on purpose."""
+
+
+class InputError(VfemError, ValueError):
+    """The model is wrong: the message names the problem and where it is (body, key, node)."""
+
+
+class AnalysisError(VfemError, RuntimeError):
+    """The analysis could not be completed; results of converged steps stay valid."""
+
+
+class RindViolation(AnalysisError):
+    """A node went deeper than the outer layer ("rind") of elements of another body (thesis §5.6).
+
+    The step was too large for the contact surface to be found reliably; the solver cuts the step.
+    """

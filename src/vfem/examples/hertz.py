@@ -1,0 +1,127 @@
+"""Thesis §5.2: the Hertz problem — an elastic cylinder pressed on a (nearly rigid) flat.
+
+Plane strain, half model about the central plane. Cylinder: radius 1, E = 1e6, nu = 0.2, its top
+face (the plane through its axis) pushed down by a rigid, force-controlled platen with 1530 on the
+half model (3060 per unit length on the whole cylinder). Flat: a layer of E = 3e9, nu = 0.2, fixed
+on its lower face. Theory (with the flat's compliance): a = 0.061168, p0 = 31848.
+
+Meshes: the cylinder in triangles of size a/n (n = ``facets_per_half_width``) over 1.5 a from
+the contact point, growing beyond; the flat in quadrilaterals 1.37 times larger (non-matching).
+``refinement`` doubles n and halves the largest element size per level.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..bodies import Body, Platen, Support
+from ..contact.settings import ContactSettings
+from ..materials import LinearElastic
+from ..mesh import graded_layer, graded_quarter_disk
+from ..solver import AnalysisResult, Model
+
+
+@dataclass(frozen=True)
+class HertzParameters:
+    """Parameters of the Hertz example; the thesis's values are the defaults."""
+
+    radius: float = 1.0
+    cylinder_youngs_modulus: float = 1.0e6
+    cylinder_poissons_ratio: float = 0.2
+    flat_youngs_modulus: float = 3.0e9
+    flat_poissons_ratio: float = 0.2
+    flat_width: float = 1.0
+    flat_thickness: float = 0.1
+    force: float = 1530.0  # on the half model
+    steps: int = 5
+    refinement: int = 0
+    facets_per_half_width: int = 12
+    flat_size_ratio: float = 1.37
+    max_element_size: float = 0.05
+    growth: float = 0.15
+    penetration_tolerance: float | None = None
+    equilibrium_tolerance: float = 1e-3
+    swap_bodies: bool = False
+
+
+def theory(p: HertzParameters) -> dict[str, float]:
+    """Hertz's half-width and peak pressure for the force on the whole cylinder (2 x half)."""
+    e1 = LinearElastic(p.cylinder_youngs_modulus, p.cylinder_poissons_ratio)
+    e2 = LinearElastic(p.flat_youngs_modulus, p.flat_poissons_ratio)
+    e_star = 1.0 / (1.0 / e1.plane_strain_modulus() + 1.0 / e2.plane_strain_modulus())
+    P = 2.0 * p.force
+    a = math.sqrt(4.0 * P * p.radius / (math.pi * e_star))
+    return {"a_theory": a, "p0_theory": 2.0 * P / (math.pi * a), "e_star": e_star}
+
+
+def build(p: HertzParameters | None = None) -> Model:
+    p = p or HertzParameters()
+    th = theory(p) if p.cylinder_youngs_modulus > 0 and p.flat_youngs_modulus > 0 else None
+    a = th["a_theory"] if th else 0.06
+    n = p.facets_per_half_width * 2**p.refinement
+    h = a / n
+    h_max = p.max_element_size / 2**p.refinement
+    cylinder = Body(
+        name="cylinder",
+        mesh=graded_quarter_disk(p.radius, h, h_max, p.growth, plateau=1.5 * a),
+        material=LinearElastic(p.cylinder_youngs_modulus, p.cylinder_poissons_ratio),
+        supports=(Support("symmetry", ("x",)),),
+        platen=Platen("top", "y", -p.force),
+    )
+    flat = Body(
+        name="flat",
+        mesh=graded_layer(p.flat_width, p.flat_thickness, p.flat_size_ratio * h,
+                          h_max, p.growth, plateau=1.5 * a),
+        material=LinearElastic(p.flat_youngs_modulus, p.flat_poissons_ratio),
+        supports=(Support("bottom", ("x", "y")), Support("symmetry", ("x",))),
+    )
+    bodies = [flat, cylinder] if p.swap_bodies else [cylinder, flat]
+    settings = ContactSettings(penetration_tolerance=p.penetration_tolerance,
+                               equilibrium_tolerance=p.equilibrium_tolerance)
+    factors = tuple((k + 1) / p.steps for k in range(p.steps))
+    return Model("hertz", bodies, settings, factors)
+
+
+def evaluate(result: AnalysisResult, p: HertzParameters) -> dict:
+    """Compare the last step with Hertz: peak pressure, half-width, RMS error, force balance.
+
+    Pressures are nominal: the cylinder's nodal contact force divided by its undeformed
+    tributary length (small-strain analysis; see docs/method.md).
+    """
+    th = theory(p)
+    a, p0 = th["a_theory"], th["p0_theory"]
+    last = result.steps[-1]
+    cyl = last.bodies["cylinder"]
+    flat = last.bodies["flat"]
+    mesh = next(b.mesh for b in result.model.bodies if b.name == "cylinder")
+    x = mesh.p[0]
+    contact = np.flatnonzero(cyl.contact_status > 0)
+    on_arc = np.unique(mesh.facets[:, mesh.boundaries["contact"]])
+    on_arc = np.union1d(on_arc, [int(np.argmin(np.hypot(*mesh.p)))])
+    xs = np.sort(x[on_arc])
+    x_edge = x[contact].max()
+    beyond = xs[xs > x_edge + 1e-14]
+    a_est = 0.5 * (x_edge + beyond[0]) if len(beyond) else x_edge
+    inside = contact[x[contact] < a]
+    p_theory = p0 * np.sqrt(np.clip(1 - (x[inside] / a) ** 2, 0, None))
+    rms = float(np.sqrt(np.mean((cyl.contact_pressure[inside] - p_theory) ** 2)) / p0)
+    total_cyl = float(cyl.contact_force[:, 1].sum())  # upwards on the cylinder
+    total_flat = float(-flat.contact_force[:, 1].sum())  # downwards on the flat
+    facet_len = np.diff(xs)
+    return {
+        "p0_theory": p0,
+        "a_theory": a,
+        "p_max": float(cyl.contact_pressure.max()),
+        "p_max_error": float(cyl.contact_pressure.max() / p0 - 1),
+        "p_max_flat": float(flat.contact_pressure.max()),
+        "a_estimate": float(a_est),
+        "contact_facet_length": float(facet_len[xs[:-1] < a].max()),
+        "rms_error_over_p0": rms,
+        "total_contact_force": total_cyl,
+        "total_contact_force_flat": total_flat,
+        "applied_force": p.force,
+        "contact_nodes_cylinder": int(len(contact)),
+    }

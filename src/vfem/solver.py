@@ -1,0 +1,300 @@
+"""The incremental driver (thesis Fig. 4.2): steps, the contact solve, platens, step cutting.
+
+For each step (an increment of the load factor):
+
+1. **predict** — every body is solved on its own with the new loads and the contact forces it
+   already carries (for linear bodies this is a change of the load factor in the superposition
+   ``u = load_factor * u_load + platen * u_platen + K^-1 f_contact``);
+2. **resolve contact** — :class:`~vfem.contact.algorithm.VirtualElementContact` iterates
+   detect -> check -> correct until converged;
+3. where a body has a force-controlled platen, steps 1–2 sit inside a safeguarded secant search
+   on the platen's displacement until its reaction equals the scheduled force;
+4. a step that fails (no convergence, or a node pushed past the rind of another body) is cut in
+   half and retried from the last converged state (vfem-method §3.2, *Reading*).
+
+Results of converged steps are kept in :class:`AnalysisResult` and handed to a callback as soon
+as each step converges, so a later failure never loses them.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .bodies import Body
+from .contact.algorithm import ContactState, IterationRecord, Pairing, VirtualElementContact
+from .contact.settings import ContactSettings
+from .contact.surface import ContactSurface, select_candidate_facets
+from .errors import AnalysisError, InputError, RindViolation
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class Model:
+    """Bodies, the contact settings and the load schedule (load factors of the steps, to 1)."""
+
+    name: str
+    bodies: list[Body]
+    contact: ContactSettings = field(default_factory=ContactSettings)
+    load_factors: tuple[float, ...] = (1.0,)
+    contact_pairs: tuple[tuple[str, str], ...] | None = None  # default: every pair may touch
+
+    def validate(self) -> None:
+        names = [b.name for b in self.bodies]
+        if not self.bodies:
+            raise InputError(f"model {self.name!r} has no bodies")
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise InputError(f"model {self.name!r}: body names must be unique, repeated: "
+                             f"{', '.join(sorted(dup))}")
+        lf = np.asarray(self.load_factors, dtype=float)
+        if lf.size == 0 or not np.all(np.isfinite(lf)) or np.any(np.diff(np.r_[0.0, lf]) <= 0):
+            raise InputError(f"model {self.name!r}: load_factors must increase from above 0, "
+                             f"got {list(self.load_factors)}")
+        for a, b in self.contact_pairs or ():
+            for n in (a, b):
+                if n not in names:
+                    raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
+        if sum(b.platen is not None for b in self.bodies) > 1:
+            raise InputError(f"model {self.name!r}: at most one force-controlled platen")
+        self.contact.validate()
+
+
+@dataclass
+class BodyStepResult:
+    """The state of one body at the end of a converged step (full mesh fields)."""
+
+    displacement: np.ndarray  # (nvertices, 2)
+    contact_force: np.ndarray  # (nvertices, 2) nodal force applied by the other bodies
+    contact_pressure: np.ndarray  # (nvertices,) nominal normal pressure (force / undeformed length)
+    contact_status: np.ndarray  # (nvertices,) 0 free, 1 in contact
+    penetration: np.ndarray  # (nvertices,) signed penetration at candidate nodes (0 elsewhere)
+
+
+@dataclass
+class StepResult:
+    step: int
+    load_factor: float
+    iterations: int
+    converged: bool
+    history: list[IterationRecord]
+    platen_displacement: float = 0.0
+    platen_trials: int = 0
+    cuts: int = 0
+    bodies: dict[str, BodyStepResult] = field(default_factory=dict)
+
+
+@dataclass
+class AnalysisResult:
+    model: Model
+    converged: bool
+    steps: list[StepResult]
+    timings: dict[str, float]
+    message: str = ""
+    surfaces: list[ContactSurface] = field(default_factory=list)
+
+
+class Analysis:
+    """Set up the bodies and their contact surfaces, then run the steps of a :class:`Model`."""
+
+    def __init__(self, model: Model, backend: str = "superlu"):
+        model.validate()
+        self.model = model
+        self.backend = backend
+        self.timings: dict[str, float] = {}
+
+    def setup(self) -> None:
+        t0 = time.perf_counter()
+        for b in self.model.bodies:
+            b.setup(self.backend)
+        t1 = time.perf_counter()
+        bodies = self.model.bodies
+        index = {b.name: i for i, b in enumerate(bodies)}
+        if self.model.contact_pairs is None:
+            pairs = {frozenset((i, j)) for i in range(len(bodies)) for j in range(i)}
+        else:
+            pairs = {frozenset((index[a], index[b])) for a, b in self.model.contact_pairs}
+        distance = self.model.contact.search_distance
+        if distance is None:
+            diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in bodies]
+            distance = 0.05 * min(diag)
+        facets = select_candidate_facets(bodies, pairs, distance)
+        self.surfaces = [ContactSurface.build(b, f) for b, f in zip(bodies, facets)]
+        for s in self.surfaces:
+            s.compute_flexibility()
+            log.info("body %s: %d contact candidate nodes", s.body.name, s.nc)
+        self.contact = VirtualElementContact(self.surfaces, pairs, self.model.contact)
+        t2 = time.perf_counter()
+        self.timings.update(assemble_factorize_s=t1 - t0, flexibility_s=t2 - t1)
+
+    # -- one step -------------------------------------------------------------------------------
+
+    def _platen(self) -> tuple[int, Body] | None:
+        for i, b in enumerate(self.model.bodies):
+            if b.platen is not None:
+                return i, b
+        return None
+
+    def platen_reaction(self, state: ContactState) -> float:
+        found = self._platen()
+        if found is None:
+            return 0.0
+        i, b = found
+        s = self.surfaces[i]
+        r_load = b.platen_reaction(b.u_load, 1.0)
+        r_platen = b.platen_reaction(b.u_platen, 1.0)
+        return (state.load_factor * r_load + state.platen_displacement * r_platen
+                + float(s.platen_row @ state.forces[i].ravel()))
+
+    def solve_step(self, start: ContactState, load_factor: float, history_out: list
+                   ) -> tuple[ContactState, list[Pairing], int]:
+        """Resolve the contact at ``load_factor`` from the converged ``start`` state.
+
+        Returns the converged state, its pairings and the number of platen trials. Raises
+        :class:`AnalysisError` (or :class:`RindViolation`) when it cannot.
+        """
+        found = self._platen()
+        state = start.copy()
+        state.load_factor = load_factor
+        if found is None:
+            res = self.contact.solve(state)
+            history_out.extend(res.history)
+            if not res.converged:
+                raise AnalysisError(res.message)
+            return state, res.pairings, 0
+        _, body = found
+        return self._solve_platen(start, load_factor, body, history_out)
+
+    def _solve_platen(self, start: ContactState, load_factor: float, body: Body,
+                      history_out: list) -> tuple[ContactState, list[Pairing], int]:
+        """Secant search (with bracketing) on the platen displacement for the scheduled force."""
+        target = load_factor * body.platen.force
+        tol = self.model.contact.platen_tolerance * abs(target)
+        d0 = start.platen_displacement
+        g0 = self.platen_reaction(start) - target  # old state, new target
+        # First trial: previous secant stiffness, else the body's stiffness at its contact nodes.
+        k = getattr(self, "_platen_stiffness", None)
+        if k is None:
+            i = self.model.bodies.index(body)
+            s = self.surfaces[i]
+            comp = 0 if body.platen.component == "x" else 1
+            # the stiffest candidate node: a shallow first trial, refined by the secant
+            k = float(1.0 / np.min(np.diag(s.C)[comp::2][np.diag(s.C)[comp::2] > 0]))
+        lo = hi = None  # brackets: (d, g) with g < 0 and g > 0
+        d, g_prev, d_prev = d0 - g0 / k, g0, d0
+        if g0 < 0:
+            lo = (d0, g0)
+        else:
+            hi = (d0, g0)
+        warm = start
+        for trial in range(1, 60):
+            state = warm.copy()
+            state.load_factor = load_factor
+            state.platen_displacement = d
+            try:
+                res = self.contact.solve(state)
+                history_out.extend(res.history)
+                ok = res.converged
+            except RindViolation:
+                ok = False
+            if not ok:
+                # too deep (or too hard) a trial: step back halfway to the last good side
+                ref = lo if (lo is not None and (d - lo[0]) * (d - d0) > 0) else (d0, g0)
+                d = 0.5 * (d + ref[0])
+                continue
+            g = self.platen_reaction(state) - target
+            log.debug("platen trial %d: displacement %.6g, reaction error %.3g", trial, d, g)
+            if abs(g) <= tol:
+                if d != d_prev:
+                    self._platen_stiffness = (g - g_prev) / (d - d_prev) or k
+                return state, res.pairings, trial
+            if g < 0:
+                lo = (d, g)
+            else:
+                hi = (d, g)
+            warm = state
+            slope = (g - g_prev) / (d - d_prev) if d != d_prev else k
+            d_prev, g_prev = d, g
+            d_new = d - g / slope if slope != 0 else d
+            if lo is not None and hi is not None:
+                a, b = sorted((lo[0], hi[0]))
+                if not a < d_new < b:  # fall back to regula falsi inside the bracket
+                    d_new = lo[0] - lo[1] * (hi[0] - lo[0]) / (hi[1] - lo[1])
+            d = d_new
+        raise AnalysisError(f"platen of body {body.name!r}: reaction did not reach the "
+                            f"scheduled force {target:.6g}")
+
+    # -- the steps ------------------------------------------------------------------------------
+
+    def run(self, on_step: Callable[[StepResult], None] | None = None) -> AnalysisResult:
+        if not hasattr(self, "contact"):
+            self.setup()
+        t_setup = time.perf_counter()
+        state = self.contact.new_state()
+        steps: list[StepResult] = []
+        targets = list(self.model.load_factors)
+        message = ""
+        converged = True
+        cuts = 0
+        while targets:
+            lf = targets[0]
+            history: list[IterationRecord] = []
+            try:
+                new, pairings, trials = self.solve_step(state, lf, history)
+            except AnalysisError as exc:
+                prev = state.load_factor
+                if cuts >= self.model.contact.max_step_cuts:
+                    converged = False
+                    message = f"step to load factor {lf:.6g} failed after {cuts} cuts: {exc}"
+                    log.error(message)
+                    break
+                cuts += 1
+                log.warning("step to load factor %.6g failed (%s); cutting it to %.6g", lf, exc,
+                            0.5 * (prev + lf))
+                targets.insert(0, 0.5 * (prev + lf))
+                continue
+            targets.pop(0)
+            state = self.state = new
+            iterations = sum(1 for h in history if h.iteration > 0) or 0
+            step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=iterations,
+                              converged=True, history=history,
+                              platen_displacement=state.platen_displacement,
+                              platen_trials=trials, cuts=cuts)
+            step.bodies = self._fields(state, pairings)
+            steps.append(step)
+            cuts = 0
+            log.info("step %d (load factor %.4g) converged in %d iterations", step.step, lf,
+                     iterations)
+            if on_step is not None:
+                on_step(step)
+        self.timings["steps_s"] = time.perf_counter() - t_setup
+        self.timings["total_s"] = sum(self.timings[k] for k in
+                                      ("assemble_factorize_s", "flexibility_s", "steps_s"))
+        return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
+                              self.surfaces)
+
+    def _fields(self, state: ContactState, pairings: list[Pairing]) -> dict[str, BodyStepResult]:
+        """Full-mesh results of a converged state (one back-substitution per body)."""
+        out = {}
+        for s, F, p in zip(self.surfaces, state.forces, pairings):
+            b = s.body
+            f = np.zeros(b.ndofs)
+            f[s.candidate_dofs] = F.ravel()
+            u = b.displacement(state.load_factor, state.platen_displacement, f)
+            nv = b.mesh.nvertices
+            cand = s.nodes[: s.nc]
+            force = np.zeros((nv, 2))
+            force[cand] = F
+            pressure = np.zeros(nv)
+            pressure[cand] = np.where(p.other >= 0, p.force, 0.0) / s.tributary
+            status = np.zeros(nv, dtype=int)
+            status[cand] = (p.force > 0).astype(int)
+            pen = np.zeros(nv)
+            pen[cand] = np.where(np.isfinite(p.penetration), p.penetration, 0.0)
+            out[b.name] = BodyStepResult(u.reshape(-1, 2), force, pressure, status, pen)
+        return out
