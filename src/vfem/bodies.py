@@ -110,7 +110,7 @@ class Body:
 
     def setup(self, backend: str = "superlu") -> None:
         """Validate, assemble the stiffness, factorize it and solve the unit load cases."""
-        self._validate()
+        self.validate()
         elem = ElementTriP1() if isinstance(self.mesh, MeshTri) else ElementQuad1()
         self.basis = Basis(self.mesh, ElementVector(elem))
         lam, mu = self.material.lame()
@@ -152,7 +152,8 @@ class Body:
         log.info("body %s: %d nodes, %d dofs (%d fixed)", self.name, self.mesh.nvertices,
                  self.ndofs, len(self.fixed_dofs))
 
-    def _validate(self) -> None:
+    def validate(self) -> None:
+        """Raise :class:`InputError` naming the body if its definition cannot be analysed."""
         where = f"body {self.name!r}"
         if not isinstance(self.mesh, (MeshTri, MeshQuad)) or type(self.mesh).__name__ not in (
             "MeshTri1", "MeshQuad1"
@@ -190,14 +191,18 @@ class Body:
                  "rotation": np.column_stack([-(y - y.mean()), x - x.mean()])}
         R = np.column_stack([m.ravel() for m in modes.values()])  # interleaved dofs
         Rc = R[self.fixed_dofs]
-        if np.linalg.matrix_rank(Rc, tol=1e-10 * max(1.0, np.abs(R).max())) < 3:
-            # name a free motion: the null space of the constrained rows
-            _, _, vt = np.linalg.svd(Rc if len(Rc) else np.zeros((1, 3)))
-            v = vt[-1]
-            free = max(zip(np.abs(v), modes), key=lambda t: t[0])[1]
+        names = list(modes)
+        _, sv, vt = np.linalg.svd(Rc if len(Rc) else np.zeros((1, 3)))
+        tol = 1e-10 * max(1.0, float(np.abs(R).max())) * max(1, len(Rc))
+        rank = int((sv > tol).sum())
+        if rank < 3:
+            free = []
+            for v in vt[rank:]:
+                parts = [names[i] for i in np.flatnonzero(np.abs(v) > 1e-6 * np.abs(v).max())]
+                free.append(parts[0] if len(parts) == 1 else "a combination of " + " and ".join(parts))
             raise InputError(
                 f"body {self.name!r} is not supported: it can move freely as a rigid body "
-                f"({free}), so its stiffness is singular; add supports or a platen"
+                f"({'; '.join(free)}), so its stiffness is singular; add supports or a platen"
             )
 
     def _traction_vector(self, tr: Traction) -> np.ndarray:

@@ -60,6 +60,8 @@ class Model:
             for n in (a, b):
                 if n not in names:
                     raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
+        for b in self.bodies:
+            b.validate()
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
         self.contact.validate()

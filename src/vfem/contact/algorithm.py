@@ -173,9 +173,11 @@ class VirtualElementContact:
         other = owners[seg]
         facet = local[seg]
 
+        # Point location in the opposing rind, for the nodes that may be inside at all.
         embedded = np.zeros(nc, dtype=bool)
-        for j in np.unique(other):
-            sel = np.flatnonzero(other == j)
+        maybe = penetration > -self.penetration_tolerance
+        for j in np.unique(other[maybe]):
+            sel = np.flatnonzero(maybe & (other == j))
             embedded[sel] = self.surfaces[j].locate(x[j], pts[sel]) >= 0
         interior = (t > 1e-9) & (t < 1 - 1e-9)
         deep = (penetration > self.penetration_tolerance) & interior & ~embedded

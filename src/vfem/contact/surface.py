@@ -182,11 +182,14 @@ class ContactSurface:
         for j in range(k):
             hit = inside(near[:, j], points) & (found < 0)
             found[hit] = near[hit, j]
-        for i in np.flatnonzero(found < 0):
-            tind = np.arange(len(self.rind))
-            hit = np.flatnonzero(inside(tind, np.repeat(points[i:i + 1], len(tind), axis=0)))
-            if len(hit):
-                found[i] = hit[0]
+        rest = np.flatnonzero(found < 0)
+        nt = len(self.rind)
+        for lo in range(0, len(rest), max(1, 200_000 // nt)):
+            idx = rest[lo:lo + max(1, 200_000 // nt)]
+            hit = inside(np.tile(np.arange(nt), len(idx)),
+                         np.repeat(points[idx], nt, axis=0)).reshape(len(idx), nt)
+            ok = hit.any(axis=1)
+            found[idx[ok]] = hit[ok].argmax(axis=1)
         return found
 
     def quadrature(self, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

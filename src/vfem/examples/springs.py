@@ -34,8 +34,11 @@ class SpringsParameters:
     equilibrium_tolerance: float = 1e-3
 
 
-def run(params: SpringsParameters | None = None) -> dict:
-    """Run the example; returns the ``summary.json`` dictionary with the iteration traces."""
+def run(params: SpringsParameters | None = None, out=None) -> dict:
+    """Run the example; returns the ``summary.json`` dictionary with the iteration traces.
+
+    With ``out``, the summary is also written to ``out/summary.json``.
+    """
     p = params or SpringsParameters()
     start = time.perf_counter()
     a = SecantSpring(length=p.length_a, k0=p.stiffness_a, a=10.0)
@@ -58,7 +61,7 @@ def run(params: SpringsParameters | None = None) -> dict:
                             converged=ok, iterations=history))
         log.info("springs step %d: contact at %.4f in, force %.2f lb, %d iterations",
                  k, steps[-1].position, steps[-1].contact_force, len(history))
-    return {
+    summary = {
         "example": "springs",
         "converged": all(s.converged for s in steps),
         "steps": [{"step": s.step, "load_factor": s.step / p.steps,
@@ -71,3 +74,8 @@ def run(params: SpringsParameters | None = None) -> dict:
         "parameters": asdict(p),
         "timings": {"total_s": time.perf_counter() - start},
     }
+    if out is not None:
+        from ..io.results import write_summary
+
+        write_summary(out, summary)
+    return summary

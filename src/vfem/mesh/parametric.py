@@ -40,8 +40,8 @@ def graded_quarter_disk(radius: float, h_contact: float, h_max: float,
                         growth: float = 0.15, plateau: float = 0.0) -> MeshTri:
     """The lower-right quarter of a disc of centre (0, radius), touching the x-axis at the origin.
 
-    Triangles of size ``h_contact`` within ``plateau`` of the origin, growing beyond. Named boundaries: ``contact`` (the arc),
-    ``symmetry`` (x = 0) and ``top`` (y = radius).
+    Triangles of size ``h_contact`` within ``plateau`` of the origin, growing beyond. Named
+    boundaries: ``contact`` (the arc), ``symmetry`` (x = 0) and ``top`` (y = radius).
     """
     R = radius
     h = size_function(h_contact, growth, h_max, plateau)

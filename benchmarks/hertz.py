@@ -1,0 +1,12 @@
+"""Hertz benchmark: vfem against one plain linear solve of the same bodies, by refinement.
+
+    python benchmarks/hertz.py [LEVEL ...]        # same as: vfem bench hertz --levels ...
+"""
+
+import sys
+
+from vfem.bench import hertz_benchmark
+
+if __name__ == "__main__":
+    levels = [int(a) for a in sys.argv[1:]] or [0, 1, 2, 3, 4]
+    hertz_benchmark(levels, print_row=print)

@@ -1,0 +1,1 @@
+"""Input and output: results files (VTU/PVD, JSON) and figures. The core never imports this."""

@@ -1,0 +1,62 @@
+"""Figures of the examples (matplotlib, Agg backend: no display needed)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.collections import PolyCollection  # noqa: E402
+
+
+def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[str, np.ndarray],
+                   title: str) -> None:
+    """p/p0 against x/a for each body, with Hertz's ellipse (like thesis Fig. 5.3)."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    s = np.linspace(0, 1, 200)
+    ax.plot(s, np.sqrt(1 - s**2), "k-", lw=1.5, label="Hertz")
+    for (name, xa), marker in zip(x_over_a.items(), ("o", "s", "^", "v")):
+        order = np.argsort(xa)
+        ax.plot(xa[order], p_over_p0[name][order], marker, ms=4, mfc="none", ls="",
+                label=f"vfem, {name} (nodal force / undeformed length)")
+    ax.set_xlim(0, 1.4)
+    ax.set_ylim(-0.1, 1.15)
+    ax.axhline(0, color="0.7", lw=0.8)
+    ax.set_xlabel("x / a")
+    ax.set_ylabel("p / p0")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8, loc="upper right")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def deformed_region(path: Path, meshes: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]],
+                    window: tuple[float, float, float, float], title: str) -> None:
+    """The deformed meshes (true scale) inside ``window`` = (xmin, xmax, ymin, ymax).
+
+    ``meshes``: (name, points (n, 2), cells (m, k), displacement (n, 2)).
+    """
+    fig, ax = plt.subplots(figsize=(7.0, 4.2))
+    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red")
+    xmin, xmax, ymin, ymax = window
+    for (name, p, t, u), c in zip(meshes, colors):
+        x = p + u
+        poly = x[t]
+        cx, cy = poly[..., 0].mean(axis=1), poly[..., 1].mean(axis=1)
+        pad = 0.2 * (xmax - xmin)
+        keep = (cx > xmin - pad) & (cx < xmax + pad) & (cy > ymin - pad) & (cy < ymax + pad)
+        ax.add_collection(PolyCollection(poly[keep], facecolors="none", edgecolors=c,
+                                         linewidths=0.5, label=name))
+    ax.set_xlim(xmin, xmax)
+    ax.set_ylim(ymin, ymax)
+    ax.set_aspect("equal")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8, loc="upper right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)

@@ -1,0 +1,59 @@
+"""The command line: the examples end to end, files that ParaView opens, bad input."""
+
+import json
+import subprocess
+import sys
+
+import meshio
+import pytest
+
+from vfem.cli import main
+
+
+def test_springs_writes_a_summary(tmp_path, capsys):
+    assert main(["run", "springs", "--out", str(tmp_path)]) == 0
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["example"] == "springs" and s["converged"]
+    assert s["contact_force"][5] == pytest.approx(893.4, abs=1)
+    out = capsys.readouterr().out
+    assert "compatibility force  333.33 lb" in out
+
+
+def test_hertz_writes_summary_figures_and_paraview_files(tmp_path):
+    assert main(["-q", "run", "hertz", "--out", str(tmp_path)]) == 0
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["converged"] and len(s["steps"]) == 5
+    for key in ("p0_theory", "a_theory", "p_max", "a_estimate", "rms_error_over_p0",
+                "total_contact_force", "applied_force"):
+        assert key in s["hertz"]
+    assert s["timings"]["total_s"] > 0
+    assert (tmp_path / "pressure.png").stat().st_size > 10_000
+    assert (tmp_path / "deformed.png").stat().st_size > 10_000
+    pvd = (tmp_path / "results.pvd").read_text()
+    assert pvd.count("<DataSet") == 10  # 2 bodies x 5 steps
+    m = meshio.read(tmp_path / "cylinder_step0005.vtu")
+    for field in ("displacement", "contact_pressure", "contact_status", "contact_force"):
+        assert field in m.point_data
+    assert "von_mises" in m.cell_data
+    assert m.point_data["contact_pressure"].max() == pytest.approx(s["hertz"]["p_max"])
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["run", "hertzz"], "unknown example 'hertzz' (did you mean 'hertz'?)"),
+    (["run", "hertz", "--set", "cylinder_youngs_modulus=-1e6"], "youngs_modulus must be"),
+    (["run", "hertz", "--set", "flat_poissons_ratio=0.5"], "poissons_ratio must lie in"),
+    (["run", "hertz", "--set", "cylinder_young=1"], "did you mean 'cylinder_youngs_modulus'"),
+    (["run", "hertz", "--set", "steps=many"], "expected a number"),
+])
+def test_bad_input_is_one_message_and_exit_2(args, message, capsys, tmp_path):
+    assert main([*args, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_bad_input_from_the_shell_has_no_traceback():
+    proc = subprocess.run([sys.executable, "-m", "vfem.cli", "run", "hertz", "--set",
+                           "cylinder_poissons_ratio=0.7"], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert "poissons_ratio" in proc.stderr and "Traceback" not in proc.stderr

@@ -1,0 +1,69 @@
+"""Thesis §5.2, Hertz: the acceptance numbers of issue 2 on the default mesh, and refinement."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from vfem.examples.hertz import HertzParameters, build, evaluate, theory
+from vfem.solver import Analysis
+
+
+def test_theory_matches_the_method_notes():
+    th = theory(HertzParameters())
+    assert th["a_theory"] == pytest.approx(0.061168, abs=2e-6)
+    assert th["p0_theory"] == pytest.approx(31848, abs=1)
+
+
+def test_mesh_has_ten_or_more_facets_across_the_half_width(hertz_level0):
+    p, result, h = hertz_level0
+    assert h["a_theory"] / h["contact_facet_length"] >= 10
+
+
+def test_every_step_converges(hertz_level0):
+    _, result, _ = hertz_level0
+    assert result.converged
+    assert [s.load_factor for s in result.steps] == pytest.approx([0.2, 0.4, 0.6, 0.8, 1.0])
+    assert all(s.converged and s.iterations >= 1 for s in result.steps)
+
+
+def test_peak_pressure_half_width_and_profile(hertz_level0):
+    _, _, h = hertz_level0
+    assert h["p_max"] == pytest.approx(31848, rel=0.03)
+    assert abs(h["a_estimate"] - 0.06117) <= h["contact_facet_length"]
+    assert h["rms_error_over_p0"] < 0.05
+
+
+def test_contact_forces_balance_the_applied_load(hertz_level0):
+    """Conservation: the platen's force reaches the flat through the contact."""
+    _, _, h = hertz_level0
+    assert h["total_contact_force"] == pytest.approx(1530, rel=0.005)
+    # the flat receives the same total through the virtual elements
+    assert h["total_contact_force_flat"] == pytest.approx(1530, rel=0.01)
+
+
+def test_no_node_penetrates_at_convergence(hertz_level0):
+    _, result, _ = hertz_level0
+    last = result.steps[-1]
+    for name, body in last.bodies.items():
+        inside = body.penetration[body.contact_status > 0]
+        assert np.all(inside < 1e-6), name  # far below the 0.007 approach
+
+
+def test_swapping_the_bodies_changes_nothing(hertz_level0):
+    p, result, h = hertz_level0
+    swapped = dataclasses.replace(p, swap_bodies=True)
+    r2 = Analysis(build(swapped)).run()
+    h2 = evaluate(r2, swapped)
+    assert h2["p_max"] == pytest.approx(h["p_max"], rel=1e-8)
+    assert [s.iterations for s in r2.steps] == [s.iterations for s in result.steps]
+
+
+def test_refinement_keeps_p_max_within_a_fraction_of_a_percent():
+    errors = []
+    for level in (1, 2):
+        p = HertzParameters(refinement=level)
+        r = Analysis(build(p)).run()
+        assert r.converged
+        errors.append(evaluate(r, p)["p_max_error"])
+    assert max(abs(e) for e in errors) < 0.005
