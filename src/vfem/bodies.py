@@ -199,7 +199,8 @@ class Body:
             free = []
             for v in vt[rank:]:
                 parts = [names[i] for i in np.flatnonzero(np.abs(v) > 1e-6 * np.abs(v).max())]
-                free.append(parts[0] if len(parts) == 1 else "a combination of " + " and ".join(parts))
+                free.append(parts[0] if len(parts) == 1
+                            else "a combination of " + " and ".join(parts))
             raise InputError(
                 f"body {self.name!r} is not supported: it can move freely as a rigid body "
                 f"({'; '.join(free)}), so its stiffness is singular; add supports or a platen"
