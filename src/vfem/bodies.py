@@ -142,12 +142,17 @@ class Body:
         for dof, value in fixed.items():
             u_fixed[dof] = value
         self.u_load = self._solve_with(f, u_fixed)
+        # The platen's reaction (the force it applies to the body, along its component) is
+        # linear in the state: load_factor * platen_load_reaction + platen_displacement *
+        # platen_stiffness + (reaction per unit contact force) . contact forces.
+        self.u_platen = np.zeros(self.ndofs)
+        self.platen_load_reaction = self.platen_stiffness = 0.0
         if self.platen is not None:
             u_unit = np.zeros(self.ndofs)
             u_unit[platen_dofs] = 1.0
             self.u_platen = self._solve_with(np.zeros(self.ndofs), u_unit)
-        else:
-            self.u_platen = np.zeros(self.ndofs)
+            self.platen_load_reaction = float((self.K @ self.u_load - f)[platen_dofs].sum())
+            self.platen_stiffness = float((self.K @ self.u_platen)[platen_dofs].sum())
         self._ready = True
         log.info("body %s: %d nodes, %d dofs (%d fixed)", self.name, self.mesh.nvertices,
                  self.ndofs, len(self.fixed_dofs))
@@ -252,13 +257,6 @@ class Body:
         """Full displacement vector (ndofs) for the given state."""
         return (load_factor * self.u_load + platen_displacement * self.u_platen
                 + self.response(contact_force))
-
-    def platen_reaction(self, u: np.ndarray, load_factor: float) -> float:
-        """Reaction on the platen dofs for displacement ``u`` (external loads subtracted)."""
-        if self.platen is None:
-            return 0.0
-        r = self.K @ u
-        return float(r[self.platen_dofs].sum())
 
     def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
         """Element-average stresses: sxx, syy, sxy, szz and von Mises (per element)."""

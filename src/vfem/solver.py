@@ -7,9 +7,7 @@ For each step (an increment of the load factor):
    ``u = load_factor * u_load + platen * u_platen + K^-1 f_contact``);
 2. **resolve contact** — :class:`~vfem.contact.algorithm.VirtualElementContact` iterates
    detect -> check -> correct until converged;
-3. where a body has a force-controlled platen, steps 1–2 sit inside a safeguarded secant search
-   on the platen's displacement until its reaction equals the scheduled force;
-4. a step that fails (no convergence, or a node pushed past the rind of another body) is cut in
+3. a step that fails (no convergence, or a node pushed past the rind of another body) is cut in
    half and retried from the last converged state (vfem-method §3.2, *Reading*).
 
 Results of converged steps are kept in :class:`AnalysisResult` and handed to a callback as soon
@@ -86,7 +84,6 @@ class StepResult:
     converged: bool
     history: list[IterationRecord]
     platen_displacement: float = 0.0
-    platen_trials: int = 0
     cuts: int = 0
     bodies: dict[str, BodyStepResult] = field(default_factory=dict)
 
@@ -124,7 +121,7 @@ class Analysis:
         distance = self.model.contact.search_distance
         if distance is None:
             diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in bodies]
-            distance = 0.05 * min(diag)
+            distance = 0.02 * min(diag)
         facets = select_candidate_facets(bodies, pairs, distance)
         self.surfaces = [ContactSurface.build(b, f) for b, f in zip(bodies, facets)]
         for s in self.surfaces:
@@ -136,100 +133,23 @@ class Analysis:
 
     # -- one step -------------------------------------------------------------------------------
 
-    def _platen(self) -> tuple[int, Body] | None:
-        for i, b in enumerate(self.model.bodies):
-            if b.platen is not None:
-                return i, b
-        return None
-
-    def platen_reaction(self, state: ContactState) -> float:
-        found = self._platen()
-        if found is None:
-            return 0.0
-        i, b = found
-        s = self.surfaces[i]
-        r_load = b.platen_reaction(b.u_load, 1.0)
-        r_platen = b.platen_reaction(b.u_platen, 1.0)
-        return (state.load_factor * r_load + state.platen_displacement * r_platen
-                + float(s.platen_row @ state.forces[i].ravel()))
-
     def solve_step(self, start: ContactState, load_factor: float, history_out: list
-                   ) -> tuple[ContactState, list[Pairing], int]:
+                   ) -> tuple[ContactState, list[Pairing]]:
         """Resolve the contact at ``load_factor`` from the converged ``start`` state.
 
-        Returns the converged state, its pairings and the number of platen trials. Raises
-        :class:`AnalysisError` (or :class:`RindViolation`) when it cannot.
+        The prediction is the start state at the new load factor (contact forces and platen held);
+        a force-controlled platen gets its new force and is moved by the contact iteration.
+        Raises :class:`AnalysisError` (or :class:`RindViolation`) when it cannot converge.
         """
-        found = self._platen()
         state = start.copy()
         state.load_factor = load_factor
-        if found is None:
-            res = self.contact.solve(state)
-            history_out.extend(res.history)
-            if not res.converged:
-                raise AnalysisError(res.message)
-            return state, res.pairings, 0
-        _, body = found
-        return self._solve_platen(start, load_factor, body, history_out)
-
-    def _solve_platen(self, start: ContactState, load_factor: float, body: Body,
-                      history_out: list) -> tuple[ContactState, list[Pairing], int]:
-        """Secant search (with bracketing) on the platen displacement for the scheduled force."""
-        target = load_factor * body.platen.force
-        tol = self.model.contact.platen_tolerance * abs(target)
-        d0 = start.platen_displacement
-        g0 = self.platen_reaction(start) - target  # old state, new target
-        # First trial: previous secant stiffness, else the body's stiffness at its contact nodes.
-        k = getattr(self, "_platen_stiffness", None)
-        if k is None:
-            i = self.model.bodies.index(body)
-            s = self.surfaces[i]
-            comp = 0 if body.platen.component == "x" else 1
-            # the stiffest candidate node: a shallow first trial, refined by the secant
-            k = float(1.0 / np.min(np.diag(s.C)[comp::2][np.diag(s.C)[comp::2] > 0]))
-        lo = hi = None  # brackets: (d, g) with g < 0 and g > 0
-        d, g_prev, d_prev = d0 - g0 / k, g0, d0
-        if g0 < 0:
-            lo = (d0, g0)
-        else:
-            hi = (d0, g0)
-        warm = start
-        for trial in range(1, 60):
-            state = warm.copy()
-            state.load_factor = load_factor
-            state.platen_displacement = d
-            try:
-                res = self.contact.solve(state)
-                history_out.extend(res.history)
-                ok = res.converged
-            except RindViolation:
-                ok = False
-            if not ok:
-                # too deep (or too hard) a trial: step back halfway to the last good side
-                ref = lo if (lo is not None and (d - lo[0]) * (d - d0) > 0) else (d0, g0)
-                d = 0.5 * (d + ref[0])
-                continue
-            g = self.platen_reaction(state) - target
-            log.debug("platen trial %d: displacement %.6g, reaction error %.3g", trial, d, g)
-            if abs(g) <= tol:
-                if d != d_prev:
-                    self._platen_stiffness = (g - g_prev) / (d - d_prev) or k
-                return state, res.pairings, trial
-            if g < 0:
-                lo = (d, g)
-            else:
-                hi = (d, g)
-            warm = state
-            slope = (g - g_prev) / (d - d_prev) if d != d_prev else k
-            d_prev, g_prev = d, g
-            d_new = d - g / slope if slope != 0 else d
-            if lo is not None and hi is not None:
-                a, b = sorted((lo[0], hi[0]))
-                if not a < d_new < b:  # fall back to regula falsi inside the bracket
-                    d_new = lo[0] - lo[1] * (hi[0] - lo[0]) / (hi[1] - lo[1])
-            d = d_new
-        raise AnalysisError(f"platen of body {body.name!r}: reaction did not reach the "
-                            f"scheduled force {target:.6g}")
+        platen = next((b.platen for b in self.model.bodies if b.platen is not None), None)
+        state.platen_force = load_factor * platen.force if platen is not None else 0.0
+        res = self.contact.solve(state)
+        history_out.extend(res.history)
+        if not res.converged:
+            raise AnalysisError(res.message)
+        return state, res.pairings
 
     # -- the steps ------------------------------------------------------------------------------
 
@@ -247,7 +167,7 @@ class Analysis:
             lf = targets[0]
             history: list[IterationRecord] = []
             try:
-                new, pairings, trials = self.solve_step(state, lf, history)
+                new, pairings = self.solve_step(state, lf, history)
             except AnalysisError as exc:
                 prev = state.load_factor
                 if cuts >= self.model.contact.max_step_cuts:
@@ -265,8 +185,7 @@ class Analysis:
             iterations = sum(1 for h in history if h.iteration > 0) or 0
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=iterations,
                               converged=True, history=history,
-                              platen_displacement=state.platen_displacement,
-                              platen_trials=trials, cuts=cuts)
+                              platen_displacement=state.platen_displacement, cuts=cuts)
             step.bodies = self._fields(state, pairings)
             steps.append(step)
             cuts = 0

@@ -14,6 +14,12 @@ forces each body carries), one iteration is
 and the corrections of all bodies are applied at once (the 1D shares assume both sides move
 together). Every body is treated alike: each computes corrections for its own nodes only, from its
 pairing with the others' virtual nodes.
+
+A force-controlled platen (a rigid boundary whose total force is scheduled, used to load a body
+that only contact holds, like the Hertz cylinder) is one more unknown of the compatibility stage
+of its body: the platen displacement is solved together with the nodal forces that realise the
+prescribed normal displacements, so that the platen's reaction meets its force in every iteration.
+The platen never moves ahead of the contact, so no node is driven through another body's rind.
 """
 
 from __future__ import annotations
@@ -65,10 +71,12 @@ class ContactState:
     platen_displacement: float
     forces: list[np.ndarray]  # per body (nc, 2), the force the other bodies apply on it
     released: list[np.ndarray] = field(default_factory=list)  # nodes released last iteration
+    platen_force: float = 0.0  # the force the platen must apply (scheduled force x load factor)
 
     def copy(self) -> ContactState:
         return ContactState(self.load_factor, self.platen_displacement,
-                            [f.copy() for f in self.forces], [r.copy() for r in self.released])
+                            [f.copy() for f in self.forces], [r.copy() for r in self.released],
+                            self.platen_force)
 
 
 @dataclass
@@ -82,6 +90,7 @@ class IterationRecord:
     tension_nodes: int
     force_correction: float = 0.0
     displacement_correction: float = 0.0
+    platen_error: float = 0.0  # platen reaction minus its scheduled force
 
 
 @dataclass
@@ -105,6 +114,8 @@ class VirtualElementContact:
         self.penetration_tolerance = (settings.penetration_tolerance
                                       if settings.penetration_tolerance is not None
                                       else 1e-5 * float(lengths.min()))
+        platens = [i for i, s in enumerate(surfaces) if s.body.platen is not None]
+        self.platen_body = platens[0] if platens else None
 
     # -- state ----------------------------------------------------------------------------------
 
@@ -124,6 +135,22 @@ class VirtualElementContact:
                  * b.u_platen[dofs] + s.G @ F.ravel())
             out.append(s.X + u.reshape(-1, 2))
         return out
+
+    def platen_reaction(self, state: ContactState) -> float:
+        """Reaction of the platen (force it applies to its body), linear in the state."""
+        if self.platen_body is None:
+            return 0.0
+        s = self.surfaces[self.platen_body]
+        b = s.body
+        return (state.load_factor * b.platen_load_reaction
+                + state.platen_displacement * b.platen_stiffness
+                + float(s.platen_row @ state.forces[self.platen_body].ravel()))
+
+    def _platen_motion(self, nodes: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        """Normal displacement of candidate nodes of the platen body per unit platen motion."""
+        s = self.surfaces[self.platen_body]
+        u = s.body.u_platen[s.candidate_dofs].reshape(-1, 2)[nodes]
+        return np.einsum("ij,ij->i", u, normal)
 
     def opponents(self, i: int) -> list[int]:
         return [j for j in range(len(self.surfaces))
@@ -298,12 +325,13 @@ class VirtualElementContact:
     # -- correct --------------------------------------------------------------------------------
 
     def corrections(self, state: ContactState, pairings: list[Pairing], iteration: int
-                    ) -> list[np.ndarray]:
-        """Corrective nodal forces for every body, all computed from the same state."""
+                    ) -> tuple[list[np.ndarray], float]:
+        """Corrective nodal forces for every body (and the platen's motion), from one state."""
         cfg = self.settings
         _, _, eq_tol, _, _ = self.errors(pairings)
         omega = cfg.first_relaxation if iteration < cfg.relaxed_iterations else cfg.relaxation
         out = []
+        d_platen = 0.0
         for i, (s, p) in enumerate(zip(self.surfaces, pairings)):
             F = state.forces[i]
             dF = np.zeros_like(F)
@@ -321,19 +349,80 @@ class VirtualElementContact:
             err = p.equilibrium_error
             eq_on = active & (np.abs(err) > eq_tol)
             d_lam = np.zeros(s.nc)
-            d_lam[eq_on] = equilibrium_force(p.stiffness[eq_on], p.virtual_stiffness[eq_on],
-                                             err[eq_on])
+            d_lam[eq_on] = omega * equilibrium_force(p.stiffness[eq_on],
+                                                     p.virtual_stiffness[eq_on], err[eq_on])
+            dF += d_lam[:, None] * n
             # Compatibility (eq. 4.2.4): the own share of the penetration as a displacement,
             # turned into forces by prescribing it along the normals with every other candidate
             # dof free (§4.5.2, stage 2): d_lam = (n^T C n)^-1 du over the corrected nodes.
-            comp = np.flatnonzero(active & (np.abs(p.penetration) > self.penetration_tolerance))
-            if len(comp):
-                du = compatibility_displacement(p.stiffness[comp], p.virtual_stiffness[comp],
-                                                p.penetration[comp])
-                d_lam[comp] += np.linalg.solve(self._normal_flexibility(s, comp, n[comp]), du)
-            dF += omega * d_lam[:, None] * n
-            out.append(dF)
-        return out
+            comp = active & (np.abs(p.penetration) > self.penetration_tolerance)
+            if i == self.platen_body:
+                dF_comp, d_platen = self._platen_compatibility(state, p, comp, dF, omega)
+            else:
+                dF_comp = np.zeros_like(F)
+                idx = np.flatnonzero(comp)
+                if len(idx):
+                    du = omega * compatibility_displacement(
+                        p.stiffness[idx], p.virtual_stiffness[idx], p.penetration[idx])
+                    mu = np.linalg.solve(self._normal_flexibility(s, idx, n[idx]), du)
+                    dF_comp[idx] = mu[:, None] * n[idx]
+            out.append(dF + dF_comp)
+        return out, d_platen
+
+    def _platen_compatibility(self, state: ContactState, p: Pairing, comp: np.ndarray,
+                              dF_other: np.ndarray, omega: float) -> tuple[np.ndarray, float]:
+        """Compatibility stage 2 of the platen's body, with the platen force as one more condition.
+
+        Unknowns: the normal forces mu at the corrected nodes and the platen motion d. Conditions:
+        each corrected node moves by its share du along its normal,
+        ``sum_t (n_s^T C_st n_t) mu_t + a_s d = du_s``, and the platen's reaction reaches its
+        force, ``sum_t b_t mu_t + r d = target - R - h.dF_other``, where ``a_s`` is the node's
+        normal motion per unit platen motion, ``b_t`` the platen reaction per unit normal force at
+        node t and ``r`` the platen's own stiffness (zero for a body only contact holds). While
+        the platen is off its force, nodes touching within tolerance are held on the surface too.
+        """
+        s = self.surfaces[self.platen_body]
+        n = p.normal
+        dF = np.zeros((s.nc, 2))
+        b = s.body
+        r_platen = b.platen_stiffness
+        need = (state.platen_force - self.platen_reaction(state)
+                - float(s.platen_row @ dF_other.ravel()))
+        off = abs(need) > self.settings.platen_tolerance * max(abs(state.platen_force), 1e-300)
+        sel = comp.copy()
+        if off:
+            sel |= p.participating & (p.force >= 0) & (p.penetration > -self.penetration_tolerance)
+        idx = np.flatnonzero(sel)
+        if len(idx) == 0:
+            if not off:
+                return dF, 0.0
+            if r_platen != 0.0:
+                return dF, need / r_platen
+            # Nothing touches: move the platen the way its force points (the sign of `need`)
+            # just far enough to close the smallest gap: a node's penetration changes by -a d.
+            a = self._platen_motion(np.arange(s.nc), n)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                d = np.where(np.isfinite(p.penetration) & (a != 0), p.penetration / a, np.nan)
+            ok = np.isfinite(d) & (np.sign(d) == np.sign(need))
+            if not ok.any():
+                return dF, 0.0
+            return dF, float(d[ok][np.argmin(np.abs(d[ok]))])
+        du = omega * compatibility_displacement(p.stiffness[idx], p.virtual_stiffness[idx],
+                                                p.penetration[idx])
+        a = self._platen_motion(idx, n[idx])
+        row = s.platen_row.reshape(-1, 2)[idx]
+        bvec = np.einsum("ij,ij->i", row, n[idx])
+        m = len(idx)
+        A = np.zeros((m + 1, m + 1))
+        A[:m, :m] = self._normal_flexibility(s, idx, n[idx])
+        A[:m, m] = a
+        A[m, :m] = bvec
+        A[m, m] = r_platen
+        # when the force is already met, keep it met while correcting compatibility
+        rhs = np.concatenate([du, [need if off else 0.0]])
+        sol = np.linalg.lstsq(A, rhs, rcond=None)[0]
+        dF[idx] = sol[:m, None] * n[idx]
+        return dF, float(sol[m])
 
     @staticmethod
     def _normal_flexibility(s: ContactSurface, nodes: np.ndarray, n: np.ndarray) -> np.ndarray:
@@ -372,28 +461,36 @@ class VirtualElementContact:
         for k in range(cfg.max_iterations + 1):
             pairings = self.detect(state)
             pen, eq, eq_tol, contact, tension = self.errors(pairings)
-            rec = IterationRecord(k, pen, eq, contact, tension)
+            platen_error = self.platen_reaction(state) - state.platen_force
+            rec = IterationRecord(k, pen, eq, contact, tension, platen_error=platen_error)
             history.append(rec)
-            if pen <= self.penetration_tolerance and eq <= eq_tol and tension == 0:
+            platen_ok = abs(platen_error) <= cfg.platen_tolerance * max(
+                abs(state.platen_force), 1e-300) or self.platen_body is None
+            if pen <= self.penetration_tolerance and eq <= eq_tol and tension == 0 and platen_ok:
                 return SolveResult(True, k, history, pairings)
             if k == cfg.max_iterations:
                 break
-            dF = self.corrections(state, pairings, k)
+            dF, d_platen = self.corrections(state, pairings, k)
             dU = [(s.C @ d.ravel()).reshape(-1, 2) for s, d in zip(self.surfaces, dF)]
+            if d_platen:
+                i = self.platen_body
+                s = self.surfaces[i]
+                dU[i] += d_platen * s.body.u_platen[s.candidate_dofs].reshape(-1, 2)
             df = float(np.sqrt(sum((d**2).sum() for d in dF)))
             du = float(np.sqrt(sum((d**2).sum() for d in dU)))
             rec.force_correction, rec.displacement_correction = df, du
-            if cfg.convergence == "stationary" and tension == 0:
+            if cfg.convergence == "stationary" and tension == 0 and platen_ok:
                 node_df = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dF)
                 node_du = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dU)
                 if node_df <= eq_tol and node_du <= self.penetration_tolerance:
                     return SolveResult(True, k, history, pairings)
-            if cfg.convergence == "thesis" and k > 0 and (
+            if cfg.convergence == "thesis" and k > 0 and platen_ok and (
                     df <= cfg.thesis_fraction * max_df or du <= cfg.thesis_fraction * max_du):
                 return SolveResult(True, k, history, pairings)
             max_df, max_du = max(max_df, df), max(max_du, du)
             for F, d in zip(state.forces, dF):
                 F += d
+            state.platen_displacement += d_platen
             log.debug("iteration %d: penetration %.3g, equilibrium error %.3g (tol %.3g), "
                       "%d in contact, %d in tension", k, pen, eq, eq_tol, contact, tension)
         return SolveResult(False, cfg.max_iterations, history, pairings,

@@ -37,7 +37,7 @@ class ContactSettings:
             cause below that fraction of the largest (thesis §5.6).
         thesis_fraction: the fraction of the thesis criterion (1 %).
         search_distance: facets farther than this from another body in the undeformed
-            configuration are not contact candidates. Default (None): 5 % of the smaller of the
+            configuration are not contact candidates. Default (None): 2 % of the smaller of the
             two bodies' bounding-box diagonals.
         quadrature_order: polynomial order integrated exactly on the virtual elements.
         size_ratio_limit: when a facet is longer than this many times the opposing facets, the

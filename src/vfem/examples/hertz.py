@@ -136,7 +136,7 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
         "converged": result.converged,
         "message": result.message,
         "steps": [{"step": s.step, "load_factor": s.load_factor, "iterations": s.iterations,
-                   "converged": s.converged, "platen_trials": s.platen_trials, "cuts": s.cuts,
+                   "converged": s.converged, "cuts": s.cuts,
                    "platen_displacement": s.platen_displacement,
                    "max_penetration": s.history[-1].max_penetration,
                    "max_equilibrium_error": s.history[-1].max_equilibrium_error}
