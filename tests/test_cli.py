@@ -57,3 +57,23 @@ def test_bad_input_from_the_shell_has_no_traceback():
                            "cylinder_poissons_ratio=0.7"], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "poissons_ratio" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_a_body_without_supports_is_one_message_and_exit_2(monkeypatch, capsys, tmp_path):
+    import dataclasses
+
+    import vfem.examples.hertz as hertz
+
+    real_build = hertz.build
+
+    def unsupported(p):
+        model = real_build(p)
+        flat = next(b for b in model.bodies if b.name == "flat")
+        model.bodies[model.bodies.index(flat)] = dataclasses.replace(flat, supports=())
+        return model
+
+    monkeypatch.setattr(hertz, "build", unsupported)
+    assert main(["-q", "run", "hertz", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "body 'flat' is not supported" in err and "singular" in err
+    assert err.count("\n") == 1 and "Traceback" not in err

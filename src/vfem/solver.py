@@ -27,7 +27,7 @@ from .bodies import Body
 from .contact.algorithm import ContactState, IterationRecord, Pairing, VirtualElementContact
 from .contact.settings import ContactSettings
 from .contact.surface import ContactSurface, select_candidate_facets
-from .errors import AnalysisError, InputError, RindViolation
+from .errors import AnalysisError, InputError
 
 log = logging.getLogger(__name__)
 

@@ -284,6 +284,15 @@ class VirtualElementContact:
         seg, t, dist = project_points(pts, A, B)
         own_len = np.repeat(s.lengths, nq)
         near = dist <= np.maximum(own_len, opp_len[seg])
+        # A point whose closest opposing point is an end of the opposing contact surface lies
+        # beyond that surface: no opposing traction reaches it.
+        for j in np.unique(owners[seg]):
+            sel = np.flatnonzero(owners[seg] == j)
+            ends = self.surfaces[j].facets[local[seg[sel]]]
+            free_end = self.surfaces[j].surface_ends
+            beyond = (((t[sel] <= 0.0) & free_end[ends[:, 0]])
+                      | ((t[sel] >= 1.0) & free_end[ends[:, 1]]))
+            near[sel[beyond]] = False
         # Tractions are nominal (per undeformed length of the body that carries them). The same
         # current-configuration stretch of surface is ds/stretch_own of own undeformed length and
         # ds/stretch_opp of the opposing one, so the opposing traction is weighted by
@@ -483,6 +492,12 @@ class VirtualElementContact:
                 node_df = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dF)
                 node_du = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dU)
                 if node_df <= eq_tol and node_du <= self.penetration_tolerance:
+                    if pen > self.penetration_tolerance or eq > eq_tol:
+                        log.warning(
+                            "contact stopped at a fixed point of the iteration with residual "
+                            "penetration %.3g (tolerance %.3g) and equilibrium error %.3g "
+                            "(tolerance %.3g): the corrections cancel each other there "
+                            "(docs/method.md §5)", pen, self.penetration_tolerance, eq, eq_tol)
                     return SolveResult(True, k, history, pairings)
             if cfg.convergence == "thesis" and k > 0 and platen_ok and (
                     df <= cfg.thesis_fraction * max_df or du <= cfg.thesis_fraction * max_du):

@@ -133,6 +133,14 @@ class ContactSurface:
             self.platen_row = np.zeros(2 * self.nc)
 
     @property
+    def surface_ends(self) -> np.ndarray:
+        """(nc,) True at the ends of the candidate surface (nodes on a single candidate facet)."""
+        if not hasattr(self, "_ends"):
+            valence = np.bincount(self.facets.ravel(), minlength=self.nc)[: self.nc]
+            self._ends = valence == 1
+        return self._ends
+
+    @property
     def C(self) -> np.ndarray:
         """Flexibility on the candidate dofs, (2 nc, 2 nc)."""
         return self.G[: 2 * self.nc]
