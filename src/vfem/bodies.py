@@ -108,8 +108,12 @@ class Body:
 
     # -- set-up ---------------------------------------------------------------------------------
 
-    def setup(self, backend: str = "superlu") -> None:
-        """Validate, assemble the stiffness, factorize it and solve the unit load cases."""
+    def setup(self, backend: str = "superlu", tracked_dofs: np.ndarray | None = None) -> None:
+        """Validate, assemble the stiffness, factorize it and solve the unit load cases.
+
+        With ``tracked_dofs`` (the dofs contact follows), the factorization also yields the
+        inverse stiffness among them (``tracked_flexibility``, supports kept: zero on fixed dofs).
+        """
         self.validate()
         elem = ElementTriP1() if isinstance(self.mesh, MeshTri) else ElementQuad1()
         self.basis = Basis(self.mesh, ElementVector(elem))
@@ -133,7 +137,20 @@ class Body:
 
         self.free_dofs = np.setdiff1d(np.arange(self.ndofs), self.fixed_dofs)
         self.K_ff = self.K[self.free_dofs][:, self.free_dofs].tocsc()
-        self.factor = factorize(self.K_ff, backend)
+        trailing = None
+        if tracked_dofs is not None:
+            tracked_dofs = np.asarray(tracked_dofs, dtype=int)
+            pos = np.searchsorted(self.free_dofs, tracked_dofs)
+            free = self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == tracked_dofs
+            trailing = pos[free]
+        self.factor = factorize(self.K_ff, backend, trailing=trailing,
+                                groups=self.free_dofs // 2)
+        self.tracked_flexibility = None
+        if tracked_dofs is not None:
+            G = np.zeros((len(tracked_dofs), len(tracked_dofs)))
+            ix = np.flatnonzero(free)
+            G[np.ix_(ix, ix)] = self.factor.trailing_inverse
+            self.tracked_flexibility = G
 
         f = np.zeros(self.ndofs)
         for tr in self.tractions:

@@ -3,11 +3,16 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 
-def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray,
-                   max_pairs: int = 4_000_000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Closest point on a set of segments for each point, vectorised over points and segments.
+def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closest point on a set of segments for each point.
+
+    A KD-tree on the segment midpoints limits the candidates: the closest segment's midpoint is
+    no farther than the nearest midpoint plus half the longest segment. The exact projection onto
+    the candidates is vectorised.
 
     Args:
         points: (m, 2) query points.
@@ -18,25 +23,25 @@ def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray,
         closest point on it (0 at ``a``, 1 at ``b``) and the distance.
     """
     m, s = len(points), len(a)
-    seg = np.zeros(m, dtype=int)
-    tt = np.zeros(m)
-    dist = np.full(m, np.inf)
     if s == 0 or m == 0:
-        return seg, tt, dist
+        return np.zeros(m, dtype=int), np.zeros(m), np.full(m, np.inf)
     d = b - a
     L2 = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
-    step = max(1, max_pairs // s)
-    for lo in range(0, m, step):
-        P = points[lo:lo + step, None, :]
-        t = np.clip(np.einsum("msk,sk->ms", P - a[None], d) / L2, 0.0, 1.0)
-        diff = P - (a[None] + t[..., None] * d[None])
-        d2 = np.einsum("msk,msk->ms", diff, diff)
-        j = np.argmin(d2, axis=1)
-        rows = np.arange(len(j))
-        seg[lo:lo + step] = j
-        tt[lo:lo + step] = t[rows, j]
-        dist[lo:lo + step] = np.sqrt(d2[rows, j])
-    return seg, tt, dist
+    mid = 0.5 * (a + b)
+    tree = cKDTree(mid)
+    d0, _ = tree.query(points)
+    radius = d0 + 0.5 * np.sqrt(L2.max()) * (1 + 1e-9) + 1e-300
+    lists = tree.query_ball_point(points, radius)
+    counts = np.fromiter((len(c) for c in lists), dtype=int, count=m)
+    pt = np.repeat(np.arange(m), counts)
+    sg = np.fromiter((j for c in lists for j in c), dtype=int, count=int(counts.sum()))
+    t = np.clip(np.einsum("ij,ij->i", points[pt] - a[sg], d[sg]) / L2[sg], 0.0, 1.0)
+    diff = points[pt] - (a[sg] + t[:, None] * d[sg])
+    d2 = np.einsum("ij,ij->i", diff, diff)
+    # per point, the candidate with the smallest distance (ties: the lowest segment number)
+    order = np.lexsort((sg, d2, pt))
+    first = order[np.r_[0, np.flatnonzero(np.diff(pt[order])) + 1]]
+    return sg[first], t[first], np.sqrt(d2[first])
 
 
 def outward_normals(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -20,8 +20,9 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.spatial import cKDTree
-from skfem import BilinearForm, ElementLineP1, ElementQuad1, ElementTriP1, FacetBasis, MeshTri, asm
+from skfem import BilinearForm, ElementLineP1, ElementQuad1, ElementTriP1, FacetBasis, MeshTri
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
@@ -122,15 +123,21 @@ class ContactSurface:
         return np.column_stack([2 * n, 2 * n + 1]).ravel()
 
     def compute_flexibility(self) -> None:
-        """Solve for the flexibility columns of the candidate dofs (one back-substitution each)."""
-        cols = self.body.flexibility_columns(self.candidate_dofs)
-        self.G = cols[self.tracked_dofs]
-        if self.body.platen is not None:
-            self.platen_row = (self.body.K[self.body.platen_dofs] @ cols).sum(axis=0)
-            # the unit force itself, where a candidate dof is a platen dof, is not a reaction
-            self.platen_row -= np.isin(self.candidate_dofs, self.body.platen_dofs)
+        """The flexibility rows of the tracked dofs for the candidate dofs, and the platen row.
+
+        Taken from the body's factorization (tracked dofs ordered last, see ``vfem.linalg``), or
+        else one back-substitution per candidate dof. The platen's reaction per unit force at a
+        candidate dof is, by reciprocity, minus that dof's motion under a unit platen motion.
+        """
+        body = self.body
+        nc2 = 2 * self.nc
+        if getattr(body, "tracked_flexibility", None) is not None and \
+                len(body.tracked_flexibility) == len(self.tracked_dofs):
+            self.G = body.tracked_flexibility[:, :nc2].copy()
         else:
-            self.platen_row = np.zeros(2 * self.nc)
+            cols = body.flexibility_columns(self.candidate_dofs)
+            self.G = cols[self.tracked_dofs]
+        self.platen_row = -body.u_platen[self.candidate_dofs]
 
     @property
     def surface_ends(self) -> np.ndarray:
@@ -211,29 +218,42 @@ class ContactSurface:
         phi = np.vstack([e.lbasis(X, i)[0] for i in range(2)])
         return X[0], phi, self.lengths[:, None] * W[None, :]
 
-    def mass_matrix(self, facet_weight: np.ndarray):
+    def mass_matrix(self, facet_weight: np.ndarray) -> sp.csr_matrix:
         """Redistribution matrix N* over the facets with nonzero weight (eq. 4.4.10), (nc, nc).
 
-        Built by scikit-fem on the undeformed candidate facets; the weight (1 for a facet that
-        takes part, 0 otherwise) is a per-facet field, so leaving facets out of the assembly
-        (the thesis's N*) needs no new basis.
+        scikit-fem integrates ``phi phi^T`` on each undeformed candidate facet once; N* for a set
+        of facets (the thesis's N*: unloaded facets left out) is the sum of their entries.
         """
-        fb = self._facet_basis()
+        if not hasattr(self, "_mass_entries"):
+            self._mass_entries = self._facet_mass_entries()
+        facet, rows, cols, vals = self._mass_entries
+        return sp.csr_matrix((vals * facet_weight[facet], (rows, cols)), shape=(self.nc, self.nc))
+
+    def _facet_mass_entries(self):
+        """(facet, row, col, value) of every nonzero of every facet's mass matrix."""
+        elem = ElementTriP1() if isinstance(self.body.mesh, MeshTri) else ElementQuad1()
+        fb = FacetBasis(self.body.mesh, elem, facets=self.facet_ids)
 
         @BilinearForm
         def mass(u, v, w):
-            return w["active"] * u * v
+            return w["tag"] * u * v
 
-        active = np.repeat(facet_weight[:, None], fb.X.shape[1], axis=1)
-        N = asm(mass, fb, active=active).tocsr()
-        cand = self.nodes[: self.nc]
-        return N[cand][:, cand]
+        nq = fb.X.shape[1]
+        ones = asm_coo(mass, fb, np.ones((len(self.facet_ids), nq)))
+        tagged = asm_coo(mass, fb, np.repeat(np.arange(1.0, len(self.facet_ids) + 1)[:, None],
+                                             nq, axis=1))
+        # entries of the element's nodes off the facet vanish (to round-off) on the facet
+        keep = np.abs(ones.data) > 1e-12 * np.abs(ones.data).max()
+        facet = np.rint(tagged.data[keep] / ones.data[keep]).astype(int) - 1
+        local = np.full(self.body.mesh.nvertices, -1)
+        local[self.nodes[: self.nc]] = np.arange(self.nc)
+        rows, cols = local[ones.indices[0][keep]], local[ones.indices[1][keep]]
+        return facet, rows, cols, ones.data[keep]
 
-    def _facet_basis(self):
-        if not hasattr(self, "_fb"):
-            elem = ElementTriP1() if isinstance(self.body.mesh, MeshTri) else ElementQuad1()
-            self._fb = FacetBasis(self.body.mesh, elem, facets=self.facet_ids)
-        return self._fb
+
+def asm_coo(form, basis, tag: np.ndarray):
+    """scikit-fem's unsummed (per element) entries of a form with a per-facet field ``tag``."""
+    return form.coo_data(basis, tag=tag)
 
 
 def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
