@@ -2,10 +2,11 @@
 
 ``vfem bench hertz`` (and ``benchmarks/hertz.py``) runs the Hertz example at several refinements
 and prints, per level: dofs, contact candidate dofs, vfem's analysis time (assembly,
-factorization, flexibility, all contact steps; mesh generation and file output excluded), the time
-of one plain linear solve of the same bodies with the same backend (factor + solve, assembly
-excluded), their ratio, the contact iterations and the p_max error. Ratios are measured in the same
-process, one after the other.
+factorization with the flexibility, all contact steps; mesh generation and file output
+excluded), the time of one plain linear solve of the same bodies with the same backend (factor +
+solve, assembly excluded), their ratio, the same ratio with the assembly left out of vfem's time
+too, the parts of vfem's time, the contact iterations and the p_max error. Both are measured in
+the same process, one after the other.
 """
 
 from __future__ import annotations
@@ -20,7 +21,8 @@ from .linalg import factorize
 from .solver import Analysis
 
 HEADER = (f"{'level':>5} {'dofs':>8} {'contact':>8} {'vfem s':>8} {'plain s':>8} {'ratio':>6} "
-          f"{'setup s':>8} {'flex s':>7} {'steps s':>8} {'iters':>6} {'p_max err':>10}")
+          f"{'w/o asm':>7} {'asm s':>7} {'factor s':>8} {'steps s':>8} {'iters':>6} "
+          f"{'p_max err':>10}")
 
 
 def plain_solve_time(model) -> float:
@@ -56,8 +58,9 @@ def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None =
             "vfem_s": vfem_s,
             "plain_solve_s": plain_s,
             "ratio": vfem_s / plain_s,
-            "assemble_factorize_s": result.timings["assemble_factorize_s"],
-            "flexibility_s": result.timings["flexibility_s"],
+            "ratio_without_assembly": (vfem_s - result.timings["assemble_s"]) / plain_s,
+            "assemble_s": result.timings["assemble_s"],
+            "factorize_s": result.timings["factorize_s"],
             "steps_s": result.timings["steps_s"],
             "iterations": int(sum(s.iterations for s in result.steps)),
             "converged": result.converged,
@@ -68,7 +71,7 @@ def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None =
         if print_row:
             print_row(f"{level:>5} {row['dofs']:>8} {row['contact_dofs']:>8} "
                       f"{vfem_s:>8.2f} {plain_s:>8.2f} {row['ratio']:>6.1f} "
-                      f"{row['assemble_factorize_s']:>8.2f} {row['flexibility_s']:>7.2f} "
-                      f"{row['steps_s']:>8.2f} {row['iterations']:>6} "
+                      f"{row['ratio_without_assembly']:>7.1f} {row['assemble_s']:>7.2f} "
+                      f"{row['factorize_s']:>8.2f} {row['steps_s']:>8.2f} {row['iterations']:>6} "
                       f"{row['p_max_error']:>+10.4%}")
     return rows

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -115,11 +116,13 @@ class Body:
         inverse stiffness among them (``tracked_flexibility``, supports kept: zero on fixed dofs).
         """
         self.validate()
+        t0 = time.perf_counter()
         elem = ElementTriP1() if isinstance(self.mesh, MeshTri) else ElementQuad1()
         self.basis = Basis(self.mesh, ElementVector(elem))
         lam, mu = self.material.lame()
         self.K = asm(linear_elasticity(lam, mu), self.basis).tocsr()
         self.ndofs = self.K.shape[0]
+        t1 = time.perf_counter()
 
         fixed: dict[int, float] = {}  # dof -> prescribed value at factor 1
         for s in self.supports:
@@ -143,8 +146,10 @@ class Body:
             pos = np.searchsorted(self.free_dofs, tracked_dofs)
             free = self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == tracked_dofs
             trailing = pos[free]
+        t2 = time.perf_counter()
         self.factor = factorize(self.K_ff, backend, trailing=trailing,
                                 groups=self.free_dofs // 2)
+        t3 = time.perf_counter()
         self.tracked_flexibility = None
         if tracked_dofs is not None:
             G = np.zeros((len(tracked_dofs), len(tracked_dofs)))
@@ -171,6 +176,8 @@ class Body:
             self.platen_load_reaction = float((self.K @ self.u_load - f)[platen_dofs].sum())
             self.platen_stiffness = float((self.K @ self.u_platen)[platen_dofs].sum())
         self._ready = True
+        self.timings = {"assemble_s": t1 - t0, "constraints_s": t2 - t1, "factorize_s": t3 - t2,
+                        "load_cases_s": time.perf_counter() - t3}
         log.info("body %s: %d nodes, %d dofs (%d fixed)", self.name, self.mesh.nvertices,
                  self.ndofs, len(self.fixed_dofs))
 

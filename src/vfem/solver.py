@@ -137,6 +137,8 @@ class Analysis:
         t3 = time.perf_counter()
         self.timings.update(search_s=t1 - t0, assemble_factorize_s=t2 - t1,
                             flexibility_s=t3 - t2)
+        for key in ("assemble_s", "factorize_s"):
+            self.timings[key] = sum(b.timings[key] for b in bodies)
 
     def solve_step(self, start: ContactState, load_factor: float, history_out: list
                    ) -> tuple[ContactState, list[Pairing]]:
