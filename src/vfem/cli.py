@@ -132,6 +132,12 @@ def _print_hertz(s: dict, out: Path, elapsed: float) -> None:
               f"   half-width {h['a_estimate']:.5f} (theory {h['a_theory']:.5f})")
         print(f"  RMS error over |x| < a: {h['rms_error_over_p0']:.3%} of p0   "
               f"contact force {h['total_contact_force']:.2f} (applied {h['applied_force']:g})")
+    fixed = [x for x in s["steps"] if x.get("stopped_at_fixed_point")]
+    if fixed:
+        worst = max(fixed, key=lambda x: x["max_penetration"])
+        print(f"  note: {len(fixed)} of {len(s['steps'])} steps stopped where the compatibility "
+              f"and equilibrium corrections cancel (largest residual penetration "
+              f"{worst['max_penetration']:.2e}); see docs/method.md §5")
     print(f"  results: {out}/summary.json, results.pvd (ParaView), pressure.png, deformed.png")
 
 

@@ -85,6 +85,7 @@ class StepResult:
     history: list[IterationRecord]
     platen_displacement: float = 0.0
     cuts: int = 0
+    fixed_point: bool = False  # stopped where the corrections cancel, with residual errors
     bodies: dict[str, BodyStepResult] = field(default_factory=dict)
 
 
@@ -156,6 +157,7 @@ class Analysis:
         history_out.extend(res.history)
         if not res.converged:
             raise AnalysisError(res.message)
+        self._fixed_point = res.fixed_point
         return state, res.pairings
 
     # -- the steps ------------------------------------------------------------------------------
@@ -192,7 +194,8 @@ class Analysis:
             iterations = sum(1 for h in history if h.iteration > 0) or 0
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=iterations,
                               converged=True, history=history,
-                              platen_displacement=state.platen_displacement, cuts=cuts)
+                              platen_displacement=state.platen_displacement, cuts=cuts,
+                              fixed_point=self._fixed_point)
             step.bodies = self._fields(state, pairings)
             steps.append(step)
             cuts = 0

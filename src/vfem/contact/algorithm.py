@@ -100,6 +100,7 @@ class SolveResult:
     history: list[IterationRecord]
     pairings: list[Pairing]
     message: str = ""
+    fixed_point: bool = False  # stopped where corrections cancel, errors above tolerance
 
 
 class VirtualElementContact:
@@ -492,13 +493,14 @@ class VirtualElementContact:
                 node_df = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dF)
                 node_du = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dU)
                 if node_df <= eq_tol and node_du <= self.penetration_tolerance:
-                    if pen > self.penetration_tolerance or eq > eq_tol:
-                        log.warning(
+                    residual = pen > self.penetration_tolerance or eq > eq_tol
+                    if residual:
+                        log.info(
                             "contact stopped at a fixed point of the iteration with residual "
                             "penetration %.3g (tolerance %.3g) and equilibrium error %.3g "
                             "(tolerance %.3g): the corrections cancel each other there "
                             "(docs/method.md §5)", pen, self.penetration_tolerance, eq, eq_tol)
-                    return SolveResult(True, k, history, pairings)
+                    return SolveResult(True, k, history, pairings, fixed_point=residual)
             if cfg.convergence == "thesis" and k > 0 and platen_ok and (
                     df <= cfg.thesis_fraction * max_df or du <= cfg.thesis_fraction * max_du):
                 return SolveResult(True, k, history, pairings)

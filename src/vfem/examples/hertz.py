@@ -138,6 +138,7 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
         "steps": [{"step": s.step, "load_factor": s.load_factor, "iterations": s.iterations,
                    "converged": s.converged, "cuts": s.cuts,
                    "platen_displacement": s.platen_displacement,
+                   "stopped_at_fixed_point": s.fixed_point,
                    "max_penetration": s.history[-1].max_penetration,
                    "max_equilibrium_error": s.history[-1].max_equilibrium_error}
                   for s in result.steps],
