@@ -67,3 +67,16 @@ def test_refinement_keeps_p_max_within_a_fraction_of_a_percent():
         assert r.converged
         errors.append(evaluate(r, p)["p_max_error"])
     assert max(abs(e) for e in errors) < 0.005
+
+
+def test_a_cylinder_starting_clear_of_the_flat_ends_in_the_same_state(hertz_level0):
+    """The platen first closes the gap, then the contact builds up as before."""
+    p, _, h = hertz_level0
+    gapped = dataclasses.replace(p, initial_gap=1e-3)
+    r = Analysis(build(gapped)).run()
+    assert r.converged
+    h2 = evaluate(r, gapped)
+    assert h2["p_max"] == pytest.approx(h["p_max"], rel=1e-3)
+    assert h2["total_contact_force"] == pytest.approx(1530, rel=1e-4)
+    assert r.steps[-1].platen_displacement == pytest.approx(
+        -1e-3 + Analysis(build(p)).run().steps[-1].platen_displacement, rel=1e-3)

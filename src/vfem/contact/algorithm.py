@@ -181,17 +181,17 @@ class VirtualElementContact:
 
     def _pair(self, i: int, x: list[np.ndarray], state: ContactState,
               tractions: list[np.ndarray]) -> Pairing:
+        """Virtual node, penetration, stiffnesses and forces of every candidate node of body i."""
         s = self.surfaces[i]
         nc = s.nc
         F = state.forces[i]
         opp = self._opposing(i, x)
-        empty = Pairing(other=np.full(nc, -1), facet=np.zeros(nc, int), t=np.zeros(nc),
-                        normal=np.zeros((nc, 2)), penetration=np.full(nc, -np.inf),
-                        embedded=np.zeros(nc, bool), stiffness=np.zeros(nc),
-                        virtual_stiffness=np.zeros(nc), force=np.zeros(nc),
-                        virtual_force=np.zeros(nc), participating=np.zeros(nc, bool))
-        if opp is None or nc == 0:
-            return empty
+        if opp is None or nc == 0:  # nothing this body may touch
+            return Pairing(other=np.full(nc, -1), facet=np.zeros(nc, int), t=np.zeros(nc),
+                           normal=np.zeros((nc, 2)), penetration=np.full(nc, -np.inf),
+                           embedded=np.zeros(nc, bool), stiffness=np.zeros(nc),
+                           virtual_stiffness=np.zeros(nc), force=np.zeros(nc),
+                           virtual_force=np.zeros(nc), participating=np.zeros(nc, bool))
         owners, local, A, B = opp
         pts = x[i][:nc]
         seg, t, _ = project_points(pts, A, B)
@@ -219,7 +219,6 @@ class VirtualElementContact:
 
         stiffness = s.normal_stiffness(np.arange(nc), normals)
         virtual_stiffness = np.zeros(nc)
-        virtual_force = np.zeros(nc)
         for j in np.unique(other):
             sel = np.flatnonzero(other == j)
             sj = self.surfaces[j]

@@ -44,6 +44,7 @@ class HertzParameters:
     growth: float = 0.15
     penetration_tolerance: float | None = None
     equilibrium_tolerance: float = 1e-3
+    initial_gap: float = 0.0  # the cylinder starts this far above the flat
     swap_bodies: bool = False
 
 
@@ -66,7 +67,8 @@ def build(p: HertzParameters | None = None) -> Model:
     h_max = p.max_element_size / 2**p.refinement
     cylinder = Body(
         name="cylinder",
-        mesh=graded_quarter_disk(p.radius, h, h_max, p.growth, plateau=1.5 * a),
+        mesh=graded_quarter_disk(p.radius, h, h_max, p.growth,
+                                 plateau=1.5 * a).translated((0.0, p.initial_gap)),
         material=LinearElastic(p.cylinder_youngs_modulus, p.cylinder_poissons_ratio),
         supports=(Support("symmetry", ("x",)),),
         platen=Platen("top", "y", -p.force),
