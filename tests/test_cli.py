@@ -77,3 +77,11 @@ def test_a_body_without_supports_is_one_message_and_exit_2(monkeypatch, capsys, 
     err = capsys.readouterr().err
     assert "body 'flat' is not supported" in err and "singular" in err
     assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_bench_prints_and_saves_the_table(tmp_path, capsys):
+    path = tmp_path / "bench.json"
+    assert main(["bench", "hertz", "--levels", "0", "--json", str(path)]) == 0
+    assert "ratio" in capsys.readouterr().out
+    (row,) = json.loads(path.read_text())
+    assert row["dofs"] > 1000 and row["ratio"] > 0 and abs(row["p_max_error"]) < 0.03

@@ -1,0 +1,83 @@
+"""Contact settings: relaxation, the thesis's convergence criterion, tension release, validation."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from skfem import MeshQuad, MeshTri
+
+from vfem.bodies import Body, Support
+from vfem.contact.algorithm import VirtualElementContact
+from vfem.contact.settings import ContactSettings
+from vfem.contact.surface import ContactSurface
+from vfem.errors import InputError
+from vfem.examples.hertz import build, evaluate
+from vfem.materials import LinearElastic
+from vfem.solver import Analysis, Model
+
+
+@pytest.mark.parametrize("changes", [
+    {"first_relaxation": 0.8, "relaxed_iterations": 3},
+    {"convergence": "thesis"},
+])
+def test_other_settings_reach_the_same_hertz_answer(hertz_level0, changes):
+    p, _, h = hertz_level0
+    model = build(p)
+    model.contact = dataclasses.replace(model.contact, **changes)
+    r = Analysis(model).run()
+    assert r.converged
+    assert evaluate(r, p)["p_max"] == pytest.approx(h["p_max"], rel=0.01)
+
+
+def two_blocks():
+    def block(cls, y0, y1, nx, name, support):
+        m = cls.init_tensor(np.linspace(0, 1, nx + 1), np.linspace(y0, y1, 3))
+        m = m.with_boundaries({"top": lambda x: x[1] > y1 - 1e-9,
+                               "bottom": lambda x: x[1] < y0 + 1e-9})
+        return Body(name, m, LinearElastic(1e3, 0.3), supports=(Support(support),))
+
+    bodies = [block(MeshQuad, -0.5, 0.0, 4, "lower", "bottom"),
+              block(MeshTri, 0.0, 0.5, 5, "upper", "top")]
+    surfaces = []
+    for b, name in zip(bodies, ("top", "bottom")):
+        b.setup()
+        s = ContactSurface.build(b, b.mesh.boundaries[name])
+        s.compute_flexibility()
+        surfaces.append(s)
+    return VirtualElementContact(surfaces, {frozenset((0, 1))}, ContactSettings())
+
+
+def test_a_tensile_force_is_released_over_two_iterations():
+    contact = two_blocks()
+    state = contact.new_state()
+    node = 2
+    state.forces[1][node] = (0.0, -5.0)  # pulls the upper block's node into the lower block
+    pairings = contact.detect(state)
+    assert pairings[1].force[node] == pytest.approx(-5.0)
+    dF, _ = contact.corrections(state, pairings, 0)
+    assert dF[1][node] == pytest.approx([0.0, 2.5])  # half released
+    state.forces[1] += dF[1]
+    dF, _ = contact.corrections(state, contact.detect(state), 1)
+    np.testing.assert_allclose(state.forces[1][node] + dF[1][node], 0.0, atol=1e-12)  # the rest
+
+
+@pytest.mark.parametrize(("changes", "message"), [
+    ({"equilibrium_tolerance": 0.0}, "equilibrium_tolerance must be > 0"),
+    ({"convergence": "fast"}, "convergence must be one of"),
+    ({"penetration_tolerance": -1.0}, "penetration_tolerance must be > 0"),
+    ({"relaxation": float("nan")}, "relaxation must be a finite number"),
+])
+def test_bad_settings_are_named(changes, message):
+    with pytest.raises(InputError, match=message):
+        dataclasses.replace(ContactSettings(), **changes).validate()
+
+
+def test_bad_models_are_named(hertz_level0):
+    p = hertz_level0[0]
+    bodies = build(p).bodies
+    with pytest.raises(InputError, match="body names must be unique"):
+        Model("m", [bodies[0], bodies[0]]).validate()
+    with pytest.raises(InputError, match="load_factors must increase"):
+        Model("m", bodies, load_factors=(0.5, 0.2)).validate()
+    with pytest.raises(InputError, match="unknown body 'plate'"):
+        Model("m", bodies, contact_pairs=(("cylinder", "plate"),)).validate()
