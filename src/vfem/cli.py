@@ -110,7 +110,11 @@ def cmd_run(args) -> int:
 
 def _print_springs(s: dict) -> None:
     print("vfem: springs — thesis §4.2.1, two nonlinear springs pressed end to end")
-    for step, trace, x, f in zip(s["steps"], s["trace"], s["contact_point"], s["contact_force"]):
+    for step, trace, x, f, gap in zip(s["steps"], s["trace"], s["contact_point"],
+                                      s["contact_force"], s["gap"]):
+        if x is None:
+            print(f"step {step['step']}: no contact, gap {gap:.4f} in")
+            continue
         print(f"step {step['step']}: contact point {x:.4f} in, contact force {f:.2f} lb, "
               f"{step['iterations']} iterations")
         for k, it in enumerate(trace, 1):

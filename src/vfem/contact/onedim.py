@@ -67,10 +67,11 @@ class Iteration1D:
 @dataclass
 class Step1D:
     step: int
-    position: float
+    position: float | None  # where the springs meet; None while they are apart
     contact_force: float
     converged: bool
     iterations: list[Iteration1D] = field(default_factory=list)
+    gap: float = 0.0
 
 
 def solve_step(

@@ -57,16 +57,19 @@ def run(params: SpringsParameters | None = None, out=None) -> dict:
             penetration_tolerance=p.penetration_tolerance,
             equilibrium_tolerance=p.equilibrium_tolerance,
         )
-        steps.append(Step1D(step=k, position=b_left + db, contact_force=a.reaction(da),
-                            converged=ok, iterations=history))
-        log.info("springs step %d: contact at %.4f in, force %.2f lb, %d iterations",
+        gap = (b_left + db) - (p.length_a + left_a - da)
+        steps.append(Step1D(step=k, position=b_left + db if gap <= p.penetration_tolerance
+                            else None, contact_force=a.reaction(da), converged=ok,
+                            iterations=history, gap=max(gap, 0.0)))
+        log.info("springs step %d: contact at %s in, force %.2f lb, %d iterations",
                  k, steps[-1].position, steps[-1].contact_force, len(history))
     summary = {
         "example": "springs",
         "converged": all(s.converged for s in steps),
         "steps": [{"step": s.step, "load_factor": s.step / p.steps,
                    "iterations": len(s.iterations), "converged": s.converged} for s in steps],
-        "contact_point": [s.position for s in steps],
+        "contact_point": [s.position for s in steps],  # None while the springs are apart
+        "gap": [s.gap for s in steps],
         "contact_force": [s.contact_force for s in steps],
         "stiffness_a": a.stiffness(da),
         "stiffness_b": b.stiffness(db),
