@@ -12,23 +12,12 @@ import difflib
 import json
 import logging
 import sys
-import time
 from pathlib import Path
 
 from .errors import InputError, VfemError
-from .examples import EXAMPLES
+from .examples import EXAMPLES, load
 
 log = logging.getLogger("vfem")
-
-
-def _params_class(name: str):
-    if name == "springs":
-        from .examples.springs import SpringsParameters
-
-        return SpringsParameters
-    from .examples.hertz import HertzParameters
-
-    return HertzParameters
 
 
 def _parse_value(text: str, current, key: str, cls):
@@ -50,7 +39,7 @@ def _parse_value(text: str, current, key: str, cls):
 
 def build_parameters(example: str, assignments: list[str]):
     """The example's parameters with ``key=value`` overrides applied."""
-    cls = _params_class(example)
+    cls = load(example).Parameters
     params = cls()
     names = [f.name for f in dataclasses.fields(cls)]
     changes = {}
@@ -75,74 +64,29 @@ def cmd_run(args) -> int:
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         raise InputError(f"unknown example {args.example!r}{hint}; "
                          f"available: {', '.join(EXAMPLES)}")
+    example = load(args.example)
     params = build_parameters(args.example, args.set or [])
+    if hasattr(example, "validate"):
+        example.validate(params)  # bad input is reported before anything is written
     out = Path(args.out or Path("results") / args.example)
-    start = time.perf_counter()
-    if args.example == "springs":
-        from .examples.springs import run
 
-        summary = run(params, out)
+    def progress(step):
         if not args.quiet:
-            _print_springs(summary)
-    else:
-        from .examples.hertz import build, run
+            h = step.history[-1]
+            print(f"  step {step.step:3d}  load factor {step.load_factor:7.4f}  "
+                  f"{step.iterations:3d} iterations  penetration {h.max_penetration:.2e}  "
+                  f"equilibrium error {h.max_equilibrium_error:.2e}", flush=True)
 
-        build(params).validate()
-
-        def progress(step):
-            if not args.quiet:
-                h = step.history[-1]
-                print(f"  step {step.step:3d}  load factor {step.load_factor:7.4f}  "
-                      f"{step.iterations:3d} iterations  penetration {h.max_penetration:.2e}  "
-                      f"equilibrium error {h.max_equilibrium_error:.2e}", flush=True)
-
-        if not args.quiet:
-            print(f"vfem: hertz, {params.steps} steps, results in {out}/", flush=True)
-        summary = run(params, out, on_step=progress)
-        if not args.quiet:
-            _print_hertz(summary, out, time.perf_counter() - start)
+    if not args.quiet and args.example == "hertz":
+        print(f"vfem: hertz, {params.steps} steps, results in {out}/", flush=True)
+    summary = example.run(params, out, on_step=progress)
+    if not args.quiet:
+        print("\n".join(example.report(summary)))
     if not summary["converged"]:
         print(f"vfem: the analysis did not converge: {summary.get('message', '')}",
               file=sys.stderr)
         return 1
     return 0
-
-
-def _print_springs(s: dict) -> None:
-    print("vfem: springs — thesis §4.2.1, two nonlinear springs pressed end to end")
-    for step, trace, x, f, gap in zip(s["steps"], s["trace"], s["contact_point"],
-                                      s["contact_force"], s["gap"]):
-        if x is None:
-            print(f"step {step['step']}: no contact, gap {gap:.4f} in")
-            continue
-        print(f"step {step['step']}: contact point {x:.4f} in, contact force {f:.2f} lb, "
-              f"{step['iterations']} iterations")
-        for k, it in enumerate(trace, 1):
-            print(f"    iteration {k}: penetration {it['penetration']:+.4f} in, "
-                  f"compatibility force {it['compatibility_force']:7.2f} lb, "
-                  f"equilibrium error {it['equilibrium_error']:+8.2f} lb "
-                  f"(A needs {it['reaction_a']:.1f}, B gives {it['reaction_b']:.1f}), "
-                  f"equilibrium corrections A {it['equilibrium_force_a']:+.2f} lb, "
-                  f"B {it['equilibrium_force_b']:+.2f} lb")
-
-
-def _print_hertz(s: dict, out: Path, elapsed: float) -> None:
-    print(f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(s['steps'])} "
-          f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
-          f"{s['dofs']} dofs, {elapsed:.1f} s")
-    if "hertz" in s:
-        h = s["hertz"]
-        print(f"  p_max {h['p_max']:.1f} (theory {h['p0_theory']:.1f}, {h['p_max_error']:+.3%})"
-              f"   half-width {h['a_estimate']:.5f} (theory {h['a_theory']:.5f})")
-        print(f"  RMS error over |x| < a: {h['rms_error_over_p0']:.3%} of p0   "
-              f"contact force {h['total_contact_force']:.2f} (applied {h['applied_force']:g})")
-    fixed = [x for x in s["steps"] if x.get("stopped_at_fixed_point")]
-    if fixed:
-        worst = max(fixed, key=lambda x: x["max_penetration"])
-        print(f"  note: {len(fixed)} of {len(s['steps'])} steps stopped where the compatibility "
-              f"and equilibrium corrections cancel (largest residual penetration "
-              f"{worst['max_penetration']:.2e}); see docs/method.md §5")
-    print(f"  results: {out}/summary.json, results.pvd (ParaView), pressure.png, deformed.png")
 
 
 def cmd_bench(args) -> int:

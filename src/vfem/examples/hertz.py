@@ -48,6 +48,9 @@ class HertzParameters:
     swap_bodies: bool = False
 
 
+Parameters = HertzParameters
+
+
 def theory(p: HertzParameters) -> dict[str, float]:
     """Hertz's half-width and peak pressure for the force on the whole cylinder (2 x half)."""
     e1 = LinearElastic(p.cylinder_youngs_modulus, p.cylinder_poissons_ratio)
@@ -56,6 +59,11 @@ def theory(p: HertzParameters) -> dict[str, float]:
     P = 2.0 * p.force
     a = math.sqrt(4.0 * P * p.radius / (math.pi * e_star))
     return {"a_theory": a, "p0_theory": 2.0 * P / (math.pi * a), "e_star": e_star}
+
+
+def validate(p: HertzParameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    build(p).validate()
 
 
 def build(p: HertzParameters | None = None) -> Model:
@@ -142,7 +150,11 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
                    "platen_displacement": s.platen_displacement,
                    "stopped_at_fixed_point": s.fixed_point,
                    "max_penetration": s.history[-1].max_penetration,
-                   "max_equilibrium_error": s.history[-1].max_equilibrium_error}
+                   "max_equilibrium_error": s.history[-1].max_equilibrium_error,
+                   "history": [{"iteration": r.iteration, "max_penetration": r.max_penetration,
+                                "max_equilibrium_error": r.max_equilibrium_error,
+                                "contact_nodes": r.contact_nodes,
+                                "tension_nodes": r.tension_nodes} for r in s.history]}
                   for s in result.steps],
         "bodies": {s.body.name: {"nodes": int(s.body.mesh.nvertices), "dofs": int(s.body.ndofs),
                                  "contact_candidate_nodes": int(s.nc)}
@@ -203,3 +215,26 @@ def run(p: HertzParameters, out, on_step=None, figures: bool = True) -> dict:
                         f"(a = {a:.4f})")
     write_summary(out, summary)
     return summary
+
+
+def report(s: dict) -> list[str]:
+    """The closing lines of a Hertz run."""
+    lines = [f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(s['steps'])} "
+             f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
+             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+    if "hertz" in s:
+        h = s["hertz"]
+        lines.append(f"  p_max {h['p_max']:.1f} (theory {h['p0_theory']:.1f}, "
+                     f"{h['p_max_error']:+.3%})   half-width {h['a_estimate']:.5f} "
+                     f"(theory {h['a_theory']:.5f})")
+        lines.append(f"  RMS error over |x| < a: {h['rms_error_over_p0']:.3%} of p0   "
+                     f"contact force {h['total_contact_force']:.2f} "
+                     f"(applied {h['applied_force']:g})")
+    fixed = [x for x in s["steps"] if x.get("stopped_at_fixed_point")]
+    if fixed:
+        worst = max(fixed, key=lambda x: x["max_penetration"])
+        lines.append(f"  note: {len(fixed)} of {len(s['steps'])} steps stopped where the "
+                     f"compatibility and equilibrium corrections cancel (largest residual "
+                     f"penetration {worst['max_penetration']:.2e}); see docs/method.md §5")
+    lines.append("  results: summary.json, results.pvd (ParaView), pressure.png, deformed.png")
+    return lines

@@ -34,7 +34,10 @@ class SpringsParameters:
     equilibrium_tolerance: float = 1e-3
 
 
-def run(params: SpringsParameters | None = None, out=None) -> dict:
+Parameters = SpringsParameters
+
+
+def run(params: SpringsParameters | None = None, out=None, on_step=None) -> dict:
     """Run the example; returns the ``summary.json`` dictionary with the iteration traces.
 
     With ``out``, the summary is also written to ``out/summary.json``.
@@ -82,3 +85,24 @@ def run(params: SpringsParameters | None = None, out=None) -> dict:
 
         write_summary(out, summary)
     return summary
+
+
+def report(s: dict) -> list[str]:
+    """The iteration trace of every step, in the thesis's terms."""
+    lines = ["vfem: springs — thesis §4.2.1, two nonlinear springs pressed end to end"]
+    for step, trace, x, f, gap in zip(s["steps"], s["trace"], s["contact_point"],
+                                      s["contact_force"], s["gap"]):
+        if x is None:
+            lines.append(f"step {step['step']}: no contact, gap {gap:.4f} in")
+            continue
+        lines.append(f"step {step['step']}: contact point {x:.4f} in, contact force {f:.2f} lb, "
+                     f"{step['iterations']} iterations")
+        for k, it in enumerate(trace, 1):
+            lines.append(
+                f"    iteration {k}: penetration {it['penetration']:+.4f} in, "
+                f"compatibility force {it['compatibility_force']:7.2f} lb, "
+                f"equilibrium error {it['equilibrium_error']:+8.2f} lb "
+                f"(A needs {it['reaction_a']:.1f}, B gives {it['reaction_b']:.1f}), "
+                f"equilibrium corrections A {it['equilibrium_force_a']:+.2f} lb, "
+                f"B {it['equilibrium_force_b']:+.2f} lb")
+    return lines
