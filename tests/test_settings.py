@@ -18,7 +18,8 @@ from vfem.solver import Analysis, Model
 
 @pytest.mark.parametrize("changes", [
     {"first_relaxation": 0.8, "relaxed_iterations": 3},
-    {"convergence": "thesis"},
+    {"first_relaxation": 0.8, "relaxed_iterations": 3, "variant": "thesis"},
+    {"convergence": "thesis", "variant": "thesis"},
 ])
 def test_other_settings_reach_the_same_hertz_answer(hertz_level0, changes):
     p, _, h = hertz_level0
@@ -66,6 +67,7 @@ def test_a_tensile_force_is_released_over_two_iterations():
     ({"convergence": "fast"}, "convergence must be one of"),
     ({"penetration_tolerance": -1.0}, "penetration_tolerance must be > 0"),
     ({"relaxation": float("nan")}, "relaxation must be a finite number"),
+    ({"variant": "mortar"}, "variant must be one of"),
 ])
 def test_bad_settings_are_named(changes, message):
     with pytest.raises(InputError, match=message):

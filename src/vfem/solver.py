@@ -134,7 +134,12 @@ class Analysis:
         for s in self.surfaces:
             s.compute_flexibility()
             log.info("body %s: %d contact candidate nodes", s.body.name, s.nc)
-        self.contact = VirtualElementContact(self.surfaces, pairs, self.model.contact)
+        if self.model.contact.variant == "paired":
+            from .contact.paired import PairedContact
+
+            self.contact = PairedContact(self.surfaces, pairs, self.model.contact)
+        else:
+            self.contact = VirtualElementContact(self.surfaces, pairs, self.model.contact)
         t3 = time.perf_counter()
         self.timings.update(search_s=t1 - t0, assemble_factorize_s=t2 - t1,
                             flexibility_s=t3 - t2)

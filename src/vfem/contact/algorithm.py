@@ -72,11 +72,13 @@ class ContactState:
     forces: list[np.ndarray]  # per body (nc, 2), the force the other bodies apply on it
     released: list[np.ndarray] = field(default_factory=list)  # nodes released last iteration
     platen_force: float = 0.0  # the force the platen must apply (scheduled force x load factor)
+    multipliers: dict = field(default_factory=dict)  # per-pair nodal forces (paired variant)
 
     def copy(self) -> ContactState:
         return ContactState(self.load_factor, self.platen_displacement,
                             [f.copy() for f in self.forces], [r.copy() for r in self.released],
-                            self.platen_force)
+                            self.platen_force,
+                            {k: v.copy() for k, v in self.multipliers.items()})
 
 
 @dataclass

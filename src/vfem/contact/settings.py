@@ -8,6 +8,7 @@ from dataclasses import dataclass, fields
 from ..errors import InputError
 
 CONVERGENCE_CRITERIA = ("stationary", "physical", "thesis")
+VARIANTS = ("thesis", "paired")
 
 
 @dataclass(frozen=True)
@@ -15,6 +16,10 @@ class ContactSettings:
     """Settings of the virtual finite element contact algorithm.
 
     Attributes:
+        variant: ``"thesis"`` — the plain reading: every node of both bodies checked for both
+            compatibility and equilibrium (docs/method.md); ``"paired"`` — per contact pair the
+            finer surface carries compatibility and the coarser equilibrium, so the exact
+            discrete contact state is the fixed point (``vfem/contact/paired.py``).
         penetration_tolerance: largest penetration (length) left uncorrected (thesis §5.6). Must
             be small against the thickness of the surface elements. Default (None): 1e-5 times the
             shortest candidate contact facet.
@@ -46,6 +51,7 @@ class ContactSettings:
         platen_tolerance: relative mismatch allowed between a platen's reaction and its force.
     """
 
+    variant: str = "paired"
     penetration_tolerance: float | None = None
     equilibrium_tolerance: float = 1e-3
     relaxation: float = 1.0
@@ -75,6 +81,8 @@ class ContactSettings:
             v = getattr(self, name)
             if v is not None and v <= 0:
                 raise InputError(f"contact.{name} must be > 0, got {v!r}")
+        if self.variant not in VARIANTS:
+            raise InputError(f"contact.variant must be one of {VARIANTS}, got {self.variant!r}")
         if self.convergence not in CONVERGENCE_CRITERIA:
             raise InputError(f"contact.convergence must be one of {CONVERGENCE_CRITERIA}, "
                              f"got {self.convergence!r}")

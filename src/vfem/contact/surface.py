@@ -139,6 +139,29 @@ class ContactSurface:
             self.G = cols[self.tracked_dofs]
         self.platen_row = -body.u_platen[self.candidate_dofs]
 
+    def node_normals(self) -> np.ndarray:
+        """(nc, 2) outward unit normals at the candidate nodes (mean of the adjacent facets)."""
+        a, b = self.X[self.facets[:, 0]], self.X[self.facets[:, 1]]
+        t = b - a
+        n = np.column_stack([t[:, 1], -t[:, 0]]) / self.lengths[:, None]
+        out = np.zeros((self.nc, 2))
+        np.add.at(out, self.facets[:, 0], n)
+        np.add.at(out, self.facets[:, 1], n)
+        return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
+
+    @property
+    def rind_depth(self) -> np.ndarray:
+        """(nf,) thickness of the element behind each candidate facet: its area / facet length."""
+        if not hasattr(self, "_rind_depth"):
+            mesh = self.body.mesh
+            elem = mesh.f2t[0, self.facet_ids]
+            pts = mesh.p[:, mesh.t[:, elem]]  # (2, nv, nf)
+            x, y = pts[0], pts[1]
+            area = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y,
+                                       axis=0))
+            self._rind_depth = area / self.lengths
+        return self._rind_depth
+
     @property
     def surface_ends(self) -> np.ndarray:
         """(nc,) True at the ends of the candidate surface (nodes on a single candidate facet)."""

@@ -45,6 +45,7 @@ class HertzParameters:
     penetration_tolerance: float | None = None
     equilibrium_tolerance: float = 1e-3
     initial_gap: float = 0.0  # the cylinder starts this far above the flat
+    variant: str = "paired"
     swap_bodies: bool = False
 
 
@@ -89,7 +90,7 @@ def build(p: HertzParameters | None = None) -> Model:
         supports=(Support("bottom", ("x", "y")), Support("symmetry", ("x",))),
     )
     bodies = [flat, cylinder] if p.swap_bodies else [cylinder, flat]
-    settings = ContactSettings(penetration_tolerance=p.penetration_tolerance,
+    settings = ContactSettings(variant=p.variant, penetration_tolerance=p.penetration_tolerance,
                                equilibrium_tolerance=p.equilibrium_tolerance)
     factors = tuple((k + 1) / p.steps for k in range(p.steps))
     return Model("hertz", bodies, settings, factors)

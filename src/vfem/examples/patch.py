@@ -39,6 +39,7 @@ class Parameters:
     youngs_modulus: float = 1.0e6
     displacement: float = 1.0e-3
     tight: bool = False
+    variant: str = "paired"
 
 
 def block(y0: float, n: int) -> MeshQuad:
@@ -53,9 +54,9 @@ def settings(p: Parameters) -> ContactSettings:
     if p.tight:
         # near round-off; the stationary rule still stops (and flags) a fixed point where the
         # corrections cancel, so the residual errors it leaves are reported
-        return ContactSettings(penetration_tolerance=1e-13, equilibrium_tolerance=1e-11,
-                               max_iterations=2000, max_step_cuts=0)
-    return ContactSettings()
+        return ContactSettings(variant=p.variant, penetration_tolerance=1e-13,
+                               equilibrium_tolerance=1e-11, max_iterations=2000, max_step_cuts=0)
+    return ContactSettings(variant=p.variant)
 
 
 def build(p: Parameters, n_lower: int, n_upper: int, nu: float) -> Model:

@@ -1,0 +1,418 @@
+"""The paired variant: one condition per contact force, so the exact state is the fixed point.
+
+The thesis's plain reading checks every node of both bodies for both compatibility and
+equilibrium: twice as many conditions as there are nodal forces. On non-matching meshes they
+cannot all hold, and the iteration stops where the two corrections cancel (docs/method.md §5).
+Checking compatibility at the nodes of *both* surfaces instead would force two non-matching
+polylines to coincide, which makes any curved interface straight (locking). So each contact pair
+splits the two conditions between its two surfaces:
+
+* the **finer** surface (shorter facets, by the median over the pair) carries **compatibility**:
+  each of its nodes against its virtual node on the other surface;
+* the **coarser** surface carries **equilibrium** in weak form: its nodal forces are the finer
+  side's traction re-integrated over its own shape functions, segment by segment (exact).
+
+The rule depends on the geometry only, so listing the bodies in the other order changes nothing.
+The finer side's nodal forces are redistributed into a traction with q = 0 at the nodes that carry
+no force (thesis §4.4, the first of its two options): the traction falls to zero across the last
+facet, which is the consistent edge of the contact.
+
+The compatibility correction is eq. (4.2.4) in matrix form. In 1D the force that closes an overlap
+P is ``K_A K_B / (K_A + K_B) P = (1/K_A + 1/K_B)^-1 P``; here it is ``W^-1 p`` with W the
+flexibility of the pair seen at the finer side's contact nodes (its own condensed flexibility plus
+the coarser side's, mapped through the virtual nodes and the traction transfer). Each body still
+uses only its own factorization; the corrections are still forces applied at the global level.
+For a fixed set of contact nodes one correction closes every gap exactly, so the iteration spends
+its steps only on finding which nodes touch (and on releasing tension, thesis §5.6).
+
+Small-strain analyses pair the surfaces in the undeformed configuration (linear kinematics: the
+virtual nodes, normals and transfer are fixed, the gap is linear in the displacements).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefLine
+
+from ..errors import RindViolation
+from .algorithm import (
+    ContactState,
+    IterationRecord,
+    Pairing,
+    SolveResult,
+    VirtualElementContact,
+)
+from .search import outward_normals, project_points
+from .surface import ContactSurface
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class ContactPair:
+    """A finer (compatibility) surface against a coarser (equilibrium) one, undeformed geometry.
+
+    Arrays over the pair's nodes of the finer body (m of them, ``nodes`` in its local numbering).
+    """
+
+    fine: int  # body index
+    coarse: int
+    nodes: np.ndarray  # (m,) candidate nodes of the fine body in this pair
+    normal: np.ndarray  # (m, 2) outward normal of the coarse surface at the virtual node
+    gap0: np.ndarray  # (m,) undeformed gap (> 0 open)
+    interp: np.ndarray  # (m, nc_coarse) virtual node = interp @ coarse candidate nodes
+    transfer: np.ndarray  # (nc_coarse, nc_fine) coarse nodal force per unit fine traction value
+    mass: np.ndarray  # (nc_fine, nc_fine) the fine surface's N (all candidate facets)
+    rind_depth: np.ndarray  # (m,) thickness of the coarse element under each virtual node
+
+
+class PairedContact(VirtualElementContact):
+    """Frictionless contact with one condition per nodal force (see the module docstring)."""
+
+    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings):
+        super().__init__(surfaces, pairs, settings)
+        self.contact_pairs = [p for p in (self._make_pair(*sorted(pp)) for pp in sorted(
+            pairs, key=sorted)) if p is not None]
+
+    # -- geometry of the pairs (once) -------------------------------------------------------------
+
+    def _make_pair(self, i: int, j: int) -> ContactPair | None:
+        si, sj = self.surfaces[i], self.surfaces[j]
+        if len(si.facets) == 0 or len(sj.facets) == 0:
+            return None
+        hi, hj = self._facing_length(i, j), self._facing_length(j, i)
+        if abs(hi - hj) > 1e-9 * max(hi, hj):
+            fine, coarse = (i, j) if hi < hj else (j, i)
+        else:  # equal: a rule that does not depend on the order of the bodies
+            fine, coarse = (i, j) if si.body.name < sj.body.name else (j, i)
+        sf, sc = self.surfaces[fine], self.surfaces[coarse]
+        nodes = self._facing_nodes(fine, coarse)
+        a, b = sc.segments(sc.X)
+        seg, t, _ = project_points(sf.X[nodes], a, b)
+        n = outward_normals(a, b)[seg]
+        closest = a[seg] + t[:, None] * (b - a)[seg]
+        gap0 = np.einsum("ij,ij->i", sf.X[nodes] - closest, n)
+        interp = np.zeros((len(nodes), sc.nc))
+        ends = sc.facets[seg]
+        interp[np.arange(len(nodes)), ends[:, 0]] += 1 - t
+        interp[np.arange(len(nodes)), ends[:, 1]] += t
+        mass = sf.mass_matrix(np.ones(len(sf.facets))).toarray()
+        log.info("contact pair: %s (compatibility, %d nodes) against %s (equilibrium)",
+                 sf.body.name, len(nodes), sc.body.name)
+        return ContactPair(fine, coarse, nodes, n, gap0, interp, self._transfer(sf, sc), mass,
+                           sc.rind_depth[seg])
+
+    def _facing_length(self, i: int, j: int) -> float:
+        """Median length of body i's candidate facets whose nearest other body is j."""
+        s = self.surfaces[i]
+        mid = 0.5 * (s.X[s.facets[:, 0]] + s.X[s.facets[:, 1]])
+        near = self._nearest_body(i, mid)
+        lengths = s.lengths[near == j]
+        return float(np.median(lengths if len(lengths) else s.lengths))
+
+    def _facing_nodes(self, i: int, j: int) -> np.ndarray:
+        s = self.surfaces[i]
+        return np.flatnonzero(self._nearest_body(i, s.X[: s.nc]) == j)
+
+    def _nearest_body(self, i: int, points: np.ndarray) -> np.ndarray:
+        best = np.full(len(points), -1)
+        dist = np.full(len(points), np.inf)
+        for j in self.opponents(i):
+            a, b = self.surfaces[j].segments(self.surfaces[j].X)
+            _, _, d = project_points(points, a, b)
+            closer = d < dist
+            best[closer], dist[closer] = j, d[closer]
+        return best
+
+    @staticmethod
+    def _transfer(sf: ContactSurface, sc: ContactSurface) -> np.ndarray:
+        """Coarse nodal forces from a fine traction: T[c, f] = int phi_c(proj(y)) phi_f(y) dy.
+
+        Integrated over the fine facets, split where the projection onto the coarse surface
+        passes a coarse node, with 3 Gauss points per piece: exact for the piecewise-linear
+        integrand, so a uniform traction crosses exactly and the total force is conserved.
+        """
+        fa, fb = sf.segments(sf.X)
+        ca, cb = sc.segments(sc.X)
+        d = fb - fa
+        # coarse nodes seen along their (vertex) normal: where they split the fine facets
+        vn = np.zeros((sc.nc, 2))
+        cn = outward_normals(ca, cb)
+        np.add.at(vn, sc.facets[:, 0], cn)
+        np.add.at(vn, sc.facets[:, 1], cn)
+        vn /= np.maximum(np.linalg.norm(vn, axis=1), 1e-300)[:, None]
+        P = sc.X[: sc.nc]
+        # solve fa + s d = P + tau vn for every (facet, coarse node)
+        det = d[:, None, 0] * (-vn[None, :, 1]) - d[:, None, 1] * (-vn[None, :, 0])
+        rx = P[None, :, 0] - fa[:, None, 0]
+        ry = P[None, :, 1] - fa[:, None, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = (rx * (-vn[None, :, 1]) - ry * (-vn[None, :, 0])) / det
+            tau = (d[:, None, 0] * ry - d[:, None, 1] * rx) / det
+        reach = 2.0 * (sf.lengths.max() + sc.lengths.max())
+        ok = np.isfinite(s) & (s > 1e-12) & (s < 1 - 1e-12) & (np.abs(tau) < reach)
+        X, W = get_quadrature(RefLine, 5)
+        xi, w = X[0], W
+        pts, wts, fac, sloc = [], [], [], []
+        for f in range(len(sf.facets)):
+            cuts = np.unique(np.concatenate([[0.0, 1.0], s[f, ok[f]]]))
+            lo, hi = cuts[:-1], cuts[1:]
+            sq = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
+            pts.append(fa[f] + sq[:, None] * d[f])
+            wts.append((sf.lengths[f] * (hi - lo)[:, None] * w[None, :]).ravel())
+            fac.append(np.full(len(sq), f))
+            sloc.append(sq)
+        pts, wts = np.vstack(pts), np.concatenate(wts)
+        fac, sloc = np.concatenate(fac), np.concatenate(sloc)
+        seg, tt, dist = project_points(pts, ca, cb)
+        cend = sc.facets[seg]
+        beyond = (((tt <= 0) & sc.surface_ends[cend[:, 0]])
+                  | ((tt >= 1) & sc.surface_ends[cend[:, 1]]))
+        wts = np.where(beyond | (dist > reach), 0.0, wts)
+        T = np.zeros((sc.nc, sf.nc))
+        fend = sf.facets[fac]
+        for ci, cw in ((cend[:, 0], 1 - tt), (cend[:, 1], tt)):
+            for fi, fw in ((fend[:, 0], 1 - sloc), (fend[:, 1], sloc)):
+                np.add.at(T, (ci, fi), wts * cw * fw)
+        return T
+
+    # -- state of the pairs -----------------------------------------------------------------------
+
+    def _lam(self, state: ContactState, k: int) -> np.ndarray:
+        pair = self.contact_pairs[k]
+        if k not in state.multipliers:
+            state.multipliers[k] = np.zeros(len(pair.nodes))
+        return state.multipliers[k]
+
+    def _carriers(self, state: ContactState, k: int, extra: np.ndarray | None = None
+                  ) -> np.ndarray:
+        """Fine nodes of pair k whose traction is redistributed: q = 0 at the others (§4.4)."""
+        lam = self._lam(state, k)
+        on = lam != 0
+        if extra is not None:
+            on = on | extra
+        return np.flatnonzero(on)
+
+    def _coarse_map(self, k: int, R: np.ndarray) -> np.ndarray:
+        """Coarse nodal force per unit normal force at the fine carriers R: (nc_c, 2, |R|)."""
+        pair = self.contact_pairs[k]
+        rows = pair.nodes[R]
+        NRR = pair.mass[np.ix_(rows, rows)]
+        # q_R = N_RR^-1 F_R; F_c = -T[:, R] q_R, per component, with F_R = lam n
+        TN = -pair.transfer[:, rows] @ np.linalg.inv(NRR) if len(R) else np.zeros((0, 0))
+        out = np.zeros((self.surfaces[pair.coarse].nc, 2, len(R)))
+        for comp in range(2):
+            out[:, comp, :] = TN * pair.normal[R, comp][None, :]
+        return out
+
+    def assemble_forces(self, state: ContactState) -> None:
+        """Every body's nodal forces from the pairs' normal forces (equilibrium in weak form)."""
+        for F in state.forces:
+            F[:] = 0.0
+        for k, pair in enumerate(self.contact_pairs):
+            lam = self._lam(state, k)
+            R = self._carriers(state, k)
+            state.forces[pair.fine][pair.nodes] += lam[:, None] * pair.normal
+            if len(R):
+                state.forces[pair.coarse] += np.einsum("cdr,r->cd", self._coarse_map(k, R),
+                                                       lam[R])
+
+    def penetrations(self, state: ContactState) -> list[np.ndarray]:
+        """Penetration (> 0 overlap) of every pair's fine nodes, linear kinematics."""
+        x = self.positions(state)
+        out = []
+        for pair in self.contact_pairs:
+            sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
+            uf = x[pair.fine][pair.nodes] - sf.X[pair.nodes]
+            uc = pair.interp @ (x[pair.coarse][: sc.nc] - sc.X[: sc.nc])
+            out.append(-(pair.gap0 + np.einsum("ij,ij->i", uf - uc, pair.normal)))
+        return out
+
+    # -- the iteration ----------------------------------------------------------------------------
+
+    def solve(self, state: ContactState) -> SolveResult:
+        cfg = self.settings
+        tol = self.penetration_tolerance
+        history: list[IterationRecord] = []
+        self.assemble_forces(state)
+        for it in range(cfg.max_iterations + 1):
+            pens = self.penetrations(state)
+            lams = [self._lam(state, k) for k in range(len(self.contact_pairs))]
+            self._check_rind(pens)
+            pen_err = 0.0
+            tension = contact = 0
+            for p, lam in zip(pens, lams):
+                touching = (lam > 0) | (p > tol)
+                if touching.any():
+                    pen_err = max(pen_err, float(np.abs(p[touching]).max()))
+                tension += int((lam < 0).sum())
+                contact += int((lam > 0).sum())
+            platen_error = self.platen_reaction(state) - state.platen_force
+            platen_ok = self.platen_body is None or abs(platen_error) <= (
+                cfg.platen_tolerance * max(abs(state.platen_force), 1e-300))
+            history.append(IterationRecord(it, pen_err, 0.0, contact, tension,
+                                           platen_error=platen_error))
+            if pen_err <= tol and tension == 0 and platen_ok:
+                return SolveResult(True, it, history, self.pairings(state, pens))
+            if it == cfg.max_iterations:
+                break
+            self._correct(state, pens, it, platen_ok)
+            self.assemble_forces(state)
+        return SolveResult(False, cfg.max_iterations, history, self.pairings(state, pens),
+                           f"no convergence in {cfg.max_iterations} iterations "
+                           f"(penetration {pen_err:.3g}, {tension} nodes in tension)")
+
+    def _check_rind(self, pens: list[np.ndarray]) -> None:
+        for pair, p in zip(self.contact_pairs, pens):
+            deep = p > pair.rind_depth
+            if deep.any():
+                k = int(np.flatnonzero(deep)[0])
+                sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
+                raise RindViolation(
+                    f"node {int(sf.nodes[pair.nodes[k]])} of body {sf.body.name!r} went "
+                    f"{p[k]:.3g} deep into body {sc.body.name!r}, past its outer layer of "
+                    "elements: the step is too large")
+
+    def _correct(self, state: ContactState, pens: list[np.ndarray], it: int,
+                 platen_ok: bool) -> None:
+        """Tension release, then the compatibility correction of every pair at once."""
+        cfg = self.settings
+        tol = self.penetration_tolerance
+        omega = cfg.first_relaxation if it < cfg.relaxed_iterations else cfg.relaxation
+        active, targets = [], []
+        for k, p in enumerate(pens):
+            lam = self._lam(state, k)
+            key = ("released", k)
+            released = state.multipliers.get(key, np.zeros(len(lam), bool))
+            tension = lam < 0
+            frac = np.where(released, 1.0, 1.0 / cfg.tension_release_iterations)
+            lam[tension] -= frac[tension] * lam[tension]
+            state.multipliers[key] = tension & (frac < 1.0)
+            S = ~tension & ((lam > 0) | (p > tol))
+            if not platen_ok and not S.any():
+                S = ~tension & (p > -tol)  # touching within tolerance: hold them there
+            active.append(np.flatnonzero(S))
+            targets.append(omega * p[S])
+        m = sum(len(a) for a in active)
+        need_platen = self.platen_body is not None and not platen_ok
+        if m == 0:
+            if need_platen:
+                self._close_gap(state, pens)
+            return
+        W, dp_dplaten, dR = self._pair_flexibility(state, active)
+        rhs = np.concatenate(targets)
+        if self.platen_body is not None and state.platen_force != 0.0:
+            b = self.surfaces[self.platen_body].body
+            A = np.zeros((m + 1, m + 1))
+            A[:m, :m] = W
+            A[:m, m] = -dp_dplaten
+            A[m, :m] = dR
+            A[m, m] = b.platen_stiffness
+            need = state.platen_force - self.platen_reaction(state)
+            sol = np.linalg.lstsq(A, np.concatenate([rhs, [need]]), rcond=None)[0]
+            dlam, dplaten = sol[:m], float(sol[m])
+        else:
+            dlam, dplaten = np.linalg.solve(W, rhs), 0.0
+        pos = 0
+        for k, a in enumerate(active):
+            self._lam(state, k)[a] += dlam[pos:pos + len(a)]
+            pos += len(a)
+        state.platen_displacement += dplaten
+
+    def _pair_flexibility(self, state: ContactState, active: list[np.ndarray]):
+        """W = d(penetration reduction)/d(normal force) over the active fine nodes of all pairs.
+
+        Also the penetration change per unit platen motion and the platen reaction per unit
+        normal force. Each body's motion comes from its own flexibility C.
+        """
+        m = sum(len(a) for a in active)
+        dF = [np.zeros((s.nc, 2, m)) for s in self.surfaces]  # body forces per unit dlam
+        col = 0
+        for k, a in enumerate(active):
+            pair = self.contact_pairs[k]
+            cols = np.arange(col, col + len(a))
+            dF[pair.fine][pair.nodes[a], :, cols] += pair.normal[a]
+            R = self._carriers(state, k, extra=np.isin(np.arange(len(pair.nodes)), a))
+            if len(R):
+                cm = self._coarse_map(k, R)  # (nc_c, 2, |R|)
+                where = np.searchsorted(R, a)
+                dF[pair.coarse][:, :, cols] += cm[:, :, where]
+            col += len(a)
+        du = [(s.C @ f.reshape(2 * s.nc, m)).reshape(s.nc, 2, m)
+              for s, f in zip(self.surfaces, dF)]
+        W = np.zeros((m, m))
+        dp_dplaten = np.zeros(m)
+        row = 0
+        for k, a in enumerate(active):
+            pair = self.contact_pairs[k]
+            n = pair.normal[a]
+            uf = du[pair.fine][pair.nodes[a]]  # (|a|, 2, m)
+            uc = np.einsum("ic,cdm->idm", pair.interp[a], du[pair.coarse])
+            # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dlam
+            W[row:row + len(a)] = np.einsum("id,idm->im", n, uf - uc)
+            if self.platen_body is not None:
+                up = [s.body.u_platen[s.candidate_dofs].reshape(-1, 2) for s in self.surfaces]
+                vf = up[pair.fine][pair.nodes[a]]
+                vc = pair.interp[a] @ up[pair.coarse]
+                dp_dplaten[row:row + len(a)] = np.einsum("id,id->i", n, vc - vf)
+            row += len(a)
+        dR = np.zeros(m)
+        if self.platen_body is not None:
+            s = self.surfaces[self.platen_body]
+            dR = s.platen_row @ dF[self.platen_body].reshape(2 * s.nc, m)
+        return W, dp_dplaten, dR
+
+    def _close_gap(self, state: ContactState, pens: list[np.ndarray]) -> None:
+        """Nothing touches: move the platen just far enough to close the smallest gap."""
+        need = state.platen_force - self.platen_reaction(state)
+        up = [s.body.u_platen[s.candidate_dofs].reshape(-1, 2) for s in self.surfaces]
+        best = None
+        for pair, p in zip(self.contact_pairs, pens):
+            rate = np.einsum("id,id->i", pair.normal,
+                             pair.interp @ up[pair.coarse] - up[pair.fine][pair.nodes])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                d = np.where(rate != 0, -p / rate, np.nan)
+            ok = np.isfinite(d) & (np.sign(d) == np.sign(need))
+            if ok.any():
+                cand = float(d[ok][np.argmin(np.abs(d[ok]))])
+                best = cand if best is None or abs(cand) < abs(best) else best
+        if best is not None:
+            state.platen_displacement += best
+
+    # -- what the results need --------------------------------------------------------------------
+
+    def pairings(self, state: ContactState, pens: list[np.ndarray] | None = None
+                 ) -> list[Pairing]:
+        """Per body: normal force, penetration and contact status for the output fields."""
+        pens = self.penetrations(state) if pens is None else pens
+        out = []
+        for i, s in enumerate(self.surfaces):
+            nc = s.nc
+            force = np.zeros(nc)
+            pen = np.zeros(nc)
+            other = np.full(nc, -1)
+            normal = np.zeros((nc, 2))
+            for k, pair in enumerate(self.contact_pairs):
+                if pair.fine == i:
+                    lam = self._lam(state, k)
+                    force[pair.nodes] = lam
+                    pen[pair.nodes] = pens[k]
+                    other[pair.nodes] = pair.coarse
+                    normal[pair.nodes] = pair.normal
+                elif pair.coarse == i:
+                    nn = s.node_normals()
+                    f = -np.einsum("ij,ij->i", state.forces[i], nn)
+                    on = np.abs(state.forces[i]).sum(axis=1) > 0
+                    force[on] = f[on]
+                    other[on] = pair.fine
+                    normal[on] = -nn[on]
+            zeros = np.zeros(nc)
+            out.append(Pairing(other=other, facet=np.zeros(nc, int), t=zeros, normal=normal,
+                               penetration=pen, embedded=pen > 0, stiffness=zeros,
+                               virtual_stiffness=zeros, force=force, virtual_force=force.copy(),
+                               participating=force > 0))
+        return out
