@@ -37,13 +37,13 @@ def plain_solve_time(model) -> float:
     return total
 
 
-def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None = None
-                    ) -> list[dict]:
+def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None = None,
+                    variant: str = "paired") -> list[dict]:
     rows = []
     if print_row:
         print_row(HEADER)
     for level in levels:
-        p = HertzParameters(refinement=level)
+        p = HertzParameters(refinement=level, variant=variant)
         model = build(p)
         t0 = time.perf_counter()
         analysis = Analysis(model)
@@ -53,6 +53,7 @@ def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None =
         h = evaluate(result, p) if result.converged else {}
         row = {
             "level": level,
+            "variant": variant,
             "dofs": int(sum(b.ndofs for b in model.bodies)),
             "contact_dofs": int(sum(2 * s.nc for s in result.surfaces)),
             "vfem_s": vfem_s,
@@ -66,6 +67,7 @@ def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None =
             "converged": result.converged,
             "p_max_error": h.get("p_max_error", float("nan")),
             "rms_error_over_p0": h.get("rms_error_over_p0", float("nan")),
+            "p_max_flat_error": (h["p_max_flat"] / h["p0_theory"] - 1) if h else float("nan"),
         }
         rows.append(row)
         if print_row:

@@ -94,7 +94,7 @@ def cmd_bench(args) -> int:
 
     if args.example != "hertz":
         raise InputError(f"no benchmark for {args.example!r}; available: hertz")
-    rows = hertz_benchmark(args.levels, print_row=print)
+    rows = hertz_benchmark(args.levels, print_row=print, variant=args.variant)
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
     return 0
@@ -116,6 +116,8 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("example", help="hertz")
     bench.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3, 4])
     bench.add_argument("--json", help="also write the table to this JSON file")
+    bench.add_argument("--variant", default="paired", choices=("paired", "thesis"),
+                       help="contact variant (default paired)")
     args = parser.parse_args(argv)
 
     level = (logging.WARNING if args.verbose == 0 else
