@@ -44,6 +44,7 @@ def test_hertz_writes_summary_figures_and_paraview_files(tmp_path):
     (["run", "hertz", "--set", "flat_poissons_ratio=0.5"], "poissons_ratio must lie in"),
     (["run", "hertz", "--set", "cylinder_young=1"], "did you mean 'cylinder_youngs_modulus'"),
     (["run", "hertz", "--set", "steps=many"], "expected a number"),
+    (["run", "hertz", "--set", "variant=mortar"], "contact.variant must be one of"),
 ])
 def test_bad_input_is_one_message_and_exit_2(args, message, capsys, tmp_path):
     assert main([*args, "--out", str(tmp_path)]) == 2
@@ -85,3 +86,11 @@ def test_bench_prints_and_saves_the_table(tmp_path, capsys):
     assert "ratio" in capsys.readouterr().out
     (row,) = json.loads(path.read_text())
     assert row["dofs"] > 1000 and row["ratio"] > 0 and abs(row["p_max_error"]) < 0.03
+
+
+def test_the_thesis_variant_from_the_command_line(tmp_path, capsys):
+    assert main(["run", "hertz", "--set", "variant=thesis", "--out", str(tmp_path)]) == 0
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["parameters"]["variant"] == "thesis"
+    assert all(x["stopped_at_fixed_point"] for x in s["steps"])
+    assert "note: 5 of 5 steps stopped where" in capsys.readouterr().out

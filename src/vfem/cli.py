@@ -25,6 +25,8 @@ def _parse_value(text: str, current, key: str, cls):
     t = text.strip()
     if t.lower() in ("none", "null", "default"):
         return None
+    if isinstance(current, str):
+        return t  # checked where it is used (e.g. contact.variant names its choices)
     if isinstance(current, bool):
         if t.lower() in ("true", "yes", "1"):
             return True
