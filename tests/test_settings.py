@@ -45,7 +45,7 @@ def two_blocks():
         s = ContactSurface.build(b, b.mesh.boundaries[name])
         s.compute_flexibility()
         surfaces.append(s)
-    return VirtualElementContact(surfaces, {frozenset((0, 1))}, ContactSettings())
+    return VirtualElementContact(surfaces, {frozenset((0, 1))}, ContactSettings(variant="thesis"))
 
 
 def test_a_tensile_force_is_released_over_two_iterations():

@@ -230,7 +230,7 @@ class Analysis:
             pressure = np.zeros(nv)
             pressure[cand] = np.where(p.other >= 0, p.force, 0.0) / s.tributary
             status = np.zeros(nv, dtype=int)
-            status[cand] = (p.force > 0).astype(int)
+            status[cand] = p.participating & (p.force > 0)
             pen = np.zeros(nv)
             pen[cand] = np.where(np.isfinite(p.penetration), p.penetration, 0.0)
             out[b.name] = BodyStepResult(u.reshape(-1, 2), force, pressure, status, pen)

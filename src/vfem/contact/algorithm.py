@@ -351,7 +351,7 @@ class VirtualElementContact:
             # iteration and still in tension gives up the rest. Every node that carries a tensile
             # force is released, whether or not it still touches the other body.
             tension = p.force < 0
-            frac = np.where(state.released[i], 1.0, 1.0 / cfg.tension_release_iterations)
+            frac = np.where(state.released[i], 1.0, 1.0 / cfg.release_iterations)
             dF[tension] -= frac[tension, None] * F[tension]
             state.released[i] = tension & (frac < 1.0)
             active = part & ~tension & np.isfinite(p.stiffness)

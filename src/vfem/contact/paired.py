@@ -7,15 +7,18 @@ Checking compatibility at the nodes of *both* surfaces instead would force two n
 polylines to coincide, which makes any curved interface straight (locking). So each contact pair
 splits the two conditions between its two surfaces:
 
-* the **finer** surface (shorter facets, by the median over the pair) carries **compatibility**:
+* the surface that gives way more per unit length (median nodal flexibility 1/K over median
+  facet length: the softer, and of two equally stiff ones the finer) carries **compatibility**:
   each of its nodes against its virtual node on the other surface;
-* the **coarser** surface carries **equilibrium** in weak form: its nodal forces are the finer
-  side's traction re-integrated over its own shape functions, segment by segment (exact).
+* the other surface carries **equilibrium** in weak form: its nodal forces are the first one's
+  traction re-integrated over its own shape functions, segment by segment (exact).
 
 The rule depends on the geometry only, so listing the bodies in the other order changes nothing.
-The finer side's nodal forces are redistributed into a traction with q = 0 at the nodes that carry
-no force (thesis §4.4, the first of its two options): the traction falls to zero across the last
-facet, which is the consistent edge of the contact.
+The unknowns are the normal traction values q at the finer side's nodes, zero at the nodes not in
+contact (thesis §4.4, the first of its two options): the traction falls to zero across the last
+facet, which is the consistent edge of the contact. Both sides' nodal forces follow from the same
+traction, ``F_fine = N q`` (eq. 4.4.11, so a free node next to the contact takes its share too)
+and ``F_coarse = -T q``, which makes them equal and opposite in weak form, to round-off.
 
 The compatibility correction is eq. (4.2.4) in matrix form. In 1D the force that closes an overlap
 P is ``K_A K_B / (K_A + K_B) P = (1/K_A + 1/K_B)^-1 P``; here it is ``W^-1 p`` with W the
@@ -54,9 +57,10 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class ContactPair:
-    """A finer (compatibility) surface against a coarser (equilibrium) one, undeformed geometry.
+    """A compatibility surface ("fine") against an equilibrium one ("coarse"), undeformed geometry.
 
-    Arrays over the pair's nodes of the finer body (m of them, ``nodes`` in its local numbering).
+    Arrays over the pair's nodes of the compatibility side (m of them, ``nodes`` in its local
+    numbering).
     """
 
     fine: int  # body index
@@ -84,9 +88,9 @@ class PairedContact(VirtualElementContact):
         si, sj = self.surfaces[i], self.surfaces[j]
         if len(si.facets) == 0 or len(sj.facets) == 0:
             return None
-        hi, hj = self._facing_length(i, j), self._facing_length(j, i)
-        if abs(hi - hj) > 1e-9 * max(hi, hj):
-            fine, coarse = (i, j) if hi < hj else (j, i)
+        ci, cj = self._compliance_density(i, j), self._compliance_density(j, i)
+        if abs(ci - cj) > 1e-9 * max(ci, cj):
+            fine, coarse = (i, j) if ci > cj else (j, i)
         else:  # equal: a rule that does not depend on the order of the bodies
             fine, coarse = (i, j) if si.body.name < sj.body.name else (j, i)
         sf, sc = self.surfaces[fine], self.surfaces[coarse]
@@ -106,13 +110,24 @@ class PairedContact(VirtualElementContact):
         return ContactPair(fine, coarse, nodes, n, gap0, interp, self._transfer(sf, sc), mass,
                            sc.rind_depth[seg])
 
-    def _facing_length(self, i: int, j: int) -> float:
-        """Median length of body i's candidate facets whose nearest other body is j."""
+    def _compliance_density(self, i: int, j: int) -> float:
+        """How much body i's surface facing j gives way, per unit length: the median nodal
+        flexibility along the normal (1 / Castigliano stiffness) over the median facet length.
+
+        The compatibility side must be the one whose own flexibility carries the pair: the
+        softer surface, and of two equally stiff ones the finer. A much stiffer surface with a
+        finer mesh would hold a traction that the other surface cannot control, and the
+        pressures would oscillate (measured on Hertz with the flat as compatibility side:
+        nodal pressures up to 56 % off).
+        """
         s = self.surfaces[i]
         mid = 0.5 * (s.X[s.facets[:, 0]] + s.X[s.facets[:, 1]])
-        near = self._nearest_body(i, mid)
-        lengths = s.lengths[near == j]
-        return float(np.median(lengths if len(lengths) else s.lengths))
+        facing = self._nearest_body(i, mid) == j
+        lengths = s.lengths[facing] if facing.any() else s.lengths
+        nodes = np.unique(s.facets[facing]) if facing.any() else np.arange(s.nc)
+        stiffness = s.normal_stiffness(nodes, s.node_normals()[nodes])
+        flexibility = 1.0 / stiffness[np.isfinite(stiffness) & (stiffness > 0)]
+        return float(np.median(flexibility) / np.median(lengths)) if len(flexibility) else 0.0
 
     def _facing_nodes(self, i: int, j: int) -> np.ndarray:
         s = self.surfaces[i]
@@ -188,38 +203,14 @@ class PairedContact(VirtualElementContact):
             state.multipliers[k] = np.zeros(len(pair.nodes))
         return state.multipliers[k]
 
-    def _carriers(self, state: ContactState, k: int, extra: np.ndarray | None = None
-                  ) -> np.ndarray:
-        """Fine nodes of pair k whose traction is redistributed: q = 0 at the others (§4.4)."""
-        lam = self._lam(state, k)
-        on = lam != 0
-        if extra is not None:
-            on = on | extra
-        return np.flatnonzero(on)
-
-    def _coarse_map(self, k: int, R: np.ndarray) -> np.ndarray:
-        """Coarse nodal force per unit normal force at the fine carriers R: (nc_c, 2, |R|)."""
-        pair = self.contact_pairs[k]
-        rows = pair.nodes[R]
-        NRR = pair.mass[np.ix_(rows, rows)]
-        # q_R = N_RR^-1 F_R; F_c = -T[:, R] q_R, per component, with F_R = lam n
-        TN = -pair.transfer[:, rows] @ np.linalg.inv(NRR) if len(R) else np.zeros((0, 0))
-        out = np.zeros((self.surfaces[pair.coarse].nc, 2, len(R)))
-        for comp in range(2):
-            out[:, comp, :] = TN * pair.normal[R, comp][None, :]
-        return out
-
     def assemble_forces(self, state: ContactState) -> None:
-        """Every body's nodal forces from the pairs' normal forces (equilibrium in weak form)."""
+        """Every body's nodal forces from the pairs' tractions (equilibrium in weak form)."""
         for F in state.forces:
             F[:] = 0.0
         for k, pair in enumerate(self.contact_pairs):
-            lam = self._lam(state, k)
-            R = self._carriers(state, k)
-            state.forces[pair.fine][pair.nodes] += lam[:, None] * pair.normal
-            if len(R):
-                state.forces[pair.coarse] += np.einsum("cdr,r->cd", self._coarse_map(k, R),
-                                                       lam[R])
+            q = self._lam(state, k)[:, None] * pair.normal  # traction vector at the fine nodes
+            state.forces[pair.fine] += pair.mass[:, pair.nodes] @ q
+            state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ q
 
     def penetrations(self, state: ContactState) -> list[np.ndarray]:
         """Penetration (> 0 overlap) of every pair's fine nodes, linear kinematics."""
@@ -289,7 +280,7 @@ class PairedContact(VirtualElementContact):
             key = ("released", k)
             released = state.multipliers.get(key, np.zeros(len(lam), bool))
             tension = lam < 0
-            frac = np.where(released, 1.0, 1.0 / cfg.tension_release_iterations)
+            frac = np.where(released, 1.0, 1.0 / cfg.release_iterations)
             lam[tension] -= frac[tension] * lam[tension]
             state.multipliers[key] = tension & (frac < 1.0)
             S = ~tension & ((lam > 0) | (p > tol))
@@ -297,6 +288,10 @@ class PairedContact(VirtualElementContact):
                 S = ~tension & (p > -tol)  # touching within tolerance: hold them there
             active.append(np.flatnonzero(S))
             targets.append(omega * p[S])
+        self.assemble_forces(state)  # the releases change the forces the platen sees
+        platen_ok = self.platen_body is None or abs(
+            self.platen_reaction(state) - state.platen_force) <= cfg.platen_tolerance * max(
+            abs(state.platen_force), 1e-300)
         m = sum(len(a) for a in active)
         need_platen = self.platen_body is not None and not platen_ok
         if m == 0:
@@ -324,23 +319,21 @@ class PairedContact(VirtualElementContact):
         state.platen_displacement += dplaten
 
     def _pair_flexibility(self, state: ContactState, active: list[np.ndarray]):
-        """W = d(penetration reduction)/d(normal force) over the active fine nodes of all pairs.
+        """W = d(penetration reduction)/d(traction value) over the active fine nodes of all pairs.
 
         Also the penetration change per unit platen motion and the platen reaction per unit
-        normal force. Each body's motion comes from its own flexibility C.
+        traction value. Each body's motion comes from its own flexibility C.
         """
         m = sum(len(a) for a in active)
-        dF = [np.zeros((s.nc, 2, m)) for s in self.surfaces]  # body forces per unit dlam
+        dF = [np.zeros((s.nc, 2, m)) for s in self.surfaces]  # body forces per unit traction
         col = 0
         for k, a in enumerate(active):
             pair = self.contact_pairs[k]
-            cols = np.arange(col, col + len(a))
-            dF[pair.fine][pair.nodes[a], :, cols] += pair.normal[a]
-            R = self._carriers(state, k, extra=np.isin(np.arange(len(pair.nodes)), a))
-            if len(R):
-                cm = self._coarse_map(k, R)  # (nc_c, 2, |R|)
-                where = np.searchsorted(R, a)
-                dF[pair.coarse][:, :, cols] += cm[:, :, where]
+            cols = slice(col, col + len(a))
+            n = pair.normal[a]  # (|a|, 2)
+            rows = pair.nodes[a]
+            dF[pair.fine][:, :, cols] += pair.mass[:, rows][:, None, :] * n.T[None, :, :]
+            dF[pair.coarse][:, :, cols] -= pair.transfer[:, rows][:, None, :] * n.T[None, :, :]
             col += len(a)
         du = [(s.C @ f.reshape(2 * s.nc, m)).reshape(s.nc, 2, m)
               for s, f in zip(self.surfaces, dF)]
@@ -396,12 +389,19 @@ class PairedContact(VirtualElementContact):
             pen = np.zeros(nc)
             other = np.full(nc, -1)
             normal = np.zeros((nc, 2))
+            touching = np.zeros(nc, dtype=bool)
+            compat = np.zeros(nc, dtype=bool)  # nodes where this body carries compatibility
             for k, pair in enumerate(self.contact_pairs):
                 if pair.fine == i:
-                    lam = self._lam(state, k)
-                    force[pair.nodes] = lam
+                    # in contact: where the traction is positive (a free node next to the
+                    # contact still takes its share of N q as nodal force)
+                    f = np.einsum("ij,ij->i", state.forces[i][pair.nodes], pair.normal)
+                    on = np.abs(f) > 0
+                    force[pair.nodes[on]] = f[on]
+                    touching[pair.nodes] = self._lam(state, k) > 0
+                    compat[pair.nodes] = True
                     pen[pair.nodes] = pens[k]
-                    other[pair.nodes] = pair.coarse
+                    other[pair.nodes[on]] = pair.coarse
                     normal[pair.nodes] = pair.normal
                 elif pair.coarse == i:
                     nn = s.node_normals()
@@ -414,5 +414,5 @@ class PairedContact(VirtualElementContact):
             out.append(Pairing(other=other, facet=np.zeros(nc, int), t=zeros, normal=normal,
                                penetration=pen, embedded=pen > 0, stiffness=zeros,
                                virtual_stiffness=zeros, force=force, virtual_force=force.copy(),
-                               participating=force > 0))
+                               participating=np.where(compat, touching, force > 0)))
         return out

@@ -30,7 +30,9 @@ class ContactSettings:
             iterations of a step (under-relaxation < 1 often helps, thesis §5.6).
         relaxed_iterations: how many iterations use ``first_relaxation``.
         tension_release_iterations: a node found in tension gives up its force over this many
-            iterations (thesis §5.6: half in each of two).
+            iterations. Default (None): 2 for the thesis variant (thesis §5.6: half in each of
+            two, which softens the disturbance to its approximate corrections), 1 for the paired
+            variant, whose correction re-closes every gap exactly after a release.
         max_iterations: contact iterations allowed per solve before the step is cut.
         convergence: when a contact solve stops. Always when the physical errors are within
             tolerance (largest penetration, largest equilibrium error, no node in tension).
@@ -57,7 +59,7 @@ class ContactSettings:
     relaxation: float = 1.0
     first_relaxation: float = 1.0
     relaxed_iterations: int = 0
-    tension_release_iterations: int = 2
+    tension_release_iterations: int | None = None
     max_iterations: int = 100
     convergence: str = "stationary"
     thesis_fraction: float = 0.01
@@ -87,5 +89,13 @@ class ContactSettings:
             raise InputError(f"contact.convergence must be one of {CONVERGENCE_CRITERIA}, "
                              f"got {self.convergence!r}")
         for name in ("tension_release_iterations", "max_iterations", "quadrature_order"):
-            if int(getattr(self, name)) < 1:
+            v = getattr(self, name)
+            if v is not None and int(v) < 1:
                 raise InputError(f"contact.{name} must be >= 1")
+
+    @property
+    def release_iterations(self) -> int:
+        """``tension_release_iterations`` with its variant-dependent default applied."""
+        if self.tension_release_iterations is not None:
+            return int(self.tension_release_iterations)
+        return 1 if self.variant == "paired" else 2

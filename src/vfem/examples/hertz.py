@@ -116,7 +116,7 @@ def evaluate(result: AnalysisResult, p: HertzParameters) -> dict:
     x_edge = x[contact].max()
     beyond = xs[xs > x_edge + 1e-14]
     a_est = 0.5 * (x_edge + beyond[0]) if len(beyond) else x_edge
-    inside = contact[x[contact] < a]
+    inside = on_arc[x[on_arc] < a]  # every surface node under the Hertz contact, touching or not
     p_theory = p0 * np.sqrt(np.clip(1 - (x[inside] / a) ** 2, 0, None))
     rms = float(np.sqrt(np.mean((cyl.contact_pressure[inside] - p_theory) ** 2)) / p0)
     total_cyl = float(cyl.contact_force[:, 1].sum())  # upwards on the cylinder
