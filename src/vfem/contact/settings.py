@@ -17,9 +17,10 @@ class ContactSettings:
 
     Attributes:
         variant: ``"thesis"`` — the plain reading: every node of both bodies checked for both
-            compatibility and equilibrium (docs/method.md); ``"paired"`` — per contact pair the
-            finer surface carries compatibility and the coarser equilibrium, so the exact
-            discrete contact state is the fixed point (``vfem/contact/paired.py``).
+            compatibility and equilibrium (docs/method.md); ``"paired"`` — per contact pair one
+            surface (the softer, or of equals the finer) carries compatibility and the other
+            equilibrium, so the exact discrete contact state is the fixed point
+            (``vfem/contact/paired.py``).
         penetration_tolerance: largest penetration (length) left uncorrected (thesis §5.6). Must
             be small against the thickness of the surface elements. Default (None): 1e-5 times the
             shortest candidate contact facet.
