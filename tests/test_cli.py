@@ -94,3 +94,11 @@ def test_the_thesis_variant_from_the_command_line(tmp_path, capsys):
     assert s["parameters"]["variant"] == "thesis"
     assert all(x["stopped_at_fixed_point"] for x in s["steps"])
     assert "note: 5 of 5 steps stopped where" in capsys.readouterr().out
+
+
+def test_study_writes_the_table_and_the_convergence_plot(tmp_path):
+    assert main(["-q", "study", "hertz", "--levels", "0", "1", "--out", str(tmp_path)]) == 0
+    study = json.loads((tmp_path / "study.json").read_text())
+    assert set(study) == {"paired", "thesis"}
+    assert [r["facets_across_a"] for r in study["paired"]] == [12, 24]
+    assert (tmp_path / "convergence.png").stat().st_size > 10_000

@@ -55,6 +55,7 @@ def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None =
             "level": level,
             "variant": variant,
             "dofs": int(sum(b.ndofs for b in model.bodies)),
+            "facets_across_a": p.facets_per_half_width * 2**level,
             "contact_dofs": int(sum(2 * s.nc for s in result.surfaces)),
             "vfem_s": vfem_s,
             "plain_solve_s": plain_s,

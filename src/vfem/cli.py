@@ -102,6 +102,28 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def cmd_study(args) -> int:
+    from .bench import hertz_benchmark
+    from .io.plots import convergence
+
+    if args.example != "hertz":
+        raise InputError(f"no study for {args.example!r}; available: hertz")
+    out = Path(args.out or Path("results") / "hertz_study")
+    out.mkdir(parents=True, exist_ok=True)
+    series = {}
+    for variant in ("paired", "thesis"):
+        if not args.quiet:
+            print(f"vfem: hertz refinement study, {variant} variant")
+        series[variant] = hertz_benchmark(args.levels, print_row=None if args.quiet else print,
+                                          variant=variant)
+    (out / "study.json").write_text(json.dumps(series, indent=2) + "\n", encoding="utf-8")
+    convergence(out / "convergence.png", series,
+                "Hertz (thesis §5.2) under refinement: error against Hertz's theory")
+    if not args.quiet:
+        print(f"vfem: wrote {out}/study.json and {out}/convergence.png")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="vfem", description=(
         "Contact between deformable bodies by the virtual finite element method."))
@@ -120,6 +142,10 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--json", help="also write the table to this JSON file")
     bench.add_argument("--variant", default="paired", choices=("paired", "thesis"),
                        help="contact variant (default paired)")
+    study = sub.add_parser("study", help="an example under refinement, both variants, plotted")
+    study.add_argument("example", help="hertz")
+    study.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3, 4])
+    study.add_argument("--out", help="results directory (default results/hertz_study)")
     args = parser.parse_args(argv)
 
     level = (logging.WARNING if args.verbose == 0 else
@@ -128,7 +154,8 @@ def main(argv: list[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     logging.getLogger("skfem").setLevel(max(logging.WARNING, level))
     try:
-        return cmd_run(args) if args.command == "run" else cmd_bench(args)
+        command = {"run": cmd_run, "bench": cmd_bench, "study": cmd_study}[args.command]
+        return command(args)
     except InputError as exc:
         print(f"vfem: error: {exc}", file=sys.stderr)
         return 2

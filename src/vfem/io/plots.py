@@ -10,6 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
+from matplotlib.ticker import NullFormatter  # noqa: E402
 
 
 def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[str, np.ndarray],
@@ -57,6 +58,32 @@ def deformed_region(path: Path, meshes: list[tuple[str, np.ndarray, np.ndarray, 
     ax.set_aspect("equal")
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="upper right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
+    """|p_max error| and RMS profile error against contact facets across a, log-log, per series.
+
+    ``series``: name -> rows with ``facets_across_a``, ``p_max_error``, ``rms_error_over_p0``.
+    """
+    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.8), sharex=True)
+    for (name, rows), marker in zip(series.items(), ("o", "s", "^", "v")):
+        n = np.array([r["facets_across_a"] for r in rows], dtype=float)
+        axes[0].loglog(n, [abs(r["p_max_error"]) * 100 for r in rows], marker + "-", label=name)
+        axes[1].loglog(n, [r["rms_error_over_p0"] * 100 for r in rows], marker + "-", label=name)
+    axes[0].set_ylabel("|p_max / p0 - 1|  (%)")
+    axes[1].set_ylabel("RMS (p - p_Hertz) / p0 over |x| < a  (%)")
+    ticks = sorted({r["facets_across_a"] for rows in series.values() for r in rows})
+    for ax in axes:
+        ax.set_xlabel("contact facets across the half-width a")
+        ax.set_xticks(ticks)
+        ax.set_xticklabels([str(t) for t in ticks])
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
