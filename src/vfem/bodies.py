@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from skfem import (
@@ -103,7 +103,6 @@ class Body:
     tractions: tuple[Traction, ...] = ()
     platen: Platen | None = None
     contact_boundaries: tuple[str, ...] | None = None
-    _ready: bool = field(default=False, init=False, repr=False)
 
     # -- set-up ---------------------------------------------------------------------------------
 
@@ -176,7 +175,6 @@ class Body:
             # a body that only contact holds moves rigidly with its platen: zero up to round-off
             scale = float(self.K.diagonal()[platen_dofs].sum())
             self.platen_stiffness = stiffness if abs(stiffness) > 1e-9 * scale else 0.0
-        self._ready = True
         self.timings = {"assemble_s": t1 - t0, "constraints_s": t2 - t1, "factorize_s": t3 - t2,
                         "load_cases_s": time.perf_counter() - t3}
         log.info("body %s: %d nodes, %d dofs (%d fixed)", self.name, self.mesh.nvertices,

@@ -5,8 +5,10 @@ For each step (an increment of the load factor):
 1. **predict** — every body is solved on its own with the new loads and the contact forces it
    already carries (for linear bodies this is a change of the load factor in the superposition
    ``u = load_factor * u_load + platen * u_platen + K^-1 f_contact``);
-2. **resolve contact** — :class:`~vfem.contact.algorithm.VirtualElementContact` iterates
-   detect -> check -> correct until converged;
+2. **resolve contact** — the variant chosen by ``ContactSettings.variant``
+   (:class:`~vfem.contact.paired.PairedContact` by default, or the thesis's
+   :class:`~vfem.contact.algorithm.VirtualElementContact`) iterates check -> correct until
+   converged, moving a force-controlled platen as it goes;
 3. a step that fails (no convergence, or a node pushed past the rind of another body) is cut in
    half and retried from the last converged state (vfem-method §3.2, *Reading*).
 
@@ -24,7 +26,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .bodies import Body
-from .contact.algorithm import ContactState, IterationRecord, Pairing, VirtualElementContact
+from .contact.algorithm import (
+    ContactState,
+    IterationRecord,
+    Pairing,
+    SolveResult,
+    VirtualElementContact,
+)
 from .contact.settings import ContactSettings
 from .contact.surface import ContactSurface, select_candidate_facets
 from .errors import AnalysisError, InputError
@@ -147,7 +155,7 @@ class Analysis:
             self.timings[key] = sum(b.timings[key] for b in bodies)
 
     def solve_step(self, start: ContactState, load_factor: float, history_out: list
-                   ) -> tuple[ContactState, list[Pairing]]:
+                   ) -> tuple[ContactState, SolveResult]:
         """Resolve the contact at ``load_factor`` from the converged ``start`` state.
 
         The prediction is the start state at the new load factor (contact forces and platen held);
@@ -162,8 +170,7 @@ class Analysis:
         history_out.extend(res.history)
         if not res.converged:
             raise AnalysisError(res.message)
-        self._fixed_point = res.fixed_point
-        return state, res.pairings
+        return state, res
 
     # -- the steps ------------------------------------------------------------------------------
 
@@ -181,7 +188,7 @@ class Analysis:
             lf = targets[0]
             history: list[IterationRecord] = []
             try:
-                new, pairings = self.solve_step(state, lf, history)
+                new, res = self.solve_step(state, lf, history)
             except AnalysisError as exc:
                 prev = state.load_factor
                 if cuts >= self.model.contact.max_step_cuts:
@@ -200,8 +207,8 @@ class Analysis:
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=iterations,
                               converged=True, history=history,
                               platen_displacement=state.platen_displacement, cuts=cuts,
-                              fixed_point=self._fixed_point)
-            step.bodies = self._fields(state, pairings)
+                              fixed_point=res.fixed_point)
+            step.bodies = self._fields(state, res.pairings)
             steps.append(step)
             cuts = 0
             log.info("step %d (load factor %.4g) converged in %d iterations", step.step, lf,

@@ -72,7 +72,7 @@ class ContactState:
     forces: list[np.ndarray]  # per body (nc, 2), the force the other bodies apply on it
     released: list[np.ndarray] = field(default_factory=list)  # nodes released last iteration
     platen_force: float = 0.0  # the force the platen must apply (scheduled force x load factor)
-    multipliers: dict = field(default_factory=dict)  # per-pair nodal forces (paired variant)
+    multipliers: dict = field(default_factory=dict)  # per-pair traction values (paired)
 
     def copy(self) -> ContactState:
         return ContactState(self.load_factor, self.platen_displacement,
@@ -105,6 +105,18 @@ class SolveResult:
     fixed_point: bool = False  # stopped where corrections cancel, errors above tolerance
 
 
+def closing_motion(penetration: np.ndarray, rate: np.ndarray, need: float) -> float:
+    """The platen motion that just closes the smallest gap when nothing touches yet.
+
+    ``rate`` is each node's change of penetration per unit platen motion; the platen moves the
+    way its missing force points (the sign of ``need``). Zero when no gap can be closed so.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.where(np.isfinite(penetration) & (rate != 0), -penetration / rate, np.nan)
+    ok = np.isfinite(d) & (np.sign(d) == np.sign(need))
+    return float(d[ok][np.argmin(np.abs(d[ok]))]) if ok.any() else 0.0
+
+
 class VirtualElementContact:
     """Frictionless contact between any number of linear bodies by the virtual element method."""
 
@@ -119,6 +131,8 @@ class VirtualElementContact:
                                       else 1e-5 * float(lengths.min()))
         platens = [i for i, s in enumerate(surfaces) if s.body.platen is not None]
         self.platen_body = platens[0] if platens else None
+        # each body's candidate-node motion per unit platen motion (zero but for the platen's)
+        self.platen_motion = [s.body.u_platen[s.candidate_dofs].reshape(-1, 2) for s in surfaces]
 
     # -- state ----------------------------------------------------------------------------------
 
@@ -149,11 +163,16 @@ class VirtualElementContact:
                 + state.platen_displacement * b.platen_stiffness
                 + float(s.platen_row @ state.forces[self.platen_body].ravel()))
 
+    def platen_met(self, state: ContactState) -> bool:
+        """Whether the platen's reaction is on its scheduled force (always, without a platen)."""
+        if self.platen_body is None:
+            return True
+        error = self.platen_reaction(state) - state.platen_force
+        return abs(error) <= self.settings.platen_tolerance * max(abs(state.platen_force), 1e-300)
+
     def _platen_motion(self, nodes: np.ndarray, normal: np.ndarray) -> np.ndarray:
         """Normal displacement of candidate nodes of the platen body per unit platen motion."""
-        s = self.surfaces[self.platen_body]
-        u = s.body.u_platen[s.candidate_dofs].reshape(-1, 2)[nodes]
-        return np.einsum("ij,ij->i", u, normal)
+        return np.einsum("ij,ij->i", self.platen_motion[self.platen_body][nodes], normal)
 
     def opponents(self, i: int) -> list[int]:
         return [j for j in range(len(self.surfaces))
@@ -409,15 +428,9 @@ class VirtualElementContact:
                 return dF, 0.0
             if r_platen != 0.0:
                 return dF, need / r_platen
-            # Nothing touches: move the platen the way its force points (the sign of `need`)
-            # just far enough to close the smallest gap: a node's penetration changes by -a d.
+            # Nothing touches: a node's penetration changes by -a per unit platen motion.
             a = self._platen_motion(np.arange(s.nc), n)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                d = np.where(np.isfinite(p.penetration) & (a != 0), p.penetration / a, np.nan)
-            ok = np.isfinite(d) & (np.sign(d) == np.sign(need))
-            if not ok.any():
-                return dF, 0.0
-            return dF, float(d[ok][np.argmin(np.abs(d[ok]))])
+            return dF, closing_motion(p.penetration, -a, need)
         du = omega * compatibility_displacement(p.stiffness[idx], p.virtual_stiffness[idx],
                                                 p.penetration[idx])
         a = self._platen_motion(idx, n[idx])
@@ -475,8 +488,7 @@ class VirtualElementContact:
             platen_error = self.platen_reaction(state) - state.platen_force
             rec = IterationRecord(k, pen, eq, contact, tension, platen_error=platen_error)
             history.append(rec)
-            platen_ok = abs(platen_error) <= cfg.platen_tolerance * max(
-                abs(state.platen_force), 1e-300) or self.platen_body is None
+            platen_ok = self.platen_met(state)
             if pen <= self.penetration_tolerance and eq <= eq_tol and tension == 0 and platen_ok:
                 return SolveResult(True, k, history, pairings)
             if k == cfg.max_iterations:
@@ -484,9 +496,7 @@ class VirtualElementContact:
             dF, d_platen = self.corrections(state, pairings, k)
             dU = [(s.C @ d.ravel()).reshape(-1, 2) for s, d in zip(self.surfaces, dF)]
             if d_platen:
-                i = self.platen_body
-                s = self.surfaces[i]
-                dU[i] += d_platen * s.body.u_platen[s.candidate_dofs].reshape(-1, 2)
+                dU[self.platen_body] += d_platen * self.platen_motion[self.platen_body]
             df = float(np.sqrt(sum((d**2).sum() for d in dF)))
             du = float(np.sqrt(sum((d**2).sum() for d in dU)))
             rec.force_correction, rec.displacement_correction = df, du

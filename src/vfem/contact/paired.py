@@ -48,6 +48,7 @@ from .algorithm import (
     Pairing,
     SolveResult,
     VirtualElementContact,
+    closing_motion,
 )
 from .search import outward_normals, project_points
 from .surface import ContactSurface
@@ -72,6 +73,7 @@ class ContactPair:
     transfer: np.ndarray  # (nc_coarse, nc_fine) coarse nodal force per unit fine traction value
     mass: np.ndarray  # (nc_fine, nc_fine) the fine surface's N (all candidate facets)
     rind_depth: np.ndarray  # (m,) thickness of the coarse element under each virtual node
+    platen_rate: np.ndarray | None = None  # (m,) penetration change per unit platen motion
 
 
 class PairedContact(VirtualElementContact):
@@ -81,6 +83,11 @@ class PairedContact(VirtualElementContact):
         super().__init__(surfaces, pairs, settings)
         self.contact_pairs = [p for p in (self._make_pair(*sorted(pp)) for pp in sorted(
             pairs, key=sorted)) if p is not None]
+        # penetration p = -(gap0 + n.(u_fine - u_coarse)): its change per unit platen motion
+        v = self.platen_motion
+        for pair in self.contact_pairs:
+            pair.platen_rate = np.einsum("id,id->i", pair.normal, pair.interp @ v[pair.coarse]
+                                         - v[pair.fine][pair.nodes])
 
     # -- geometry of the pairs (once) -------------------------------------------------------------
 
@@ -197,7 +204,8 @@ class PairedContact(VirtualElementContact):
 
     # -- state of the pairs -----------------------------------------------------------------------
 
-    def _lam(self, state: ContactState, k: int) -> np.ndarray:
+    def _q(self, state: ContactState, k: int) -> np.ndarray:
+        """The normal traction values of pair k at its compatibility-side nodes (the unknowns)."""
         pair = self.contact_pairs[k]
         if k not in state.multipliers:
             state.multipliers[k] = np.zeros(len(pair.nodes))
@@ -208,7 +216,7 @@ class PairedContact(VirtualElementContact):
         for F in state.forces:
             F[:] = 0.0
         for k, pair in enumerate(self.contact_pairs):
-            q = self._lam(state, k)[:, None] * pair.normal  # traction vector at the fine nodes
+            q = self._q(state, k)[:, None] * pair.normal  # traction vector at the fine nodes
             state.forces[pair.fine] += pair.mass[:, pair.nodes] @ q
             state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ q
 
@@ -232,7 +240,7 @@ class PairedContact(VirtualElementContact):
         self.assemble_forces(state)
         for it in range(cfg.max_iterations + 1):
             pens = self.penetrations(state)
-            lams = [self._lam(state, k) for k in range(len(self.contact_pairs))]
+            lams = [self._q(state, k) for k in range(len(self.contact_pairs))]
             self._check_rind(pens)
             pen_err = 0.0
             tension = contact = 0
@@ -243,8 +251,7 @@ class PairedContact(VirtualElementContact):
                 tension += int((lam < 0).sum())
                 contact += int((lam > 0).sum())
             platen_error = self.platen_reaction(state) - state.platen_force
-            platen_ok = self.platen_body is None or abs(platen_error) <= (
-                cfg.platen_tolerance * max(abs(state.platen_force), 1e-300))
+            platen_ok = self.platen_met(state)
             history.append(IterationRecord(it, pen_err, 0.0, contact, tension,
                                            platen_error=platen_error))
             if pen_err <= tol and tension == 0 and platen_ok:
@@ -276,26 +283,22 @@ class PairedContact(VirtualElementContact):
         omega = cfg.first_relaxation if it < cfg.relaxed_iterations else cfg.relaxation
         active, targets = [], []
         for k, p in enumerate(pens):
-            lam = self._lam(state, k)
-            key = ("released", k)
-            released = state.multipliers.get(key, np.zeros(len(lam), bool))
+            lam = self._q(state, k)
+            pair = self.contact_pairs[k]
+            released = state.released[pair.fine][pair.nodes]
             tension = lam < 0
             frac = np.where(released, 1.0, 1.0 / cfg.release_iterations)
             lam[tension] -= frac[tension] * lam[tension]
-            state.multipliers[key] = tension & (frac < 1.0)
+            state.released[pair.fine][pair.nodes] = tension & (frac < 1.0)
             S = ~tension & ((lam > 0) | (p > tol))
             if not platen_ok and not S.any():
                 S = ~tension & (p > -tol)  # touching within tolerance: hold them there
             active.append(np.flatnonzero(S))
             targets.append(omega * p[S])
         self.assemble_forces(state)  # the releases change the forces the platen sees
-        platen_ok = self.platen_body is None or abs(
-            self.platen_reaction(state) - state.platen_force) <= cfg.platen_tolerance * max(
-            abs(state.platen_force), 1e-300)
         m = sum(len(a) for a in active)
-        need_platen = self.platen_body is not None and not platen_ok
         if m == 0:
-            if need_platen:
+            if not self.platen_met(state):
                 self._close_gap(state, pens)
             return
         W, dp_dplaten, dR = self._pair_flexibility(state, active)
@@ -314,7 +317,7 @@ class PairedContact(VirtualElementContact):
             dlam, dplaten = np.linalg.solve(W, rhs), 0.0
         pos = 0
         for k, a in enumerate(active):
-            self._lam(state, k)[a] += dlam[pos:pos + len(a)]
+            self._q(state, k)[a] += dlam[pos:pos + len(a)]
             pos += len(a)
         state.platen_displacement += dplaten
 
@@ -347,11 +350,7 @@ class PairedContact(VirtualElementContact):
             uc = np.einsum("ic,cdm->idm", pair.interp[a], du[pair.coarse])
             # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dlam
             W[row:row + len(a)] = np.einsum("id,idm->im", n, uf - uc)
-            if self.platen_body is not None:
-                up = [s.body.u_platen[s.candidate_dofs].reshape(-1, 2) for s in self.surfaces]
-                vf = up[pair.fine][pair.nodes[a]]
-                vc = pair.interp[a] @ up[pair.coarse]
-                dp_dplaten[row:row + len(a)] = np.einsum("id,id->i", n, vc - vf)
+            dp_dplaten[row:row + len(a)] = pair.platen_rate[a]
             row += len(a)
         dR = np.zeros(m)
         if self.platen_body is not None:
@@ -362,19 +361,11 @@ class PairedContact(VirtualElementContact):
     def _close_gap(self, state: ContactState, pens: list[np.ndarray]) -> None:
         """Nothing touches: move the platen just far enough to close the smallest gap."""
         need = state.platen_force - self.platen_reaction(state)
-        up = [s.body.u_platen[s.candidate_dofs].reshape(-1, 2) for s in self.surfaces]
-        best = None
-        for pair, p in zip(self.contact_pairs, pens):
-            rate = np.einsum("id,id->i", pair.normal,
-                             pair.interp @ up[pair.coarse] - up[pair.fine][pair.nodes])
-            with np.errstate(divide="ignore", invalid="ignore"):
-                d = np.where(rate != 0, -p / rate, np.nan)
-            ok = np.isfinite(d) & (np.sign(d) == np.sign(need))
-            if ok.any():
-                cand = float(d[ok][np.argmin(np.abs(d[ok]))])
-                best = cand if best is None or abs(cand) < abs(best) else best
-        if best is not None:
-            state.platen_displacement += best
+        moves = [closing_motion(p, pair.platen_rate, need)
+                 for pair, p in zip(self.contact_pairs, pens)]
+        moves = [d for d in moves if d != 0.0]
+        if moves:
+            state.platen_displacement += min(moves, key=abs)
 
     # -- what the results need --------------------------------------------------------------------
 
@@ -398,7 +389,7 @@ class PairedContact(VirtualElementContact):
                     f = np.einsum("ij,ij->i", state.forces[i][pair.nodes], pair.normal)
                     on = np.abs(f) > 0
                     force[pair.nodes[on]] = f[on]
-                    touching[pair.nodes] = self._lam(state, k) > 0
+                    touching[pair.nodes] = self._q(state, k) > 0
                     compat[pair.nodes] = True
                     pen[pair.nodes] = pens[k]
                     other[pair.nodes[on]] = pair.coarse

@@ -262,9 +262,10 @@ class ContactSurface:
             return w["tag"] * u * v
 
         nq = fb.X.shape[1]
-        ones = asm_coo(mass, fb, np.ones((len(self.facet_ids), nq)))
-        tagged = asm_coo(mass, fb, np.repeat(np.arange(1.0, len(self.facet_ids) + 1)[:, None],
-                                             nq, axis=1))
+        # scikit-fem's unsummed (per facet) entries; the tag tells which facet each came from
+        ones = mass.coo_data(fb, tag=np.ones((len(self.facet_ids), nq)))
+        tagged = mass.coo_data(fb, tag=np.repeat(
+            np.arange(1.0, len(self.facet_ids) + 1)[:, None], nq, axis=1))
         # entries of the element's nodes off the facet vanish (to round-off) on the facet
         keep = np.abs(ones.data) > 1e-12 * np.abs(ones.data).max()
         facet = np.rint(tagged.data[keep] / ones.data[keep]).astype(int) - 1
@@ -272,11 +273,6 @@ class ContactSurface:
         local[self.nodes[: self.nc]] = np.arange(self.nc)
         rows, cols = local[ones.indices[0][keep]], local[ones.indices[1][keep]]
         return facet, rows, cols, ones.data[keep]
-
-
-def asm_coo(form, basis, tag: np.ndarray):
-    """scikit-fem's unsummed (per element) entries of a form with a per-facet field ``tag``."""
-    return form.coo_data(basis, tag=tag)
 
 
 def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
