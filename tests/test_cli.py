@@ -97,8 +97,12 @@ def test_the_thesis_variant_from_the_command_line(tmp_path, capsys):
 
 
 def test_study_writes_the_table_and_the_convergence_plot(tmp_path):
-    assert main(["-q", "study", "hertz", "--levels", "0", "1", "--out", str(tmp_path)]) == 0
+    assert main(["-q", "study", "hertz", "--levels", "0", "1", "--quadratic-levels", "0",
+                 "--out", str(tmp_path)]) == 0
     study = json.loads((tmp_path / "study.json").read_text())
-    assert set(study) == {"paired", "thesis"}
-    assert [r["facets_across_a"] for r in study["paired"]] == [12, 24]
+    assert set(study) == {"linear, paired", "linear, thesis", "quadratic, paired"}
+    assert [r["facets_across_a"] for r in study["linear, paired"]] == [12, 24]
+    assert [r["order"] for r in study["quadratic, paired"]] == [2]
+    # every series reads the Hertz error on the same problem
+    assert all(abs(r["p_max_error"]) < 0.01 for rows in study.values() for r in rows)
     assert (tmp_path / "convergence.png").stat().st_size > 10_000

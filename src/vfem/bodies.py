@@ -21,7 +21,9 @@ import numpy as np
 from skfem import (
     Basis,
     ElementQuad1,
+    ElementQuad2,
     ElementTriP1,
+    ElementTriP2,
     ElementVector,
     FacetBasis,
     LinearForm,
@@ -30,6 +32,7 @@ from skfem import (
     asm,
 )
 from skfem.helpers import sym_grad, trace
+from skfem.mesh.mesh_2d_2 import Mesh2D2
 from skfem.models.elasticity import linear_elasticity
 
 from .errors import InputError
@@ -87,12 +90,21 @@ class Body:
 
     Args:
         name: unique name, used in messages and output files.
-        mesh: a scikit-fem ``MeshTri`` or ``MeshQuad`` with named boundaries.
+        mesh: a scikit-fem ``MeshTri`` or ``MeshQuad`` with named boundaries; ``MeshTri2`` or
+            ``MeshQuad2`` for curved (quadratic) facets, e.g. a cylinder's arc
+            (:func:`vfem.mesh.quadratic.curved`).
         material: its material.
         supports, prescribed, tractions: boundary conditions on named boundaries.
         platen: an optional force-controlled rigid platen.
         contact_boundaries: boundaries that may touch other bodies; default: every exterior facet
             on which no displacement is prescribed (symmetry planes and supports cannot touch).
+        order: 1 for linear elements (3-node triangles, 4-node quadrilaterals), 2 for quadratic
+            ones (6-node triangles, 9-node quadrilaterals) on the same mesh.
+
+    Points: the nodes of the elements. For linear elements they are the mesh vertices; quadratic
+    elements add one point at the middle of each facet (numbered after the vertices, in facet
+    order) and, for quadrilaterals, one at each element's centre. Point k carries dofs 2k (x) and
+    2k + 1 (y), as scikit-fem numbers them.
     """
 
     name: str
@@ -103,6 +115,7 @@ class Body:
     tractions: tuple[Traction, ...] = ()
     platen: Platen | None = None
     contact_boundaries: tuple[str, ...] | None = None
+    order: int = 1
 
     # -- set-up ---------------------------------------------------------------------------------
 
@@ -114,8 +127,7 @@ class Body:
         """
         self.validate()
         t0 = time.perf_counter()
-        elem = ElementTriP1() if isinstance(self.mesh, MeshTri) else ElementQuad1()
-        self.basis = Basis(self.mesh, ElementVector(elem))
+        self.basis = Basis(self.mesh, ElementVector(self.element()))
         lam, mu = self.material.lame()
         self.K = asm(linear_elasticity(lam, mu), self.basis).tocsr()
         self.ndofs = self.K.shape[0]
@@ -177,17 +189,64 @@ class Body:
             self.platen_stiffness = stiffness if abs(stiffness) > 1e-9 * scale else 0.0
         self.timings = {"assemble_s": t1 - t0, "constraints_s": t2 - t1, "factorize_s": t3 - t2,
                         "load_cases_s": time.perf_counter() - t3}
-        log.info("body %s: %d nodes, %d dofs (%d fixed)", self.name, self.mesh.nvertices,
+        log.info("body %s: %d points, %d dofs (%d fixed)", self.name, self.ndofs // 2,
                  self.ndofs, len(self.fixed_dofs))
+
+    def element(self):
+        """The scalar scikit-fem element of each displacement component."""
+        tri = isinstance(self.mesh, MeshTri)
+        if self.order == 2:
+            return ElementTriP2() if tri else ElementQuad2()
+        return ElementTriP1() if tri else ElementQuad1()
+
+    @property
+    def points(self) -> np.ndarray:
+        """(2, npoints) coordinates of the element nodes (see the class docstring)."""
+        mesh = self.mesh
+        if self.order == 1:
+            return mesh.p[:, : mesh.nvertices]
+        if isinstance(mesh, Mesh2D2):  # curved (quadratic) geometry: its nodes are the points
+            return mesh.doflocs
+        parts = [mesh.p, mesh.p[:, mesh.facets].mean(axis=1)]
+        if not isinstance(mesh, MeshTri):
+            parts.append(mesh.p[:, mesh.t].mean(axis=1))
+        return np.hstack(parts)
+
+    @property
+    def npoints(self) -> int:
+        return self.points.shape[1]
+
+    def facet_points(self, facets: np.ndarray) -> np.ndarray:
+        """(nf, 2 or 3) points of the given facets: the two vertices, then the midpoint."""
+        fp = self.mesh.facets[:, facets].T
+        if self.order == 2:
+            fp = np.column_stack([fp, self.mesh.nvertices + np.asarray(facets)])
+        return fp
+
+    def boundary_points(self, boundary: str) -> np.ndarray:
+        """Sorted points on a named boundary."""
+        return np.unique(self.facet_points(self.mesh.boundaries[boundary]))
+
+    def cells(self) -> tuple[str, np.ndarray]:
+        """VTK cell type and (nelements, k) point connectivity, in VTK's node order."""
+        tri = isinstance(self.mesh, MeshTri)
+        if self.order == 1:
+            return ("triangle" if tri else "quad"), self.mesh.t.T
+        # scikit-fem's element dofs: vertices, then facets in VTK's edge order, then the centre
+        conn = Basis(self.mesh, self.element()).element_dofs.T
+        return ("triangle6" if tri else "quad9"), conn
 
     def validate(self) -> None:
         """Raise :class:`InputError` naming the body if its definition cannot be analysed."""
         where = f"body {self.name!r}"
         if not isinstance(self.mesh, (MeshTri, MeshQuad)) or type(self.mesh).__name__ not in (
-            "MeshTri1", "MeshQuad1"
+            "MeshTri1", "MeshQuad1", "MeshTri2", "MeshQuad2"
         ):
-            raise InputError(f"{where}: mesh must be linear triangles or quadrilaterals, "
+            raise InputError(f"{where}: mesh must be triangles or quadrilaterals, "
                              f"got {type(self.mesh).__name__}")
+        if self.order not in (1, 2):
+            raise InputError(f"{where}: order must be 1 (linear) or 2 (quadratic elements), "
+                             f"got {self.order!r}")
         self.material.validate(f"{where}, material")
         names = set((self.mesh.boundaries or {}).keys())
         for bc in (*self.supports, *self.prescribed, *self.tractions,
@@ -209,11 +268,11 @@ class Body:
 
     def _boundary_dofs(self, boundary: str, component: str) -> np.ndarray:
         facets = self.mesh.boundaries[boundary]
-        return self.basis.get_dofs(facets).nodal[f"u^{COMPONENTS[component] + 1}"]
+        return self.basis.get_dofs(facets).all(f"u^{COMPONENTS[component] + 1}")
 
     def _check_supported(self) -> None:
         """Refuse a body that can move as a rigid body: its stiffness would be singular."""
-        x, y = self.mesh.p
+        x, y = self.points
         modes = {"translation in x": np.column_stack([np.ones_like(x), 0 * y]),
                  "translation in y": np.column_stack([0 * x, np.ones_like(y)]),
                  "rotation": np.column_stack([-(y - y.mean()), x - x.mean()])}

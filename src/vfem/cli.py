@@ -111,11 +111,14 @@ def cmd_study(args) -> int:
     out = Path(args.out or Path("results") / "hertz_study")
     out.mkdir(parents=True, exist_ok=True)
     series = {}
-    for variant in ("paired", "thesis"):
+    for name, variant, order, levels in (
+            ("linear, paired", "paired", 1, args.levels),
+            ("linear, thesis", "thesis", 1, args.levels),
+            ("quadratic, paired", "paired", 2, args.quadratic_levels)):
         if not args.quiet:
-            print(f"vfem: hertz refinement study, {variant} variant")
-        series[variant] = hertz_benchmark(args.levels, print_row=None if args.quiet else print,
-                                          variant=variant)
+            print(f"vfem: hertz refinement study, {name}")
+        series[name] = hertz_benchmark(levels, print_row=None if args.quiet else print,
+                                       variant=variant, order=order)
     (out / "study.json").write_text(json.dumps(series, indent=2) + "\n", encoding="utf-8")
     convergence(out / "convergence.png", series,
                 "Hertz (thesis §5.2) under refinement: error against Hertz's theory")
@@ -144,7 +147,10 @@ def main(argv: list[str] | None = None) -> int:
                        help="contact variant (default paired)")
     study = sub.add_parser("study", help="an example under refinement, both variants, plotted")
     study.add_argument("example", help="hertz")
-    study.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3, 4])
+    study.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3, 4],
+                       help="refinement levels with linear elements")
+    study.add_argument("--quadratic-levels", type=int, nargs="+", default=[0, 1, 2, 3],
+                       help="refinement levels with quadratic elements")
     study.add_argument("--out", help="results directory (default results/hertz_study)")
     args = parser.parse_args(argv)
 

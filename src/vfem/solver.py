@@ -68,6 +68,10 @@ class Model:
                     raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
         for b in self.bodies:
             b.validate()
+            if b.order != 1 and self.contact.variant == "thesis":
+                raise InputError(f"model {self.name!r}, body {b.name!r}: the thesis variant "
+                                 "supports linear elements only (order 1); use the paired "
+                                 "variant for quadratic elements")
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
         self.contact.validate()
@@ -77,11 +81,11 @@ class Model:
 class BodyStepResult:
     """The state of one body at the end of a converged step (full mesh fields)."""
 
-    displacement: np.ndarray  # (nvertices, 2)
-    contact_force: np.ndarray  # (nvertices, 2) nodal force applied by the other bodies
-    contact_pressure: np.ndarray  # (nvertices,) nominal normal pressure (force / undeformed length)
-    contact_status: np.ndarray  # (nvertices,) 0 free, 1 in contact
-    penetration: np.ndarray  # (nvertices,) signed penetration at candidate nodes (0 elsewhere)
+    displacement: np.ndarray  # (npoints, 2), at the body's points (Body.points)
+    contact_force: np.ndarray  # (npoints, 2) nodal force applied by the other bodies
+    contact_pressure: np.ndarray  # (npoints,) nominal normal pressure (force / undeformed length)
+    contact_status: np.ndarray  # (npoints,) 0 free, 1 in contact
+    penetration: np.ndarray  # (npoints,) signed penetration at candidate nodes (0 elsewhere)
 
 
 @dataclass
@@ -230,7 +234,7 @@ class Analysis:
             f = np.zeros(b.ndofs)
             f[s.candidate_dofs] = F.ravel()
             u = b.displacement(state.load_factor, state.platen_displacement, f)
-            nv = b.mesh.nvertices
+            nv = b.npoints
             cand = s.nodes[: s.nc]
             force = np.zeros((nv, 2))
             force[cand] = F

@@ -50,7 +50,7 @@ from .algorithm import (
     VirtualElementContact,
     closing_motion,
 )
-from .search import outward_normals, project_points
+from .search import outward_normals
 from .surface import ContactSurface
 
 log = logging.getLogger(__name__)
@@ -102,15 +102,13 @@ class PairedContact(VirtualElementContact):
             fine, coarse = (i, j) if si.body.name < sj.body.name else (j, i)
         sf, sc = self.surfaces[fine], self.surfaces[coarse]
         nodes = self._facing_nodes(fine, coarse)
-        a, b = sc.segments(sc.X)
-        seg, t, _ = project_points(sf.X[nodes], a, b)
-        n = outward_normals(a, b)[seg]
-        closest = a[seg] + t[:, None] * (b - a)[seg]
+        seg, t, _, n = sc.project(sf.X[nodes])
+        closest, _ = sc.curve(seg, t)
         gap0 = np.einsum("ij,ij->i", sf.X[nodes] - closest, n)
         interp = np.zeros((len(nodes), sc.nc))
-        ends = sc.facets[seg]
-        interp[np.arange(len(nodes)), ends[:, 0]] += 1 - t
-        interp[np.arange(len(nodes)), ends[:, 1]] += t
+        rows = np.arange(len(nodes))
+        for col, phi in zip(sc.facets[seg].T, sc.shape(t).T):
+            interp[rows, col] += phi
         mass = sf.mass_matrix(np.ones(len(sf.facets))).toarray()
         log.info("contact pair: %s (compatibility, %d nodes) against %s (equilibrium)",
                  sf.body.name, len(nodes), sc.body.name)
@@ -144,8 +142,7 @@ class PairedContact(VirtualElementContact):
         best = np.full(len(points), -1)
         dist = np.full(len(points), np.inf)
         for j in self.opponents(i):
-            a, b = self.surfaces[j].segments(self.surfaces[j].X)
-            _, _, d = project_points(points, a, b)
+            _, _, d, _ = self.surfaces[j].project(points)
             closer = d < dist
             best[closer], dist[closer] = j, d[closer]
         return best
@@ -155,19 +152,23 @@ class PairedContact(VirtualElementContact):
         """Coarse nodal forces from a fine traction: T[c, f] = int phi_c(proj(y)) phi_f(y) dy.
 
         Integrated over the fine facets, split where the projection onto the coarse surface
-        passes a coarse node, with 3 Gauss points per piece: exact for the piecewise-linear
-        integrand, so a uniform traction crosses exactly and the total force is conserved.
+        passes a coarse facet's end, with a Gauss rule exact to degree 5 on each piece: exact for
+        the piecewise polynomial integrand (degree 4 at most, with quadratic elements) on
+        straight facets, so a uniform traction crosses exactly and the total force is conserved.
+        On curved (quadratic) facets the points and weights follow the curve; the splits are
+        found on the chords.
         """
         fa, fb = sf.segments(sf.X)
         ca, cb = sc.segments(sc.X)
         d = fb - fa
-        # coarse nodes seen along their (vertex) normal: where they split the fine facets
+        # coarse facet ends seen along their (vertex) normal: where they split the fine facets
+        ends = np.unique(sc.facets[:, :2])
         vn = np.zeros((sc.nc, 2))
         cn = outward_normals(ca, cb)
         np.add.at(vn, sc.facets[:, 0], cn)
         np.add.at(vn, sc.facets[:, 1], cn)
-        vn /= np.maximum(np.linalg.norm(vn, axis=1), 1e-300)[:, None]
-        P = sc.X[: sc.nc]
+        vn = vn[ends] / np.maximum(np.linalg.norm(vn[ends], axis=1), 1e-300)[:, None]
+        P = sc.X[ends]
         # solve fa + s d = P + tau vn for every (facet, coarse node)
         det = d[:, None, 0] * (-vn[None, :, 1]) - d[:, None, 1] * (-vn[None, :, 0])
         rx = P[None, :, 0] - fa[:, None, 0]
@@ -179,26 +180,27 @@ class PairedContact(VirtualElementContact):
         ok = np.isfinite(s) & (s > 1e-12) & (s < 1 - 1e-12) & (np.abs(tau) < reach)
         X, W = get_quadrature(RefLine, 5)
         xi, w = X[0], W
-        pts, wts, fac, sloc = [], [], [], []
+        wts, fac, sloc = [], [], []
         for f in range(len(sf.facets)):
             cuts = np.unique(np.concatenate([[0.0, 1.0], s[f, ok[f]]]))
             lo, hi = cuts[:-1], cuts[1:]
             sq = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
-            pts.append(fa[f] + sq[:, None] * d[f])
-            wts.append((sf.lengths[f] * (hi - lo)[:, None] * w[None, :]).ravel())
+            wts.append(((hi - lo)[:, None] * w[None, :]).ravel())
             fac.append(np.full(len(sq), f))
             sloc.append(sq)
-        pts, wts = np.vstack(pts), np.concatenate(wts)
+        wts = np.concatenate(wts)
         fac, sloc = np.concatenate(fac), np.concatenate(sloc)
-        seg, tt, dist = project_points(pts, ca, cb)
+        pts, tangent = sf.curve(fac, sloc)
+        wts = wts * np.linalg.norm(tangent, axis=1)
+        seg, tt, dist, _ = sc.project(pts)
         cend = sc.facets[seg]
         beyond = (((tt <= 0) & sc.surface_ends[cend[:, 0]])
                   | ((tt >= 1) & sc.surface_ends[cend[:, 1]]))
         wts = np.where(beyond | (dist > reach), 0.0, wts)
         T = np.zeros((sc.nc, sf.nc))
         fend = sf.facets[fac]
-        for ci, cw in ((cend[:, 0], 1 - tt), (cend[:, 1], tt)):
-            for fi, fw in ((fend[:, 0], 1 - sloc), (fend[:, 1], sloc)):
+        for ci, cw in zip(cend.T, sc.shape(tt).T):
+            for fi, fw in zip(fend.T, sf.shape(sloc).T):
                 np.add.at(T, (ci, fi), wts * cw * fw)
         return T
 

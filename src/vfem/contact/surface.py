@@ -22,11 +22,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
-from skfem import BilinearForm, ElementLineP1, ElementQuad1, ElementTriP1, FacetBasis, MeshTri
+from skfem import BilinearForm, ElementLineP1, FacetBasis, MeshTri
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
 from ..bodies import Body
+from .search import project_points
 
 log = logging.getLogger(__name__)
 
@@ -53,14 +54,18 @@ class ContactSurface:
     Attributes:
         body: the body.
         facet_ids: (nf,) indices of the candidate facets in ``mesh.facets``.
-        facets: (nf, 2) local node numbers, ordered so the outward normal is (t_y, -t_x).
-        nodes: (nt,) mesh node numbers of the tracked nodes; the first ``nc`` are the candidate
-            nodes (on candidate facets), the rest the other nodes of the rind elements.
+        facets: (nf, 2) local node numbers, ordered so the outward normal is (t_y, -t_x) (the
+            first node to the second); with quadratic elements (nf, 3), the midpoint third.
+        nodes: (nt,) point numbers (``Body.points``) of the tracked nodes; the first ``nc`` are
+            the candidate nodes (on candidate facets), the rest the other vertices of the rind
+            elements.
         nc: number of candidate nodes.
         X: (nt, 2) undeformed coordinates of the tracked nodes.
         lengths: (nf,) undeformed facet lengths.
-        tributary: (nc,) undeformed tributary length of each candidate node (half of each
-            adjacent candidate facet), which turns nodal forces into nominal pressures.
+        tributary: (nc,) each candidate node's consistent share of a unit pressure on the
+            undeformed candidate facets (half of each adjacent facet for linear elements; 1/6 and
+            2/3 for a quadratic facet's ends and midpoint): nodal force / tributary is the
+            nominal pressure.
         rind: (ne, 3) triangles of the rind (quadrilaterals split in two), local node numbers.
         G: (2 nt, 2 nc) flexibility rows of the tracked dofs for the candidate dofs.
         platen_row: (2 nc,) the platen reaction per unit contact force on the candidate dofs.
@@ -81,7 +86,7 @@ class ContactSurface:
     @classmethod
     def build(cls, body: Body, facet_ids: np.ndarray) -> ContactSurface:
         mesh = body.mesh
-        fn = mesh.facets[:, facet_ids].T.copy()  # (nf, 2) mesh node numbers
+        fn = body.facet_points(facet_ids).copy()  # (nf, 2 or 3) point numbers
         # Orient each facet so that (t_y, -t_x) points away from its element.
         elem = mesh.f2t[0, facet_ids]
         centroid = mesh.p[:, mesh.t[:, elem]].mean(axis=1).T
@@ -89,25 +94,38 @@ class ContactSurface:
         t = b - a
         normal = np.column_stack([t[:, 1], -t[:, 0]])
         flip = np.einsum("ij,ij->i", normal, 0.5 * (a + b) - centroid) < 0
-        fn[flip] = fn[flip][:, ::-1]
+        fn[flip, :2] = fn[flip][:, 1::-1]
 
         cand = np.unique(fn)
         rind_elems = np.flatnonzero(np.isin(mesh.t, cand).any(axis=0))
         rind_nodes = np.setdiff1d(np.unique(mesh.t[:, rind_elems]), cand)
         nodes = np.concatenate([cand, rind_nodes])
-        local = np.full(mesh.nvertices, -1)
+        local = np.full(body.npoints, -1)
         local[nodes] = np.arange(len(nodes))
         t_rind = mesh.t[:, rind_elems]
         if t_rind.shape[0] == 4:  # quadrilaterals: two triangles each, for point location
             t_rind = np.hstack([t_rind[[0, 1, 3]], t_rind[[1, 2, 3]]])
-        X = mesh.p[:, nodes].T.copy()
+        X = body.points[:, nodes].T.copy()
         facets = local[fn]
         lengths = np.linalg.norm(X[facets[:, 1]] - X[facets[:, 0]], axis=1)
-        tributary = np.zeros(len(cand))
-        np.add.at(tributary, facets.ravel(), np.repeat(0.5 * lengths, 2))
-        return cls(body=body, facet_ids=np.asarray(facet_ids), facets=facets, nodes=nodes,
-                   nc=len(cand), X=X, lengths=lengths, tributary=tributary,
-                   rind=local[t_rind].T.copy())
+        surface = cls(body=body, facet_ids=np.asarray(facet_ids), facets=facets, nodes=nodes,
+                      nc=len(cand), X=X, lengths=lengths, tributary=np.zeros(len(cand)),
+                      rind=local[t_rind].T.copy())
+        if len(facets):
+            # a unit pressure's consistent nodal forces: the integral of each shape function
+            ones = np.ones(len(facets))
+            surface.tributary = np.asarray(surface.mass_matrix(ones).sum(axis=1)).ravel()
+        return surface
+
+    @property
+    def order(self) -> int:
+        """1: two-node facets (linear elements); 2: three-node facets (quadratic elements)."""
+        return self.facets.shape[1] - 1
+
+    def shape(self, t: np.ndarray) -> np.ndarray:
+        """(n, 2 or 3) facet shape functions at local coordinates t (0 at the first node, 1 at
+        the second), in the column order of ``facets``."""
+        return facet_shape(np.asarray(t, dtype=float), self.order)
 
     # -- dofs -----------------------------------------------------------------------------------
 
@@ -145,8 +163,8 @@ class ContactSurface:
         t = b - a
         n = np.column_stack([t[:, 1], -t[:, 0]]) / self.lengths[:, None]
         out = np.zeros((self.nc, 2))
-        np.add.at(out, self.facets[:, 0], n)
-        np.add.at(out, self.facets[:, 1], n)
+        for col in self.facets.T:
+            np.add.at(out, col, n)
         return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
 
     @property
@@ -166,7 +184,7 @@ class ContactSurface:
     def surface_ends(self) -> np.ndarray:
         """(nc,) True at the ends of the candidate surface (nodes on a single candidate facet)."""
         if not hasattr(self, "_ends"):
-            valence = np.bincount(self.facets.ravel(), minlength=self.nc)[: self.nc]
+            valence = np.bincount(self.facets[:, :2].ravel(), minlength=self.nc)[: self.nc]
             self._ends = valence == 1
         return self._ends
 
@@ -194,6 +212,44 @@ class ContactSurface:
     def segments(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Start and end points of the candidate facets for tracked positions ``x``."""
         return x[self.facets[:, 0]], x[self.facets[:, 1]]
+
+    def curve(self, seg: np.ndarray, t: np.ndarray, x: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """Position and tangent dx/dt at local coordinates ``t`` of facets ``seg``.
+
+        The facet is the curve its nodes interpolate: straight for two nodes, a parabola through
+        the midpoint for three (curved quadratic meshes), for nodal positions ``x`` (default:
+        undeformed).
+        """
+        x = self.X if x is None else x
+        nodes = x[self.facets[seg]]  # (n, k, 2)
+        pos = np.einsum("nk,nkd->nd", self.shape(t), nodes)
+        tangent = np.einsum("nk,nkd->nd", facet_shape_derivative(t, self.order), nodes)
+        return pos, tangent
+
+    def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                   np.ndarray]:
+        """Closest point on the undeformed candidate surface for each point.
+
+        Returns (facet, t, distance, outward normal there). The chords give the facet and a
+        first t; on curved facets a few Newton steps then find the closest point on the curve.
+        """
+        a, b = self.segments(self.X)
+        seg, t, dist = project_points(points, a, b)
+        pos, tangent = self.curve(seg, t)
+        if self.order == 2:
+            for _ in range(4):
+                second = np.einsum("k,nkd->nd", _SECOND[:, 0],
+                                   self.X[self.facets[seg]])  # d2x/dt2, constant on a facet
+                r = pos - points
+                f = np.einsum("nd,nd->n", r, tangent)
+                df = np.einsum("nd,nd->n", tangent, tangent) + np.einsum("nd,nd->n", r, second)
+                t = np.clip(t - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
+                pos, tangent = self.curve(seg, t)
+            dist = np.linalg.norm(points - pos, axis=1)
+        normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+        normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+        return seg, t, dist, normal
 
     def locate(self, x_tracked: np.ndarray, points: np.ndarray) -> np.ndarray:
         """Rind element containing each point (current configuration), or -1.
@@ -254,8 +310,7 @@ class ContactSurface:
 
     def _facet_mass_entries(self):
         """(facet, row, col, value) of every nonzero of every facet's mass matrix."""
-        elem = ElementTriP1() if isinstance(self.body.mesh, MeshTri) else ElementQuad1()
-        fb = FacetBasis(self.body.mesh, elem, facets=self.facet_ids)
+        fb = FacetBasis(self.body.mesh, self.body.element(), facets=self.facet_ids)
 
         @BilinearForm
         def mass(u, v, w):
@@ -269,10 +324,28 @@ class ContactSurface:
         # entries of the element's nodes off the facet vanish (to round-off) on the facet
         keep = np.abs(ones.data) > 1e-12 * np.abs(ones.data).max()
         facet = np.rint(tagged.data[keep] / ones.data[keep]).astype(int) - 1
-        local = np.full(self.body.mesh.nvertices, -1)
+        local = np.full(self.body.npoints, -1)
         local[self.nodes[: self.nc]] = np.arange(self.nc)
         rows, cols = local[ones.indices[0][keep]], local[ones.indices[1][keep]]
         return facet, rows, cols, ones.data[keep]
+
+
+def facet_shape(t: np.ndarray, order: int) -> np.ndarray:
+    """(n, order + 1) shape functions of a straight 2- or 3-node facet at local coordinates t:
+    the ends (t = 0, 1) first, then the midpoint."""
+    if order == 1:
+        return np.column_stack([1 - t, t])
+    return np.column_stack([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])
+
+
+def facet_shape_derivative(t: np.ndarray, order: int) -> np.ndarray:
+    """(n, order + 1) derivatives d/dt of :func:`facet_shape`."""
+    if order == 1:
+        return np.column_stack([-np.ones_like(t), np.ones_like(t)])
+    return np.column_stack([4 * t - 3, 4 * t - 1, 4 - 8 * t])
+
+
+_SECOND = np.array([[4.0], [4.0], [-8.0]])  # second derivatives of the 3-node shape functions
 
 
 def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],

@@ -40,6 +40,7 @@ class Parameters:
     displacement: float = 1.0e-3
     tight: bool = False
     variant: str = "paired"
+    order: int = 1  # 2: quadratic elements (9-node quadrilaterals)
 
 
 def block(y0: float, n: int) -> MeshQuad:
@@ -63,10 +64,11 @@ def build(p: Parameters, n_lower: int, n_upper: int, nu: float) -> Model:
     mat = LinearElastic(p.youngs_modulus, nu)
     base = Support("bottom", ("x", "y") if nu == 0 else ("y",))
     lower = Body("lower", block(-1.0, n_lower), mat,
-                 supports=(base, Support("left", ("x",))), contact_boundaries=("top",))
+                 supports=(base, Support("left", ("x",))), contact_boundaries=("top",),
+                 order=p.order)
     upper = Body("upper", block(0.0, n_upper), mat, supports=(Support("left", ("x",)),),
                  prescribed=(PrescribedDisplacement("top", "y", -p.displacement),),
-                 contact_boundaries=("bottom",))
+                 contact_boundaries=("bottom",), order=p.order)
     return Model(f"patch {n_lower}/{n_upper} nu={nu}", [lower, upper], settings(p),
                  load_factors=(1.0,))
 

@@ -5,7 +5,8 @@ fields: ``displacement`` (3 components, z = 0, so ParaView's *Warp By Vector* wo
 ``contact_force`` (nodal force applied by the other bodies), ``contact_pressure`` (nominal: normal
 contact force per undeformed tributary length), ``contact_status`` (1 in contact, 0 free),
 ``penetration``. Cell fields: ``stress_xx``, ``stress_yy``, ``stress_xy``, ``stress_zz``,
-``von_mises`` (element averages).
+``von_mises`` (element averages). Quadratic elements are written as VTK's 6-node triangles and
+9-node quadrilaterals, with the fields at every node.
 
 Files are written as each step converges, into a temporary name first and then renamed, so an
 analysis that fails later never damages what was already written.
@@ -42,17 +43,17 @@ class ResultsWriter:
     def write_step(self, step: StepResult) -> None:
         for body in self.model.bodies:
             r = step.bodies[body.name]
-            mesh = body.mesh
-            cell_type = "triangle" if mesh.t.shape[0] == 3 else "quad"
+            cell_type, conn = body.cells()
+            npts = body.npoints
             u = np.column_stack([r.displacement, np.zeros(len(r.displacement))])
             stress = body.stress(r.displacement.ravel())
             name = f"{_safe(body.name)}_step{step.step:04d}.vtu"
             m = meshio.Mesh(
-                points=np.column_stack([mesh.p.T, np.zeros(mesh.nvertices)]),
-                cells=[(cell_type, mesh.t.T)],
+                points=np.column_stack([body.points.T, np.zeros(npts)]),
+                cells=[(cell_type, conn)],
                 point_data={"displacement": u,
                             "contact_force": np.column_stack([r.contact_force,
-                                                              np.zeros(mesh.nvertices)]),
+                                                              np.zeros(npts)]),
                             "contact_pressure": r.contact_pressure,
                             "contact_status": r.contact_status.astype(np.int32),
                             "penetration": r.penetration},

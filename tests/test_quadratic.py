@@ -1,0 +1,105 @@
+"""Quadratic elements (6-node triangles, 9-node quadrilaterals): bodies, contact, output."""
+
+import dataclasses
+
+import meshio
+import numpy as np
+import pytest
+from skfem import Basis, ElementTriP2, ElementVector, MeshQuad, MeshTri
+
+from vfem.bodies import Body, Support
+from vfem.errors import InputError
+from vfem.examples import patch
+from vfem.examples.hertz import HertzParameters, build, evaluate
+from vfem.io.results import ResultsWriter
+from vfem.materials import LinearElastic
+from vfem.mesh import graded_quarter_disk
+from vfem.mesh.quadratic import curved
+from vfem.solver import Analysis
+
+
+@pytest.fixture(scope="module")
+def hertz_quadratic():
+    p = HertzParameters(order=2)
+    result = Analysis(build(p)).run()
+    return p, result, evaluate(result, p)
+
+
+@pytest.mark.parametrize("mesh", [MeshTri().refined(2), MeshQuad().refined(2)])
+def test_points_carry_dofs_2k_and_2k_plus_1(mesh):
+    body = Body("b", mesh.with_boundaries({"left": lambda x: x[0] < 1e-9}),
+                LinearElastic(1.0, 0.3), supports=(Support("left"),), order=2)
+    body.setup()
+    assert np.allclose(body.basis.doflocs[:, ::2], body.points)
+    assert np.allclose(body.basis.doflocs[:, 1::2], body.points)
+
+
+def test_curved_mesh_puts_the_arc_midpoints_on_the_circle():
+    mesh = graded_quarter_disk(1.0, 0.01, 0.1, 0.2, plateau=0.05)
+    m2 = curved(mesh, "contact", (0.0, 1.0), 1.0)
+    body = Body("c", m2, LinearElastic(1.0, 0.2), supports=(Support("symmetry", ("x",)),),
+                order=2)
+    pts = body.points[:, body.boundary_points("contact")]
+    assert np.allclose(np.hypot(pts[0], pts[1] - 1.0), 1.0, atol=1e-14)
+    # interior midpoints stay on their chords
+    assert np.allclose(Basis(m2, ElementVector(ElementTriP2())).doflocs[:, ::2], body.points)
+
+
+@pytest.mark.parametrize("pair", [(4, 7), (2, 10)])
+@pytest.mark.parametrize("nu", [0.0, 0.3])
+def test_patch_test_with_quadratic_elements_to_round_off(pair, nu):
+    p = patch.Parameters(order=2)
+    for lower, upper in (pair, pair[::-1]):
+        case = patch.run_case(p, lower, upper, nu)
+        assert case["converged"]
+        assert case["pressure_deviation"] < 1e-10
+        assert case["stress_deviation"] < 1e-10
+
+
+def test_hertz_with_quadratic_elements(hertz_quadratic):
+    _, result, h = hertz_quadratic
+    assert result.converged
+    assert abs(h["p_max_error"]) < 0.002
+    assert h["rms_error_over_p0"] < 0.01
+    # both bodies read the same pressure, and the force crosses the contact exactly
+    assert h["p_max_flat"] == pytest.approx(h["p_max"], rel=0.003)
+    assert h["total_contact_force"] == pytest.approx(1530.0, rel=1e-9)
+    assert h["total_contact_force_flat"] == pytest.approx(1530.0, rel=1e-9)
+    last = result.steps[-1].history[-1]
+    assert last.max_penetration <= 1e-9
+
+
+def test_swapping_the_bodies_changes_nothing_with_quadratic_elements(hertz_quadratic):
+    p, result, h = hertz_quadratic
+    swapped = dataclasses.replace(p, swap_bodies=True)
+    h2 = evaluate(Analysis(build(swapped)).run(), swapped)
+    assert h2["p_max"] == pytest.approx(h["p_max"], rel=1e-8)
+
+
+def test_quadratic_results_are_written_as_quadratic_cells(hertz_quadratic, tmp_path):
+    _, result, _ = hertz_quadratic
+    writer = ResultsWriter(tmp_path, result.model)
+    writer.write_step(result.steps[-1])
+    for body in result.model.bodies:
+        m = meshio.read(tmp_path / f"{body.name}_step0005.vtu")
+        kind = "triangle6" if isinstance(body.mesh, MeshTri) else "quad9"
+        assert m.cells[0].type == kind
+        conn = m.cells[0].data
+        pts = m.points[:, :2]
+        # VTK's order: each edge midpoint lies between that edge's vertices (on straight edges)
+        nv = 3 if kind == "triangle6" else 4
+        for e in range(nv):
+            mid = pts[conn[:, nv + e]]
+            ends = 0.5 * (pts[conn[:, e]] + pts[conn[:, (e + 1) % nv]])
+            assert np.median(np.linalg.norm(mid - ends, axis=1)) < 1e-12
+        assert len(m.point_data["displacement"]) == body.npoints
+
+
+def test_thesis_variant_refuses_quadratic_elements():
+    with pytest.raises(InputError, match="linear elements only"):
+        build(HertzParameters(order=2, variant="thesis")).validate()
+
+
+def test_order_must_be_one_or_two():
+    with pytest.raises(InputError, match="order must be 1"):
+        build(HertzParameters(order=3)).validate()
