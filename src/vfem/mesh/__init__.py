@@ -1,5 +1,16 @@
 """Built-in parametric meshes for the examples."""
 
 from .parametric import graded_layer, graded_quarter_disk, march
+from .shapes import block, gasket, gasket_pair, graded_nodes, wedge, wedge_plate
 
-__all__ = ["graded_layer", "graded_quarter_disk", "march"]
+__all__ = [
+    "block",
+    "gasket",
+    "gasket_pair",
+    "graded_layer",
+    "graded_nodes",
+    "graded_quarter_disk",
+    "march",
+    "wedge",
+    "wedge_plate",
+]

@@ -1,0 +1,397 @@
+"""Parametric meshes for the wedge, block and gasket examples of the thesis (§5.3 to §5.5).
+
+Each generator returns a scikit-fem mesh with named boundaries, its elements counter-clockwise
+(triangle meshes are built with ``sort_t=False`` so that skfem keeps that order). Sizes follow
+the conventions of :mod:`vfem.mesh.parametric`: ``h(d) = min(h_contact + growth * (d - plateau),
+h_max)`` of the distance ``d`` from the point of first contact.
+
+* **Wedge** (§5.3): "a wide shallow wedge is driven slightly into a flat plate. The flat plate is
+  of unit thickness and is rigidly fixed on its lower surface. The wedge varies from unit thickness
+  at the outer edges to a thickness of 1.3 at the center ... The central portion of the wedge has
+  an imposed downward motion of 0.3 ... only the right half is modelled." The thesis gives no
+  width; :func:`wedge_plate` and :func:`wedge` default to a half-width of 5 (slope 0.06, total
+  width ten times the centre thickness: "wide" and "shallow"). Note that the rise of the lower
+  face, 1.3 - 1.0 = 0.3, equals the imposed motion: the linear prediction overlaps the plate over
+  the whole half-width whatever that width is, the outer edge just reaching the plate's top.
+* **Block** (§5.4): "a larger block is forced against a smaller, fixed block ... the sharp
+  corners of the smaller block". :func:`block` is a rectangle of quadrilaterals (or triangles),
+  uniform or graded towards given lines (such as the other block's corners).
+* **Gasket** (§5.5): "a soft gasket of semicircular section and a similar stiff gasket against
+  which the soft one is pushed ... The back side of each gasket has all of its displacements
+  prescribed. Both gaskets have unit radius and a thickness of 0.1. There is a vertical offset of
+  0.25 between the centers and a horizontal separation of 0.2. They are forced together by a
+  prescribed horizontal motion of their backs such that each moves 0.25." :func:`gasket` is the
+  half annulus, :func:`gasket_pair` the two placed as the thesis describes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+from scipy.spatial import Delaunay, cKDTree
+from skfem import MeshQuad, MeshTri
+
+from .parametric import march, size_function
+
+__all__ = [
+    "block", "gasket", "gasket_pair", "graded_nodes", "wedge", "wedge_plate",
+]
+
+#: Unit vector of each gasket opening (the side its two cut ends, the back, face).
+OPENINGS = {"left": (-1.0, 0.0), "right": (1.0, 0.0), "up": (0.0, 1.0), "down": (0.0, -1.0)}
+
+
+# ---------------------------------------------------------------------------------------------
+# Wedge example (thesis §5.3)
+# ---------------------------------------------------------------------------------------------
+
+def wedge_plate(half_width: float = 5.0, thickness: float = 1.0, h_contact: float = 0.05,
+                h_max: float = 0.25, growth: float = 0.1, plateau: float = 0.0) -> MeshTri:
+    """The right half of the wedge example's plate, ``[0, half_width] x [-thickness, 0]``.
+
+    Triangles of size ``h_contact`` near the origin, where the wedge's point first touches,
+    growing with the distance from it up to ``h_max``. Triangles rather than a tensor grid of
+    quadrilaterals because the plate deforms through its whole thickness (case 1 of §5.3 puts
+    all the deflection in the plate) and a tensor grid graded towards a point is stretched far
+    from it. ``h_max`` stays moderate by default because, in the stiff-wedge case, contact
+    spreads over the whole top face (see the module notes).
+
+    Named boundaries: ``contact`` (top, y = 0), ``bottom`` (y = -thickness, fixed in the
+    thesis), ``symmetry`` (x = 0) and ``right`` (x = half_width).
+    """
+    W, T = float(half_width), float(thickness)
+    h = size_function(h_contact, growth, h_max, plateau)
+    mesh = _graded_trapezoid(W, lower=(-T, -T), upper=(0.0, 0.0), focus=(0.0, 0.0), h=h)
+    tol = 1e-9 * max(W, T)
+    return mesh.with_boundaries({
+        "contact": lambda x: x[1] > -tol,
+        "bottom": lambda x: x[1] < -T + tol,
+        "symmetry": lambda x: x[0] < tol,
+        "right": lambda x: x[0] > W - tol,
+    })
+
+
+def wedge(half_width: float = 5.0, edge_thickness: float = 1.0, centre_thickness: float = 1.3,
+          h_contact: float = 0.05, h_max: float = 0.25, growth: float = 0.1,
+          plateau: float = 0.0, loaded_width: float | None = None) -> MeshTri:
+    """The right half of the shallow wedge of §5.3, its point touching the plate at the origin.
+
+    The lower face is the straight line from the tip (0, 0) to (half_width, rise), rise =
+    centre_thickness - edge_thickness; the top face is flat at y = centre_thickness, so the
+    wedge is ``centre_thickness`` thick at the centre and ``edge_thickness`` at its outer edge.
+    Triangles of size ``h_contact`` near the tip, growing with the distance from it up to
+    ``h_max``.
+
+    The thesis loads "the central portion of the wedge" by a downward motion of 0.3 without
+    saying how wide that portion is; ``loaded_width`` (default ``half_width / 5``, i.e. the
+    middle fifth of the full wedge) is the part of the top face, measured from the centre
+    plane, that carries it. A node sits exactly at x = loaded_width.
+
+    Named boundaries: ``contact`` (the inclined lower face), ``symmetry`` (x = 0),
+    ``top_loaded`` (top face, 0 <= x <= loaded_width), ``top`` (the rest of the top face) and
+    ``right`` (the outer edge x = half_width).
+    """
+    W, T = float(half_width), float(centre_thickness)
+    rise = T - float(edge_thickness)
+    if not 0.0 < rise < T:
+        raise ValueError("need 0 < edge_thickness < centre_thickness")
+    b = W / 5.0 if loaded_width is None else float(loaded_width)
+    if not 0.0 < b <= W:
+        raise ValueError(f"loaded_width must lie in (0, half_width], got {b}")
+    h = size_function(h_contact, growth, h_max, plateau)
+    mesh = _graded_trapezoid(W, lower=(0.0, rise), upper=(T, T), focus=(0.0, 0.0), h=h,
+                             upper_breaks=(b,) if b < W else ())
+    tol = 1e-9 * max(W, T)
+    on_top = lambda x: x[1] > T - tol  # noqa: E731
+    return mesh.with_boundaries({
+        "contact": lambda x: (x[1] < T - tol) & (x[0] > tol) & (x[0] < W - tol),
+        "symmetry": lambda x: x[0] < tol,
+        "top_loaded": lambda x: on_top(x) & (x[0] < b),
+        "top": lambda x: on_top(x) & (x[0] > b),
+        "right": lambda x: x[0] > W - tol,
+    })
+
+
+def _graded_trapezoid(width: float, lower: tuple[float, float], upper: tuple[float, float],
+                      focus: tuple[float, float], h: Callable,
+                      upper_breaks: Sequence[float] = ()) -> MeshTri:
+    """Triangles of ``{0 <= x <= width, lower(x) <= y <= upper(x)}``, sized ``h(|p - focus|)``.
+
+    ``lower`` and ``upper`` are the faces' heights at x = 0 and x = width (straight faces).
+    Boundary nodes are marched along each side from its end nearer the focus; interior nodes
+    lie on rings about the focus (as in :func:`~vfem.mesh.parametric.graded_quarter_disk`).
+    ``upper_breaks`` are x positions that must be nodes of the upper face.
+
+    The connectivity is the Delaunay triangulation of the nodes mapped to the rectangle
+    ``(x, eta)``, eta = (y - lower) / (upper - lower), where the boundary nodes have exactly
+    collinear coordinates. On an inclined face, rounding can put a node a hair outside the
+    hull of its neighbours; Delaunay then makes a sliver there, and dropping the sliver would
+    leave the node in no triangle.
+    """
+    W = width
+    f = np.asarray(focus, dtype=float)
+    lo = lambda x: lower[0] + (lower[1] - lower[0]) * x / W  # noqa: E731
+    up = lambda x: upper[0] + (upper[1] - upper[0]) * x / W  # noqa: E731
+    corners = np.array([[0.0, lower[0]], [W, lower[1]], [W, upper[1]], [0.0, upper[0]]])
+    size = lambda q: h(np.linalg.norm(np.atleast_2d(q) - f, axis=1))  # noqa: E731
+
+    # Boundary nodes as (x, eta): the four corners, then each side's own nodes.
+    xe = [np.array([[0.0, 0.0], [W, 0.0], [W, 1.0], [0.0, 1.0]])]
+    sides = [(corners[0], corners[1], (0.0, 0.0), (W, 0.0), ()),
+             (corners[1], corners[2], (W, 0.0), (W, 1.0), ()),
+             (corners[3], corners[2], (0.0, 1.0), (W, 1.0), tuple(upper_breaks)),
+             (corners[0], corners[3], (0.0, 0.0), (0.0, 1.0), ())]
+    for a, b, ta, tb, breaks in sides:
+        s = _side_parameters(a, b, size, [x / W for x in breaks])
+        s = s[(s > 0.0) & (s < 1.0)]
+        xe.append(np.column_stack([ta[0] + s * (tb[0] - ta[0]), ta[1] + s * (tb[1] - ta[1])]))
+    bnd_xe = np.vstack(xe)
+    bnd = np.column_stack([bnd_xe[:, 0], lo(bnd_xe[:, 0])
+                           + bnd_xe[:, 1] * (up(bnd_xe[:, 0]) - lo(bnd_xe[:, 0]))])
+
+    # Interior nodes on rings about the focus, kept if well inside the domain.
+    reach = np.max(np.linalg.norm(corners - f, axis=1))
+    rings, rho = [], float(h(0.0))
+    while rho < reach:
+        hr = float(h(rho))
+        n = max(2, int(np.ceil(2.0 * np.pi * rho / hr)))
+        phi = 2.0 * np.pi * np.arange(n) / n
+        rings.append(f + rho * np.column_stack([np.cos(phi), np.sin(phi)]))
+        rho += hr
+    pts = np.vstack(rings)
+    x, y = pts[:, 0], pts[:, 1]
+    hp = size(pts)
+    inside = (x > 0.0) & (x < W) & (y > lo(x)) & (y < up(x))
+    pts, hp = pts[inside], hp[inside]
+    d_side = np.min([_distance_to_segment(pts, corners[i], corners[(i + 1) % 4])
+                     for i in range(4)], axis=0)
+    d_node, _ = cKDTree(bnd).query(pts)
+    keep = (d_side > 0.45 * hp) & (d_node > 0.6 * hp)
+    pts = pts[keep]
+
+    p = np.vstack([bnd, pts])
+    eta = (p[:, 1] - lo(p[:, 0])) / (up(p[:, 0]) - lo(p[:, 0]))
+    eta[: len(bnd)] = bnd_xe[:, 1]  # exact 0 / 1 on the lower / upper faces
+    xe_all = np.column_stack([p[:, 0], eta * 0.5 * (upper[0] - lower[0] + upper[1] - lower[1])])
+    t = _triangulate(xe_all, p)
+    return MeshTri(p.T.copy(), t.T.copy(), sort_t=False)
+
+
+def _side_parameters(a: np.ndarray, b: np.ndarray, size: Callable,
+                     breaks: Sequence[float]) -> np.ndarray:
+    """Parameters 0 = s_0 < ... < s_n = 1 of nodes on segment a-b spaced by ``size``.
+
+    The segment is split at ``breaks`` (parameters in (0, 1)); each piece is marched from its
+    end where ``size`` is smaller, so the spacing grows away from the focus.
+    """
+    cuts = np.unique(np.concatenate([[0.0, 1.0], np.clip(breaks, 0.0, 1.0)]))
+    out = [np.zeros(1)]
+    L = float(np.linalg.norm(b - a))
+    for s0, s1 in zip(cuts[:-1], cuts[1:]):
+        p0, p1 = a + s0 * (b - a), a + s1 * (b - a)
+        length = (s1 - s0) * L
+        if float(size(p0)[0]) <= float(size(p1)[0]):
+            u = march(length, lambda s, p0=p0, p1=p1, length=length:
+                      size(p0 + (s / length) * (p1 - p0))[0])
+            s = s0 + (s1 - s0) * u / length
+        else:
+            u = march(length, lambda s, p0=p0, p1=p1, length=length:
+                      size(p1 + (s / length) * (p0 - p1))[0])
+            s = s1 - (s1 - s0) * u[::-1] / length
+        s[0], s[-1] = s0, s1
+        out.append(s[1:])
+    return np.concatenate(out)
+
+
+def _distance_to_segment(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance of each point of ``q`` (n, 2) from the segment a-b."""
+    ab = b - a
+    s = np.clip((q - a) @ ab / (ab @ ab), 0.0, 1.0)
+    return np.linalg.norm(q - (a + s[:, None] * ab), axis=1)
+
+
+def _triangulate(q: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Delaunay triangles of the convex point set ``q``, oriented counter-clockwise in ``p``.
+
+    ``q`` are the points in the coordinates used for the connectivity, ``p`` the same points
+    where the mesh lives. Degenerate triangles (zero area in ``q``) are dropped; every point
+    must still belong to some triangle.
+    """
+    t = Delaunay(q).simplices
+    keep = np.abs(_polygon_areas(q.T, t.T)) > 1e-12 * np.ptp(q, axis=0).max() ** 2
+    t = t[keep]
+    area = _polygon_areas(p.T, t.T)
+    t[area < 0] = t[area < 0][:, [0, 2, 1]]
+    if np.any(np.abs(area) <= 1e-12 * np.ptp(p, axis=0).max() ** 2):
+        raise RuntimeError("degenerate triangle in the mapped triangulation")
+    if len(np.unique(t)) != len(p):
+        raise RuntimeError("a mesh node belongs to no triangle")
+    return t
+
+
+def _polygon_areas(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Signed areas (shoelace) of the elements ``t`` (nodes, n) of points ``p`` (2, m).
+
+    Positive for counter-clockwise elements; a quadrilateral's area is exact for any shape.
+    """
+    x, y = p[0][t], p[1][t]
+    return 0.5 * np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y, axis=0)
+
+
+# ---------------------------------------------------------------------------------------------
+# Block example (thesis §5.4)
+# ---------------------------------------------------------------------------------------------
+
+def graded_nodes(a: float, b: float, h: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """Nodes a = x_0 < ... < x_n = b whose spacing follows the size function ``h(x)``.
+
+    The nodes equidistribute ``N(x) = int_a^x dx / h``: n = ceil(N(b)) intervals, node k where
+    N = k N(b) / n. Unlike :func:`~vfem.mesh.parametric.march`, the spacing may shrink and grow
+    again along the interval (grading towards both ends, or towards an interior point).
+    """
+    xs = np.linspace(a, b, 4001)
+    inv = 1.0 / np.asarray(h(xs), dtype=float)
+    N = np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(xs))])
+    n = max(1, int(np.ceil(N[-1] - 1e-6)))
+    x = np.interp(np.arange(n + 1) * N[-1] / n, N, xs)
+    x[0], x[-1] = a, b
+    return x
+
+
+def block(x0: float, y0: float, width: float, height: float, h: float, *,
+          h_fine: float | None = None, growth: float = 0.2, fine_x: Sequence[float] = (),
+          fine_y: Sequence[float] = (), symmetry: str | None = None,
+          triangles: bool = False) -> MeshQuad | MeshTri:
+    """The rectangle ``[x0, x0 + width] x [y0, y0 + height]`` as a tensor grid of elements.
+
+    Uniform with spacing at most ``h``, or, given ``h_fine``, graded: the column widths are
+    ``h_fine`` at the lines x = ``fine_x`` (for instance the other block's corners) and grow
+    with ``growth`` per unit distance up to ``h``; the row heights likewise towards
+    y = ``fine_y`` (for instance the contact face). Lines of ``fine_x``/``fine_y`` inside the
+    rectangle are grid lines. Quadrilaterals unless ``triangles`` (each split in two).
+
+    Named boundaries: ``top``, ``bottom``, ``left`` and ``right``; with ``symmetry`` = "left"
+    or "right" that side is named ``symmetry`` instead (half model about a vertical plane).
+    """
+    x1, y1 = x0 + width, y0 + height
+    if width <= 0 or height <= 0:
+        raise ValueError("width and height must be positive")
+    if symmetry not in (None, "left", "right"):
+        raise ValueError(f"symmetry must be None, 'left' or 'right', got {symmetry!r}")
+    x = _grid_line(x0, x1, h, h_fine, growth, fine_x)
+    y = _grid_line(y0, y1, h, h_fine, growth, fine_y)
+    grid = (MeshTri if triangles else MeshQuad).init_tensor(x, y)
+    t = _counter_clockwise(grid.p, grid.t)  # init_tensor's quadrilaterals are clockwise
+    mesh = MeshTri(grid.p, t, sort_t=False) if triangles else MeshQuad(grid.p, t)
+    tol = 1e-9 * max(width, height)
+    names = {"left": "left", "right": "right"}
+    if symmetry is not None:
+        names[symmetry] = "symmetry"
+    return mesh.with_boundaries({
+        "top": lambda p: p[1] > y1 - tol,
+        "bottom": lambda p: p[1] < y0 + tol,
+        names["left"]: lambda p: p[0] < x0 + tol,
+        names["right"]: lambda p: p[0] > x1 - tol,
+    })
+
+
+def _grid_line(a: float, b: float, h: float, h_fine: float | None, growth: float,
+               fine: Sequence[float]) -> np.ndarray:
+    """Grid positions on [a, b]: uniform (spacing <= h), or graded towards ``fine``."""
+    if h_fine is None or len(fine) == 0:
+        return np.linspace(a, b, max(1, int(np.ceil((b - a) / h - 1e-9))) + 1)
+    f = np.asarray(fine, dtype=float)
+    size = size_function(h_fine, growth, h)
+    hx = lambda x: size(np.min(np.abs(np.asarray(x)[:, None] - f[None, :]), axis=1))  # noqa: E731
+    cuts = np.unique(np.concatenate([[a, b], f[(f > a) & (f < b)]]))
+    return np.concatenate([graded_nodes(c0, c1, hx)[:-1] for c0, c1 in zip(cuts[:-1], cuts[1:])]
+                          + [[b]])
+
+
+def _counter_clockwise(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Elements ``t`` (nodes, n) of points ``p`` (2, m), the clockwise ones reversed."""
+    t = t.copy()
+    cw = _polygon_areas(p, t) < 0
+    t[:, cw] = t[::-1, cw]
+    return t
+
+
+# ---------------------------------------------------------------------------------------------
+# Gasket example (thesis §5.5)
+# ---------------------------------------------------------------------------------------------
+
+def gasket(centre: tuple[float, float] = (0.0, 0.0), radius: float = 1.0,
+           thickness: float = 0.1, opening: str = "left", n_around: int = 120,
+           n_through: int = 4) -> MeshQuad:
+    """A gasket of semicircular section: the half annulus ``radius - thickness <= r <= radius``.
+
+    ``radius`` is the outer radius, that of the contact face. ``opening`` is the side the
+    open half faces ("left", "right", "up" or "down"): the material spans the 180 degrees
+    centred on the opposite direction, so a gasket opening "left" bulges to the right. Its two
+    cut ends lie on the diameter through ``centre``; they are the **back** that the thesis
+    prescribes ("The back side of each gasket has all of its displacements prescribed") and
+    moves horizontally. Why the ends and not the concave inner face: with the inner face held,
+    each gasket could only squeeze through its 0.1 thickness, while the motion the thesis
+    imposes (each back 0.25, first overlap at step 5) makes the outer faces overlap by about
+    0.28 at the deepest step; held at its ends, each gasket is an arch that bends out of the
+    way.
+
+    Structured polar grid of ``n_around`` x ``n_through`` quadrilaterals (straight-sided; for
+    faces on the true circles see :func:`vfem.mesh.quadratic.curved`).
+
+    Named boundaries: ``outer`` (r = radius, the contact face), ``inner`` (r = radius -
+    thickness) and ``back`` (the two cut ends).
+    """
+    if opening not in OPENINGS:
+        raise ValueError(f"opening must be one of {sorted(OPENINGS)}, got {opening!r}")
+    if not 0.0 < thickness < radius:
+        raise ValueError("need 0 < thickness < radius")
+    c = np.asarray(centre, dtype=float)
+    o = np.asarray(OPENINGS[opening])
+    middle = np.arctan2(-o[1], -o[0])
+    theta = middle + np.pi * (np.arange(n_around + 1) / n_around - 0.5)
+    r = np.linspace(radius - thickness, radius, n_through + 1)
+    # Node (i, j) at angle theta[i], radius r[j]; index i * (n_through + 1) + j.
+    R, TH = np.meshgrid(r, theta)
+    cos, sin = np.cos(TH).ravel(), np.sin(TH).ravel()
+    cos[np.abs(cos) < 1e-15] = 0.0  # exact ends on the diameter
+    sin[np.abs(sin) < 1e-15] = 0.0
+    p = np.vstack([c[0] + R.ravel() * cos, c[1] + R.ravel() * sin])
+    i, j = np.meshgrid(np.arange(n_around), np.arange(n_through), indexing="ij")
+    k = (i * (n_through + 1) + j).ravel()
+    # Outwards then round: counter-clockwise since e_r x e_theta = +e_z.
+    t = np.vstack([k, k + 1, k + n_through + 2, k + n_through + 1])
+    mesh = MeshQuad(p, t)
+    tol = 1e-9 * radius
+    back = lambda x: np.abs((x[0] - c[0]) * o[0] + (x[1] - c[1]) * o[1]) < tol  # noqa: E731
+    dist = lambda x: np.hypot(x[0] - c[0], x[1] - c[1])  # noqa: E731
+    mid = radius - 0.5 * thickness
+    return mesh.with_boundaries({
+        "outer": lambda x: ~back(x) & (dist(x) > mid),
+        "inner": lambda x: ~back(x) & (dist(x) < mid),
+        "back": back,
+    })
+
+
+def gasket_pair(radius: float = 1.0, thickness: float = 0.1, offset: float = 0.25,
+                separation: float = 0.2, n_around: int = 120, n_through: int = 4
+                ) -> tuple[MeshQuad, MeshQuad]:
+    """The two gaskets of §5.5, bulging towards each other: (left, right).
+
+    The left gasket opens to the left (bulges right), the right one opens to the right; their
+    backs move horizontally towards each other. "A vertical offset of 0.25 between the centers"
+    is ``offset`` (the right centre is higher), and "a horizontal separation of 0.2" is read as
+    the horizontal clearance between the two outermost points of the contact faces, so the
+    centres are ``2 radius + separation`` apart horizontally. The centres sit at
+    ``(-(radius + separation / 2), -offset / 2)`` and ``(radius + separation / 2, offset / 2)``.
+
+    Check against the thesis: the outer faces touch when the backs have closed by
+    ``separation + 2 R - sqrt(4 R^2 - offset^2)`` = 0.2157 for the thesis data, so with each
+    back moving 0.025 per step (0.05 closure) the first overlap comes at step 5, and after the
+    full 0.25 each (step 10) the faces overlap by 0.28, as the thesis describes.
+    """
+    dx = radius + 0.5 * separation
+    left = gasket((-dx, -0.5 * offset), radius, thickness, "left", n_around, n_through)
+    right = gasket((dx, 0.5 * offset), radius, thickness, "right", n_around, n_through)
+    return left, right
