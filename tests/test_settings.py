@@ -79,7 +79,10 @@ def test_bad_models_are_named(hertz_level0):
     bodies = build(p).bodies
     with pytest.raises(InputError, match="body names must be unique"):
         Model("m", [bodies[0], bodies[0]]).validate()
-    with pytest.raises(InputError, match="load_factors must increase"):
-        Model("m", bodies, load_factors=(0.5, 0.2)).validate()
+    with pytest.raises(InputError, match="each different from the one before"):
+        Model("m", bodies, load_factors=(0.5, 0.5)).validate()
+    with pytest.raises(InputError, match="load_factors must be finite"):
+        Model("m", bodies, load_factors=(0.5, float("nan"))).validate()
+    Model("m", bodies, load_factors=(0.5, 1.0, 0.5, 0.0)).validate()  # unloading is allowed
     with pytest.raises(InputError, match="unknown body 'plate'"):
         Model("m", bodies, contact_pairs=(("cylinder", "plate"),)).validate()

@@ -172,6 +172,7 @@ class Body:
         u_fixed = np.zeros(self.ndofs)
         for dof, value in fixed.items():
             u_fixed[dof] = value
+        self.f_load = f
         self.u_load = self._solve_with(f, u_fixed)
         # The platen's reaction (the force it applies to the body, along its component) is
         # linear in the state: load_factor * platen_load_reaction + platen_displacement *
@@ -339,6 +340,16 @@ class Body:
         """Full displacement vector (ndofs) for the given state."""
         return (load_factor * self.u_load + platen_displacement * self.u_platen
                 + self.response(contact_force))
+
+    def reaction(self, u: np.ndarray, boundary: str, component: str, load_factor: float = 1.0,
+                 contact_force: np.ndarray | None = None) -> float:
+        """Total force the supports (or prescribed displacements) on ``boundary`` apply to the
+        body along ``component``, for displacement ``u`` (ndofs) under the body's loads at
+        ``load_factor`` and the nodal ``contact_force`` (ndofs)."""
+        r = self.K @ u - load_factor * self.f_load
+        if contact_force is not None:
+            r -= contact_force
+        return float(r[self._boundary_dofs(boundary, component)].sum())
 
     def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
         """Element-average stresses: sxx, syy, sxy, szz and von Mises (per element)."""

@@ -42,7 +42,11 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class Model:
-    """Bodies, the contact settings and the load schedule (load factors of the steps, to 1)."""
+    """Bodies, the contact settings and the load schedule.
+
+    ``load_factors``: the load factor at the end of each step, starting from 0. They may go down
+    as well as up (unloading, thesis §5.5); loads and prescribed displacements scale with them.
+    """
 
     name: str
     bodies: list[Body]
@@ -59,9 +63,10 @@ class Model:
             raise InputError(f"model {self.name!r}: body names must be unique, repeated: "
                              f"{', '.join(sorted(dup))}")
         lf = np.asarray(self.load_factors, dtype=float)
-        if lf.size == 0 or not np.all(np.isfinite(lf)) or np.any(np.diff(np.r_[0.0, lf]) <= 0):
-            raise InputError(f"model {self.name!r}: load_factors must increase from above 0, "
-                             f"got {list(self.load_factors)}")
+        if lf.size == 0 or not np.all(np.isfinite(lf)) or np.any(np.diff(np.r_[0.0, lf]) == 0):
+            raise InputError(f"model {self.name!r}: load_factors must be finite numbers, each "
+                             f"different from the one before (and the first not 0), got "
+                             f"{list(self.load_factors)}")
         for a, b in self.contact_pairs or ():
             for n in (a, b):
                 if n not in names:

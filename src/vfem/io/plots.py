@@ -9,7 +9,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.collections import PolyCollection  # noqa: E402
+from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.ticker import NullFormatter  # noqa: E402
 
 
@@ -88,6 +88,70 @@ def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
     fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np.ndarray,
+                                                                   np.ndarray]]]],
+                   title: str, window: tuple[float, float, float, float] | None = None,
+                   mesh_lines: bool | None = None) -> None:
+    """One or more configurations of a model drawn over each other (thesis Figs. 5.4-5.23).
+
+    ``frames``: (label, bodies) with bodies a list of (points (n, 2), cells (m, k) of vertex
+    numbers, displacement (n, 2)). Each frame gets its own colour; with one frame each body
+    gets its own. Mesh lines are drawn when there is a single frame (default), outlines only
+    when several are overlaid. ``window`` = (xmin, xmax, ymin, ymax), default: everything.
+    """
+    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    mesh_lines = len(frames) == 1 if mesh_lines is None else mesh_lines
+    fig, ax = plt.subplots(figsize=(7.5, 4.6))
+    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+    for k, (label, bodies) in enumerate(frames):
+        for j, (p, t, u) in enumerate(bodies):
+            c = colors[(j if len(frames) == 1 else k) % len(colors)]
+            x = np.asarray(p)[:, :2] + np.asarray(u)[:, :2]
+            lo, hi = np.minimum(lo, x.min(axis=0)), np.maximum(hi, x.max(axis=0))
+            name = label if j == 0 or len(frames) == 1 else None
+            if mesh_lines:
+                ax.add_collection(PolyCollection(x[t], facecolors="none", edgecolors=c,
+                                                 linewidths=0.4, label=name))
+            else:
+                ax.add_collection(LineCollection(x[_outline(np.asarray(t))], colors=c,
+                                                 linewidths=0.9, label=name))
+    if window is None:
+        pad = 0.03 * (hi - lo).max()
+        window = (lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad)
+    ax.set_xlim(window[0], window[1])
+    ax.set_ylim(window[2], window[3])
+    ax.set_aspect("equal")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def _outline(cells: np.ndarray) -> np.ndarray:
+    """(e, 2) boundary edges of a mesh given by its cells: the edges of one cell only."""
+    edges = np.sort(np.stack([cells, np.roll(cells, -1, axis=1)], axis=-1).reshape(-1, 2),
+                    axis=1)
+    uniq, count = np.unique(edges, axis=0, return_counts=True)
+    return uniq[count == 1]
+
+
+def history(path: Path, x: np.ndarray, series: dict[str, np.ndarray], xlabel: str, ylabel: str,
+            title: str) -> None:
+    """Quantities against the step (e.g. the contact force of the gasket's load and unload)."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    for (name, y), marker in zip(series.items(), ("o-", "s--", "^-", "v--")):
+        ax.plot(x, y, marker, ms=4, label=name)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
