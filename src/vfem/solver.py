@@ -114,6 +114,7 @@ class AnalysisResult:
     timings: dict[str, float]
     message: str = ""
     surfaces: list[ContactSurface] = field(default_factory=list)
+    penetration_tolerance: float = 0.0  # the one the contact iteration used
 
 
 class Analysis:
@@ -229,7 +230,7 @@ class Analysis:
                                       ("search_s", "assemble_factorize_s", "flexibility_s",
                                        "steps_s"))
         return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
-                              self.surfaces)
+                              self.surfaces, self.contact.penetration_tolerance)
 
     def _fields(self, state: ContactState, pairings: list[Pairing]) -> dict[str, BodyStepResult]:
         """Full-mesh results of a converged state (one back-substitution per body)."""

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import importlib
 
-EXAMPLES = ("springs", "hertz", "patch")
+EXAMPLES = ("springs", "hertz", "patch", "block")
 
 
 def load(name: str):

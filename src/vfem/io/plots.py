@@ -100,20 +100,25 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     """One or more configurations of a model drawn over each other (thesis Figs. 5.4-5.23).
 
     ``frames``: (label, bodies) with bodies a list of (points (n, 2), cells (m, k) of vertex
-    numbers, displacement (n, 2)). Each frame gets its own colour; with one frame each body
-    gets its own. Mesh lines are drawn when there is a single frame (default), outlines only
-    when several are overlaid. ``window`` = (xmin, xmax, ymin, ymax), default: everything.
+    numbers, displacement (n, 2)), optionally preceded by the body's name (for the legend).
+    Each frame gets its own colour; with one frame each body gets its own. Mesh lines are drawn
+    when there is a single frame (default), outlines only when several are overlaid.
+    ``window`` = (xmin, xmax, ymin, ymax), default: everything.
     """
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     mesh_lines = len(frames) == 1 if mesh_lines is None else mesh_lines
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
     for k, (label, bodies) in enumerate(frames):
-        for j, (p, t, u) in enumerate(bodies):
+        for j, entry in enumerate(bodies):
+            body_name, (p, t, u) = (entry[0], entry[1:]) if len(entry) == 4 else (None, entry)
             c = colors[(j if len(frames) == 1 else k) % len(colors)]
             x = np.asarray(p)[:, :2] + np.asarray(u)[:, :2]
             lo, hi = np.minimum(lo, x.min(axis=0)), np.maximum(hi, x.max(axis=0))
-            name = label if j == 0 or len(frames) == 1 else None
+            if len(frames) == 1:
+                name = f"{label}: {body_name}" if body_name else (label if j == 0 else None)
+            else:
+                name = label if j == 0 else None
             if mesh_lines:
                 ax.add_collection(PolyCollection(x[t], facecolors="none", edgecolors=c,
                                                  linewidths=0.4, label=name))

@@ -1,0 +1,214 @@
+"""Thesis §5.4: a larger block forced against a smaller fixed block — sharp corners in the contact.
+
+The thesis gives no dimensions ("the model used is very crude"); these are ours. Plane strain,
+half model about x = 0 (symmetry: u_x = 0), both blocks of the same material (E = 1000,
+nu = 0.3):
+
+* the **small block** 0 <= x <= 0.5, -0.5 <= y <= 0, fixed on its base; its top corner (0.5, 0)
+  is the sharp corner that presses into the large block. Quadrilaterals graded towards that
+  corner (0.02 there, up to 0.1);
+* the **large block** 0 <= x <= 1, 0 <= y <= 1, its top face moved down by ``displacement``
+  (0.05: 5 % of its height, enough to see in true-scale figures). Columns of equal width 1/27,
+  so no node of its face sits on the corner (the corner lies inside one of its facets), rows
+  graded towards the contact face. Its face is the coarser of the two, so the small block,
+  sharp corner and all, carries compatibility (docs/method.md §6). With 27 columns (finer than
+  the small block's face) the roles swap and the corner indents the large block's face by
+  8.4e-4 (1.7 % of the press's motion), which the both-ways penetration check reports.
+
+The blocks touch along y = 0 before loading. The linear prediction (contact ignored) moves the
+large block down rigidly by ``displacement``, so it overlaps the small block's whole top face.
+The exact answer is not known in closed form (the corner is a stress singularity); the checks are
+the ones any contact solution must meet: no penetration beyond the tolerance at convergence, the
+contact force equal to the fixed block's support reaction and to the force the press applies,
+and the same answer with the bodies listed in the other order.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..bodies import Body, PrescribedDisplacement, Support
+from ..contact.check import largest_penetrations
+from ..contact.settings import ContactSettings
+from ..materials import LinearElastic
+from ..mesh import block
+from ..solver import Analysis, AnalysisResult, Model
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """Parameters of the block example (our dimensions; see the module docstring)."""
+
+    youngs_modulus: float = 1000.0
+    poissons_ratio: float = 0.3
+    small_half_width: float = 0.5
+    small_height: float = 0.5
+    large_half_width: float = 1.0
+    large_height: float = 1.0
+    displacement: float = 0.05  # of the large block's top face, downwards
+    h: float = 0.1  # largest element size
+    h_corner: float = 0.02  # element size at the small block's corner
+    large_columns: int = 17  # equal columns of the large block (odd: no node on the corner)
+    steps: int = 1
+    variant: str = "paired"
+    swap_bodies: bool = False
+
+
+def build(p: Parameters) -> Model:
+    mat = LinearElastic(p.youngs_modulus, p.poissons_ratio)
+    w, c = p.small_half_width, p.h_corner
+    small_mesh = block(0.0, -p.small_height, w, p.small_height, p.h, h_fine=c, growth=0.3,
+                       fine_x=(w,), fine_y=(0.0,), symmetry="left")
+    large_mesh = block(0.0, 0.0, p.large_half_width, p.large_height,
+                       p.large_half_width / p.large_columns, h_fine=c, growth=0.3,
+                       fine_y=(0.0,), symmetry="left")
+    small = Body("small", small_mesh, mat,
+                 supports=(Support("bottom", ("x", "y")), Support("symmetry", ("x",))))
+    large = Body("large", large_mesh, mat, supports=(Support("symmetry", ("x",)),),
+                 prescribed=(PrescribedDisplacement("top", "y", -p.displacement),))
+    bodies = [large, small] if p.swap_bodies else [small, large]
+    factors = tuple((k + 1) / p.steps for k in range(p.steps))
+    return Model("block", bodies, ContactSettings(variant=p.variant), factors)
+
+
+def validate(p: Parameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    from ..errors import InputError
+
+    if p.small_half_width >= p.large_half_width:
+        raise InputError("block: small_half_width must be less than large_half_width (the "
+                         "small block's corner must lie under the large block)")
+    if p.steps < 1:
+        raise InputError(f"block: steps must be at least 1, got {p.steps}")
+    build(p).validate()
+
+
+def evaluate(result: AnalysisResult, p: Parameters) -> dict:
+    """Force balance and residual penetration of the last step."""
+    last = result.steps[-1]
+    bodies = {b.name: b for b in result.model.bodies}
+    surfaces = {s.body.name: s for s in result.surfaces}
+    out = {}
+    for name, boundary in (("small", "bottom"), ("large", "top")):
+        b, r = bodies[name], last.bodies[name]
+        f = np.zeros(b.ndofs)
+        s = surfaces[name]
+        f[s.candidate_dofs] = r.contact_force[s.nodes[: s.nc]].ravel()
+        out[f"{name}_reaction_y"] = b.reaction(r.displacement.ravel(), boundary, "y",
+                                               last.load_factor, f)
+        out[f"{name}_contact_force_y"] = float(r.contact_force[:, 1].sum())
+    # the contact pushes the small block down and the large block up
+    force = out["large_contact_force_y"]
+    out["contact_force"] = force
+    out["balance_error_small"] = abs(out["small_reaction_y"] - force) / abs(force)
+    out["balance_error_large"] = abs(-out["large_reaction_y"] - force) / abs(force)
+    out["equal_and_opposite_error"] = (abs(out["small_contact_force_y"] + force) / abs(force))
+    h = last.history[-1]
+    out["max_penetration"] = h.max_penetration
+    out["penetration_tolerance"] = result.penetration_tolerance
+    both = largest_penetrations(result, last)
+    out["largest_penetration_any_node"] = max(v["penetration"] for v in both.values())
+    out["penetration_by_body"] = both
+    small = last.bodies["small"]
+    pts = bodies["small"].points
+    top = np.flatnonzero((np.abs(pts[1]) < 1e-12) & (small.contact_status > 0))
+    out["contact_nodes_small"] = int(len(top))
+    out["corner_pressure"] = float(small.contact_pressure[
+        int(np.argmin(np.hypot(pts[0] - p.small_half_width, pts[1])))])
+    return out
+
+
+def summarize(result: AnalysisResult, p: Parameters) -> dict:
+    summary = {
+        "example": "block",
+        "converged": result.converged,
+        "message": result.message,
+        "steps": [{"step": s.step, "load_factor": s.load_factor, "iterations": s.iterations,
+                   "converged": s.converged, "cuts": s.cuts,
+                   "max_penetration": s.history[-1].max_penetration,
+                   "max_equilibrium_error": s.history[-1].max_equilibrium_error}
+                  for s in result.steps],
+        "dofs": int(sum(b.ndofs for b in result.model.bodies)),
+        "parameters": dataclasses.asdict(p),
+        "timings": result.timings,
+    }
+    if result.converged:
+        summary["block"] = evaluate(result, p)
+    return summary
+
+
+def run(p: Parameters, out, on_step=None, figures: bool = True) -> dict:
+    """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
+    from ..io.results import ResultsWriter, write_summary
+
+    out = Path(out)
+    model = build(p)
+    analysis = Analysis(model)
+    analysis.setup()
+    writer = ResultsWriter(out, model)
+
+    def step_done(step):
+        writer.write_step(step)
+        if on_step is not None:
+            on_step(step)
+
+    result = analysis.run(step_done)
+    summary = summarize(result, p)
+    if figures and result.steps:
+        _figures(out, model, result, p)
+    write_summary(out, summary)
+    return summary
+
+
+def _figures(out: Path, model: Model, result: AnalysisResult, p: Parameters) -> None:
+    """Thesis Figs. 5.14-5.16 (initial, linear prediction, final) and the contact pressure."""
+    from ..io.plots import configurations, history
+
+    def frame(displacement):
+        return [(b.name, b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
+                 displacement(b)[: b.mesh.nvertices]) for b in model.bodies]
+
+    last = result.steps[-1]
+    zero = frame(lambda b: np.zeros((b.npoints, 2)))
+    predicted = frame(lambda b: (last.load_factor * b.u_load).reshape(-1, 2))
+    final = frame(lambda b: last.bodies[b.name].displacement)
+    window = (0.0, p.large_half_width, -p.small_height, p.large_height)
+    configurations(out / "initial.png", [("initial", zero)], "Block: initial configuration "
+                   "(thesis Fig. 5.14)", window)
+    configurations(out / "prediction.png", [("linear prediction", predicted)],
+                   "Block: linear prediction, contact ignored (Fig. 5.15)", window)
+    configurations(out / "final.png", [("final", final)],
+                   "Block: final configuration, true scale (Fig. 5.16)", window)
+    w = p.small_half_width
+    zoom = (w - 0.15, w + 0.15, -0.15, 0.1)
+    configurations(out / "corner.png", [("final", final)],
+                   "Block: the small block's corner, final configuration", zoom)
+    b = next(b for b in model.bodies if b.name == "small")
+    pts = b.points
+    top = np.flatnonzero(np.abs(pts[1]) < 1e-12)
+    order = top[np.argsort(pts[0, top])]
+    series = {"small block (top face)": last.bodies["small"].contact_pressure[order]}
+    history(out / "pressure.png", pts[0, order], series, "x",
+            "nominal contact pressure", "Block: contact pressure on the small block")
+
+
+def report(s: dict) -> list[str]:
+    steps = s["steps"]
+    lines = [f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(steps)} "
+             f"step(s), {sum(x['iterations'] for x in steps)} contact iterations, "
+             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+    if "block" in s:
+        b = s["block"]
+        lines.append(f"  contact force {b['contact_force']:.4g}; fixed block's reaction "
+                     f"{b['small_reaction_y']:.4g} ({b['balance_error_small']:.1e} off); "
+                     f"press {-b['large_reaction_y']:.4g} ({b['balance_error_large']:.1e} off)")
+        lines.append(f"  largest residual penetration {b['max_penetration']:.2e} (tolerance "
+                     f"{b['penetration_tolerance']:.1e}); any node of either block, checked "
+                     f"both ways: {b['largest_penetration_any_node']:.2e}")
+    lines.append("  results: summary.json, results.pvd (ParaView), initial.png, prediction.png, "
+                 "final.png, corner.png, pressure.png")
+    return lines

@@ -1,0 +1,74 @@
+"""Thesis §5.4, block: a sharp corner in the contact, same material on both sides."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from vfem.contact.check import largest_penetrations
+from vfem.examples import block
+from vfem.solver import Analysis
+
+
+@pytest.fixture(scope="module")
+def solved():
+    p = block.Parameters()
+    result = Analysis(block.build(p)).run()
+    return p, result, block.evaluate(result, p)
+
+
+def test_converges_without_penetration_on_either_side(solved):
+    _, result, b = solved
+    assert result.converged
+    assert b["max_penetration"] <= b["penetration_tolerance"]
+    # checked independently, every node of both blocks against the other block
+    assert b["largest_penetration_any_node"] <= b["penetration_tolerance"]
+
+
+def test_contact_force_balances_the_fixed_block_and_the_press(solved):
+    _, _, b = solved
+    assert b["contact_force"] > 0
+    assert b["balance_error_small"] < 0.005
+    assert b["balance_error_large"] < 0.005
+    assert b["equal_and_opposite_error"] < 1e-9
+
+
+def test_the_pressure_peaks_near_the_corner(solved):
+    p, result, b = solved
+    small = result.steps[-1].bodies["small"]
+    x, y = result.model.bodies[0].points
+    top = np.abs(y) < 1e-12
+    near = top & (x > p.small_half_width - 0.1)
+    far = top & (x < 0.25)
+    mean = b["contact_force"] / p.small_half_width
+    assert small.contact_pressure[near].max() > 1.2 * mean
+    assert small.contact_pressure[far] == pytest.approx(small.contact_pressure[far].mean(),
+                                                        rel=0.05)  # nearly uniform far away
+
+
+def test_swapping_the_bodies_changes_nothing(solved):
+    p, _, b = solved
+    swapped = dataclasses.replace(p, swap_bodies=True)
+    b2 = block.evaluate(Analysis(block.build(swapped)).run(), swapped)
+    for key in ("contact_force", "small_reaction_y", "corner_pressure"):
+        assert b2[key] == pytest.approx(b[key], rel=1e-8)
+
+
+def test_the_check_sees_a_corner_indenting_the_compatibility_side():
+    """With the large block's face the finer one, it carries compatibility and the small block's
+    corner indents it: the both-ways check must report it (it is not part of the iteration)."""
+    p = block.Parameters(large_columns=27)
+    result = Analysis(block.build(p)).run()
+    pen = largest_penetrations(result)
+    assert pen["small"]["penetration"] > 1e-4
+    assert pen["small"]["into"] == "large"
+    x = result.model.bodies[0].points[:, pen["small"]["node"]]
+    assert np.hypot(x[0] - p.small_half_width, x[1]) < 0.05  # next to the corner
+
+
+def test_run_writes_summary_and_figures(tmp_path):
+    s = block.run(block.Parameters(), tmp_path)
+    assert s["converged"] and "block" in s
+    for name in ("summary.json", "results.pvd", "initial.png", "prediction.png", "final.png",
+                 "corner.png", "pressure.png"):
+        assert (tmp_path / name).stat().st_size > 0
