@@ -41,6 +41,7 @@ class Parameters:
     tight: bool = False
     variant: str = "paired"
     order: int = 1  # 2: quadratic elements (9-node quadrilaterals)
+    swap_bodies: bool = False  # list the upper block first
 
 
 def block(y0: float, n: int) -> MeshQuad:
@@ -69,8 +70,8 @@ def build(p: Parameters, n_lower: int, n_upper: int, nu: float) -> Model:
     upper = Body("upper", block(0.0, n_upper), mat, supports=(Support("left", ("x",)),),
                  prescribed=(PrescribedDisplacement("top", "y", -p.displacement),),
                  contact_boundaries=("bottom",), order=p.order)
-    return Model(f"patch {n_lower}/{n_upper} nu={nu}", [lower, upper], settings(p),
-                 load_factors=(1.0,))
+    bodies = [upper, lower] if p.swap_bodies else [lower, upper]
+    return Model(f"patch {n_lower}/{n_upper} nu={nu}", bodies, settings(p), load_factors=(1.0,))
 
 
 def validate(p: Parameters) -> None:
