@@ -112,7 +112,9 @@ class PairedContact(VirtualElementContact):
         mass = sf.mass_matrix(np.ones(len(sf.facets))).toarray()
         log.info("contact pair: %s (compatibility, %d nodes) against %s (equilibrium)",
                  sf.body.name, len(nodes), sc.body.name)
-        return ContactPair(fine, coarse, nodes, n, gap0, interp, self._transfer(sf, sc), mass,
+        # the transfer must reach across every gap the pair may close (bodies that start apart)
+        gap = float(np.abs(gap0).max()) if len(gap0) else 0.0
+        return ContactPair(fine, coarse, nodes, n, gap0, interp, self._transfer(sf, sc, gap), mass,
                            sc.rind_depth[seg])
 
     def _compliance_density(self, i: int, j: int) -> float:
@@ -148,7 +150,7 @@ class PairedContact(VirtualElementContact):
         return best
 
     @staticmethod
-    def _transfer(sf: ContactSurface, sc: ContactSurface) -> np.ndarray:
+    def _transfer(sf: ContactSurface, sc: ContactSurface, gap: float = 0.0) -> np.ndarray:
         """Coarse nodal forces from a fine traction: T[c, f] = int phi_c(proj(y)) phi_f(y) dy.
 
         Integrated over the fine facets, split where the projection onto the coarse surface
@@ -176,7 +178,9 @@ class PairedContact(VirtualElementContact):
         with np.errstate(divide="ignore", invalid="ignore"):
             s = (rx * (-vn[None, :, 1]) - ry * (-vn[None, :, 0])) / det
             tau = (d[:, None, 0] * ry - d[:, None, 1] * rx) / det
-        reach = 2.0 * (sf.lengths.max() + sc.lengths.max())
+        # points farther than this from the coarse surface face something else (``gap``: the
+        # largest undeformed gap of the pair's nodes)
+        reach = gap + 2.0 * (sf.lengths.max() + sc.lengths.max())
         ok = np.isfinite(s) & (s > 1e-12) & (s < 1 - 1e-12) & (np.abs(tau) < reach)
         X, W = get_quadrature(RefLine, 5)
         xi, w = X[0], W
