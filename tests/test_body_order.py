@@ -1,6 +1,7 @@
 """No master/slave bias, measured: every example gives the same answer with its bodies listed in
 the other order (issue 4). Each example has a ``swap_bodies`` parameter; the key numbers must
-agree to 1e-8 relative."""
+agree to 1e-8 relative. The wedge's and the gasket's are in ``test_wedge.py`` and
+``test_gasket.py``, on the meshes those files already solve."""
 
 import dataclasses
 

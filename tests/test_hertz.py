@@ -117,3 +117,16 @@ def test_flat_facets_up_to_ten_times_the_cylinders(ratio, bound):
     h = evaluate(r, p)
     assert abs(h["p_max_error"]) < bound
     assert h["total_contact_force_flat"] == pytest.approx(1530, rel=1e-9)  # exact transfer
+
+
+def test_step_cutting_is_bounded_and_reported():
+    """A step that cannot converge is cut at most max_step_cuts times below its scheduled
+    increment, then the analysis stops with a message (it never creeps up on a load factor)."""
+    model = build(HertzParameters())
+    model.contact = dataclasses.replace(model.contact, max_iterations=3, max_step_cuts=3)
+    result = Analysis(model).run()
+    assert not result.converged
+    assert "failed after 3 cuts" in result.message
+    assert all(s.cuts <= 3 for s in result.steps)
+    # the smallest increment tried is the scheduled one (0.2) over 2**3
+    assert "load factor 0.025 " in result.message

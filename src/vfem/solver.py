@@ -190,12 +190,14 @@ class Analysis:
         t_setup = time.perf_counter()
         state = self.contact.new_state()
         steps: list[StepResult] = []
-        targets = list(self.model.load_factors)
+        # (load factor, halvings of the scheduled increment that led to it): a step is never
+        # cut below 1 / 2**max_step_cuts of its scheduled increment, so a load factor at which
+        # the iteration cannot converge ends the analysis instead of being crept up on forever
+        targets = [(lf, 0) for lf in self.model.load_factors]
         message = ""
         converged = True
-        cuts = 0
         while targets:
-            lf = targets[0]
+            lf, cuts = targets[0]
             history: list[IterationRecord] = []
             try:
                 new, res = self.solve_step(state, lf, history)
@@ -206,10 +208,10 @@ class Analysis:
                     message = f"step to load factor {lf:.6g} failed after {cuts} cuts: {exc}"
                     log.error(message)
                     break
-                cuts += 1
                 log.warning("step to load factor %.6g failed (%s); cutting it to %.6g", lf, exc,
                             0.5 * (prev + lf))
-                targets.insert(0, 0.5 * (prev + lf))
+                targets[0] = (lf, cuts + 1)  # the rest of this increment, as deeply cut
+                targets.insert(0, (0.5 * (prev + lf), cuts + 1))
                 continue
             targets.pop(0)
             state = self.state = new
@@ -220,7 +222,6 @@ class Analysis:
                               fixed_point=res.fixed_point)
             step.bodies = self._fields(state, res.pairings)
             steps.append(step)
-            cuts = 0
             log.info("step %d (load factor %.4g) converged in %d iterations", step.step, lf,
                      iterations)
             if on_step is not None:

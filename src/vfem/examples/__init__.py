@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import importlib
 
-EXAMPLES = ("springs", "hertz", "patch", "block")
+EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket")
 
 
 def load(name: str):

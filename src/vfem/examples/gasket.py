@@ -1,0 +1,493 @@
+"""Thesis §5.5: the gasket example — a soft gasket pushed against a stiff one, then withdrawn.
+
+Two gaskets of semicircular section (outer radius 1, thickness 0.1) bulge towards each other,
+their centres 0.25 apart vertically and their faces 0.2 apart horizontally
+(:func:`vfem.mesh.gasket_pair`). The back of each (its two cut ends) has every displacement
+prescribed: x moves ``back_motion`` (0.25) towards the other gasket at load factor 1, y is held.
+The load factors go 0.1, 0.2, ..., 1.0 and back down 0.9, ..., 0.0: each back approaches 0.025 per
+step for ten steps, then retreats the same way. The faces first overlap (contact ignored) at
+step 5 and overlap most at step 10; after step 20 every node must be back where it started.
+
+The left gasket is the soft one; the right one is ``stiffness_ratio`` (10) times stiffer. Plane
+strain, nu = 0.3: a gasket is a long extrusion whose section does not change along it.
+
+Mesh: 120 x 1 nine-node quadrilaterals per gasket, the outer face curved. One element through
+the thickness because each step's linear prediction drives the faces about 0.05 into each other
+and a node may not go deeper than the element behind the opposing face (thesis §5.6): with two
+elements (0.05 deep) the steps are cut; quadratic because one linear element locks in bending.
+Contact candidates are chosen in the undeformed configuration, where the faces are 0.214 apart:
+``search_distance`` 0.4 reaches past the contact of step 10. Numbers and the choice of the
+paired variant: ``docs/examples.md``, Gasket.
+
+The module also measures what the contact algorithm's own numbers cannot show: the state of the
+faces in the *current* configuration (:func:`current_contact`): how far any node of one gasket
+lies inside the other's deformed section, how wide a gap a loaded node bridges, and the angle
+between each nodal contact force and its face's current normal. With the paired variant's
+linear kinematics (pairs fixed in the undeformed configuration) these test whether the
+small-strain idealisation still holds for gaskets that move 0.5 relative to each other.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from matplotlib.path import Path as PolygonPath
+
+from ..bodies import Body, PrescribedDisplacement, Support
+from ..contact.search import project_points
+from ..contact.settings import ContactSettings
+from ..errors import InputError
+from ..materials import LinearElastic
+from ..mesh import gasket_pair
+from ..mesh.quadratic import curved
+from ..solver import AnalysisResult, Model, StepResult
+
+
+@dataclass(frozen=True)
+class GasketParameters:
+    """Parameters of the gasket example; the thesis's geometry and motion are the defaults.
+
+    The thesis gives no material constants; the ratio of the two gaskets' moduli is
+    ``stiffness_ratio`` (soft: ``soft_youngs_modulus``). Forces scale with the moduli, the
+    displacements do not depend on them, only on the ratio.
+    """
+
+    radius: float = 1.0
+    thickness: float = 0.1
+    offset: float = 0.25  # vertical offset between the centres
+    separation: float = 0.2  # horizontal clearance between the faces
+    back_motion: float = 0.25  # each back's motion towards the other at load factor 1
+    steps: int = 10  # loading steps; as many unloading steps follow
+    soft_youngs_modulus: float = 1.0e6
+    stiffness_ratio: float = 10.0
+    poissons_ratio: float = 0.3
+    plane: str = "strain"
+    n_around: int = 120  # elements around each half annulus
+    n_through: int = 1  # elements through the thickness
+    order: int = 2  # 2: 9-node quadrilaterals, the contact face curved; 1: 4-node
+    variant: str = "paired"
+    search_distance: float = 0.4  # the faces start 0.2 apart; 0.25 is too short at step 10
+    penetration_tolerance: float | None = None
+    equilibrium_tolerance: float = 1e-3
+    swap_bodies: bool = False  # list the stiff gasket first
+
+
+Parameters = GasketParameters
+
+#: The steps the thesis draws (prediction and resolved position, Figs. 5.19 to 5.22).
+SHOWN_STEPS = (5, 10)
+
+
+def load_factors(p: GasketParameters) -> tuple[float, ...]:
+    """1/n, 2/n, ..., 1, then (n - 1)/n, ..., 0: n loading and n unloading steps."""
+    n = p.steps
+    return tuple(k / n for k in range(1, n + 1)) + tuple(k / n for k in range(n - 1, -1, -1))
+
+
+def closure_at_first_touch(p: GasketParameters) -> float:
+    """How far the backs must close (together) before the undeformed faces touch."""
+    R = p.radius
+    return p.separation + 2.0 * R - math.sqrt(4.0 * R**2 - p.offset**2)
+
+
+def validate(p: GasketParameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    if not (isinstance(p.steps, int) and p.steps >= 1):
+        raise InputError(f"steps must be an integer >= 1, got {p.steps!r}")
+    if not 0.0 < p.thickness < p.radius:
+        raise InputError(f"need 0 < thickness < radius, got thickness {p.thickness!r} and "
+                         f"radius {p.radius!r}")
+    if not 0.0 <= p.offset < 2.0 * p.radius:
+        raise InputError(f"offset must lie in [0, 2 radius), got {p.offset!r}")
+    if p.separation <= 0.0:
+        raise InputError(f"separation must be > 0, got {p.separation!r}")
+    if p.stiffness_ratio <= 0.0:
+        raise InputError(f"stiffness_ratio must be > 0, got {p.stiffness_ratio!r}")
+    if p.n_around < 2 or p.n_through < 1:
+        raise InputError("need n_around >= 2 and n_through >= 1")
+    build(p).validate()
+
+
+def centres(p: GasketParameters) -> dict[str, tuple[float, float]]:
+    """The centres of the soft (left) and stiff (right) gaskets, as gasket_pair places them."""
+    dx = p.radius + 0.5 * p.separation
+    return {"soft": (-dx, -0.5 * p.offset), "stiff": (dx, 0.5 * p.offset)}
+
+
+def build(p: GasketParameters | None = None) -> Model:
+    """The two gaskets, their backs driven towards each other and back again."""
+    p = p or GasketParameters()
+    meshes = dict(zip(("soft", "stiff"),
+                      gasket_pair(p.radius, p.thickness, p.offset, p.separation, p.n_around,
+                                  p.n_through)))
+    c = centres(p)
+    direction = {"soft": 1.0, "stiff": -1.0}  # towards the other gasket
+    moduli = {"soft": p.soft_youngs_modulus,
+              "stiff": p.soft_youngs_modulus * p.stiffness_ratio}
+    bodies = []
+    for name in ("soft", "stiff"):
+        mesh = meshes[name]
+        if p.order == 2:  # the contact face's facet midpoints on its circle
+            mesh = curved(mesh, "outer", c[name], p.radius)
+        bodies.append(Body(
+            name=name,
+            mesh=mesh,
+            material=LinearElastic(moduli[name], p.poissons_ratio, p.plane),
+            supports=(Support("back", ("y",)),),
+            prescribed=(PrescribedDisplacement("back", "x", direction[name] * p.back_motion),),
+            contact_boundaries=("outer",),
+            order=p.order,
+        ))
+    if p.swap_bodies:
+        bodies.reverse()
+    settings = ContactSettings(variant=p.variant, search_distance=p.search_distance,
+                               penetration_tolerance=p.penetration_tolerance,
+                               equilibrium_tolerance=p.equilibrium_tolerance)
+    return Model("gasket", bodies, settings, load_factors(p))
+
+
+# -- the current configuration ------------------------------------------------------------------
+
+def overlap_ignoring_contact(p: GasketParameters, load_factor: float) -> float:
+    """How deep the outer faces overlap at ``load_factor`` with contact ignored (0 if apart).
+
+    With contact ignored each gasket moves rigidly with its back (``Body.u_load`` is a
+    translation: nothing else loads it), so the overlap is that of the two outer circles along
+    the line of their centres, ``2 R - |c_soft - c_stiff|``.
+    """
+    dx = 2.0 * p.radius + p.separation - 2.0 * p.back_motion * load_factor
+    return max(0.0, 2.0 * p.radius - math.hypot(dx, p.offset))
+
+
+def _face(body: Body, centre: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """The outer and inner faces' points of a gasket, each in order along the face.
+
+    Ordered by their angle about the centre in the undeformed configuration; every point of a
+    face, midpoints included, so a curved quadratic face is followed through its midpoints.
+    """
+    X = body.points.T
+    out = []
+    for name in ("outer", "inner"):
+        idx = body.boundary_points(name)
+        ang = np.arctan2(X[idx, 1] - centre[1], X[idx, 0] - centre[0])
+        mid = np.angle(np.exp(1j * ang).mean())  # the middle of the face: no wrap-around
+        out.append(idx[np.argsort(np.angle(np.exp(1j * (ang - mid))))])
+    return out[0], out[1]
+
+
+def current_contact(model: Model, p: GasketParameters, displacements: dict[str, np.ndarray],
+                    forces: dict[str, np.ndarray] | None = None,
+                    status: dict[str, np.ndarray] | None = None) -> dict[str, float]:
+    """How the two faces meet in the current (deformed) configuration, X + u.
+
+    The contact algorithm measures its gaps its own way (the paired variant along normals
+    fixed in the undeformed configuration); this measures them geometrically, for the figures'
+    reader. ``displacements`` (and optionally ``forces``, the nodal contact forces, and
+    ``status``, 1 at nodes in contact) per body, at its points. Returns
+
+    * ``max_overlap``: the deepest any outer-face point of one gasket lies inside the other's
+      deformed section (0 if none), measured to the other's deformed outer face (polyline
+      through its points). Meaningful for overlaps shallower than the thickness;
+    * ``min_gap``: the smallest signed distance from a face point to the other face (negative:
+      overlap);
+    * with ``forces`` and ``status``: ``max_loaded_gap``, the widest gap bridged by a node in
+      contact carrying more than 1 % of the largest nodal force, and
+      ``max_force_angle_deg``, the largest angle between the line of such a node's force and the
+      normal of its own deformed face (0 for frictionless contact in the current
+      configuration); ``tensile_nodes``, how many nodes carry a force pulling their face
+      outwards (more than 1 % of the largest: consistent nodal forces of a traction next to the
+      edge of contact can be so, most of all on quadratic facets).
+    """
+    c = centres(p)
+    faces, outlines = {}, {}
+    for b in model.bodies:
+        x = b.points.T + displacements[b.name]
+        outer, inner = _face(b, c[b.name])
+        faces[b.name] = (outer, x)
+        outlines[b.name] = np.vstack([x[outer], x[inner[::-1]]])
+    out = {"max_overlap": 0.0, "min_gap": math.inf}
+    fmax = 0.0
+    if forces is not None:
+        fmax = max(float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in forces.values())
+    loaded_gap, angle, tensile = 0.0, 0.0, 0
+    for b in model.bodies:
+        other = next(o.name for o in model.bodies if o.name != b.name)
+        outer, x = faces[b.name]
+        oo, ox = faces[other]
+        face_other = ox[oo]
+        pts = x[outer]
+        _, _, dist = project_points(pts, face_other[:-1], face_other[1:])
+        inside = PolygonPath(outlines[other]).contains_points(pts)
+        gap = np.where(inside, -dist, dist)
+        out["min_gap"] = min(out["min_gap"], float(gap.min()))
+        out["max_overlap"] = max(out["max_overlap"], float(np.max(-gap, initial=0.0)))
+        if forces is None or fmax == 0.0:
+            continue
+        f = forces[b.name][outer]
+        fn = np.linalg.norm(f, axis=1)
+        # outward normal of the deformed face at each point (central differences along it)
+        tangent = pts[np.r_[1:len(pts), len(pts) - 1]] - pts[np.r_[0, 0:len(pts) - 1]]
+        normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+        normal /= np.linalg.norm(normal, axis=1)[:, None]
+        normal *= np.sign(np.einsum("ij,ij->i", normal, pts - outlines[b.name].mean(axis=0))
+                          )[:, None]
+        big = fn > 0.01 * fmax
+        inward = -np.einsum("ij,ij->i", f, normal)
+        tensile += int((big & (inward < 0)).sum())
+        on = big & (status[b.name][outer] > 0 if status is not None else True)
+        if on.any():
+            loaded_gap = max(loaded_gap, float(gap[on].max()))
+            cosine = np.abs(inward[on]) / fn[on]
+            angle = max(angle, float(np.degrees(np.arccos(np.clip(cosine, 0.0, 1.0))).max()))
+    if forces is not None:
+        out.update(max_loaded_gap=loaded_gap, max_force_angle_deg=angle, tensile_nodes=tensile)
+    return out
+
+
+# -- results ------------------------------------------------------------------------------------
+
+def total_force(step: StepResult, body: str = "soft") -> np.ndarray:
+    """The resultant (x, y) of the contact forces the other gasket applies to ``body``."""
+    return step.bodies[body].contact_force.sum(axis=0)
+
+
+def prediction(model: Model, previous: StepResult | None, load_factor: float
+               ) -> dict[str, np.ndarray]:
+    """The linear prediction of a step (thesis Figs. 5.19 and 5.21), per body, at its points.
+
+    As the solver predicts (``Analysis.solve_step``): the previous converged state's contact
+    forces held, the backs moved to the new load factor. Before the first contact it is the
+    configuration with contact ignored.
+    """
+    out = {}
+    for b in model.bodies:
+        f = np.zeros(b.ndofs)
+        if previous is not None:
+            f = previous.bodies[b.name].contact_force.ravel()
+        out[b.name] = b.displacement(load_factor, 0.0, f).reshape(-1, 2)
+    return out
+
+
+def scheduled_steps(result: AnalysisResult) -> list[StepResult | None]:
+    """The converged step at each scheduled load factor, None where the analysis stopped.
+
+    A step the solver had to cut adds intermediate steps to ``result.steps``; the example's
+    step k is the one that reached the k-th scheduled load factor.
+    """
+    out: list[StepResult | None] = []
+    it = iter(result.steps)
+    for lf in result.model.load_factors:
+        out.append(next((s for s in it if abs(s.load_factor - lf) <= 1e-12), None))
+    return out
+
+
+def force_history(summary: dict) -> np.ndarray:
+    """F[k], the total contact force after step k (F[0] = 0, the initial state)."""
+    return np.r_[0.0, [r["contact_force"] for r in summary["steps"]]]
+
+
+def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
+    """The ``summary.json`` dictionary of a gasket run."""
+    model = result.model
+    steps = scheduled_steps(result)
+    rows = []
+    previous = None
+    for k, s in enumerate(steps):
+        if s is None:
+            break
+        disp = {n: r.displacement for n, r in s.bodies.items()}
+        forces = {n: r.contact_force for n, r in s.bodies.items()}
+        status = {n: r.contact_status for n, r in s.bodies.items()}
+        pred = current_contact(model, p, prediction(model, previous, s.load_factor))
+        F, F_stiff = total_force(s), total_force(s, "stiff")
+        back = {}
+        for b in model.bodies:
+            u = disp[b.name].ravel()
+            back[b.name] = [b.reaction(u, "back", c, s.load_factor, forces[b.name].ravel())
+                            for c in ("x", "y")]
+        rows.append({
+            "step": k + 1,
+            "load_factor": s.load_factor,
+            "iterations": s.iterations,
+            "cuts": s.cuts,
+            "contact_force": float(np.linalg.norm(F)),
+            "contact_force_soft": [float(v) for v in F],
+            "contact_force_stiff": [float(v) for v in F_stiff],
+            "back_reaction": back,
+            "contact_nodes": {n: int((v > 0).sum()) for n, v in status.items()},
+            "max_penetration": s.history[-1].max_penetration,
+            "max_equilibrium_error": s.history[-1].max_equilibrium_error,
+            "stopped_at_fixed_point": s.fixed_point,
+            "prediction_overlap": pred["max_overlap"],
+            "current_configuration": current_contact(model, p, disp, forces, status),
+        })
+        previous = s
+    n = p.steps
+    summary: dict = {
+        "example": "gasket",
+        "converged": result.converged and len(rows) == len(model.load_factors),
+        "message": result.message,
+        "steps": rows,
+        "solver_steps": len(result.steps),
+        "closure_at_first_touch": closure_at_first_touch(p),
+        "overlap_ignoring_contact": [overlap_ignoring_contact(p, lf)
+                                     for lf in model.load_factors[:n]],
+    }
+    overlap = [r["step"] for r in rows if r["prediction_overlap"] > 0]
+    touch = [r["step"] for r in rows if r["contact_force"] > 0]
+    summary["first_overlap_step"] = overlap[0] if overlap else None
+    summary["first_contact_step"] = touch[0] if touch else None
+    F = force_history(summary)
+    summary["largest_force_step"] = int(np.argmax(F)) if F.max() > 0 else None
+    summary["largest_force"] = float(F.max())
+    if len(rows) == 2 * n:
+        summary["mirror_error"] = (float(np.max(np.abs(F[: n + 1] - F[::-1][: n + 1])) / F.max())
+                                   if F.max() > 0 else 0.0)
+        summary["reversibility"] = float(max(np.abs(r.displacement).max()
+                                             for r in steps[-1].bodies.values()))
+    # Newton's third law across the interface: the two resultants must cancel
+    imbalance = [float(np.linalg.norm(np.add(r["contact_force_soft"], r["contact_force_stiff"])))
+                 / r["contact_force"] for r in rows if r["contact_force"] > 0]
+    summary["max_force_imbalance"] = max(imbalance, default=0.0)
+    summary["bodies"] = {s.body.name: {"nodes": int(s.body.npoints), "dofs": int(s.body.ndofs),
+                                       "contact_candidate_nodes": int(s.nc),
+                                       "youngs_modulus": s.body.material.youngs_modulus}
+                         for s in result.surfaces}
+    summary["dofs"] = int(sum(s.body.ndofs for s in result.surfaces))
+    summary["parameters"] = asdict(p)
+    summary["timings"] = result.timings
+    return summary
+
+
+# -- running ------------------------------------------------------------------------------------
+
+def run(p: GasketParameters, out, on_step=None, figures: bool = True) -> dict:
+    """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
+    from pathlib import Path
+
+    from ..io.results import ResultsWriter, write_summary
+    from ..solver import Analysis
+
+    out = Path(out)
+    model = build(p)
+    analysis = Analysis(model)
+    analysis.setup()
+    writer = ResultsWriter(out, model)
+
+    def step_done(step):
+        writer.write_step(step)
+        if on_step is not None:
+            on_step(step)
+
+    result = analysis.run(step_done)
+    summary = summarize(result, p)
+    if figures:
+        summary["figures"] = draw(result, p, out)
+    write_summary(out, summary)
+    return summary
+
+
+def draw(result: AnalysisResult, p: GasketParameters, out) -> list[str]:
+    """The figures of thesis Figs. 5.17 to 5.23 and the force history; returns their names.
+
+    Configurations at true scale (the meshes' vertices; quadratic elements drawn straight).
+    """
+    from pathlib import Path
+
+    from ..io.plots import configurations, history
+
+    out = Path(out)
+    model = result.model
+    steps = scheduled_steps(result)
+    bodies = sorted(model.bodies, key=lambda b: b.name)  # soft, stiff: the same colours always
+    zero = {b.name: np.zeros((b.npoints, 2)) for b in bodies}
+    names: list[str] = []
+
+    def frame(label, disp):
+        return (label, [(b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
+                         disp[b.name][: b.mesh.nvertices]) for b in bodies])
+
+    def save(name, frames, title, **kw):
+        configurations(out / name, frames, title, **kw)
+        names.append(name)
+
+    n = p.steps
+    save("initial.png", [frame("initial (soft left, stiff right)", zero)],
+         "Gasket: initial configuration")
+    ignored = {b.name: b.u_load.reshape(-1, 2) for b in bodies}
+    save("ignoring_contact.png", [frame("initial", zero),
+                                  frame(f"step {n}, contact ignored", ignored)],
+         f"Gasket: initial and step {n} positions, contact ignored")
+    for k in SHOWN_STEPS:
+        if k > len(steps) or steps[k - 1] is None:
+            continue
+        res = steps[k - 1]
+        pred = prediction(model, steps[k - 2] if k >= 2 else None, res.load_factor)
+        disp = {name: r.displacement for name, r in res.bodies.items()}
+        save(f"step{k:02d}_prediction.png", [frame(f"step {k}, linear prediction", pred)],
+             f"Gasket: linear prediction for step {k} (step {k - 1}'s contact forces held)")
+        save(f"step{k:02d}_resolved.png", [frame(f"step {k}, resolved", disp)],
+             f"Gasket: resolved position after iterations, step {k}")
+        window = _contact_window(model, res)
+        if window is not None:
+            save(f"step{k:02d}_contact.png",
+                 [frame(f"step {k}, linear prediction", pred), frame(f"step {k}, resolved", disp)],
+                 f"Gasket: contact region, step {k}, true scale", window=window,
+                 mesh_lines=False)
+    if steps and steps[-1] is not None:
+        disp = {name: r.displacement for name, r in steps[-1].bodies.items()}
+        save("initial_final.png", [frame("initial", zero), frame(f"final (step {2 * n})", disp)],
+             "Gasket: initial and final configurations")
+    F = np.r_[0.0, [float(np.linalg.norm(total_force(s))) for s in steps if s is not None]]
+    k = np.arange(n + 1)
+    series = {"loading: after step k": F[: n + 1]}
+    if len(F) == 2 * n + 1:
+        series[f"unloading: after step {2 * n} - k"] = F[::-1][: n + 1]
+    history(out / "contact_force.png", k, series, "step k", "total contact force on a gasket",
+            "Gasket: contact force, loading and unloading (mirrored)")
+    names.append("contact_force.png")
+    return names
+
+
+def _contact_window(model: Model, step: StepResult) -> tuple[float, float, float, float] | None:
+    """A square window around the nodes carrying contact force (current configuration)."""
+    pts = [(b.points.T + step.bodies[b.name].displacement)[
+        np.linalg.norm(step.bodies[b.name].contact_force, axis=1) > 0] for b in model.bodies]
+    pts = np.vstack(pts)
+    if len(pts) == 0:
+        return None
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    half = 0.5 * float((hi - lo).max()) + 0.1
+    cx, cy = 0.5 * (lo + hi)
+    return (cx - half, cx + half, cy - half, cy + half)
+
+
+def report(s: dict) -> list[str]:
+    """The closing lines of a gasket run."""
+    rows = s["steps"]
+    lines = [f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(rows)} steps, "
+             f"{sum(r['iterations'] for r in rows)} contact iterations, {s['dofs']} dofs, "
+             f"{s['timings']['total_s']:.1f} s"]
+    lines.append(f"  first overlap at step {s['first_overlap_step']}, largest contact force "
+                 f"{s['largest_force']:.6g} at step {s['largest_force_step']}")
+    if "mirror_error" in s:
+        lines.append(f"  unloading mirrors loading to {s['mirror_error']:.1e} of the largest "
+                     f"force; after step {len(rows)} no node is more than "
+                     f"{s['reversibility']:.1e} from its start")
+    if rows:
+        geo = [r["current_configuration"] for r in rows]
+        lines.append(f"  current configuration: deepest overlap "
+                     f"{max(g['max_overlap'] for g in geo):.2e}, widest gap bridged by a node "
+                     f"in contact {max(g['max_loaded_gap'] for g in geo):.2e}, forces up to "
+                     f"{max(g['max_force_angle_deg'] for g in geo):.1f} deg off the face normal")
+        imbalance = s["max_force_imbalance"]
+        if imbalance > 1e-6:
+            lines.append(f"  WARNING: the contact forces on the two gaskets differ by up to "
+                         f"{imbalance:.1%} of the force")
+        else:
+            lines.append(f"  contact forces on the two gaskets balance to {imbalance:.1e}")
+    lines.append("  results: summary.json, results.pvd (ParaView), "
+                 + ", ".join(s.get("figures", [])))
+    return lines

@@ -1,0 +1,532 @@
+"""Thesis §5.3: a wide shallow wedge driven into a flat plate, five stiffness ratios.
+
+Plane strain, right half of the model (the symmetry plane x = 0 has u_x = 0 on both bodies).
+Plate: ``[0, 5] x [-1, 0]``, fixed on its lower face. Wedge: 1.3 thick at the centre and 1 at its
+outer edge (x = 5); its lower face rises straight from the tip, which touches the plate at the
+origin, to 0.3 at the edge; its top face is flat. The central portion of the wedge's top face,
+0 <= x <= 1 (the middle fifth of the whole wedge: the thesis gives no width), moves down by 0.3.
+Both bodies have nu = 0.3; the plate's modulus is 1 and the wedge's 1000, 2, 1, 1/2 and 1/1000
+times that in the five cases (only the ratio matters: displacements are prescribed, so the
+displacements do not depend on the moduli's common scale and the forces are proportional to it).
+
+Ignoring contact, the wedge moves down rigidly by 0.3 (the linear prediction, thesis Fig. 5.5):
+its tip overlaps the plate by 0.3 and the overlap falls linearly to 0 at the outer edge, so the
+whole lower face of the wedge is a contact candidate (``search_distance`` is set to 1.1 times
+the rise). The example reports how the 0.3 overlap at the tip is shared: the plate's share is
+the plate tip's downward displacement over 0.3, the wedge's share how far its tip was pushed
+back up from the prediction over 0.3; at convergence the two add up to 1.
+
+Meshes (``mesh``):
+
+* ``"graded"`` (default): the triangles of :func:`vfem.mesh.wedge` and
+  :func:`vfem.mesh.wedge_plate`, of size ``h_contact`` (0.05) at the tip growing by ``growth``
+  per unit distance to ``h_max`` (0.25); ``refinement`` halves both per level.
+* ``"coarse"``: ``coarse_columns`` x ``coarse_rows`` (15 x 3) quadrilaterals per body, a mesh of
+  the thesis's era whose surface elements are deeper than the 0.3 overlap.
+
+Load steps. The thesis applies the whole motion in one step, but it also requires that no node
+go deeper into the other body than its outer layer of elements (thesis §5.6, the *rind*; the
+solver cuts a step that breaks it). The linear prediction puts the tip 0.3 deep, so one step
+needs surface elements deeper than 0.3: the coarse mesh takes one step, the graded one (tip
+elements about 0.025 deep) 15. ``steps = 0`` (default) chooses the fewest equal steps that keep
+the predicted overlap increment within the rind, with a 10 % margin (:func:`planned_steps`).
+The problem is linear (small strain, surfaces paired in the undeformed configuration), so the
+final state does not depend on the number of steps, only the iteration counts do.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from skfem import MeshQuad, MeshTri
+
+from ..bodies import Body, PrescribedDisplacement, Support
+from ..contact.settings import CONVERGENCE_CRITERIA, VARIANTS, ContactSettings
+from ..errors import AnalysisError, InputError
+from ..materials import LinearElastic
+from ..mesh import wedge, wedge_plate
+from ..solver import Analysis, AnalysisResult, Model, StepResult
+
+#: Wedge/plate modulus ratio of the thesis's five cases, in its numbering.
+RATIOS = (1000.0, 2.0, 1.0, 0.5, 0.001)
+#: Iterations the thesis reports for the five cases (one step each).
+THESIS_ITERATIONS = (3, 6, 4, 4, 2)
+#: The thesis's figure of each case's final configuration.
+THESIS_FIGURES = {1: "5.6", 5: "5.7", 3: "5.8", 2: "5.9", 4: "5.10"}
+#: The thesis's overlays of final configurations (cases, figure).
+OVERLAYS = (((1, 3, 5), "5.11"), ((1, 2, 3), "5.12"), ((3, 4, 5), "5.13"))
+MESHES = ("graded", "coarse")
+#: Margin of the automatic step count on the rind rule (see :func:`planned_steps`).
+RIND_MARGIN = 1.1
+
+
+@dataclass(frozen=True)
+class WedgeParameters:
+    """Parameters of the wedge example; the thesis's values (where it gives them) are defaults."""
+
+    plate_youngs_modulus: float = 1.0  # the wedge's is ratio x this
+    poissons_ratio: float = 0.3  # both bodies
+    half_width: float = 5.0  # not in the thesis: "wide"; slope 0.06
+    plate_thickness: float = 1.0
+    edge_thickness: float = 1.0
+    centre_thickness: float = 1.3
+    loaded_width: float | None = None  # default half_width / 5: the middle fifth of the wedge
+    motion: float = 0.3  # downward, on the loaded part of the wedge's top face
+    case: int = 0  # 0: all five; 1 to 5: that case only
+    mesh: str = "graded"  # or "coarse"
+    h_contact: float = 0.05  # graded mesh: element size at the tip
+    h_max: float = 0.25
+    growth: float = 0.1
+    refinement: int = 0  # graded mesh: halves h_contact and h_max per level
+    coarse_columns: int = 15  # coarse mesh: quadrilaterals across each body
+    coarse_rows: int = 3  # and through each body's thickness
+    steps: int = 0  # 0: the fewest equal steps that respect the rind rule
+    variant: str = "paired"
+    convergence: str = "stationary"
+    penetration_tolerance: float | None = None
+    equilibrium_tolerance: float = 1e-3
+    max_iterations: int = 100
+    max_step_cuts: int = 6
+    swap_bodies: bool = False  # list the plate first
+    figures: bool = True
+
+
+Parameters = WedgeParameters
+
+
+# -- the model ----------------------------------------------------------------------------------
+
+def cases(p: WedgeParameters) -> list[int]:
+    """The case numbers (1 to 5) a run covers."""
+    return [p.case] if p.case else [1, 2, 3, 4, 5]
+
+
+def loaded_width(p: WedgeParameters) -> float:
+    """Width of the moving part of the wedge's top face, from the symmetry plane."""
+    return p.half_width / 5.0 if p.loaded_width is None else float(p.loaded_width)
+
+
+def rise(p: WedgeParameters) -> float:
+    """Height of the wedge's lower face at its outer edge above the tip."""
+    return p.centre_thickness - p.edge_thickness
+
+
+def meshes(p: WedgeParameters) -> tuple[MeshTri | MeshQuad, MeshTri | MeshQuad]:
+    """(plate, wedge) meshes with the named boundaries of :mod:`vfem.mesh.shapes`."""
+    if p.mesh == "coarse":
+        return coarse_meshes(p)
+    scale = 0.5**p.refinement
+    kw = dict(h_contact=p.h_contact * scale, h_max=p.h_max * scale, growth=p.growth)
+    plate = wedge_plate(p.half_width, p.plate_thickness, **kw)
+    body = wedge(p.half_width, p.edge_thickness, p.centre_thickness,
+                 loaded_width=loaded_width(p), **kw)
+    return plate, body
+
+
+def coarse_meshes(p: WedgeParameters) -> tuple[MeshQuad, MeshQuad]:
+    """Structured quadrilaterals: ``coarse_columns`` across, ``coarse_rows`` through each body.
+
+    Columns are uniform on either side of x = loaded_width (a grid line, where the prescribed
+    motion ends); the wedge's rows follow its inclined lower face. The plate's surface
+    elements are plate_thickness / coarse_rows deep (1/3 by default, more than the 0.3 overlap
+    of the linear prediction, so the thesis's single step respects the rind rule).
+    """
+    W, b, n = p.half_width, loaded_width(p), p.coarse_columns
+    if b < W:
+        n1 = min(max(1, round(n * b / W)), n - 1)  # columns under the loaded part
+        x = np.concatenate([np.linspace(0.0, b, n1 + 1), np.linspace(b, W, n - n1 + 1)[1:]])
+    else:
+        x = np.linspace(0.0, W, n + 1)
+    T, r = p.centre_thickness, rise(p)
+    tol = 1e-9 * max(W, T, p.plate_thickness)
+    plate = _mapped_quads(x, lambda s: -p.plate_thickness + 0 * s, lambda s: 0 * s,
+                          p.coarse_rows).with_boundaries({
+        "contact": lambda q: q[1] > -tol,
+        "bottom": lambda q: q[1] < -p.plate_thickness + tol,
+        "symmetry": lambda q: q[0] < tol,
+        "right": lambda q: q[0] > W - tol,
+    })
+    on_top = lambda q: q[1] > T - tol  # noqa: E731
+    body = _mapped_quads(x, lambda s: r * s / W, lambda s: T + 0 * s,
+                         p.coarse_rows).with_boundaries({
+        "contact": lambda q: (q[1] < T - tol) & (q[0] > tol) & (q[0] < W - tol),
+        "symmetry": lambda q: q[0] < tol,
+        "top_loaded": lambda q: on_top(q) & (q[0] < b),
+        "top": lambda q: on_top(q) & (q[0] > b),
+        "right": lambda q: q[0] > W - tol,
+    })
+    return plate, body
+
+
+def _mapped_quads(x: np.ndarray, lower, upper, rows: int) -> MeshQuad:
+    """Quadrilaterals between y = lower(x) and y = upper(x) on the columns ``x``, counter-
+    clockwise, ``rows`` of them evenly spaced at each x."""
+    s = np.linspace(0.0, 1.0, rows + 1)
+    X, S = np.meshgrid(x, s, indexing="ij")
+    Y = lower(X) + S * (upper(X) - lower(X))
+    i, j = np.meshgrid(np.arange(len(x) - 1), np.arange(rows), indexing="ij")
+    k = (i * (rows + 1) + j).ravel()
+    t = np.vstack([k, k + rows + 1, k + rows + 2, k + 1])
+    return MeshQuad(np.vstack([X.ravel(), Y.ravel()]), t)
+
+
+def surface_depth(mesh: MeshTri | MeshQuad, boundary: str) -> tuple[np.ndarray, np.ndarray]:
+    """(x at the facet's end nearer the tip, depth) of each facet of ``boundary``: the depth is
+    the area of the element behind the facet over the facet's length, as the solver's rind rule
+    measures it (``ContactSurface.rind_depth``)."""
+    f = mesh.boundaries[boundary]
+    elem = mesh.f2t[0, f]
+    x, y = mesh.p[:, mesh.t[:, elem]]
+    area = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y, axis=0))
+    ends = mesh.p[:, mesh.facets[:, f]]  # (2, 2, nf)
+    length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=0)
+    return ends[0].min(axis=0), area / length
+
+
+def planned_steps(p: WedgeParameters, plate: MeshTri | MeshQuad,
+                  body: MeshTri | MeshQuad) -> int:
+    """Equal steps of the motion: ``p.steps``, or (0) the fewest that respect the rind rule.
+
+    In a step the wedge moves down rigidly by motion / steps on top of the converged state, so
+    a facet at x is overlapped by at most (motion - rise x / half_width) / steps. That must stay
+    within the depth of the surface elements of both bodies (the side whose nodes are checked
+    depends on the stiffnesses), with a margin of ``RIND_MARGIN``.
+    """
+    if p.steps > 0:
+        return int(p.steps)
+    worst = 0.0
+    for mesh in (plate, body):
+        x, depth = surface_depth(mesh, "contact")
+        overlap = np.clip(p.motion - rise(p) * x / p.half_width, 0.0, None)
+        worst = max(worst, float(np.max(overlap / depth)))
+    return max(1, math.ceil(RIND_MARGIN * worst))
+
+
+def settings(p: WedgeParameters) -> ContactSettings:
+    return ContactSettings(variant=p.variant, convergence=p.convergence,
+                           penetration_tolerance=p.penetration_tolerance,
+                           equilibrium_tolerance=p.equilibrium_tolerance,
+                           max_iterations=p.max_iterations, max_step_cuts=p.max_step_cuts,
+                           search_distance=1.1 * rise(p))
+
+
+def build(p: WedgeParameters | None = None, case: int = 3,
+          mesh_pair: tuple[MeshTri | MeshQuad, MeshTri | MeshQuad] | None = None) -> Model:
+    """The model of one case (1 to 5); ``mesh_pair`` = (plate, wedge) meshes to reuse."""
+    p = p or WedgeParameters()
+    plate_mesh, wedge_mesh = mesh_pair or meshes(p)
+    ratio = RATIOS[case - 1]
+    plate = Body(
+        name="plate", mesh=plate_mesh,
+        material=LinearElastic(p.plate_youngs_modulus, p.poissons_ratio),
+        supports=(Support("bottom", ("x", "y")), Support("symmetry", ("x",))),
+        contact_boundaries=("contact",),
+    )
+    upper = Body(
+        name="wedge", mesh=wedge_mesh,
+        material=LinearElastic(ratio * p.plate_youngs_modulus, p.poissons_ratio),
+        supports=(Support("symmetry", ("x",)),),
+        prescribed=(PrescribedDisplacement("top_loaded", "y", -p.motion),),
+        contact_boundaries=("contact",),
+    )
+    bodies = [plate, upper] if p.swap_bodies else [upper, plate]
+    n = planned_steps(p, plate_mesh, wedge_mesh)
+    return Model(f"wedge case {case} (E_wedge / E_plate = {ratio:g})", bodies, settings(p),
+                 tuple((k + 1) / n for k in range(n)))
+
+
+def validate(p: WedgeParameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    def need(ok: bool, message: str) -> None:
+        if not ok:
+            raise InputError(f"wedge: {message}")
+
+    finite = all(isinstance(v, (int, float)) and math.isfinite(v) for v in
+                 (p.half_width, p.plate_thickness, p.edge_thickness, p.centre_thickness,
+                  p.motion, p.h_contact, p.h_max, p.growth))
+    need(finite, "dimensions and mesh sizes must be finite numbers")
+    need(p.half_width > 0 and p.plate_thickness > 0, "half_width and plate_thickness must be > 0")
+    need(0 < p.edge_thickness < p.centre_thickness,
+         f"need 0 < edge_thickness < centre_thickness, got {p.edge_thickness!r} and "
+         f"{p.centre_thickness!r}")
+    need(p.motion > 0, f"motion must be > 0, got {p.motion!r}")
+    b = loaded_width(p)
+    need(0 < b <= p.half_width, f"loaded_width must lie in (0, half_width], got {b!r}")
+    need(p.case in (0, 1, 2, 3, 4, 5), f"case must be 0 (all) or 1 to 5, got {p.case!r}")
+    need(p.mesh in MESHES, f"mesh must be one of {MESHES}, got {p.mesh!r}")
+    need(p.variant in VARIANTS, f"variant must be one of {VARIANTS}, got {p.variant!r}")
+    need(p.convergence in CONVERGENCE_CRITERIA,
+         f"convergence must be one of {CONVERGENCE_CRITERIA}, got {p.convergence!r}")
+    need(0 < p.h_contact <= p.h_max and p.growth >= 0,
+         "need 0 < h_contact <= h_max and growth >= 0")
+    need(p.refinement >= 0 and p.steps >= 0, "refinement and steps must be >= 0")
+    need(p.coarse_columns >= 2 and p.coarse_rows >= 1,
+         "need coarse_columns >= 2 and coarse_rows >= 1")
+    need(p.max_step_cuts >= 0, "max_step_cuts must be >= 0")
+    try:
+        mesh_pair = meshes(p)
+    except ValueError as exc:
+        raise InputError(f"wedge: {exc}") from None
+    build(p, cases(p)[0], mesh_pair).validate()
+
+
+# -- one case -----------------------------------------------------------------------------------
+
+class StepsTooSmall(AnalysisError):
+    """Cut steps kept converging and failing again ever closer to one load factor."""
+
+
+def tip(body: Body) -> int:
+    """The body's point at the origin: the wedge's tip, the plate's point under it."""
+    return int(np.argmin(np.hypot(*body.points)))
+
+
+def solve_case(p: WedgeParameters, model: Model, on_step=None
+               ) -> tuple[AnalysisResult | None, list[StepResult], str, str | None]:
+    """Run one case's model: (result or None, converged steps, failure message, the body whose
+    surface carries compatibility in the paired variant, else None).
+
+    The solver halves a failed step and forgets the cut once a half converges, so where the
+    iteration cannot converge at all it would step ever closer to that load factor without
+    end. A converged step smaller than 1 / 2**max_step_cuts of the planned one stops the case
+    here instead (reported as not converged).
+    """
+    analysis = Analysis(model)
+    planned = model.load_factors[0]
+    smallest = planned / 2**p.max_step_cuts * (1 - 1e-9)
+    steps: list[StepResult] = []
+
+    def step_done(step: StepResult) -> None:
+        previous = steps[-1].load_factor if steps else 0.0
+        steps.append(step)
+        if on_step is not None:
+            on_step(step)
+        if step.load_factor < 1.0 and step.load_factor - previous < smallest:
+            raise StepsTooSmall(
+                f"steps shrank below 1/{2**p.max_step_cuts} of the planned {planned:.4g} near "
+                f"load factor {step.load_factor:.6g}: the {p.variant} variant does not converge "
+                "there")
+
+    try:
+        result = analysis.run(step_done)
+    except AnalysisError as exc:
+        result = None
+        message = str(exc)
+    else:
+        message = result.message
+    pairs = getattr(getattr(analysis, "contact", None), "contact_pairs", None)
+    compatibility = model.bodies[pairs[0].fine].name if pairs else None
+    return result, steps if result is None else result.steps, message, compatibility
+
+
+def evaluate(model: Model, steps: list[StepResult], p: WedgeParameters) -> dict:
+    """Shares of the tip overlap, contact forces and their balance at load factor 1."""
+    last = steps[-1]
+    bodies = {b.name: b for b in model.bodies}
+    plate, upper = bodies["plate"], bodies["wedge"]
+    rp, rw = last.bodies["plate"], last.bodies["wedge"]
+    tp, tw = tip(plate), tip(upper)
+    predicted = float(upper.u_load[2 * tw + 1])  # the wedge tip, contact ignored
+    plate_share = -float(rp.displacement[tp, 1]) / p.motion
+    wedge_share = (float(rw.displacement[tw, 1]) - predicted) / p.motion
+    f_wedge = rw.contact_force.sum(axis=0)  # on the wedge, from the plate
+    f_plate = rp.contact_force.sum(axis=0)
+    support = plate.reaction(rp.displacement.ravel(), "bottom", "y", last.load_factor,
+                             rp.contact_force.ravel())
+    drive = upper.reaction(rw.displacement.ravel(), "top_loaded", "y", last.load_factor,
+                           rw.contact_force.ravel())
+    force = float(f_wedge[1])
+    scale = max(abs(force), 1e-300)
+    x_contact = upper.points[0][rw.contact_status > 0]
+    penetration = max(float(r.penetration.max()) for r in last.bodies.values())
+    return {
+        "plate_tip_displacement": -plate_share * p.motion,
+        "wedge_tip_displacement": float(rw.displacement[tw, 1]),
+        "wedge_tip_predicted": predicted,
+        "plate_share": plate_share,
+        "wedge_share": wedge_share,
+        "share_sum": plate_share + wedge_share,
+        "contact_force": force,
+        "contact_force_x": float(f_wedge[0]),
+        "contact_force_plate": -float(f_plate[1]),
+        "plate_support_reaction": support,
+        "wedge_drive_reaction": drive,
+        "plate_balance_error": abs(support + float(f_plate[1])) / scale,
+        "action_reaction_error": float(np.linalg.norm(f_wedge + f_plate)) / scale,
+        "final_max_penetration": max(penetration, 0.0),
+        "contact_nodes_wedge": int((rw.contact_status > 0).sum()),
+        "contact_nodes_plate": int((rp.contact_status > 0).sum()),
+        "contact_extent": float(x_contact.max()) if len(x_contact) else 0.0,
+    }
+
+
+def summarize_case(p: WedgeParameters, case: int, model: Model, steps: list[StepResult],
+                   converged: bool, message: str, seconds: float,
+                   compatibility: str | None = None) -> dict:
+    """The ``summary.json`` entry of one case."""
+    iterations = [s.iterations for s in steps]
+    out = {
+        "case": case,
+        "modulus_ratio": RATIOS[case - 1],
+        "wedge_youngs_modulus": RATIOS[case - 1] * p.plate_youngs_modulus,
+        "plate_youngs_modulus": p.plate_youngs_modulus,
+        "thesis_iterations": THESIS_ITERATIONS[case - 1],
+        "thesis_figure": THESIS_FIGURES[case],
+        "planned_steps": len(model.load_factors),
+        "converged": converged,
+        "message": message,
+        "compatibility_surface": compatibility,
+        "iterations": iterations,
+        "total_iterations": int(sum(iterations)),
+        "load_factors": [s.load_factor for s in steps],
+        "cuts": int(sum(s.cuts for s in steps)),
+        "stopped_at_fixed_point": int(sum(s.fixed_point for s in steps)),
+        "max_penetration": max((s.history[-1].max_penetration for s in steps), default=None),
+        "max_equilibrium_error": max((s.history[-1].max_equilibrium_error for s in steps),
+                                     default=None),
+        "seconds": seconds,
+    }
+    if steps and steps[-1].load_factor == 1.0:
+        out.update(evaluate(model, steps, p))
+    return out
+
+
+# -- the run ------------------------------------------------------------------------------------
+
+def run(p: WedgeParameters, out=None, on_step=None) -> dict:
+    """Run the cases, writing ``out/caseN/`` (VTU/PVD), the figures and ``summary.json``."""
+    from ..io.results import ResultsWriter, write_summary
+
+    start = time.perf_counter()
+    mesh_pair = meshes(p)
+    out = Path(out) if out is not None else None
+    entries, finals, models = [], {}, {}
+    for case in cases(p):
+        t0 = time.perf_counter()
+        model = build(p, case, mesh_pair)
+        writer = ResultsWriter(out / f"case{case}", model) if out is not None else None
+
+        def step_done(step, writer=writer):
+            if writer is not None:
+                writer.write_step(step)
+            if on_step is not None:
+                on_step(step)
+
+        result, steps, message, compatibility = solve_case(p, model, step_done)
+        converged = result is not None and result.converged
+        entries.append(summarize_case(p, case, model, steps, converged, message,
+                                      time.perf_counter() - t0, compatibility))
+        models[case] = model
+        if steps and steps[-1].load_factor == 1.0:
+            finals[case] = steps[-1]
+    first = models[cases(p)[0]]
+    summary = {
+        "example": "wedge",
+        "converged": all(c["converged"] for c in entries),
+        "message": "; ".join(f"case {c['case']}: {c['message']}" for c in entries
+                             if not c["converged"]),
+        "variant": p.variant,
+        "mesh": p.mesh,
+        "steps": [{"case": c["case"], "step": k + 1, "load_factor": lf, "iterations": it,
+                   "converged": True}
+                  for c in entries for k, (lf, it) in enumerate(zip(c["load_factors"],
+                                                                      c["iterations"]))],
+        "cases": entries,
+        "bodies": {b.name: {"points": int(b.npoints), "dofs": int(b.ndofs),
+                            "elements": int(b.mesh.t.shape[1])} for b in first.bodies},
+        "dofs": int(sum(b.ndofs for b in first.bodies)),
+        "loaded_width": loaded_width(p),
+        "search_distance": settings(p).search_distance,
+        "parameters": dataclasses.asdict(p),
+        "timings": {},
+    }
+    if out is not None and p.figures:
+        summary["figures"] = draw(out, first, finals, models, p)
+    summary["timings"] = {"total_s": time.perf_counter() - start,
+                          "cases_s": float(sum(c["seconds"] for c in entries))}
+    if out is not None:
+        write_summary(out, summary)
+    return summary
+
+
+def draw(out: Path, first: Model, finals: dict[int, StepResult], models: dict[int, Model],
+         p: WedgeParameters) -> list[str]:
+    """The thesis's figures 5.4 to 5.13 (those whose cases ran); returns the file names."""
+    from ..io.plots import configurations
+
+    def frames(model: Model, disp: dict[str, np.ndarray], label: str = "") -> list:
+        """One frame per body (wedge first), so each body gets its colour and legend entry."""
+        order = sorted(model.bodies, key=lambda b: b.name != "wedge")
+        return [(f"{label}{b.name}", [(b.points.T, b.mesh.t.T, disp[b.name])]) for b in order]
+
+    def outline(model: Model, disp: dict[str, np.ndarray], label: str) -> tuple:
+        """One frame for a whole configuration: both bodies in one colour."""
+        order = sorted(model.bodies, key=lambda b: b.name != "wedge")
+        return (label, [(b.points.T, b.mesh.t.T, disp[b.name]) for b in order])
+
+    names = []
+    zero = {b.name: np.zeros((b.npoints, 2)) for b in first.bodies}
+    configurations(out / "mesh.png", frames(first, zero),
+                   f"Wedge (thesis Fig. 5.4): the meshes in the original configuration "
+                   f"({p.mesh})", mesh_lines=True)
+    names.append("mesh.png")
+    prediction = {b.name: b.u_load.reshape(-1, 2) for b in first.bodies}
+    configurations(out / "prediction.png", frames(first, prediction),
+                   f"Wedge (Fig. 5.5): the linear prediction, contact ignored: the wedge "
+                   f"moves down {p.motion:g}", mesh_lines=True)
+    names.append("prediction.png")
+    final = {case: {name: r.displacement for name, r in step.bodies.items()}
+             for case, step in finals.items()}
+    for case in sorted(finals):
+        name = f"case{case}.png"
+        configurations(out / name, frames(models[case], final[case]),
+                       f"Wedge case {case} (Fig. {THESIS_FIGURES[case]}): E_wedge / E_plate = "
+                       f"{RATIOS[case - 1]:g}, final configuration, true scale",
+                       mesh_lines=True)
+        names.append(name)
+    for group, figure in OVERLAYS:
+        if not all(c in finals for c in group):
+            continue
+        name = "cases_" + "_".join(str(c) for c in group) + ".png"
+        configurations(out / name,
+                       [outline(models[c], final[c],
+                                f"case {c}: E_wedge / E_plate = {RATIOS[c - 1]:g}")
+                        for c in group],
+                       f"Wedge (Fig. {figure}): final configurations of cases "
+                       f"{', '.join(str(c) for c in group)}, true scale", mesh_lines=False)
+        names.append(name)
+    return names
+
+
+def report(s: dict) -> list[str]:
+    """The closing lines of a wedge run: one row per case."""
+    lines = [f"vfem: wedge (thesis §5.3), {s['variant']} variant, {s['mesh']} mesh, "
+             f"{s['dofs']} dofs: {'converged' if s['converged'] else 'NOT converged'}, "
+             f"{s['timings']['total_s']:.1f} s",
+             f"  {'case':>4} {'E_w/E_p':>7} {'steps':>5} {'iterations':>10} {'thesis':>6} "
+             f"{'plate share':>11} {'wedge share':>11} {'sum':>8} {'contact force':>13} "
+             f"{'penetration':>11}"]
+    for c in s["cases"]:
+        head = (f"  {c['case']:>4} {c['modulus_ratio']:>7g} {len(c['iterations']):>5} "
+                f"{c['total_iterations']:>10} {c['thesis_iterations']:>6}")
+        if "plate_share" in c:
+            lines.append(f"{head} {c['plate_share']:>11.2%} {c['wedge_share']:>11.2%} "
+                         f"{c['share_sum']:>8.5f} {c['contact_force']:>13.5g} "
+                         f"{c['max_penetration']:>11.1e}")
+        else:
+            lines.append(f"{head}  did not reach the full motion: {c['message']}")
+    if any(len(c["iterations"]) > 1 for c in s["cases"]):
+        lines.append("  iterations: the sum over the steps; the thesis took the whole motion in "
+                     "one step (so does --set mesh=coarse, whose surface elements are deeper "
+                     "than the overlap)")
+    lines.append("  shares of the tip overlap: the plate's = its tip's downward displacement, "
+                 "the wedge's = how far its tip was pushed back up; contact force: vertical, "
+                 "on the half model")
+    if s.get("figures"):
+        lines.append(f"  results: summary.json, case*/results.pvd, {', '.join(s['figures'])}")
+    return lines
