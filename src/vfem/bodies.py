@@ -16,6 +16,7 @@ import logging
 import math
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from skfem import (
@@ -200,7 +201,7 @@ class Body:
             return ElementTriP2() if tri else ElementQuad2()
         return ElementTriP1() if tri else ElementQuad1()
 
-    @property
+    @cached_property
     def points(self) -> np.ndarray:
         """(2, npoints) coordinates of the element nodes (see the class docstring)."""
         mesh = self.mesh
@@ -229,12 +230,14 @@ class Body:
         return np.unique(self.facet_points(self.mesh.boundaries[boundary]))
 
     def cells(self) -> tuple[str, np.ndarray]:
-        """VTK cell type and (nelements, k) point connectivity, in VTK's node order."""
+        """VTK cell type and (nelements, k) point connectivity, in VTK's node order (after
+        :meth:`setup`)."""
         tri = isinstance(self.mesh, MeshTri)
         if self.order == 1:
             return ("triangle" if tri else "quad"), self.mesh.t.T
-        # scikit-fem's element dofs: vertices, then facets in VTK's edge order, then the centre
-        conn = Basis(self.mesh, self.element()).element_dofs.T
+        # scikit-fem's element dofs (x of point k is dof 2k): vertices, then facets in VTK's edge
+        # order, then the centre
+        conn = self.basis.element_dofs[::2].T // 2
         return ("triangle6" if tri else "quad9"), conn
 
     def validate(self) -> None:

@@ -36,7 +36,7 @@ from ..contact.check import largest_penetrations
 from ..contact.settings import ContactSettings
 from ..materials import LinearElastic
 from ..mesh import block
-from ..solver import Analysis, AnalysisResult, Model
+from ..solver import AnalysisResult, Model
 
 
 @dataclass(frozen=True)
@@ -123,15 +123,13 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
+    from ..io.results import step_record
+
     summary = {
         "example": "block",
         "converged": result.converged,
         "message": result.message,
-        "steps": [{"step": s.step, "load_factor": s.load_factor, "iterations": s.iterations,
-                   "converged": s.converged, "cuts": s.cuts,
-                   "max_penetration": s.history[-1].max_penetration,
-                   "max_equilibrium_error": s.history[-1].max_equilibrium_error}
-                  for s in result.steps],
+        "steps": [step_record(s) for s in result.steps],
         "dofs": int(sum(b.ndofs for b in result.model.bodies)),
         "parameters": dataclasses.asdict(p),
         "timings": result.timings,
@@ -143,20 +141,11 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
 
 def run(p: Parameters, out, on_step=None, figures: bool = True) -> dict:
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
-    from ..io.results import ResultsWriter, write_summary
+    from ..io.results import run_writing, write_summary
 
     out = Path(out)
     model = build(p)
-    analysis = Analysis(model)
-    analysis.setup()
-    writer = ResultsWriter(out, model)
-
-    def step_done(step):
-        writer.write_step(step)
-        if on_step is not None:
-            on_step(step)
-
-    result = analysis.run(step_done)
+    _, result = run_writing(model, out, on_step)
     summary = summarize(result, p)
     if figures and result.steps:
         _figures(out, model, result, p)

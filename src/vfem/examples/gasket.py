@@ -290,6 +290,8 @@ def force_history(summary: dict) -> np.ndarray:
 
 def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
     """The ``summary.json`` dictionary of a gasket run."""
+    from ..io.results import step_record
+
     model = result.model
     steps = scheduled_steps(result)
     rows = []
@@ -308,18 +310,13 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
             back[b.name] = [b.reaction(u, "back", c, s.load_factor, forces[b.name].ravel())
                             for c in ("x", "y")]
         rows.append({
+            **step_record(s),
             "step": k + 1,
-            "load_factor": s.load_factor,
-            "iterations": s.iterations,
-            "cuts": s.cuts,
             "contact_force": float(np.linalg.norm(F)),
             "contact_force_soft": [float(v) for v in F],
             "contact_force_stiff": [float(v) for v in F_stiff],
             "back_reaction": back,
             "contact_nodes": {n: int((v > 0).sum()) for n, v in status.items()},
-            "max_penetration": s.history[-1].max_penetration,
-            "max_equilibrium_error": s.history[-1].max_equilibrium_error,
-            "stopped_at_fixed_point": s.fixed_point,
             "prediction_overlap": pred["max_overlap"],
             "current_configuration": current_contact(model, p, disp, forces, status),
         })
@@ -367,21 +364,11 @@ def run(p: GasketParameters, out, on_step=None, figures: bool = True) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
     from pathlib import Path
 
-    from ..io.results import ResultsWriter, write_summary
-    from ..solver import Analysis
+    from ..io.results import run_writing, write_summary
 
     out = Path(out)
     model = build(p)
-    analysis = Analysis(model)
-    analysis.setup()
-    writer = ResultsWriter(out, model)
-
-    def step_done(step):
-        writer.write_step(step)
-        if on_step is not None:
-            on_step(step)
-
-    result = analysis.run(step_done)
+    _, result = run_writing(model, out, on_step)
     summary = summarize(result, p)
     if figures:
         summary["figures"] = draw(result, p, out)

@@ -188,16 +188,13 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
     """The ``summary.json`` dictionary of a Hertz run."""
     from dataclasses import asdict
 
+    from ..io.results import step_record
+
     summary = {
         "example": "hertz",
         "converged": result.converged,
         "message": result.message,
-        "steps": [{"step": s.step, "load_factor": s.load_factor, "iterations": s.iterations,
-                   "converged": s.converged, "cuts": s.cuts,
-                   "platen_displacement": s.platen_displacement,
-                   "stopped_at_fixed_point": s.fixed_point,
-                   "max_penetration": s.history[-1].max_penetration,
-                   "max_equilibrium_error": s.history[-1].max_equilibrium_error,
+        "steps": [{**step_record(s), "platen_displacement": s.platen_displacement,
                    "history": [{"iteration": r.iteration, "max_penetration": r.max_penetration,
                                 "max_equilibrium_error": r.max_equilibrium_error,
                                 "contact_nodes": r.contact_nodes,
@@ -221,22 +218,12 @@ def run(p: HertzParameters, out, on_step=None, figures: bool = True) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
     from pathlib import Path
 
-    from ..io.plots import deformed_region, hertz_pressure
-    from ..io.results import ResultsWriter, write_summary
-    from ..solver import Analysis
+    from ..io.plots import configurations, hertz_pressure
+    from ..io.results import run_writing, write_summary
 
     out = Path(out)
     model = build(p)
-    analysis = Analysis(model)
-    analysis.setup()
-    writer = ResultsWriter(out, model)
-
-    def step_done(step):
-        writer.write_step(step)
-        if on_step is not None:
-            on_step(step)
-
-    result = analysis.run(step_done)
+    _, result = run_writing(model, out, on_step)
     summary = summarize(result, p)
     if figures and "hertz" in summary:
         th = summary["hertz"]
@@ -257,9 +244,9 @@ def run(p: HertzParameters, out, on_step=None, figures: bool = True) -> dict:
         y0 = float(last.bodies["cylinder"].displacement[tip, 1])
         meshes = [(b.name, b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
                    last.bodies[b.name].displacement[: b.mesh.nvertices]) for b in model.bodies]
-        deformed_region(out / "deformed.png", meshes, (0.0, 2.0 * a, y0 - 0.5 * a, y0 + 0.7 * a),
-                        f"Hertz: contact region at load {p.force:g}, true scale "
-                        f"(a = {a:.4f})")
+        configurations(out / "deformed.png", [("deformed", meshes)],
+                       f"Hertz: contact region at load {p.force:g}, true scale (a = {a:.4f})",
+                       window=(0.0, 2.0 * a, y0 - 0.5 * a, y0 + 0.7 * a))
     write_summary(out, summary)
     return summary
 

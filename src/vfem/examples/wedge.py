@@ -47,10 +47,10 @@ from skfem import MeshQuad, MeshTri
 
 from ..bodies import Body, PrescribedDisplacement, Support
 from ..contact.settings import CONVERGENCE_CRITERIA, VARIANTS, ContactSettings
-from ..errors import AnalysisError, InputError
+from ..errors import InputError
 from ..materials import LinearElastic
 from ..mesh import wedge, wedge_plate
-from ..solver import Analysis, AnalysisResult, Model, StepResult
+from ..solver import AnalysisResult, Model, StepResult
 
 #: Wedge/plate modulus ratio of the thesis's five cases, in its numbering.
 RATIOS = (1000.0, 2.0, 1.0, 0.5, 0.001)
@@ -277,51 +277,22 @@ def validate(p: WedgeParameters) -> None:
 
 # -- one case -----------------------------------------------------------------------------------
 
-class StepsTooSmall(AnalysisError):
-    """Cut steps kept converging and failing again ever closer to one load factor."""
-
-
 def tip(body: Body) -> int:
     """The body's point at the origin: the wedge's tip, the plate's point under it."""
     return int(np.argmin(np.hypot(*body.points)))
 
 
-def solve_case(p: WedgeParameters, model: Model, on_step=None
-               ) -> tuple[AnalysisResult | None, list[StepResult], str, str | None]:
-    """Run one case's model: (result or None, converged steps, failure message, the body whose
-    surface carries compatibility in the paired variant, else None).
+def solve_case(model: Model, out: Path | None = None, on_step=None
+               ) -> tuple[AnalysisResult, str | None]:
+    """Run one case's model, writing its VTU files into ``out`` if given: (result, the body
+    whose surface carries compatibility in the paired variant, else None). A case that does not
+    converge ends with the solver's message once its step cuts run out (``max_step_cuts``)."""
+    from ..io.results import run_writing
 
-    The solver halves a failed step and forgets the cut once a half converges, so where the
-    iteration cannot converge at all it would step ever closer to that load factor without
-    end. A converged step smaller than 1 / 2**max_step_cuts of the planned one stops the case
-    here instead (reported as not converged).
-    """
-    analysis = Analysis(model)
-    planned = model.load_factors[0]
-    smallest = planned / 2**p.max_step_cuts * (1 - 1e-9)
-    steps: list[StepResult] = []
-
-    def step_done(step: StepResult) -> None:
-        previous = steps[-1].load_factor if steps else 0.0
-        steps.append(step)
-        if on_step is not None:
-            on_step(step)
-        if step.load_factor < 1.0 and step.load_factor - previous < smallest:
-            raise StepsTooSmall(
-                f"steps shrank below 1/{2**p.max_step_cuts} of the planned {planned:.4g} near "
-                f"load factor {step.load_factor:.6g}: the {p.variant} variant does not converge "
-                "there")
-
-    try:
-        result = analysis.run(step_done)
-    except AnalysisError as exc:
-        result = None
-        message = str(exc)
-    else:
-        message = result.message
-    pairs = getattr(getattr(analysis, "contact", None), "contact_pairs", None)
+    analysis, result = run_writing(model, out, on_step)
+    pairs = getattr(analysis.contact, "contact_pairs", None)
     compatibility = model.bodies[pairs[0].fine].name if pairs else None
-    return result, steps if result is None else result.steps, message, compatibility
+    return result, compatibility
 
 
 def evaluate(model: Model, steps: list[StepResult], p: WedgeParameters) -> dict:
@@ -400,7 +371,7 @@ def summarize_case(p: WedgeParameters, case: int, model: Model, steps: list[Step
 
 def run(p: WedgeParameters, out=None, on_step=None) -> dict:
     """Run the cases, writing ``out/caseN/`` (VTU/PVD), the figures and ``summary.json``."""
-    from ..io.results import ResultsWriter, write_summary
+    from ..io.results import write_summary
 
     start = time.perf_counter()
     mesh_pair = meshes(p)
@@ -409,16 +380,10 @@ def run(p: WedgeParameters, out=None, on_step=None) -> dict:
     for case in cases(p):
         t0 = time.perf_counter()
         model = build(p, case, mesh_pair)
-        writer = ResultsWriter(out / f"case{case}", model) if out is not None else None
-
-        def step_done(step, writer=writer):
-            if writer is not None:
-                writer.write_step(step)
-            if on_step is not None:
-                on_step(step)
-
-        result, steps, message, compatibility = solve_case(p, model, step_done)
-        converged = result is not None and result.converged
+        result, compatibility = solve_case(model, out / f"case{case}" if out else None,
+                                           on_step)
+        steps, message = result.steps, result.message
+        converged = result.converged
         entries.append(summarize_case(p, case, model, steps, converged, message,
                                       time.perf_counter() - t0, compatibility))
         models[case] = model

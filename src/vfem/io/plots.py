@@ -36,33 +36,6 @@ def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[
     plt.close(fig)
 
 
-def deformed_region(path: Path, meshes: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]],
-                    window: tuple[float, float, float, float], title: str) -> None:
-    """The deformed meshes (true scale) inside ``window`` = (xmin, xmax, ymin, ymax).
-
-    ``meshes``: (name, points (n, 2), cells (m, k), displacement (n, 2)).
-    """
-    fig, ax = plt.subplots(figsize=(7.0, 4.2))
-    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red")
-    xmin, xmax, ymin, ymax = window
-    for (name, p, t, u), c in zip(meshes, colors):
-        x = p + u
-        poly = x[t]
-        cx, cy = poly[..., 0].mean(axis=1), poly[..., 1].mean(axis=1)
-        pad = 0.2 * (xmax - xmin)
-        keep = (cx > xmin - pad) & (cx < xmax + pad) & (cy > ymin - pad) & (cy < ymax + pad)
-        ax.add_collection(PolyCollection(poly[keep], facecolors="none", edgecolors=c,
-                                         linewidths=0.5, label=name))
-    ax.set_xlim(xmin, xmax)
-    ax.set_ylim(ymin, ymax)
-    ax.set_aspect("equal")
-    ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=8, loc="upper right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-
-
 def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
     """p_max error and RMS profile error against contact facets across a, per series.
 
@@ -120,7 +93,13 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
             else:
                 name = label if j == 0 else None
             if mesh_lines:
-                ax.add_collection(PolyCollection(x[t], facecolors="none", edgecolors=c,
+                poly = x[t]
+                if window is not None:  # only the cells near the window (large meshes)
+                    cx, cy = poly[..., 0].mean(axis=1), poly[..., 1].mean(axis=1)
+                    pad = 0.2 * (window[1] - window[0])
+                    poly = poly[(cx > window[0] - pad) & (cx < window[1] + pad)
+                                & (cy > window[2] - pad) & (cy < window[3] + pad)]
+                ax.add_collection(PolyCollection(poly, facecolors="none", edgecolors=c,
                                                  linewidths=0.4, label=name))
             else:
                 ax.add_collection(LineCollection(x[_outline(np.asarray(t))], colors=c,

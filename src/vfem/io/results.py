@@ -22,7 +22,7 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from ..solver import Model, StepResult
+from ..solver import Analysis, AnalysisResult, Model, StepResult
 
 
 def _atomic_write(path: Path, write) -> None:
@@ -76,6 +76,32 @@ class ResultsWriter:
         lines += ["  </Collection>", "</VTKFile>", ""]
         _atomic_write(self.out / "results.pvd",
                       lambda p: p.write_text("\n".join(lines), encoding="utf-8"))
+
+
+def run_writing(model: Model, out: Path | None, on_step=None) -> tuple[Analysis, AnalysisResult]:
+    """Solve ``model``, writing each converged step's VTU files (and the PVD) into ``out`` as
+    it converges (nothing written when ``out`` is None), then calling ``on_step``."""
+    analysis = Analysis(model)
+    analysis.setup()
+    writer = ResultsWriter(out, model) if out is not None else None
+
+    def step_done(step: StepResult) -> None:
+        if writer is not None:
+            writer.write_step(step)
+        if on_step is not None:
+            on_step(step)
+
+    return analysis, analysis.run(step_done)
+
+
+def step_record(step: StepResult) -> dict:
+    """The fields every example's ``summary.json`` gives per step."""
+    last = step.history[-1] if step.history else None
+    return {"step": step.step, "load_factor": step.load_factor, "iterations": step.iterations,
+            "converged": step.converged, "cuts": step.cuts,
+            "stopped_at_fixed_point": step.fixed_point,
+            "max_penetration": last.max_penetration if last else 0.0,
+            "max_equilibrium_error": last.max_equilibrium_error if last else 0.0}
 
 
 def write_summary(out: Path, summary: dict) -> Path:
