@@ -10,7 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
-from matplotlib.ticker import NullFormatter  # noqa: E402
+from matplotlib.ticker import MaxNLocator, NullFormatter  # noqa: E402
 
 
 def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[str, np.ndarray],
@@ -136,6 +136,83 @@ def history(path: Path, x: np.ndarray, series: dict[str, np.ndarray], xlabel: st
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.ndarray,
+                                                                    np.ndarray]]],
+                              title: str, xlabel: str = "x (undeformed)",
+                              ylabel: str = "nominal contact pressure") -> None:
+    """Contact pressure against x, per body: the last profile of each body bold, the ones
+    before it as lighter lines of the same colour.
+
+    ``bodies``: name -> profiles (label, x, pressure), oldest first; the last one is emphasized.
+    A body without nodes in contact is listed in the legend as such.
+    """
+    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    markers = ("o", "s", "^", "v", "D", "x")
+    for j, (name, profiles) in enumerate(bodies.items()):
+        c = colors[j % len(colors)]
+        if not profiles or all(len(x) == 0 for _, x, _ in profiles):
+            ax.plot([], [], color=c, label=f"{name}: no node in contact")
+            continue
+        *before, (label, x, p) = profiles
+        if len(x) == 0:
+            label += ": no node in contact"
+        for k, (lab, xb, pb) in enumerate(before):
+            order = np.argsort(xb, kind="stable")
+            ax.plot(np.asarray(xb)[order], np.asarray(pb)[order], "-", color=c, lw=0.8,
+                    alpha=0.2 + 0.4 * (k + 1) / (len(before) + 1),
+                    label=f"{name}: {lab}")
+        order = np.argsort(x, kind="stable")
+        ax.plot(np.asarray(x)[order], np.asarray(p)[order], "-", color=c, lw=1.4,
+                marker=markers[j % len(markers)], ms=4, mfc="none", label=f"{name}: {label}")
+    ax.axhline(0, color="0.7", lw=0.8)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarray, np.ndarray]],
+                                                  bool]],
+                   xlabel: str, title: str) -> None:
+    """Several quantities against the step, one panel each, stacked with a shared x axis.
+
+    ``panels``: (ylabel, series name -> (x, y), logarithmic y axis). On a logarithmic axis,
+    values <= 0 are left out (a panel with none left stays linear).
+    """
+    fig, axes = plt.subplots(len(panels), 1, figsize=(6.4, 2.4 * len(panels) + 0.8),
+                             sharex=True, squeeze=False)
+    for ax, (ylabel, series, log) in zip(axes[:, 0], panels):
+        positive = False
+        for (name, (x, y)), marker in zip(series.items(), ("o-", "s--", "^-", "v--", "D-")):
+            x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+            if log:
+                keep = y > 0
+                positive |= bool(keep.any())
+                if not keep.all():
+                    name += " (values <= 0 not drawn)"
+                x, y = x[keep], y[keep]
+            ax.plot(x, y, marker, ms=4, label=name)
+        if log and positive:
+            ax.set_yscale("log")
+        elif all(np.all(np.mod(y, 1) == 0) for _, y in series.values()):
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.set_ylabel(ylabel, fontsize=8)
+        ax.grid(alpha=0.3, which="both")
+        if series:
+            ax.legend(fontsize=7, loc="best")
+    axes[-1, 0].set_xlabel(xlabel)
+    axes[-1, 0].xaxis.set_major_locator(MaxNLocator(integer=True))
+    fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)

@@ -1,12 +1,23 @@
-"""Results on disk: one VTU file per body and converged step, a PVD index, summary.json.
+"""Results on disk: a VTU file per body and converged step, a PVD index, contact.csv, summary.json.
 
-ParaView opens ``results.pvd`` as a time series (time = load factor) holding every body. Point
-fields: ``displacement`` (3 components, z = 0, so ParaView's *Warp By Vector* works),
-``contact_force`` (nodal force applied by the other bodies), ``contact_pressure`` (nominal: normal
-contact force per undeformed tributary length), ``contact_status`` (1 in contact, 0 free),
-``penetration``. Cell fields: ``stress_xx``, ``stress_yy``, ``stress_xy``, ``stress_zz``,
-``von_mises`` (element averages). Quadratic elements are written as VTK's 6-node triangles and
-9-node quadrilaterals, with the fields at every node.
+ParaView opens ``results.pvd`` as a time series (time = load factor) holding every body; each entry
+gives the load factor (``timestep``), the body's index in the model (``part``), its name (``name``)
+and the VTU file (``file``). Point fields: ``displacement`` (3 components, z = 0, so ParaView's
+*Warp By Vector* works), ``contact_force`` (nodal force applied by the other bodies),
+``contact_pressure`` (nominal: normal contact force per undeformed tributary length),
+``contact_status`` (1 in contact, 0 free), ``penetration`` (> 0 overlapping). Cell fields:
+``stress_xx``, ``stress_yy``, ``stress_xy``, ``stress_zz``, ``von_mises`` (element averages).
+Quadratic elements are written as VTK's 6-node triangles and 9-node quadrilaterals, with the
+fields at every node.
+
+``contact.csv`` (when the writer is given the contact surfaces, as :func:`run_writing` does): one
+row per converged step, body and contact candidate node, columns ``step, load_factor, body, node,
+x, y, ux, uy, pressure, gap, status``: ``node`` the point number in the body (the VTU's point
+index), ``x, y`` its undeformed coordinates, ``ux, uy`` its displacement, ``pressure`` the
+nominal contact pressure (as ``contact_pressure``), ``gap`` = -``penetration`` (negative:
+overlapping; 0 where the contact algorithm measured none, e.g. the coarse side of a paired
+contact), ``status`` ``contact`` or ``free``. Numbers are written with 17 significant digits
+(round-trip exact).
 
 Files are written as each step converges, into a temporary name first and then renamed, so an
 analysis that fails later never damages what was already written.
@@ -14,6 +25,8 @@ analysis that fails later never damages what was already written.
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import os
 from pathlib import Path
@@ -22,7 +35,14 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
+from ..contact.surface import ContactSurface
+from ..errors import InputError
 from ..solver import Analysis, AnalysisResult, Model, StepResult
+
+# Body.stress keys -> the VTU's cell field names
+_CELL_FIELD = {"sxx": "stress_xx", "syy": "stress_yy", "sxy": "stress_xy", "szz": "stress_zz"}
+CONTACT_COLUMNS = ("step", "load_factor", "body", "node", "x", "y", "ux", "uy", "pressure",
+                   "gap", "status")
 
 
 def _atomic_write(path: Path, write) -> None:
@@ -32,13 +52,25 @@ def _atomic_write(path: Path, write) -> None:
 
 
 class ResultsWriter:
-    """Writes the VTU/PVD series step by step into ``out`` (created if needed)."""
+    """Writes the VTU/PVD series step by step into ``out`` (created if needed).
 
-    def __init__(self, out: Path, model: Model):
+    ``surfaces``: the analysis's contact surfaces (``Analysis.surfaces``, one per body); when
+    given, every step also rewrites ``contact.csv`` with the rows of all steps so far.
+    """
+
+    def __init__(self, out: Path, model: Model, surfaces: list[ContactSurface] | None = None):
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.model = model
         self.entries: list[tuple[float, str, str]] = []  # (time, body, file)
+        self.surfaces: dict[str, ContactSurface] | None = None
+        if surfaces is not None:
+            self.surfaces = {s.body.name: s for s in surfaces}
+            missing = [b.name for b in model.bodies if b.name not in self.surfaces]
+            if missing:
+                raise InputError(f"model {model.name!r}: no contact surface given for body "
+                                 f"{', '.join(map(repr, missing))}")
+        self.contact_rows: list[list[str]] = []
 
     def write_step(self, step: StepResult) -> None:
         for body in self.model.bodies:
@@ -57,13 +89,39 @@ class ResultsWriter:
                             "contact_pressure": r.contact_pressure,
                             "contact_status": r.contact_status.astype(np.int32),
                             "penetration": r.penetration},
-                cell_data={f"stress_{k}" if k != "von_mises" else k: [v]
-                           for k, v in stress.items()},
+                cell_data={_CELL_FIELD.get(k, k): [v] for k, v in stress.items()},
             )
             _atomic_write(self.out / name,
                           lambda p, m=m: meshio.write(p, m, file_format="vtu"))
             self.entries.append((step.load_factor, body.name, name))
         self.write_pvd()
+        if self.surfaces is not None:
+            self.add_contact_rows(step)
+            self.write_contact_csv()
+
+    def add_contact_rows(self, step: StepResult) -> None:
+        """Keep the rows of ``step``'s contact candidate nodes for ``contact.csv``."""
+        for body in self.model.bodies:
+            s = self.surfaces[body.name]
+            r = step.bodies[body.name]
+            nodes = np.asarray(s.nodes[: s.nc], dtype=int)
+            X = body.points[:, nodes].T
+            u = r.displacement[nodes]
+            gap = 0.0 - r.penetration[nodes]  # 0.0 - x: no "-0" for an unmeasured gap
+            for k, n in enumerate(nodes):
+                self.contact_rows.append(
+                    [str(step.step), _num(step.load_factor), body.name, str(int(n)),
+                     _num(X[k, 0]), _num(X[k, 1]), _num(u[k, 0]), _num(u[k, 1]),
+                     _num(r.contact_pressure[n]), _num(gap[k]),
+                     "contact" if r.contact_status[n] > 0 else "free"])
+
+    def write_contact_csv(self) -> None:
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(CONTACT_COLUMNS)
+        w.writerows(self.contact_rows)
+        _atomic_write(self.out / "contact.csv",
+                      lambda p: p.write_text(buf.getvalue(), encoding="utf-8"))
 
     def write_pvd(self) -> None:
         lines = ['<?xml version="1.0"?>',
@@ -71,8 +129,8 @@ class ResultsWriter:
                  "  <Collection>"]
         parts = {b.name: i for i, b in enumerate(self.model.bodies)}
         for t, body, f in self.entries:
-            lines.append(f'    <DataSet timestep="{t:.10g}" group="" part="{parts[body]}" '
-                         f"file={quoteattr(f)}/>")
+            lines.append(f'    <DataSet timestep="{t:.17g}" group="" part="{parts[body]}" '
+                         f"name={quoteattr(body)} file={quoteattr(f)}/>")
         lines += ["  </Collection>", "</VTKFile>", ""]
         _atomic_write(self.out / "results.pvd",
                       lambda p: p.write_text("\n".join(lines), encoding="utf-8"))
@@ -80,10 +138,13 @@ class ResultsWriter:
 
 def run_writing(model: Model, out: Path | None, on_step=None) -> tuple[Analysis, AnalysisResult]:
     """Solve ``model``, writing each converged step's VTU files (and the PVD) into ``out`` as
-    it converges (nothing written when ``out`` is None), then calling ``on_step``."""
+    it converges (nothing written when ``out`` is None), then calling ``on_step``.
+
+    ``contact.csv`` is written too, with the candidate nodes of the analysis's contact surfaces.
+    """
     analysis = Analysis(model)
     analysis.setup()
-    writer = ResultsWriter(out, model) if out is not None else None
+    writer = ResultsWriter(out, model, analysis.surfaces) if out is not None else None
 
     def step_done(step: StepResult) -> None:
         if writer is not None:
@@ -110,6 +171,11 @@ def write_summary(out: Path, summary: dict) -> Path:
     _atomic_write(path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n",
                                                encoding="utf-8"))
     return path
+
+
+def _num(x: float) -> str:
+    """A float in 17 significant digits (reads back exactly)."""
+    return f"{float(x):.17g}"
 
 
 def _safe(name: str) -> str:
