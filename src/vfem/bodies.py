@@ -47,7 +47,12 @@ COMPONENTS = {"x": 0, "y": 1}
 
 @dataclass(frozen=True)
 class Support:
-    """Fixed displacement components (``"x"``, ``"y"``) on a named boundary."""
+    """Fixed displacement components on a named boundary.
+
+    Attributes:
+        boundary: the boundary's name.
+        components: the fixed components, ``"x"`` and/or ``"y"``.
+    """
 
     boundary: str
     components: tuple[str, ...] = ("x", "y")
@@ -55,7 +60,13 @@ class Support:
 
 @dataclass(frozen=True)
 class PrescribedDisplacement:
-    """A displacement component prescribed on a named boundary; ``value`` at load factor 1."""
+    """A displacement component prescribed on a named boundary.
+
+    Attributes:
+        boundary: the boundary's name.
+        component: ``"x"`` or ``"y"``.
+        value: the displacement at load factor 1.
+    """
 
     boundary: str
     component: str
@@ -64,7 +75,12 @@ class PrescribedDisplacement:
 
 @dataclass(frozen=True)
 class Traction:
-    """A distributed load (force per unit undeformed length) on a named boundary, at factor 1."""
+    """A distributed load on a named boundary.
+
+    Attributes:
+        boundary: the boundary's name.
+        value: the traction (tx, ty), force per unit undeformed length, at load factor 1.
+    """
 
     boundary: str
     value: tuple[float, float]
@@ -78,6 +94,11 @@ class Platen:
     solver finds it so that the platen's reaction equals ``force`` times the load factor. This is
     how a body held only by the load (the Hertz cylinder) is loaded without a singular stiffness.
     ``force`` is the total force on the platen along ``component`` (negative: towards -x or -y).
+
+    Attributes:
+        boundary: the boundary the platen holds.
+        component: the direction it moves in, ``"x"`` or ``"y"``.
+        force: its total force at load factor 1 (negative: towards -x or -y).
     """
 
     boundary: str
@@ -133,19 +154,8 @@ class Body:
         self.K = asm(linear_elasticity(lam, mu), self.basis).tocsr()
         self.ndofs = self.K.shape[0]
         t1 = time.perf_counter()
-
-        fixed: dict[int, float] = {}  # dof -> prescribed value at factor 1
-        for s in self.supports:
-            for c in s.components:
-                fixed.update(dict.fromkeys(self._boundary_dofs(s.boundary, c).tolist(), 0.0))
-        for pd in self.prescribed:
-            fixed.update(dict.fromkeys(self._boundary_dofs(pd.boundary, pd.component).tolist(),
-                                       float(pd.value)))
-        platen_dofs = np.array([], dtype=int)
-        if self.platen is not None:
-            platen_dofs = self._boundary_dofs(self.platen.boundary, self.platen.component)
-        self.platen_dofs = platen_dofs
-        self.fixed_dofs = np.array(sorted(set(fixed) | set(platen_dofs.tolist())), dtype=int)
+        fixed = self._constraints()
+        platen_dofs = self.platen_dofs
         self._check_supported()
 
         self.free_dofs = np.setdiff1d(np.arange(self.ndofs), self.fixed_dofs)
@@ -193,6 +203,32 @@ class Body:
                         "load_cases_s": time.perf_counter() - t3}
         log.info("body %s: %d points, %d dofs (%d fixed)", self.name, self.ndofs // 2,
                  self.ndofs, len(self.fixed_dofs))
+
+    def check_supports(self) -> None:
+        """Without assembling anything: raise :class:`InputError` if the body is invalid or
+        its supports leave it free to move as a rigid body (``vfem check``)."""
+        self.validate()
+        if not hasattr(self, "basis"):
+            self.basis = Basis(self.mesh, ElementVector(self.element()))
+        self._constraints()
+        self._check_supported()
+
+    def _constraints(self) -> dict[int, float]:
+        """The constrained dofs: sets ``platen_dofs`` and ``fixed_dofs``, returns the
+        prescribed value at load factor 1 of every supported or prescribed dof."""
+        fixed: dict[int, float] = {}  # dof -> prescribed value at factor 1
+        for s in self.supports:
+            for c in s.components:
+                fixed.update(dict.fromkeys(self._boundary_dofs(s.boundary, c).tolist(), 0.0))
+        for pd in self.prescribed:
+            fixed.update(dict.fromkeys(self._boundary_dofs(pd.boundary, pd.component).tolist(),
+                                       float(pd.value)))
+        self.platen_dofs = np.array([], dtype=int)
+        if self.platen is not None:
+            self.platen_dofs = self._boundary_dofs(self.platen.boundary, self.platen.component)
+        self.fixed_dofs = np.array(sorted(set(fixed) | set(self.platen_dofs.tolist())),
+                                   dtype=int)
+        return fixed
 
     def element(self):
         """The scalar scikit-fem element of each displacement component."""

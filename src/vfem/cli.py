@@ -1,4 +1,5 @@
-"""The ``vfem`` command: run the built-in examples, benchmark them.
+"""The ``vfem`` command: run built-in examples and input files, check and export input files,
+redraw figures, benchmark.
 
 Exit status: 0 success; 1 the analysis did not converge (results of converged steps are kept);
 2 bad input (one message naming the problem, no traceback).
@@ -60,34 +61,195 @@ def build_parameters(example: str, assignments: list[str]):
     return dataclasses.replace(params, **changes)
 
 
+class Progress:
+    """A progress bar over the steps (redrawn in place on a terminal, a line per step
+    otherwise): load factor, the step's contact iterations and its final errors."""
+
+    def __init__(self, load_factors=None, enabled: bool = True, stream=None):
+        self.factors = list(load_factors or [])
+        self.total = len(self.factors)
+        self.enabled = enabled
+        self.stream = stream or sys.stdout
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.done = 0  # scheduled steps completed (a cut step completes only at its target)
+
+    def __call__(self, step) -> None:
+        if not self.enabled:
+            return
+        if self.done < self.total and step.load_factor == self.factors[self.done]:
+            self.done += 1
+        h = step.history[-1] if step.history else None
+        pen = h.max_penetration if h else 0.0
+        eq = h.max_equilibrium_error if h else 0.0
+        text = (f"step {step.step:3d}  load factor {step.load_factor:7.4f}  "
+                f"{step.iterations:3d} iterations  penetration {pen:.2e}  "
+                f"equilibrium error {eq:.2e}" + (f"  ({step.cuts} cuts)" if step.cuts else ""))
+        if self.total:
+            width = 20
+            part = 0.0  # how far a cut step has come towards its scheduled target
+            if self.done < self.total:
+                prev = self.factors[self.done - 1] if self.done else 0.0
+                part = min(1.0, max(0.0, (step.load_factor - prev)
+                                    / (self.factors[self.done] - prev)))
+            filled = round(width * (self.done + part) / self.total)
+            text = f"[{'#' * filled}{'.' * (width - filled)}] {text}"
+        if self.tty:
+            self.stream.write("\r\033[K  " + text)
+            self.stream.flush()
+        else:
+            print("  " + text, file=self.stream, flush=True)
+
+    def close(self) -> None:
+        if self.enabled and self.tty:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def _is_input_file(target: str) -> bool:
+    return target.endswith(".toml") or Path(target).is_file()
+
+
+def _load_input(path: str):
+    from .io.input import load as load_input
+
+    return load_input(path)
+
+
 def cmd_run(args) -> int:
+    if _is_input_file(args.example):
+        return run_input_file(args)
     if args.example not in EXAMPLES:
         close = difflib.get_close_matches(args.example, EXAMPLES, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         raise InputError(f"unknown example {args.example!r}{hint}; "
-                         f"available: {', '.join(EXAMPLES)}")
+                         f"available: {', '.join(EXAMPLES)}, or an input file (.toml)")
     example = load(args.example)
     params = build_parameters(args.example, args.set or [])
     if hasattr(example, "validate"):
         example.validate(params)  # bad input is reported before anything is written
     out = Path(args.out or Path("results") / args.example)
-
-    def progress(step):
-        if not args.quiet:
-            h = step.history[-1]
-            print(f"  step {step.step:3d}  load factor {step.load_factor:7.4f}  "
-                  f"{step.iterations:3d} iterations  penetration {h.max_penetration:.2e}  "
-                  f"equilibrium error {h.max_equilibrium_error:.2e}", flush=True)
-
-    if not args.quiet and args.example == "hertz":
-        print(f"vfem: hertz, {params.steps} steps, results in {out}/", flush=True)
-    summary = example.run(params, out, on_step=progress)
+    progress = Progress(None, not args.quiet)
+    if not args.quiet:
+        print(f"vfem: {args.example}, results in {out}/", flush=True)
+    try:
+        summary = example.run(params, out, on_step=progress)
+    finally:
+        progress.close()
     if not args.quiet:
         print("\n".join(example.report(summary)))
     if not summary["converged"]:
         print(f"vfem: the analysis did not converge: {summary.get('message', '')}",
               file=sys.stderr)
         return 1
+    return 0
+
+
+def run_input_file(args) -> int:
+    from .io import runner
+
+    if args.set:
+        raise InputError("--set changes a built-in example's parameters; edit the input file "
+                         "instead")
+    from .config import check
+
+    config = _load_input(args.example)
+    base = Path(args.example).parent
+    try:
+        model = check(config, base)  # bad input is reported before anything is written
+    except InputError as exc:
+        raise InputError(f"{args.example}: {exc}") from None
+    out = Path(args.out or config.output.directory or Path("results") / config.name)
+    if not args.quiet:
+        n = len(config.steps.factors())
+        print(f"vfem: {config.name} ({args.example}), {n} step{'s' if n > 1 else ''}, "
+              f"results in {out}/", flush=True)
+    progress = Progress(config.steps.factors(), not args.quiet)
+    try:
+        summary = runner.run(config, out, model=model, on_step=progress, source=args.example)
+    finally:
+        progress.close()
+    if not args.quiet:
+        print("\n".join(runner.report(summary, out)))
+    if not summary["converged"]:
+        print(f"vfem: the analysis did not converge: {summary.get('message', '')}",
+              file=sys.stderr)
+        return 1
+    return 0
+
+
+def cmd_check(args) -> int:
+    from .config import check
+
+    config = _load_input(args.file)
+    try:
+        model = check(config, Path(args.file).parent)
+    except InputError as exc:
+        raise InputError(f"{args.file}: {exc}") from None
+    if not args.quiet:
+        print(f"vfem: {args.file}: model {config.name!r} is valid — "
+              f"{len(model.bodies)} bodies ("
+              + ", ".join(f"{b.name}: {b.npoints} nodes" for b in model.bodies)
+              + f"), {len(model.load_factors)} steps")
+    return 0
+
+
+def example_configs(name: str, assignments: list[str]) -> dict:
+    """The built-in example's model(s) as configurations, by key."""
+    if name not in EXAMPLES:
+        close = difflib.get_close_matches(name, EXAMPLES, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise InputError(f"unknown example {name!r}{hint}; available: {', '.join(EXAMPLES)}")
+    example = load(name)
+    params = build_parameters(name, assignments)
+    if hasattr(example, "configs"):
+        return example.configs(params)
+    if hasattr(example, "config"):
+        return {name: example.config(params)}
+    raise InputError(f"the {name} example is the 1D analogy of the method (two springs), not a "
+                     "model of bodies: it has no input file")
+
+
+def cmd_export(args) -> int:
+    from .io.input import dumps
+
+    configs = example_configs(args.example, args.set or [])
+    example = load(args.example)
+    title = (example.__doc__ or args.example).strip().splitlines()[0]
+    header = (f"vfem input file: the built-in example '{args.example}'.\n{title}\n"
+              f"Written by `vfem export {args.example}`"
+              + (" --set " + " --set ".join(args.set) if args.set else "")
+              + f"; `vfem run <this file>` solves the same model as `vfem run {args.example}`.\n"
+              "Keys: docs/input.md.")
+    if len(configs) == 1 and not args.out:
+        print(dumps(next(iter(configs.values())), header), end="")
+        return 0
+    if not args.out:
+        raise InputError(f"the {args.example} example has {len(configs)} models; give --out "
+                         "DIR to write one file each")
+    out = Path(args.out)
+    if len(configs) == 1:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(dumps(next(iter(configs.values())), header), encoding="utf-8")
+        written = [out]
+    else:
+        out.mkdir(parents=True, exist_ok=True)
+        written = []
+        for key, config in configs.items():
+            path = out / f"{key}.toml"
+            path.write_text(dumps(config, header + f"\nThis file: {config.name}."),
+                            encoding="utf-8")
+            written.append(path)
+    if not args.quiet:
+        print(f"vfem: wrote {', '.join(str(p) for p in written)}")
+    return 0
+
+
+def cmd_plot(args) -> int:
+    from .io.replot import plot_results
+
+    written = plot_results(Path(args.results))
+    if not args.quiet:
+        print(f"vfem: wrote {', '.join(str(p) for p in written)}")
     return 0
 
 
@@ -134,11 +296,22 @@ def main(argv: list[str] | None = None) -> int:
                         help="log more (-v: info, -vv: debug)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="run a built-in example")
-    run.add_argument("example", help=f"one of: {', '.join(EXAMPLES)}")
-    run.add_argument("--out", help="results directory (default results/<example>)")
+    run = sub.add_parser("run", help="run a built-in example or an input file")
+    run.add_argument("example", metavar="EXAMPLE|FILE",
+                     help=f"a built-in example ({', '.join(EXAMPLES)}) or an input file (.toml)")
+    run.add_argument("--out", help="results directory (default results/<name>)")
     run.add_argument("--set", action="append", metavar="KEY=VALUE",
-                     help="change a parameter of the example (repeatable)")
+                     help="change a parameter of a built-in example (repeatable)")
+    check = sub.add_parser("check", help="check an input file without solving")
+    check.add_argument("file", help="the input file (.toml)")
+    export = sub.add_parser("export", help="write a built-in example as an input file")
+    export.add_argument("example", help=", ".join(e for e in EXAMPLES if e != "springs"))
+    export.add_argument("--out", help="the file (default: print it), or a folder for an "
+                                      "example of several models")
+    export.add_argument("--set", action="append", metavar="KEY=VALUE",
+                        help="change a parameter of the example first (repeatable)")
+    plot = sub.add_parser("plot", help="redraw the figures of a results folder without solving")
+    plot.add_argument("results", help="the results folder (holding results.pvd)")
     bench = sub.add_parser("bench", help="time an example at several refinements")
     bench.add_argument("example", help="hertz")
     bench.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3, 4])
@@ -160,7 +333,8 @@ def main(argv: list[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     logging.getLogger("skfem").setLevel(max(logging.WARNING, level))
     try:
-        command = {"run": cmd_run, "bench": cmd_bench, "study": cmd_study}[args.command]
+        command = {"run": cmd_run, "check": cmd_check, "export": cmd_export, "plot": cmd_plot,
+                   "bench": cmd_bench, "study": cmd_study}[args.command]
         return command(args)
     except InputError as exc:
         print(f"vfem: error: {exc}", file=sys.stderr)

@@ -31,11 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import Body, PrescribedDisplacement, Support
+from ..bodies import PrescribedDisplacement, Support
+from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.check import largest_penetrations
 from ..contact.settings import ContactSettings
 from ..materials import LinearElastic
-from ..mesh import block
 from ..solver import AnalysisResult, Model
 
 
@@ -58,21 +58,28 @@ class Parameters:
     swap_bodies: bool = False
 
 
-def build(p: Parameters) -> Model:
+def config(p: Parameters) -> ModelConfig:
+    """The model as data (what ``examples/block.toml`` holds for the defaults)."""
     mat = LinearElastic(p.youngs_modulus, p.poissons_ratio)
     w, c = p.small_half_width, p.h_corner
-    small_mesh = block(0.0, -p.small_height, w, p.small_height, p.h, h_fine=c, growth=0.3,
-                       fine_x=(w,), fine_y=(0.0,), symmetry="left")
-    large_mesh = block(0.0, 0.0, p.large_half_width, p.large_height,
-                       p.large_half_width / p.large_columns, h_fine=c, growth=0.3,
-                       fine_y=(0.0,), symmetry="left")
-    small = Body("small", small_mesh, mat,
-                 supports=(Support("bottom", ("x", "y")), Support("symmetry", ("x",))))
-    large = Body("large", large_mesh, mat, supports=(Support("symmetry", ("x",)),),
-                 prescribed=(PrescribedDisplacement("top", "y", -p.displacement),))
-    bodies = [large, small] if p.swap_bodies else [small, large]
-    factors = tuple((k + 1) / p.steps for k in range(p.steps))
-    return Model("block", bodies, ContactSettings(variant=p.variant), factors)
+    small_mesh = MeshSpec(shape="block", parameters=as_parameters(
+        x0=0.0, y0=-p.small_height, width=w, height=p.small_height, h=p.h, h_fine=c,
+        growth=0.3, fine_x=(w,), fine_y=(0.0,), symmetry="left"))
+    large_mesh = MeshSpec(shape="block", parameters=as_parameters(
+        x0=0.0, y0=0.0, width=p.large_half_width, height=p.large_height,
+        h=p.large_half_width / p.large_columns, h_fine=c, growth=0.3, fine_y=(0.0,),
+        symmetry="left"))
+    small = BodyConfig("small", small_mesh, mat,
+                       supports=(Support("bottom", ("x", "y")), Support("symmetry", ("x",))))
+    large = BodyConfig("large", large_mesh, mat, supports=(Support("symmetry", ("x",)),),
+                       prescribed=(PrescribedDisplacement("top", "y", -p.displacement),))
+    bodies = (large, small) if p.swap_bodies else (small, large)
+    return ModelConfig("block", bodies, ContactSettings(variant=p.variant),
+                       Steps(count=p.steps))
+
+
+def build(p: Parameters) -> Model:
+    return config(p).build()
 
 
 def validate(p: Parameters) -> None:

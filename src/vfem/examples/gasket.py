@@ -36,12 +36,11 @@ import numpy as np
 from matplotlib.path import Path as PolygonPath
 
 from ..bodies import Body, PrescribedDisplacement, Support
+from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.search import project_points
 from ..contact.settings import ContactSettings
 from ..errors import InputError
 from ..materials import LinearElastic
-from ..mesh import gasket_pair
-from ..mesh.quadratic import curved
 from ..solver import AnalysisResult, Model, StepResult
 
 
@@ -116,22 +115,23 @@ def centres(p: GasketParameters) -> dict[str, tuple[float, float]]:
     return {"soft": (-dx, -0.5 * p.offset), "stiff": (dx, 0.5 * p.offset)}
 
 
-def build(p: GasketParameters | None = None) -> Model:
-    """The two gaskets, their backs driven towards each other and back again."""
+def config(p: GasketParameters | None = None) -> ModelConfig:
+    """The two gaskets as data (what ``examples/gasket.toml`` holds for the defaults): their
+    backs driven towards each other and back again."""
     p = p or GasketParameters()
-    meshes = dict(zip(("soft", "stiff"),
-                      gasket_pair(p.radius, p.thickness, p.offset, p.separation, p.n_around,
-                                  p.n_through)))
     c = centres(p)
+    opening = {"soft": "left", "stiff": "right"}  # each bulges towards the other
     direction = {"soft": 1.0, "stiff": -1.0}  # towards the other gasket
     moduli = {"soft": p.soft_youngs_modulus,
               "stiff": p.soft_youngs_modulus * p.stiffness_ratio}
     bodies = []
     for name in ("soft", "stiff"):
-        mesh = meshes[name]
-        if p.order == 2:  # the contact face's facet midpoints on its circle
-            mesh = curved(mesh, "outer", c[name], p.radius)
-        bodies.append(Body(
+        mesh = MeshSpec(shape="gasket", parameters=as_parameters(
+            centre=c[name], radius=p.radius, thickness=p.thickness, opening=opening[name],
+            n_around=p.n_around, n_through=p.n_through),
+            # quadratic elements: the contact face's facet midpoints on its circle
+            curve=Curve("outer", c[name], p.radius) if p.order == 2 else None)
+        bodies.append(BodyConfig(
             name=name,
             mesh=mesh,
             material=LinearElastic(moduli[name], p.poissons_ratio, p.plane),
@@ -145,7 +145,12 @@ def build(p: GasketParameters | None = None) -> Model:
     settings = ContactSettings(variant=p.variant, search_distance=p.search_distance,
                                penetration_tolerance=p.penetration_tolerance,
                                equilibrium_tolerance=p.equilibrium_tolerance)
-    return Model("gasket", bodies, settings, load_factors(p))
+    return ModelConfig("gasket", tuple(bodies), settings,
+                       Steps(load_factors=load_factors(p)))
+
+
+def build(p: GasketParameters | None = None) -> Model:
+    return config(p).build()
 
 
 # -- the current configuration ------------------------------------------------------------------

@@ -19,11 +19,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..bodies import Body, Platen, Support
+from ..bodies import Platen, Support
+from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
 from ..materials import LinearElastic
-from ..mesh import graded_layer, graded_quarter_disk
-from ..mesh.quadratic import curved
 from ..solver import AnalysisResult, Model
 
 
@@ -71,39 +70,47 @@ def validate(p: HertzParameters) -> None:
     build(p).validate()
 
 
-def build(p: HertzParameters | None = None) -> Model:
+def config(p: HertzParameters | None = None) -> ModelConfig:
+    """The model as data (what ``examples/hertz.toml`` holds for the defaults)."""
     p = p or HertzParameters()
     th = theory(p) if p.cylinder_youngs_modulus > 0 and p.flat_youngs_modulus > 0 else None
     a = th["a_theory"] if th else 0.06
     n = p.facets_per_half_width * 2**p.refinement
     h = a / n
     h_max = p.max_element_size / 2**p.refinement
-    cylinder_mesh = graded_quarter_disk(p.radius, h, h_max, p.growth,
-                                        plateau=1.5 * a).translated((0.0, p.initial_gap))
-    if p.order == 2:  # the arc's facet midpoints on the circle (isoparametric elements)
-        cylinder_mesh = curved(cylinder_mesh, "contact", (0.0, p.radius + p.initial_gap),
-                               p.radius)
-    cylinder = Body(
+    cylinder = BodyConfig(
         name="cylinder",
-        mesh=cylinder_mesh,
+        mesh=MeshSpec(
+            shape="graded_quarter_disk",
+            parameters=as_parameters(radius=p.radius, h_contact=h, h_max=h_max,
+                                     growth=p.growth, plateau=1.5 * a),
+            translate=(0.0, p.initial_gap),
+            # quadratic elements: the arc's facet midpoints on the circle (isoparametric)
+            curve=(Curve("contact", (0.0, p.radius + p.initial_gap), p.radius)
+                   if p.order == 2 else None)),
         material=LinearElastic(p.cylinder_youngs_modulus, p.cylinder_poissons_ratio),
         supports=(Support("symmetry", ("x",)),),
         platen=Platen("top", "y", -p.force),
         order=p.order,
     )
-    flat = Body(
+    flat = BodyConfig(
         name="flat",
-        mesh=graded_layer(p.flat_width, p.flat_thickness, p.flat_size_ratio * h,
-                          h_max, p.growth, plateau=1.5 * a),
+        mesh=MeshSpec(shape="graded_layer",
+                      parameters=as_parameters(width=p.flat_width, thickness=p.flat_thickness,
+                                               h_contact=p.flat_size_ratio * h, h_max=h_max,
+                                               growth=p.growth, plateau=1.5 * a)),
         material=LinearElastic(p.flat_youngs_modulus, p.flat_poissons_ratio),
         supports=(Support("bottom", ("x", "y")), Support("symmetry", ("x",))),
         order=p.order,
     )
-    bodies = [flat, cylinder] if p.swap_bodies else [cylinder, flat]
+    bodies = (flat, cylinder) if p.swap_bodies else (cylinder, flat)
     settings = ContactSettings(variant=p.variant, penetration_tolerance=p.penetration_tolerance,
                                equilibrium_tolerance=p.equilibrium_tolerance)
-    factors = tuple((k + 1) / p.steps for k in range(p.steps))
-    return Model("hertz", bodies, settings, factors)
+    return ModelConfig("hertz", bodies, settings, Steps(count=p.steps))
+
+
+def build(p: HertzParameters | None = None) -> Model:
+    return config(p).build()
 
 
 def averaged_theory(surface, a: float, p0: float) -> np.ndarray:

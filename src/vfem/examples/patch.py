@@ -22,9 +22,9 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies import Body, PrescribedDisplacement, Support
+from ..bodies import PrescribedDisplacement, Support
+from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
 from ..materials import LinearElastic
 from ..solver import Analysis, Model
@@ -44,12 +44,10 @@ class Parameters:
     swap_bodies: bool = False  # list the upper block first
 
 
-def block(y0: float, n: int) -> MeshQuad:
-    m = MeshQuad.init_tensor(np.linspace(0, 1, n + 1), np.linspace(y0, y0 + 1, n + 1))
-    t = 1e-9
-    return m.with_boundaries({"bottom": lambda x: x[1] < y0 + t,
-                              "top": lambda x: x[1] > y0 + 1 - t,
-                              "left": lambda x: x[0] < t})
+def block(y0: float, n: int) -> MeshSpec:
+    """A unit square of n x n quadrilaterals from height y0."""
+    return MeshSpec(shape="rectangle", parameters=as_parameters(x0=0.0, y0=y0, width=1.0,
+                                                                height=1.0, nx=n, ny=n))
 
 
 def settings(p: Parameters) -> ContactSettings:
@@ -61,17 +59,36 @@ def settings(p: Parameters) -> ContactSettings:
     return ContactSettings(variant=p.variant)
 
 
-def build(p: Parameters, n_lower: int, n_upper: int, nu: float) -> Model:
+def config(p: Parameters, n_lower: int, n_upper: int, nu: float) -> ModelConfig:
+    """One case as data (``examples/patch/*.toml`` hold the default cases)."""
     mat = LinearElastic(p.youngs_modulus, nu)
     base = Support("bottom", ("x", "y") if nu == 0 else ("y",))
-    lower = Body("lower", block(-1.0, n_lower), mat,
-                 supports=(base, Support("left", ("x",))), contact_boundaries=("top",),
-                 order=p.order)
-    upper = Body("upper", block(0.0, n_upper), mat, supports=(Support("left", ("x",)),),
-                 prescribed=(PrescribedDisplacement("top", "y", -p.displacement),),
-                 contact_boundaries=("bottom",), order=p.order)
-    bodies = [upper, lower] if p.swap_bodies else [lower, upper]
-    return Model(f"patch {n_lower}/{n_upper} nu={nu}", bodies, settings(p), load_factors=(1.0,))
+    lower = BodyConfig("lower", block(-1.0, n_lower), mat,
+                       supports=(base, Support("left", ("x",))), contact_boundaries=("top",),
+                       order=p.order)
+    upper = BodyConfig("upper", block(0.0, n_upper), mat, supports=(Support("left", ("x",)),),
+                       prescribed=(PrescribedDisplacement("top", "y", -p.displacement),),
+                       contact_boundaries=("bottom",), order=p.order)
+    bodies = (upper, lower) if p.swap_bodies else (lower, upper)
+    return ModelConfig(case_name(n_lower, n_upper, nu), bodies, settings(p), Steps(count=1))
+
+
+def case_name(n_lower: int, n_upper: int, nu: float) -> str:
+    return f"patch {n_lower}/{n_upper} nu={nu:g}"
+
+
+def configs(p: Parameters) -> dict[str, ModelConfig]:
+    """Every case, by a file-name-friendly key (``4x7_nu0``)."""
+    out = {}
+    for nu in (0.0, 0.3):
+        for a, b in PAIRS:
+            for n_lower, n_upper in ((a, b), (b, a)):
+                out[f"{n_lower}x{n_upper}_nu{nu:g}"] = config(p, n_lower, n_upper, nu)
+    return out
+
+
+def build(p: Parameters, n_lower: int, n_upper: int, nu: float) -> Model:
+    return config(p, n_lower, n_upper, nu).build()
 
 
 def validate(p: Parameters) -> None:

@@ -46,10 +46,10 @@ import numpy as np
 from skfem import MeshQuad, MeshTri
 
 from ..bodies import Body, PrescribedDisplacement, Support
+from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import CONVERGENCE_CRITERIA, VARIANTS, ContactSettings
 from ..errors import InputError
 from ..materials import LinearElastic
-from ..mesh import wedge, wedge_plate
 from ..solver import AnalysisResult, Model, StepResult
 
 #: Wedge/plate modulus ratio of the thesis's five cases, in its numbering.
@@ -116,63 +116,32 @@ def rise(p: WedgeParameters) -> float:
     return p.centre_thickness - p.edge_thickness
 
 
-def meshes(p: WedgeParameters) -> tuple[MeshTri | MeshQuad, MeshTri | MeshQuad]:
-    """(plate, wedge) meshes with the named boundaries of :mod:`vfem.mesh.shapes`."""
+def mesh_specs(p: WedgeParameters) -> tuple[MeshSpec, MeshSpec]:
+    """(plate, wedge) meshes as data: graded triangles, or the thesis's coarse quadrilaterals."""
     if p.mesh == "coarse":
-        return coarse_meshes(p)
+        # structured quadrilaterals, ``coarse_columns`` across and ``coarse_rows`` through each
+        # body: the plate's surface elements are plate_thickness / coarse_rows deep (1/3 by
+        # default, more than the 0.3 overlap of the linear prediction, so the thesis's single
+        # step respects the rind rule)
+        grid = dict(columns=p.coarse_columns, rows=p.coarse_rows, loaded_width=loaded_width(p))
+        return (MeshSpec(shape="wedge_plate_grid", parameters=as_parameters(
+                    half_width=p.half_width, thickness=p.plate_thickness, **grid)),
+                MeshSpec(shape="wedge_grid", parameters=as_parameters(
+                    half_width=p.half_width, edge_thickness=p.edge_thickness,
+                    centre_thickness=p.centre_thickness, **grid)))
     scale = 0.5**p.refinement
     kw = dict(h_contact=p.h_contact * scale, h_max=p.h_max * scale, growth=p.growth)
-    plate = wedge_plate(p.half_width, p.plate_thickness, **kw)
-    body = wedge(p.half_width, p.edge_thickness, p.centre_thickness,
-                 loaded_width=loaded_width(p), **kw)
-    return plate, body
+    return (MeshSpec(shape="wedge_plate", parameters=as_parameters(
+                half_width=p.half_width, thickness=p.plate_thickness, **kw)),
+            MeshSpec(shape="wedge", parameters=as_parameters(
+                half_width=p.half_width, edge_thickness=p.edge_thickness,
+                centre_thickness=p.centre_thickness, loaded_width=loaded_width(p), **kw)))
 
 
-def coarse_meshes(p: WedgeParameters) -> tuple[MeshQuad, MeshQuad]:
-    """Structured quadrilaterals: ``coarse_columns`` across, ``coarse_rows`` through each body.
-
-    Columns are uniform on either side of x = loaded_width (a grid line, where the prescribed
-    motion ends); the wedge's rows follow its inclined lower face. The plate's surface
-    elements are plate_thickness / coarse_rows deep (1/3 by default, more than the 0.3 overlap
-    of the linear prediction, so the thesis's single step respects the rind rule).
-    """
-    W, b, n = p.half_width, loaded_width(p), p.coarse_columns
-    if b < W:
-        n1 = min(max(1, round(n * b / W)), n - 1)  # columns under the loaded part
-        x = np.concatenate([np.linspace(0.0, b, n1 + 1), np.linspace(b, W, n - n1 + 1)[1:]])
-    else:
-        x = np.linspace(0.0, W, n + 1)
-    T, r = p.centre_thickness, rise(p)
-    tol = 1e-9 * max(W, T, p.plate_thickness)
-    plate = _mapped_quads(x, lambda s: -p.plate_thickness + 0 * s, lambda s: 0 * s,
-                          p.coarse_rows).with_boundaries({
-        "contact": lambda q: q[1] > -tol,
-        "bottom": lambda q: q[1] < -p.plate_thickness + tol,
-        "symmetry": lambda q: q[0] < tol,
-        "right": lambda q: q[0] > W - tol,
-    })
-    on_top = lambda q: q[1] > T - tol  # noqa: E731
-    body = _mapped_quads(x, lambda s: r * s / W, lambda s: T + 0 * s,
-                         p.coarse_rows).with_boundaries({
-        "contact": lambda q: (q[1] < T - tol) & (q[0] > tol) & (q[0] < W - tol),
-        "symmetry": lambda q: q[0] < tol,
-        "top_loaded": lambda q: on_top(q) & (q[0] < b),
-        "top": lambda q: on_top(q) & (q[0] > b),
-        "right": lambda q: q[0] > W - tol,
-    })
-    return plate, body
-
-
-def _mapped_quads(x: np.ndarray, lower, upper, rows: int) -> MeshQuad:
-    """Quadrilaterals between y = lower(x) and y = upper(x) on the columns ``x``, counter-
-    clockwise, ``rows`` of them evenly spaced at each x."""
-    s = np.linspace(0.0, 1.0, rows + 1)
-    X, S = np.meshgrid(x, s, indexing="ij")
-    Y = lower(X) + S * (upper(X) - lower(X))
-    i, j = np.meshgrid(np.arange(len(x) - 1), np.arange(rows), indexing="ij")
-    k = (i * (rows + 1) + j).ravel()
-    t = np.vstack([k, k + rows + 1, k + rows + 2, k + 1])
-    return MeshQuad(np.vstack([X.ravel(), Y.ravel()]), t)
+def meshes(p: WedgeParameters) -> tuple[MeshTri | MeshQuad, MeshTri | MeshQuad]:
+    """(plate, wedge) meshes with the named boundaries of :mod:`vfem.mesh.shapes`."""
+    plate, body = mesh_specs(p)
+    return plate.make(), body.make()
 
 
 def surface_depth(mesh: MeshTri | MeshQuad, boundary: str) -> tuple[np.ndarray, np.ndarray]:
@@ -215,29 +184,39 @@ def settings(p: WedgeParameters) -> ContactSettings:
                            search_distance=1.1 * rise(p))
 
 
-def build(p: WedgeParameters | None = None, case: int = 3,
-          mesh_pair: tuple[MeshTri | MeshQuad, MeshTri | MeshQuad] | None = None) -> Model:
-    """The model of one case (1 to 5); ``mesh_pair`` = (plate, wedge) meshes to reuse."""
+def config(p: WedgeParameters | None = None, case: int = 3) -> ModelConfig:
+    """One case (1 to 5) as data (``examples/wedge/case<N>.toml`` hold the defaults)."""
     p = p or WedgeParameters()
-    plate_mesh, wedge_mesh = mesh_pair or meshes(p)
+    plate_spec, wedge_spec = mesh_specs(p)
     ratio = RATIOS[case - 1]
-    plate = Body(
-        name="plate", mesh=plate_mesh,
+    plate = BodyConfig(
+        name="plate", mesh=plate_spec,
         material=LinearElastic(p.plate_youngs_modulus, p.poissons_ratio),
         supports=(Support("bottom", ("x", "y")), Support("symmetry", ("x",))),
         contact_boundaries=("contact",),
     )
-    upper = Body(
-        name="wedge", mesh=wedge_mesh,
+    upper = BodyConfig(
+        name="wedge", mesh=wedge_spec,
         material=LinearElastic(ratio * p.plate_youngs_modulus, p.poissons_ratio),
         supports=(Support("symmetry", ("x",)),),
         prescribed=(PrescribedDisplacement("top_loaded", "y", -p.motion),),
         contact_boundaries=("contact",),
     )
-    bodies = [plate, upper] if p.swap_bodies else [upper, plate]
-    n = planned_steps(p, plate_mesh, wedge_mesh)
-    return Model(f"wedge case {case} (E_wedge / E_plate = {ratio:g})", bodies, settings(p),
-                 tuple((k + 1) / n for k in range(n)))
+    bodies = (plate, upper) if p.swap_bodies else (upper, plate)
+    n = planned_steps(p, *meshes(p))
+    return ModelConfig(f"wedge case {case} (E_wedge / E_plate = {ratio:g})", bodies,
+                       settings(p), Steps(count=n))
+
+
+def configs(p: WedgeParameters | None = None) -> dict[str, ModelConfig]:
+    """Every case the parameters select, by file-name-friendly key (``case1``)."""
+    p = p or WedgeParameters()
+    return {f"case{c}": config(p, c) for c in cases(p)}
+
+
+def build(p: WedgeParameters | None = None, case: int = 3) -> Model:
+    """The model of one case (1 to 5)."""
+    return config(p, case).build()
 
 
 def validate(p: WedgeParameters) -> None:
@@ -269,10 +248,10 @@ def validate(p: WedgeParameters) -> None:
          "need coarse_columns >= 2 and coarse_rows >= 1")
     need(p.max_step_cuts >= 0, "max_step_cuts must be >= 0")
     try:
-        mesh_pair = meshes(p)
+        meshes(p)
     except ValueError as exc:
         raise InputError(f"wedge: {exc}") from None
-    build(p, cases(p)[0], mesh_pair).validate()
+    build(p, cases(p)[0]).validate()
 
 
 # -- one case -----------------------------------------------------------------------------------
@@ -374,12 +353,11 @@ def run(p: WedgeParameters, out=None, on_step=None) -> dict:
     from ..io.results import write_summary
 
     start = time.perf_counter()
-    mesh_pair = meshes(p)
     out = Path(out) if out is not None else None
     entries, finals, models = [], {}, {}
     for case in cases(p):
         t0 = time.perf_counter()
-        model = build(p, case, mesh_pair)
+        model = build(p, case)
         result, compatibility = solve_case(model, out / f"case{case}" if out else None,
                                            on_step)
         steps, message = result.steps, result.message

@@ -1,7 +1,17 @@
 """Built-in parametric meshes for the examples."""
 
 from .parametric import graded_layer, graded_quarter_disk, march
-from .shapes import block, gasket, gasket_pair, graded_nodes, wedge, wedge_plate
+from .shapes import (
+    block,
+    gasket,
+    gasket_pair,
+    graded_nodes,
+    rectangle,
+    wedge,
+    wedge_grid,
+    wedge_plate,
+    wedge_plate_grid,
+)
 
 __all__ = [
     "block",
@@ -11,6 +21,9 @@ __all__ = [
     "graded_nodes",
     "graded_quarter_disk",
     "march",
+    "rectangle",
     "wedge",
+    "wedge_grid",
     "wedge_plate",
+    "wedge_plate_grid",
 ]

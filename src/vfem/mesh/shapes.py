@@ -35,7 +35,8 @@ from skfem import MeshQuad, MeshTri
 from .parametric import march, size_function
 
 __all__ = [
-    "block", "gasket", "gasket_pair", "graded_nodes", "wedge", "wedge_plate",
+    "block", "gasket", "gasket_pair", "graded_nodes", "rectangle", "wedge", "wedge_grid",
+    "wedge_plate", "wedge_plate_grid",
 ]
 
 #: Unit vector of each gasket opening (the side its two cut ends, the back, face).
@@ -111,6 +112,70 @@ def wedge(half_width: float = 5.0, edge_thickness: float = 1.0, centre_thickness
         "top": lambda x: on_top(x) & (x[0] > b),
         "right": lambda x: x[0] > W - tol,
     })
+
+
+def wedge_plate_grid(half_width: float = 5.0, thickness: float = 1.0, columns: int = 15,
+                     rows: int = 3, loaded_width: float | None = None) -> MeshQuad:
+    """The wedge example's plate as the thesis meshed it: ``columns`` x ``rows`` quadrilaterals.
+
+    Columns are uniform on either side of x = ``loaded_width`` (default ``half_width / 5``),
+    where the wedge's prescribed motion ends, so the two bodies' grids line up as in thesis
+    Fig. 5.4. Named boundaries as :func:`wedge_plate`.
+    """
+    W, T = float(half_width), float(thickness)
+    x = _wedge_columns(W, loaded_width, columns)
+    tol = 1e-9 * max(W, T)
+    return _mapped_quads(x, lambda s: -T + 0 * s, lambda s: 0 * s, rows).with_boundaries({
+        "contact": lambda q: q[1] > -tol,
+        "bottom": lambda q: q[1] < -T + tol,
+        "symmetry": lambda q: q[0] < tol,
+        "right": lambda q: q[0] > W - tol,
+    })
+
+
+def wedge_grid(half_width: float = 5.0, edge_thickness: float = 1.0,
+               centre_thickness: float = 1.3, columns: int = 15, rows: int = 3,
+               loaded_width: float | None = None) -> MeshQuad:
+    """The wedge of §5.3 as the thesis meshed it: ``columns`` x ``rows`` quadrilaterals whose
+    rows follow the inclined lower face. Named boundaries as :func:`wedge`."""
+    W, T = float(half_width), float(centre_thickness)
+    rise = T - float(edge_thickness)
+    if not 0.0 < rise < T:
+        raise ValueError("need 0 < edge_thickness < centre_thickness")
+    b = W / 5.0 if loaded_width is None else float(loaded_width)
+    x = _wedge_columns(W, loaded_width, columns)
+    tol = 1e-9 * max(W, T)
+    on_top = lambda q: q[1] > T - tol  # noqa: E731
+    return _mapped_quads(x, lambda s: rise * s / W, lambda s: T + 0 * s, rows).with_boundaries({
+        "contact": lambda q: (q[1] < T - tol) & (q[0] > tol) & (q[0] < W - tol),
+        "symmetry": lambda q: q[0] < tol,
+        "top_loaded": lambda q: on_top(q) & (q[0] < b),
+        "top": lambda q: on_top(q) & (q[0] > b),
+        "right": lambda q: q[0] > W - tol,
+    })
+
+
+def _wedge_columns(W: float, loaded_width: float | None, n: int) -> np.ndarray:
+    """``n`` columns on [0, W], uniform on either side of the loaded width's end."""
+    b = W / 5.0 if loaded_width is None else float(loaded_width)
+    if not 0.0 < b <= W:
+        raise ValueError(f"loaded_width must lie in (0, half_width], got {b}")
+    if b < W:
+        n1 = min(max(1, round(n * b / W)), n - 1)  # columns under the loaded part
+        return np.concatenate([np.linspace(0.0, b, n1 + 1), np.linspace(b, W, n - n1 + 1)[1:]])
+    return np.linspace(0.0, W, n + 1)
+
+
+def _mapped_quads(x: np.ndarray, lower, upper, rows: int) -> MeshQuad:
+    """Quadrilaterals between y = lower(x) and y = upper(x) on the columns ``x``, counter-
+    clockwise, ``rows`` of them evenly spaced at each x."""
+    s = np.linspace(0.0, 1.0, rows + 1)
+    X, S = np.meshgrid(x, s, indexing="ij")
+    Y = lower(X) + S * (upper(X) - lower(X))
+    i, j = np.meshgrid(np.arange(len(x) - 1), np.arange(rows), indexing="ij")
+    k = (i * (rows + 1) + j).ravel()
+    t = np.vstack([k, k + rows + 1, k + rows + 2, k + 1])
+    return MeshQuad(np.vstack([X.ravel(), Y.ravel()]), t)
 
 
 def _graded_trapezoid(width: float, lower: tuple[float, float], upper: tuple[float, float],
@@ -293,6 +358,29 @@ def block(x0: float, y0: float, width: float, height: float, h: float, *,
         "bottom": lambda p: p[1] < y0 + tol,
         names["left"]: lambda p: p[0] < x0 + tol,
         names["right"]: lambda p: p[0] > x1 - tol,
+    })
+
+
+def rectangle(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: float = 1.0,
+              nx: int = 1, ny: int = 1, triangles: bool = False) -> MeshQuad | MeshTri:
+    """The rectangle ``[x0, x0 + width] x [y0, y0 + height]`` as ``nx`` x ``ny`` equal
+    quadrilaterals (each split in two triangles with ``triangles``), counter-clockwise.
+
+    Named boundaries: ``top``, ``bottom``, ``left`` and ``right``.
+    """
+    if width <= 0 or height <= 0 or nx < 1 or ny < 1:
+        raise ValueError("need width, height > 0 and nx, ny >= 1")
+    x = np.linspace(x0, x0 + width, int(nx) + 1)
+    y = np.linspace(y0, y0 + height, int(ny) + 1)
+    grid = (MeshTri if triangles else MeshQuad).init_tensor(x, y)
+    t = _counter_clockwise(grid.p, grid.t)
+    mesh = MeshTri(grid.p, t, sort_t=False) if triangles else MeshQuad(grid.p, t)
+    tol = 1e-9 * max(width, height)
+    return mesh.with_boundaries({
+        "top": lambda p: p[1] > y0 + height - tol,
+        "bottom": lambda p: p[1] < y0 + tol,
+        "left": lambda p: p[0] < x0 + tol,
+        "right": lambda p: p[0] > x0 + width - tol,
     })
 
 

@@ -1,0 +1,273 @@
+"""A model as data: the typed, frozen description that input files and the examples share.
+
+An input file (``examples/*.toml``, see ``docs/input.md``) is read into a :class:`ModelConfig`;
+every built-in example builds the same objects, so ``vfem run examples/hertz.toml`` and
+``vfem run hertz`` solve the very same model. These classes are the single source of truth for the
+names, types, defaults and help text of every key: the loader (:mod:`vfem.io.input`) checks input
+against them and the key reference in ``docs/input.md`` is generated from them (a test keeps the
+two equal).
+
+Classes that describe a body's physics are the solver's own: :class:`~vfem.materials.LinearElastic`,
+:class:`~vfem.bodies.Support`, :class:`~vfem.bodies.PrescribedDisplacement`,
+:class:`~vfem.bodies.Traction`, :class:`~vfem.bodies.Platen` and
+:class:`~vfem.contact.settings.ContactSettings`. What only a description needs (how to make the
+mesh, the steps, where results go) is defined here. :meth:`ModelConfig.build` turns the
+description into a :class:`~vfem.solver.Model`.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .bodies import Body, Platen, PrescribedDisplacement, Support, Traction
+from .contact.settings import ContactSettings
+from .errors import InputError
+from .materials import LinearElastic
+from .mesh import parametric, shapes
+from .solver import Model
+
+#: The built-in parametric meshes an input file may name as ``mesh.shape``: each is a function
+#: of ``vfem.mesh`` whose keyword parameters are the keys of the mesh table.
+SHAPES = {
+    "rectangle": shapes.rectangle,
+    "block": shapes.block,
+    "graded_quarter_disk": parametric.graded_quarter_disk,
+    "graded_layer": parametric.graded_layer,
+    "wedge": shapes.wedge,
+    "wedge_plate": shapes.wedge_plate,
+    "wedge_grid": shapes.wedge_grid,
+    "wedge_plate_grid": shapes.wedge_plate_grid,
+    "gasket": shapes.gasket,
+}
+
+
+@dataclass(frozen=True)
+class Curve:
+    """Quadratic geometry on a circular boundary (bodies with ``order = 2``).
+
+    Attributes:
+        boundary: the boundary whose facet midpoints are moved onto the circle (its vertices
+            must already lie on it), e.g. a cylinder's arc.
+        centre: the circle's centre (x, y).
+        radius: the circle's radius.
+    """
+
+    boundary: str
+    centre: tuple[float, float]
+    radius: float
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """Where a body's mesh comes from: a built-in shape or a mesh file.
+
+    Attributes:
+        shape: a built-in parametric mesh (see *Mesh shapes* below); its parameters are the
+            other keys of the same table.
+        file: a mesh file read through meshio: Gmsh ``.msh`` (format 4) or Abaqus ``.inp``;
+            relative paths are taken from the input file's folder. Physical curves (Gmsh) or
+            node sets (Abaqus) become the body's named boundaries.
+        cells: the group of ``file`` holding this body's elements: a Gmsh physical surface or
+            an Abaqus element set. Default: every 2D element of the file.
+        translate: moves the mesh by (dx, dy) after it is made.
+        curve: puts the facet midpoints of a circular boundary on the circle (quadratic
+            elements only).
+        parameters: the shape's parameters (in an input file: the other keys of the mesh
+            table, not a key of its own).
+    """
+
+    shape: str | None = None
+    file: str | None = None
+    cells: str | None = None
+    translate: tuple[float, float] = (0.0, 0.0)
+    curve: Curve | None = None
+    parameters: tuple[tuple[str, Any], ...] = ()
+
+    def __post_init__(self):
+        # one order for the same parameters, so equal descriptions compare (and cache) equal
+        object.__setattr__(self, "parameters", tuple(sorted(self.parameters)))
+
+    def make(self, base: Path | None = None):
+        """The scikit-fem mesh, with its named boundaries."""
+        if (self.shape is None) == (self.file is None):
+            raise InputError("mesh: give exactly one of 'shape' (a built-in mesh) and 'file'")
+        if self.shape is not None:
+            mesh = _shape_mesh(self.shape, self.parameters)
+        else:
+            from .mesh.imports import read_mesh
+
+            path = Path(self.file)
+            if base is not None and not path.is_absolute():
+                path = Path(base) / path
+            mesh = read_mesh(path, self.cells)
+        if any(self.translate):
+            mesh = mesh.translated(tuple(float(v) for v in self.translate))
+        if self.curve is not None:
+            from .mesh.quadratic import curved
+
+            if self.curve.boundary not in (mesh.boundaries or {}):
+                raise InputError(f"mesh.curve: no boundary named {self.curve.boundary!r}; the "
+                                 f"mesh has {', '.join(sorted(mesh.boundaries or {}))}")
+            mesh = curved(mesh, self.curve.boundary, self.curve.centre, self.curve.radius)
+        return mesh
+
+
+@lru_cache(maxsize=8)
+def _shape_mesh(shape: str, parameters: tuple[tuple[str, Any], ...]):
+    """A built-in mesh (cached: several models of one example often share their meshes;
+    meshes are never modified in place)."""
+    if shape not in SHAPES:
+        raise InputError(f"mesh: unknown shape {shape!r}; built-in shapes: "
+                         f"{', '.join(SHAPES)}")
+    try:
+        return SHAPES[shape](**dict(parameters))
+    except (ValueError, TypeError) as exc:
+        raise InputError(f"mesh shape {shape!r}: {exc}") from None
+
+
+def shape_parameters(shape: str) -> dict[str, inspect.Parameter]:
+    """The keyword parameters of a built-in shape (name -> inspect.Parameter)."""
+    return dict(inspect.signature(SHAPES[shape]).parameters)
+
+
+@dataclass(frozen=True)
+class BodyConfig:
+    """One deformable body.
+
+    Attributes:
+        name: unique name, used in messages and output file names.
+        mesh: how its mesh is made.
+        material: its material.
+        order: 1 for linear elements, 2 for quadratic ones (6-node triangles, 9-node
+            quadrilaterals) on the same mesh.
+        supports: fixed displacement components on named boundaries.
+        prescribed: displacements prescribed on named boundaries (value at load factor 1).
+        tractions: distributed loads on named boundaries (at load factor 1).
+        platen: a rigid, force-controlled platen on a named boundary.
+        contact_boundaries: the boundaries that may touch other bodies. Default: every
+            exterior facet on which no displacement is prescribed.
+    """
+
+    name: str
+    mesh: MeshSpec
+    material: LinearElastic
+    order: int = 1
+    supports: tuple[Support, ...] = ()
+    prescribed: tuple[PrescribedDisplacement, ...] = ()
+    tractions: tuple[Traction, ...] = ()
+    platen: Platen | None = None
+    contact_boundaries: tuple[str, ...] | None = None
+
+    def build(self, base: Path | None = None) -> Body:
+        try:
+            mesh = self.mesh.make(base)
+        except InputError as exc:
+            raise InputError(f"body {self.name!r}: {exc}") from None
+        if mesh.t.shape[1] == 0:
+            raise InputError(f"body {self.name!r}: its mesh has no elements")
+        return Body(self.name, mesh, self.material, supports=self.supports,
+                    prescribed=self.prescribed, tractions=self.tractions, platen=self.platen,
+                    contact_boundaries=self.contact_boundaries, order=self.order)
+
+
+@dataclass(frozen=True)
+class Steps:
+    """The load history. Every load, prescribed displacement and platen force is scaled by the
+    load factor (proportional loading); each step ends at the next load factor.
+
+    Attributes:
+        count: that many equal steps from 0 to 1 (used when ``load_factors`` is not given).
+        load_factors: the load factor at the end of each step, e.g. ``[0.5, 1.0, 0.5, 0.0]``
+            to load and unload; each differs from the one before, the first from 0.
+    """
+
+    count: int = 1
+    load_factors: tuple[float, ...] | None = None
+
+    def factors(self) -> tuple[float, ...]:
+        if self.load_factors is not None:
+            return tuple(float(f) for f in self.load_factors)
+        if self.count < 1:
+            raise InputError(f"steps.count must be at least 1, got {self.count}")
+        return tuple((k + 1) / self.count for k in range(self.count))
+
+
+@dataclass(frozen=True)
+class Output:
+    """What a run writes.
+
+    Attributes:
+        directory: the results folder, relative to where vfem runs. Default:
+            ``results/<name>``. The command line's ``--out`` overrides it.
+        figures: draw the figures (deformed shape, contact pressure, history) at the end.
+    """
+
+    directory: str | None = None
+    figures: bool = True
+
+
+@dataclass(frozen=True)
+class ModelConfig:
+    """A whole contact analysis.
+
+    Attributes:
+        name: the model's name (messages, the default results folder).
+        bodies: the bodies, two or more for contact (each one ``[[bodies]]`` table).
+        contact: settings of the contact algorithm.
+        steps: the load history.
+        contact_pairs: which pairs of bodies may touch, by name, e.g.
+            ``[["cylinder", "flat"]]``. Default: every pair.
+        output: what a run writes.
+    """
+
+    name: str
+    bodies: tuple[BodyConfig, ...]
+    contact: ContactSettings = field(default_factory=ContactSettings)
+    steps: Steps = field(default_factory=Steps)
+    contact_pairs: tuple[tuple[str, str], ...] | None = None
+    output: Output = field(default_factory=Output)
+
+    def build(self, base: Path | None = None) -> Model:
+        """The solver's model; mesh files are looked up relative to ``base``. Raises
+        :class:`InputError` naming the body and key of anything that cannot be analysed."""
+        names = [b.name for b in self.bodies]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise InputError(f"two bodies are named {dup[0]!r}: body names must be unique")
+        model = Model(self.name, [b.build(base) for b in self.bodies], self.contact,
+                      self.steps.factors(), self.contact_pairs)
+        model.validate()
+        return model
+
+
+def check(config: ModelConfig, base: Path | None = None) -> Model:
+    """Everything that can be checked without solving: build the model and each body's
+    constraints (a body that could move freely is named with its free motion)."""
+    model = config.build(base)
+    for body in model.bodies:
+        body.check_supports()
+    return model
+
+
+def finite(value: float) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(
+        value)
+
+
+def as_parameters(**kwargs) -> tuple[tuple[str, Any], ...]:
+    """Shape parameters as the frozen, hashable tuple :class:`MeshSpec` keeps (lists and
+    arrays become tuples; NumPy scalars become Python numbers, so they print exactly)."""
+    def plain(v):
+        if isinstance(v, (list, tuple, np.ndarray)):
+            return tuple(plain(x) for x in v)
+        if isinstance(v, np.generic):
+            return v.item()
+        return v
+    return tuple((k, plain(v)) for k, v in kwargs.items())

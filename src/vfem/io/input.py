@@ -1,0 +1,425 @@
+"""Input files: TOML in, checked against the configuration classes, TOML out.
+
+``load(path)`` reads an input file into a :class:`~vfem.config.ModelConfig`. Every key is checked
+against the dataclass that owns it (its name, its type, finiteness): the first problem found is
+raised as one :class:`~vfem.errors.InputError` that names the file, where in it (``bodies[1]
+(flat).material``) and the key, with the closest valid key for a misspelt one. TOML cannot
+execute anything; nothing here evaluates text.
+
+``dumps(config)`` writes a configuration back as TOML (keys at their defaults left out), which is
+how the built-in examples' input files under ``examples/`` are made (``vfem export``).
+``reference()`` is the key reference of ``docs/input.md``, generated from the same classes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import inspect
+import json
+import math
+import tomllib
+import types
+import typing
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from ..config import SHAPES, BodyConfig, Curve, MeshSpec, ModelConfig, Output, Steps
+from ..errors import InputError
+
+#: Where each configuration class sits in an input file (for messages and the reference).
+SECTIONS = {
+    "ModelConfig": "top level",
+    "ContactSettings": "[contact]",
+    "Steps": "[steps]",
+    "Output": "[output]",
+    "BodyConfig": "[[bodies]]",
+    "MeshSpec": "[bodies.mesh]",
+    "Curve": "[bodies.mesh.curve]",
+    "LinearElastic": "[bodies.material]",
+    "Support": "[[bodies.supports]]",
+    "PrescribedDisplacement": "[[bodies.prescribed]]",
+    "Traction": "[[bodies.tractions]]",
+    "Platen": "[bodies.platen]",
+}
+
+
+class _Problem(Exception):
+    """A problem at a place in the file; turned into an InputError naming the file."""
+
+    def __init__(self, where: str, message: str):
+        super().__init__(f"{where}: {message}" if where else message)
+
+
+# -- reading -------------------------------------------------------------------------------------
+
+def load(path: str | Path) -> ModelConfig:
+    """Read and check an input file."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"input file {str(path)!r} does not exist" if not path.exists()
+                         else f"input file {str(path)!r} is not a file")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read it ({exc})") from None
+    return loads(text, str(path))
+
+
+def loads(text: str, source: str = "<input>") -> ModelConfig:
+    """Check TOML text (``source`` names it in messages)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{source}: not valid TOML: {exc}") from None
+    try:
+        return from_data(ModelConfig, data, "")
+    except _Problem as exc:
+        raise InputError(f"{source}: {exc}") from None
+
+
+def from_data(cls, data: Any, where: str):
+    """An instance of dataclass ``cls`` from parsed TOML ``data``, every key checked."""
+    if not isinstance(data, dict):
+        raise _Problem(where, f"expected a table, got {_kind(data)}")
+    if cls is MeshSpec:
+        return _mesh_spec(data, where)
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    _reject_unknown(data, list(fields), where)
+    values = {}
+    for name, f in fields.items():
+        if name not in data:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                meaning = _help(cls).get(name, "").rstrip(".")
+                raise _Problem(where, f"missing key {name!r}" + (f" ({meaning})" if meaning
+                                                                 else ""))
+            continue
+        here = _join(where, name)
+        if cls is ModelConfig and name == "bodies":
+            values[name] = _bodies(data[name], here)
+        else:
+            values[name] = _convert(hints[name], data[name], here)
+    try:
+        return cls(**values)
+    except (TypeError, ValueError) as exc:
+        raise _Problem(where, str(exc)) from None
+
+
+def _bodies(data: Any, where: str) -> tuple[BodyConfig, ...]:
+    if not isinstance(data, list) or not data:
+        raise _Problem(where, "expected one or more [[bodies]] tables")
+    out = []
+    for i, item in enumerate(data):
+        name = item.get("name") if isinstance(item, dict) else None
+        label = f"bodies[{i}]" + (f" ({name})" if isinstance(name, str) else "")
+        out.append(from_data(BodyConfig, item, label))
+    return tuple(out)
+
+
+def _mesh_spec(data: dict, where: str) -> MeshSpec:
+    own = [f.name for f in dataclasses.fields(MeshSpec) if f.name != "parameters"]
+    shape = data.get("shape")
+    if shape is None:
+        _reject_unknown(data, own, where)
+        if "file" not in data:
+            raise _Problem(where, "give 'shape' (a built-in mesh) or 'file' (a mesh file)")
+        params: tuple = ()
+    else:
+        if not isinstance(shape, str):
+            raise _Problem(_join(where, "shape"), f"expected a string, got {_kind(shape)}")
+        if shape not in SHAPES:
+            raise _Problem(_join(where, "shape"), f"unknown shape {shape!r}"
+                           + _suggest(shape, list(SHAPES)) + f"; built-in: {', '.join(SHAPES)}")
+        if "file" in data:
+            raise _Problem(where, "give either 'shape' or 'file', not both")
+        signature = inspect.signature(SHAPES[shape]).parameters
+        hints = typing.get_type_hints(SHAPES[shape])
+        _reject_unknown(data, own + list(signature), where, f"shape {shape!r}")
+        params = []
+        for name, par in signature.items():
+            if name in data:
+                params.append((name, _plain(_convert(hints.get(name, Any), data[name],
+                                                     _join(where, name)))))
+            elif par.default is inspect.Parameter.empty:
+                raise _Problem(where, f"shape {shape!r} needs {name!r}")
+        params = tuple(params)
+    hints = typing.get_type_hints(MeshSpec)
+    values = {k: _convert(hints[k], data[k], _join(where, k)) for k in own if k in data}
+    return MeshSpec(parameters=params, **values)
+
+
+def _convert(tp, value, where: str):
+    """``value`` checked against type ``tp`` (and converted: arrays to tuples)."""
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if tp is Any:
+        return value
+    if origin in (typing.Union, types.UnionType):
+        inner = [a for a in args if a is not type(None)]
+        if len(inner) == 1:
+            return _convert(inner[0], value, where)
+        for a in inner:
+            try:
+                return _convert(a, value, where)
+            except _Problem:
+                continue
+        raise _Problem(where, f"expected {_type_name(tp)}, got {_kind(value)}")
+    if dataclasses.is_dataclass(tp):
+        return from_data(tp, value, where)
+    if origin in (tuple, Sequence) or tp in (tuple, Sequence):
+        if not isinstance(value, list):
+            raise _Problem(where, f"expected {_type_name(tp)}, got {_kind(value)}")
+        if origin is tuple and args and args[-1] is not Ellipsis:
+            if len(value) != len(args):
+                raise _Problem(where, f"expected {len(args)} values, got {len(value)}")
+            return tuple(_convert(a, v, f"{where}[{i}]")
+                         for i, (a, v) in enumerate(zip(args, value)))
+        item = args[0] if args else Any
+        return tuple(_convert(item, v, f"{where}[{i}]") for i, v in enumerate(value))
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise _Problem(where, f"expected true or false, got {_kind(value)}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise _Problem(where, f"expected an integer, got {_kind(value)}")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise _Problem(where, f"expected a number, got {_kind(value)}")
+        if not math.isfinite(value):
+            raise _Problem(where, f"must be a finite number, got {value!r}")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise _Problem(where, f"expected a string, got {_kind(value)}")
+        return value
+    raise _Problem(where, f"cannot read a value of type {tp!r}")  # a bug in the classes
+
+
+def _reject_unknown(data: dict, valid: list[str], where: str, owner: str = "") -> None:
+    for key in data:
+        if key not in valid:
+            place = f"{where} ({owner})" if owner else where
+            raise _Problem(place, f"unknown key {key!r}" + _suggest(key, valid)
+                           + f"; valid keys: {', '.join(valid)}")
+
+
+def _suggest(key: str, valid: list[str]) -> str:
+    close = difflib.get_close_matches(key, valid, n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _join(where: str, key: str) -> str:
+    return f"{where}.{key}" if where else key
+
+
+def _kind(value) -> str:
+    if isinstance(value, bool):
+        return f"the boolean {str(value).lower()}"
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return "an array"
+    if isinstance(value, str):
+        return f"the string {value!r}"
+    if isinstance(value, (int, float)):
+        return f"the number {value!r}"
+    return type(value).__name__
+
+
+def _plain(v):
+    return tuple(_plain(x) for x in v) if isinstance(v, (list, tuple)) else v
+
+
+# -- writing -------------------------------------------------------------------------------------
+
+def to_data(obj) -> dict:
+    """The TOML data of a configuration object (keys at their defaults left out)."""
+    if isinstance(obj, MeshSpec):
+        out = {}
+        if obj.shape is not None:
+            out["shape"] = obj.shape
+            out.update({k: _listify(v) for k, v in obj.parameters})
+        for f in dataclasses.fields(obj):
+            if f.name in ("shape", "parameters"):
+                continue
+            v = getattr(obj, f.name)
+            if v != f.default:
+                out[f.name] = to_data(v) if dataclasses.is_dataclass(v) else _listify(v)
+        return out
+    out = {}
+    for f in dataclasses.fields(obj):
+        v = getattr(obj, f.name)
+        default = (f.default if f.default is not dataclasses.MISSING else
+                   f.default_factory() if f.default_factory is not dataclasses.MISSING else
+                   dataclasses.MISSING)
+        if v == default:
+            continue
+        if dataclasses.is_dataclass(v):
+            out[f.name] = to_data(v)
+        elif isinstance(v, tuple) and v and dataclasses.is_dataclass(v[0]):
+            out[f.name] = [to_data(x) for x in v]
+        else:
+            out[f.name] = _listify(v)
+    return out
+
+
+def _listify(v):
+    return [_listify(x) for x in v] if isinstance(v, (list, tuple)) else v
+
+
+def dumps(config: ModelConfig, header: str = "") -> str:
+    """TOML text of ``config``; ``header`` becomes comment lines at the top."""
+    lines = [f"# {line}".rstrip() for line in header.splitlines()]
+    if lines:
+        lines.append("")
+    _table(to_data(config), [], lines)
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def _table(data: dict, path: list[str], lines: list[str]) -> None:
+    scalars = {k: v for k, v in data.items() if not _is_table(v) and not _is_table_array(v)}
+    for k, v in scalars.items():
+        lines.append(f"{k} = {_value(v)}")
+    for k, v in data.items():
+        if _is_table(v):
+            lines += ["", f"[{'.'.join([*path, k])}]"]
+            _table(v, [*path, k], lines)
+        elif _is_table_array(v):
+            for item in v:
+                lines += ["", f"[[{'.'.join([*path, k])}]]"]
+                _table(item, [*path, k], lines)
+
+
+def _is_table(v) -> bool:
+    return isinstance(v, dict)
+
+
+def _is_table_array(v) -> bool:
+    return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
+
+def _value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        if not math.isfinite(v):
+            raise InputError(f"cannot write the non-finite number {v!r}")
+        return repr(v)  # the shortest text that reads back as the same float
+    if isinstance(v, str):
+        return json.dumps(v)  # a TOML basic string
+    if isinstance(v, list):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    raise InputError(f"cannot write {v!r} to TOML")
+
+
+# -- the reference -------------------------------------------------------------------------------
+
+def help_texts(cls) -> dict[str, str]:
+    """Each attribute's help text, from the ``Attributes:`` section of the class docstring."""
+    return _help(cls)
+
+
+def _help(cls) -> dict[str, str]:
+    doc = inspect.cleandoc(cls.__doc__ or "")
+    out: dict[str, str] = {}
+    lines = doc.splitlines()
+    try:
+        start = next(i for i, line in enumerate(lines) if line.strip() in ("Attributes:",
+                                                                           "Args:"))
+    except StopIteration:
+        return out
+    key = None
+    for line in lines[start + 1:]:
+        if not line.strip():
+            key = None
+            continue
+        indent = len(line) - len(line.lstrip())
+        if indent == 4 and ":" in line:
+            key, text = line.strip().split(":", 1)
+            out[key] = text.strip()
+        elif indent > 4 and key is not None:
+            out[key] += " " + line.strip()
+        elif indent < 4:
+            break
+    return out
+
+
+def _type_name(tp) -> str:
+    origin, args = typing.get_origin(tp), typing.get_args(tp)
+    if origin in (typing.Union, types.UnionType):
+        inner = [a for a in args if a is not type(None)]
+        return " or ".join(_type_name(a) for a in inner)
+    if dataclasses.is_dataclass(tp):
+        return "table"
+    if origin is tuple and args and args[-1] is not Ellipsis:
+        return "[" + ", ".join(_type_name(a) for a in args) + "]"
+    if origin in (tuple, Sequence):
+        item = args[0] if args else Any
+        if dataclasses.is_dataclass(item):
+            return "array of tables"
+        name = _type_name(item)
+        return f"array of {name}" if name.endswith("]") else f"array of {name}s"
+    return {bool: "boolean", int: "integer", float: "number", str: "string",
+            Any: "value"}.get(tp, getattr(tp, "__name__", str(tp)))
+
+
+def _default_text(f) -> str:
+    if f.default is not dataclasses.MISSING:
+        v = f.default
+    elif f.default_factory is not dataclasses.MISSING:
+        return "(table)"
+    else:
+        return "required"
+    if v is None:
+        return "none"
+    return f"`{_value(_listify(v))}`"
+
+
+def reference() -> str:
+    """The key reference of ``docs/input.md`` (generated; a test compares the two)."""
+    from ..bodies import Platen, PrescribedDisplacement, Support, Traction
+    from ..contact.settings import ContactSettings
+    from ..materials import LinearElastic
+
+    classes = [ModelConfig, ContactSettings, Steps, Output, BodyConfig, MeshSpec, Curve,
+               LinearElastic, Support, PrescribedDisplacement, Traction, Platen]
+    out = []
+    for cls in classes:
+        doc = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0].replace("\n", " ")
+        out += [f"### `{SECTIONS[cls.__name__]}`", "", doc, "",
+                "| key | type | default | meaning |", "|---|---|---|---|"]
+        hints = typing.get_type_hints(cls)
+        helps = _help(cls)
+        for f in dataclasses.fields(cls):
+            if cls is MeshSpec and f.name == "parameters":
+                continue
+            text = helps.get(f.name, "").replace("|", "\\|")
+            out.append(f"| `{f.name}` | {_type_name(hints[f.name])} | {_default_text(f)} | "
+                       f"{text} |")
+        out.append("")
+    out += ["### Mesh shapes (`[bodies.mesh]` with `shape = ...`)", "",
+            "The other keys of the mesh table are the shape's parameters.", ""]
+    for name, fn in SHAPES.items():
+        doc = inspect.cleandoc(fn.__doc__ or "")
+        paragraphs = [p.replace("\n", " ") for p in doc.split("\n\n")]
+        first = paragraphs[0].split("Named boundaries")[0].strip()
+        named = ["Named boundaries" + p.split("Named boundaries", 1)[1]
+                 for p in paragraphs if "Named boundaries" in p][:1]
+        hints = typing.get_type_hints(fn)
+        params = []
+        for pname, par in inspect.signature(fn).parameters.items():
+            default = ("required" if par.default is inspect.Parameter.empty else
+                       "none" if par.default is None else _value(_listify(par.default)))
+            params.append(f"`{pname}` ({_type_name(hints.get(pname, Any))}, {default})")
+        out += [f"#### `{name}`", "", first, "", "Parameters: " + ", ".join(params) + ".", ""]
+        if named:
+            out += [named[0].replace(":func:", ""), ""]
+    return "\n".join(out).rstrip() + "\n"
+
+
+if __name__ == "__main__":  # python3 -m vfem.io.input: the key reference of docs/input.md
+    print(reference(), end="")
