@@ -184,3 +184,24 @@ def test_hertz_meshed_in_gmsh_agrees_with_the_built_in_hertz(tmp_path, hertz_lev
     assert p_max == pytest.approx(hertz_level0[2]["p_max"], rel=0.02)  # the issue's bar
     assert p_max == pytest.approx(hertz_level0[2]["p0_theory"], rel=0.003)
     assert s["bodies"]["cylinder"]["contact_force"][1] == pytest.approx(1530.0, rel=1e-9)
+
+
+def test_progress_on_a_terminal_shows_each_contact_iteration(tmp_path):
+    """On a terminal the bar is redrawn in place, with the iteration under way and its errors."""
+    import io
+
+    from vfem.cli import Progress
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    screen = Terminal()
+    config = load(EXAMPLES / "hertz.toml")
+    progress = Progress(config.steps.factors(), stream=screen)
+    result = vfem.solve(config, tmp_path, on_step=progress)
+    progress.close()
+    text = screen.getvalue()
+    assert text.count("\r") == sum(len(s.history) for s in result.steps) + len(result.steps)
+    assert "step   5  iteration   4  penetration" in text
+    assert "[####################] step   5  load factor  1.0000" in text

@@ -72,10 +72,12 @@ class Progress:
         self.stream = stream or sys.stdout
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
         self.done = 0  # scheduled steps completed (a cut step completes only at its target)
+        self.steps_seen = 0  # converged steps, cut ones included
 
     def __call__(self, step) -> None:
         if not self.enabled:
             return
+        self.steps_seen += 1
         if self.done < self.total and step.load_factor == self.factors[self.done]:
             self.done += 1
         h = step.history[-1] if step.history else None
@@ -98,6 +100,15 @@ class Progress:
             self.stream.flush()
         else:
             print("  " + text, file=self.stream, flush=True)
+
+    def iteration(self, record) -> None:
+        """On a terminal, the contact iteration under way and its errors (Analysis.run)."""
+        if not (self.enabled and self.tty):
+            return
+        self.stream.write(f"\r\033[K  step {self.steps_seen + 1:3d}  iteration "
+                          f"{record.iteration:3d}  penetration {record.max_penetration:.2e}  "
+                          f"equilibrium error {record.max_equilibrium_error:.2e}")
+        self.stream.flush()
 
     def close(self) -> None:
         if self.enabled and self.tty:

@@ -185,8 +185,12 @@ class Analysis:
     # -- the steps ------------------------------------------------------------------------------
 
     def run(self, on_step: Callable[[StepResult], None] | None = None) -> AnalysisResult:
+        """Run the steps; ``on_step(step)`` after each converged one. If ``on_step`` also has
+        an ``iteration`` attribute, it is called with every contact iteration's record (a
+        progress display shows the current errors with it)."""
         if not hasattr(self, "contact"):
             self.setup()
+        self.contact.on_iteration = getattr(on_step, "iteration", None)
         t_setup = time.perf_counter()
         state = self.contact.new_state()
         steps: list[StepResult] = []

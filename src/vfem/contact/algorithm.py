@@ -460,6 +460,9 @@ class VirtualElementContact:
 
     # -- solve ----------------------------------------------------------------------------------
 
+    #: called with each iteration's record as it is made (progress displays)
+    on_iteration = None
+
     def solve(self, state: ContactState) -> SolveResult:
         """Iterate from ``state`` (modified in place) until the contact state has converged.
 
@@ -488,6 +491,8 @@ class VirtualElementContact:
             platen_error = self.platen_reaction(state) - state.platen_force
             rec = IterationRecord(k, pen, eq, contact, tension, platen_error=platen_error)
             history.append(rec)
+            if self.on_iteration is not None:
+                self.on_iteration(rec)
             platen_ok = self.platen_met(state)
             if pen <= self.penetration_tolerance and eq <= eq_tol and tension == 0 and platen_ok:
                 return SolveResult(True, k, history, pairings)

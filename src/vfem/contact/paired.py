@@ -239,6 +239,9 @@ class PairedContact(VirtualElementContact):
 
     # -- the iteration ----------------------------------------------------------------------------
 
+    #: called with each iteration's record as it is made (progress displays)
+    on_iteration = None
+
     def solve(self, state: ContactState) -> SolveResult:
         cfg = self.settings
         tol = self.penetration_tolerance
@@ -260,6 +263,8 @@ class PairedContact(VirtualElementContact):
             platen_ok = self.platen_met(state)
             history.append(IterationRecord(it, pen_err, 0.0, contact, tension,
                                            platen_error=platen_error))
+            if self.on_iteration is not None:
+                self.on_iteration(history[-1])
             if pen_err <= tol and tension == 0 and platen_ok:
                 return SolveResult(True, it, history, self.pairings(state, pens))
             if it == cfg.max_iterations:

@@ -152,6 +152,7 @@ def run_writing(model: Model, out: Path | None, on_step=None) -> tuple[Analysis,
         if on_step is not None:
             on_step(step)
 
+    step_done.iteration = getattr(on_step, "iteration", None)  # see Analysis.run
     return analysis, analysis.run(step_done)
 
 
