@@ -11,6 +11,18 @@ PLANE_STRAIN = "strain"
 PLANE_STRESS = "stress"
 
 
+def check_elastic_constants(E: float, nu: float, where: str) -> None:
+    """Raise :class:`InputError` naming ``where`` unless E > 0 and -1 < nu < 0.5 (finite)."""
+    if not (isinstance(E, (int, float)) and math.isfinite(E)) or E <= 0:
+        raise InputError(f"{where}: youngs_modulus must be a finite number > 0, got {E!r}")
+    if not (isinstance(nu, (int, float)) and math.isfinite(nu)) or not -1.0 < nu < 0.5:
+        raise InputError(
+            f"{where}: poissons_ratio must lie in (-1, 0.5), got {nu!r}"
+            + (" (0.5 is incompressible, which displacement elements cannot represent)"
+               if isinstance(nu, (int, float)) and nu >= 0.5 else "")
+        )
+
+
 @dataclass(frozen=True)
 class LinearElastic:
     """Isotropic, linearly elastic material.
@@ -27,15 +39,7 @@ class LinearElastic:
 
     def validate(self, where: str = "material") -> None:
         """Raise :class:`InputError` naming ``where`` if the constants are not admissible."""
-        E, nu = self.youngs_modulus, self.poissons_ratio
-        if not (isinstance(E, (int, float)) and math.isfinite(E)) or E <= 0:
-            raise InputError(f"{where}: youngs_modulus must be a finite number > 0, got {E!r}")
-        if not (isinstance(nu, (int, float)) and math.isfinite(nu)) or not -1.0 < nu < 0.5:
-            raise InputError(
-                f"{where}: poissons_ratio must lie in (-1, 0.5), got {nu!r}"
-                + (" (0.5 is incompressible, which displacement elements cannot represent)"
-                   if isinstance(nu, (int, float)) and nu >= 0.5 else "")
-            )
+        check_elastic_constants(self.youngs_modulus, self.poissons_ratio, where)
         if self.plane not in (PLANE_STRAIN, PLANE_STRESS):
             raise InputError(f"{where}: plane must be 'strain' or 'stress', got {self.plane!r}")
 

@@ -1,0 +1,158 @@
+"""Isotropic hyperelastic materials for large deformations in plane strain.
+
+These laws are what :class:`vfem.nonlinear.NonlinearBody` evaluates at its quadrature points: given
+the Green–Lagrange strain ``E`` relative to the unstrained configuration (thesis §2.6, eq. 2.6.18)
+they return the second Piola–Kirchhoff stress ``S = dW/dE`` (the stress that is work-conjugate to
+``E``, thesis Ch. 3) and the material tangent ``dS/dE`` that Newton's method needs.
+
+Arrays follow scikit-fem's layout at quadrature points: a strain or stress is ``(2, 2, ...)``
+(``(2, 2, nelems, nqp)`` inside a form), a tangent is ``(2, 2, 2, 2, ...)`` with
+``D[i, j, k, l] = dS_ij / dE_kl`` taken on symmetric ``E`` (so ``D`` has the minor symmetries
+``D_ijkl = D_jikl = D_ijlk`` and, being a second derivative of ``W``, the major one
+``D_ijkl = D_klij``). Plane strain: the out-of-plane stretch is 1 (``E_33 = 0``, ``C_33 = 1``), so
+only the in-plane components are carried; :meth:`out_of_plane_stress` gives ``S_33``.
+
+Both laws reduce to isotropic linear elasticity (:class:`LinearElastic`, plane strain) for small
+strains: ``D(E = 0) = lambda I(x)I + 2 mu I_sym``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kinematics import determinant as _det
+from ..kinematics import inverse as _inv
+from .elastic import check_elastic_constants
+
+
+def _eye_like(E: np.ndarray) -> np.ndarray:
+    """The identity broadcast to the shape of the tensor field ``E`` (2, 2, ...)."""
+    eye = np.zeros_like(E)
+    eye[0, 0] = 1.0
+    eye[1, 1] = 1.0
+    return eye
+
+
+def _lame(E: float, nu: float) -> tuple[float, float]:
+    """Plane-strain (= 3D) Lamé constants (lambda, mu)."""
+    return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
+
+
+def _outer(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """(A (x) B)_ijkl = A_ij B_kl."""
+    return np.einsum("ij...,kl...->ijkl...", A, B)
+
+
+def _sym_outer(A: np.ndarray) -> np.ndarray:
+    """(A (.) A)_ijkl = (A_ik A_jl + A_il A_jk)/2; for symmetric A, d(A^-1)/dA = -A^-1 (.) A^-1."""
+    return 0.5 * (np.einsum("ik...,jl...->ijkl...", A, A) + np.einsum("il...,jk...->ijkl...", A, A))
+
+
+@dataclass(frozen=True)
+class _Isotropic:
+    """The two constants of an isotropic law, as in :class:`LinearElastic`."""
+
+    youngs_modulus: float
+    poissons_ratio: float
+
+    def validate(self, where: str = "material") -> None:
+        """Raise :class:`InputError` naming ``where`` if the constants are not admissible."""
+        check_elastic_constants(self.youngs_modulus, self.poissons_ratio, where)
+
+    def lame(self) -> tuple[float, float]:
+        """(Small-strain) Lamé constants (lambda, mu), plane strain."""
+        return _lame(self.youngs_modulus, self.poissons_ratio)
+
+
+@dataclass(frozen=True)
+class SaintVenantKirchhoff(_Isotropic):
+    """Saint Venant–Kirchhoff: linear elasticity written in the Green–Lagrange strain.
+
+        W(E) = lambda/2 (tr E)^2 + mu E:E
+        S    = lambda tr(E) I + 2 mu E
+        D    = dS/dE = lambda I (x) I + 2 mu I_sym            (constant)
+
+    Exact under rigid rotations of any size (``E`` is), but its stress ceases to grow under strong
+    compression (stretch below ``sqrt(1/3)`` uniaxially): use :class:`NeoHookean` for large
+    compressive strains.
+
+    Attributes:
+        youngs_modulus: E, > 0.
+        poissons_ratio: nu, in (-1, 0.5).
+    """
+
+    def energy(self, E: np.ndarray) -> np.ndarray:
+        """Strain energy per unit reference volume, ``W(E)`` (shape ``E.shape[2:]``)."""
+        lam, mu = self.lame()
+        tr = E[0, 0] + E[1, 1]
+        return 0.5 * lam * tr**2 + mu * np.einsum("ij...,ij...->...", E, E)
+
+    def stress(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Second Piola–Kirchhoff stress ``S`` and tangent ``dS/dE`` for Green–Lagrange ``E``."""
+        E = np.asarray(E, dtype=float)
+        lam, mu = self.lame()
+        eye = _eye_like(E)
+        S = lam * (E[0, 0] + E[1, 1]) * eye + 2.0 * mu * E
+        D = lam * _outer(eye, eye) + 2.0 * mu * _sym_outer(eye)
+        return S, D
+
+    def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray:
+        """``S_33 = lambda tr(E)`` (plane strain, ``E_33 = 0``)."""
+        lam, _ = self.lame()
+        return lam * (np.asarray(E)[0, 0] + np.asarray(E)[1, 1])
+
+
+@dataclass(frozen=True)
+class NeoHookean(_Isotropic):
+    """Compressible neo-Hookean solid (Ciarlet–Simo form), plane strain.
+
+    With ``C = I + 2E`` the right Cauchy–Green tensor (3D, ``C_33 = 1``),
+    ``J = det F = sqrt(det C)`` and ``I_1 = tr C`` (3D trace, ``= C_11 + C_22 + 1``):
+
+        W(E) = mu/2 (I_1 - 3) - mu ln J + lambda/2 (ln J)^2
+        S    = mu (I - C^-1) + lambda ln(J) C^-1
+        D    = lambda C^-1 (x) C^-1 + 2 (mu - lambda ln J) C^-1 (.) C^-1
+
+    where ``(A (.) A)_ijkl = (A_ik A_jl + A_il A_jk)/2``. At ``E = 0``: ``S = 0`` and
+    ``D = lambda I (x) I + 2 mu I_sym`` (linear elasticity). ``W -> infinity`` as ``J -> 0``: no
+    element can be compressed to zero area.
+
+    Attributes:
+        youngs_modulus: E, > 0 (small-strain modulus).
+        poissons_ratio: nu, in (-1, 0.5) (small-strain ratio).
+    """
+
+    @staticmethod
+    def _right_cauchy_green(E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        C = 2.0 * np.asarray(E, dtype=float) + _eye_like(np.asarray(E, dtype=float))
+        detC = _det(C)
+        if np.any(detC <= 0.0):
+            raise ValueError("neo-Hookean: det C <= 0, the strain is not that of a deformation")
+        return C, 0.5 * np.log(detC)
+
+    def energy(self, E: np.ndarray) -> np.ndarray:
+        """Strain energy per unit reference volume, ``W(E)``."""
+        lam, mu = self.lame()
+        C, lnJ = self._right_cauchy_green(E)
+        return 0.5 * mu * (C[0, 0] + C[1, 1] - 2.0) - mu * lnJ + 0.5 * lam * lnJ**2
+
+    def stress(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Second Piola–Kirchhoff stress ``S`` and tangent ``dS/dE`` for Green–Lagrange ``E``."""
+        lam, mu = self.lame()
+        C, lnJ = self._right_cauchy_green(E)
+        Ci = _inv(C)
+        S = mu * (_eye_like(C) - Ci) + lam * lnJ * Ci
+        D = lam * _outer(Ci, Ci) + 2.0 * (mu - lam * lnJ) * _sym_outer(Ci)
+        return S, D
+
+    def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray:
+        """``S_33 = mu (1 - 1/C_33) + lambda ln J / C_33 = lambda ln J`` (``C_33 = 1``)."""
+        lam, _ = self.lame()
+        return lam * self._right_cauchy_green(E)[1]
+
+
+HyperelasticMaterial = SaintVenantKirchhoff | NeoHookean
+
+__all__ = ["SaintVenantKirchhoff", "NeoHookean", "HyperelasticMaterial"]

@@ -1,0 +1,566 @@
+"""One hyperelastic body under large displacements, solved incrementally by Newton's method.
+
+This is the geometrically (and materially) nonlinear counterpart of :class:`vfem.bodies.Body`:
+plane strain, a hyperelastic material (:mod:`vfem.materials.hyperelastic`), prescribed
+displacements and dead nodal forces scaled by a load factor. Contact is not wired here; what the
+contact algorithm will need from a body (its current geometry, internal force and tangent
+stiffness at the current state) is exposed by :meth:`NonlinearBody.deformed_mesh`,
+:meth:`NonlinearBody.internal_force` and :meth:`NonlinearBody.tangent_stiffness`.
+
+Equilibrium (thesis eq. 3.10.8, the configurational derivative of the potential energy vanishes)
+in referential form is the residual
+
+    R(u) = int_V0 grad(v) : P dV0 - f = 0,    P = F S,   S = dW/dE,
+
+for every virtual displacement ``v``: ``B(u)^T S`` with ``B`` the variation of the Green–Lagrange
+strain, ``dE = sym(F^T grad v)``. Its derivative, the tangent stiffness, is
+
+    K = int_V0 grad(dv) : A : grad(v) dV0,     A_iJkL = F_iI D_IJKL F_kK  +  delta_ik S_JL
+                                                        (material)         (geometric, initial
+                                                                            stress)
+
+with ``D = dS/dE``. Two formulations (thesis §2.7, §2.8) give the same discrete solution:
+
+* ``"total"`` Lagrangian: the reference and configuration of transformation is the unstrained
+  mesh ``C_U``; the unknown is the total displacement, ``F = I + grad_X u``; the strain splits as
+  ``E = E1 + E2 + E3`` (eqs. 2.7.19–2.7.21) with the coupling terms of ``E2`` active.
+* ``"updated"`` Lagrangian: each load step starts from the last converged configuration ``C_1``:
+  the mesh coordinates are moved by the converged displacement and gradients are taken on the
+  moved mesh. The strain state carried from step to step is the thesis's pseudo-strain ``11_1 E``
+  (the Almansi strain of ``C_1``), obtained at the end of each step by the change of reference of
+  eq. 2.8.9. In the step the strain is ``11_1 E + E2 + E3`` with ``E2 = sym(h)`` (the coupling
+  terms vanish, eq. 2.7.36) and ``E3 = h^T h / 2``, ``h`` the increment's gradient in ``C_1``
+  (eq. 2.8.11). The stress conjugate to it per unit volume of ``C_1`` is the push-forward of the
+  material's ``S`` to ``C_1`` (:func:`vfem.kinematics.push_forward_stress`); for the isotropic
+  materials here it depends on ``C_1`` only through ``b_1 = (I - 2 11_1E)^-1``, so the carried
+  pseudo-strain is the whole state (the push-forward uses ``V_1 = sqrt(b_1)``, which differs from
+  ``F_1`` by a rotation an isotropic law does not see).
+
+Each load step is solved by Newton's method from the last converged state; the step's increment
+of the prescribed displacements enters with the first correction. The residual norm per iteration
+and the ratio ``r_k+1 / r_k^2`` (constant when convergence is quadratic) are logged at INFO level
+and kept in :attr:`NonlinearBody.steps` / :attr:`NonlinearBody.history`.
+
+Both are exact discretisations of the same problem on the same quadrature points (with isoparametric
+elements a quadrature point of the moved mesh is the same material point, and ``dV1 = J1 dV0``
+there), so they agree to the Newton tolerance.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementVector,
+    LinearForm,
+    Mesh,
+    MeshQuad1,
+    MeshQuad2,
+    MeshTri1,
+    MeshTri2,
+    asm,
+    condense,
+    solve,
+)
+from skfem.helpers import ddot, grad, mul
+
+from .errors import AnalysisError, InputError
+from .kinematics import (
+    change_reference,
+    deformation_gradient,
+    determinant,
+    green_lagrange,
+    inverse,
+    push_forward_stress,
+    strain_increment,
+    updated_strain_increment,
+)
+from .materials.hyperelastic import NeoHookean, SaintVenantKirchhoff
+
+log = logging.getLogger(__name__)
+
+TOTAL = "total"
+UPDATED = "updated"
+COMPONENTS = {"x": 0, "y": 1}
+
+# linear mesh -> the quadratic-geometry mesh of the same connectivity (for P2/Q2)
+_QUADRATIC_MESH: dict[type, type] = {MeshTri1: MeshTri2, MeshQuad1: MeshQuad2}
+
+
+_MAX_HALVINGS = 8
+
+
+class _Inverted(AnalysisError):
+    """An iterate would turn an element inside out (det F <= 0 at a quadrature point)."""
+
+
+# -- forms: residual and tangent, assembled by scikit-fem ----------------------------------------
+
+@LinearForm
+def _internal_force_form(v, w):
+    """``grad(v) : P``, P = F S the first Piola–Kirchhoff stress (per unit reference volume)."""
+    return ddot(w["P"], grad(v))
+
+
+@BilinearForm
+def _tangent_form(du, v, w):
+    """``grad(v) : A : grad(du)`` with ``A = dP/dF`` (material + geometric stiffness)."""
+    return ddot(np.einsum("ijkl...,kl...->ij...", np.asarray(w["A"]), grad(du)), grad(v))
+
+
+@dataclass
+class _State:
+    """Kinematic and stress fields at the quadrature points of ``basis`` for one iterate."""
+
+    basis: Basis
+    F: np.ndarray  # (2, 2, ne, nq) deformation gradient from the reference of the formulation
+    S: np.ndarray  # (2, 2, ne, nq) 2nd Piola–Kirchhoff stress relative to that reference
+    D: np.ndarray  # (2, 2, 2, 2, ne, nq) dS/dE
+    S33: np.ndarray  # (ne, nq) out-of-plane S_33 (plane strain)
+
+    def first_piola(self) -> np.ndarray:
+        return mul(self.F, self.S)
+
+    def tangent_moduli(self) -> np.ndarray:
+        """``A_iJkL = F_iI D_IJKL F_kK + delta_ik S_JL``."""
+        A = np.einsum("iI...,IJKL...,kK...->iJkL...", self.F, self.D, self.F)
+        A[0, :, 0] += self.S
+        A[1, :, 1] += self.S
+        return A
+
+
+@dataclass
+class NewtonStep:
+    """The record of one load step.
+
+    Attributes:
+        load_factor: the load factor the step reached.
+        residuals: norm of the residual on the free dofs, one entry per evaluation: the first at
+            the last converged state under the step's loads (zero for a step driven by prescribed
+            displacements only: those enter with the first correction), the last the converged
+            one. ``len(residuals) - 1`` Newton corrections were made.
+        reference_force: the force the residuals are measured against: the largest over the
+            step's iterations of the external and internal force norms (the latter includes the
+            reactions), not below a floor ``1e-6 E L`` (a load that strains the body by 1e-6;
+            needed when nothing loads it, e.g. a rigid motion).
+        converged: whether the tolerance was met.
+        seconds: wall time of the step.
+    """
+
+    load_factor: float
+    residuals: list[float] = field(default_factory=list)
+    reference_force: float = 0.0
+    converged: bool = False
+    seconds: float = 0.0
+
+    @property
+    def iterations(self) -> int:
+        return max(len(self.residuals) - 1, 0)
+
+    @property
+    def relative_residuals(self) -> list[float]:
+        return [r / self.reference_force for r in self.residuals]
+
+    @property
+    def quadratic_ratios(self) -> list[float]:
+        """``r_{k+1} / r_k^2`` on the relative residuals; bounded when convergence is quadratic."""
+        r = self.relative_residuals
+        return [b / a**2 if a > 0 else math.nan for a, b in zip(r[:-1], r[1:])]
+
+
+Values = float | np.ndarray | Callable[[float], np.ndarray]
+
+
+class NonlinearBody:
+    """A hyperelastic plane-strain body under large displacements (see the module docstring).
+
+    Args:
+        mesh: a scikit-fem ``MeshTri1`` or ``MeshQuad1`` (or their quadratic-geometry ``MeshTri2``
+            / ``MeshQuad2``); named boundaries are used by :meth:`boundary_dofs`.
+        material: :class:`SaintVenantKirchhoff` or :class:`NeoHookean`.
+        order: 1 (P1/Q1) or 2 (P2/Q2). Elements are isoparametric: with ``order=2`` a linear mesh is
+            given quadratic geometry (``MeshTri2.from_mesh``), so that the updated formulation can
+            move the midside nodes with the displacement.
+        formulation: ``"total"`` or ``"updated"`` Lagrangian.
+        name: used in messages.
+
+    Dofs are scikit-fem's ``ElementVector`` numbering on :attr:`basis0` (x and y of each node
+    interleaved). Prescribe with :meth:`prescribe` and load with :meth:`add_nodal_forces`, then
+    call :meth:`solve`.
+    """
+
+    def __init__(self, mesh: Mesh, material: SaintVenantKirchhoff | NeoHookean, *, order: int = 1,
+                 formulation: str = TOTAL, name: str = "body"):
+        self.name = name
+        if not isinstance(material, (SaintVenantKirchhoff, NeoHookean)):
+            raise InputError(f"{name}: material must be SaintVenantKirchhoff or NeoHookean, "
+                             f"got {type(material).__name__}")
+        material.validate(f"{name}: material")
+        if formulation not in (TOTAL, UPDATED):
+            raise InputError(f"{name}: formulation must be 'total' or 'updated', "
+                             f"got {formulation!r}")
+        if order not in (1, 2):
+            raise InputError(f"{name}: order must be 1 or 2, got {order!r}")
+        self.material = material
+        self.formulation = formulation
+        self.order = order
+        self._boundaries = mesh.boundaries
+        self.mesh = self._working_mesh(mesh)
+        self.basis0 = Basis(self.mesh, ElementVector(self.mesh.elem()))
+        self.ndofs = self.basis0.N
+        # the node of each dof, as positions in mesh.doflocs: isoparametric elements have their
+        # nodes at the mesh's doflocs, x and y interleaved
+        if not (np.allclose(self.basis0.doflocs[:, 0::2], self.mesh.doflocs)
+                and np.allclose(self.basis0.doflocs[:, 1::2], self.mesh.doflocs)):
+            raise InputError(f"{name}: dof numbering does not follow the mesh nodes")
+        p = self.mesh.doflocs
+        self.length = float(np.hypot(*(p.max(axis=1) - p.min(axis=1))))
+        self.nodal_forces = np.zeros(self.ndofs)
+        self._prescribed: list[tuple[np.ndarray, Values]] = []
+        self.displacement = np.zeros(self.ndofs)
+        self.load_factor = 0.0
+        self.steps: list[NewtonStep] = []
+        # updated Lagrangian state: the current configuration C_1 and the pseudo-strain 11_1 E
+        self._reset_updated_state()
+
+    # -- set-up ---------------------------------------------------------------------------------
+
+    def _working_mesh(self, mesh: Mesh) -> Mesh:
+        if isinstance(mesh, (MeshTri2, MeshQuad2)):
+            if self.order != 2:
+                raise InputError(f"{self.name}: a quadratic-geometry mesh needs order=2")
+            return mesh
+        for linear, quadratic in _QUADRATIC_MESH.items():
+            if isinstance(mesh, linear):
+                if self.order == 1:
+                    return mesh
+                m2 = quadratic.from_mesh(mesh)
+                if not np.array_equal(m2.facets, mesh.facets):  # boundaries index the facets
+                    raise InputError(f"{self.name}: facet numbering changed with the P2 geometry")
+                return m2
+        raise InputError(f"{self.name}: mesh must be MeshTri1/MeshQuad1/MeshTri2/MeshQuad2, "
+                         f"got {type(mesh).__name__}")
+
+    def _reset_updated_state(self) -> None:
+        self.current_mesh = self.mesh
+        self.current_basis = self.basis0
+        nq = self.basis0.X.shape[-1]
+        self.pseudo_strain = np.zeros((2, 2, self.mesh.nelements, nq))
+        self._u_at_current = np.zeros(self.ndofs)
+        self._stretch_cache: tuple[np.ndarray, np.ndarray] | None = None
+
+    def boundary_dofs(self, boundary: str | np.ndarray, component: str | None = None
+                      ) -> np.ndarray:
+        """Dofs on a named boundary (or on an array of facet indices), one component or both."""
+        if isinstance(boundary, str):
+            if not self._boundaries or boundary not in self._boundaries:
+                names = sorted(self._boundaries or {})
+                raise InputError(f"{self.name}: no boundary {boundary!r} (have {names})")
+            facets = self._boundaries[boundary]
+        else:
+            facets = np.asarray(boundary, dtype=int)
+        dofs = self.basis0.get_dofs(facets)
+        if component is None:
+            return np.sort(dofs.all())
+        if component not in COMPONENTS:
+            raise InputError(f"{self.name}: component must be 'x' or 'y', got {component!r}")
+        return np.sort(dofs.all(f"u^{COMPONENTS[component] + 1}"))
+
+    def node_dofs(self, nodes: np.ndarray, component: str | None = None) -> np.ndarray:
+        """Dofs of the given nodes (columns of ``mesh.doflocs``)."""
+        nodes = np.asarray(nodes, dtype=int)
+        if component is None:
+            return np.stack([2 * nodes, 2 * nodes + 1], axis=-1).ravel()
+        return 2 * nodes + COMPONENTS[component]
+
+    def prescribe(self, dofs: np.ndarray, values: Values = 0.0) -> None:
+        """Prescribe the (total) displacement of ``dofs``.
+
+        ``values`` is a number or an array (one per dof): the displacement at load factor 1,
+        scaled by the load factor; or a callable ``values(load_factor) -> array`` for a
+        displacement that is not proportional to the load factor (e.g. a finite rotation).
+        A dof prescribed twice takes the last value.
+        """
+        dofs = np.asarray(dofs, dtype=int).ravel()
+        if np.any((dofs < 0) | (dofs >= self.ndofs)):
+            raise InputError(f"{self.name}: prescribed dof out of range")
+        if not callable(values):
+            values = np.broadcast_to(np.asarray(values, dtype=float), dofs.shape).copy()
+        self._prescribed.append((dofs, values))
+
+    def add_nodal_forces(self, dofs: np.ndarray, forces: float | np.ndarray) -> None:
+        """Add dead nodal forces (fixed direction, at load factor 1) on ``dofs``."""
+        dofs = np.asarray(dofs, dtype=int).ravel()
+        np.add.at(self.nodal_forces, dofs,
+                  np.broadcast_to(np.asarray(forces, dtype=float), dofs.shape))
+
+    def _dirichlet(self, load_factor: float) -> tuple[np.ndarray, np.ndarray]:
+        """Prescribed dofs and their total displacement at ``load_factor``."""
+        values: dict[int, float] = {}
+        for dofs, v in self._prescribed:
+            vals = (np.asarray(v(load_factor), dtype=float).ravel() if callable(v)
+                    else load_factor * v)
+            values.update(zip(dofs.tolist(), vals.tolist()))
+        D = np.array(sorted(values), dtype=int)
+        return D, np.array([values[d] for d in D.tolist()], dtype=float)
+
+    # -- state at the quadrature points -----------------------------------------------------------
+
+    def _state(self, delta: np.ndarray) -> _State:
+        """Fields for the iterate ``u_C1 + delta`` (``delta``: displacement since the step start).
+
+        Total: gradients on the initial mesh of the total displacement; the strain of thesis
+        eq. 2.7.11 with ``C_A = C_U`` (E4 = 0): ``E1 + E2 + E3 = E(G0 + g)``.
+        Updated: gradients on the current mesh ``C_1`` of the increment; strain
+        ``11_1 E + E2 + E3`` (eqs. 2.7.31–2.7.36, 2.8.11).
+        """
+        if self.formulation == TOTAL:
+            basis = self.basis0
+            G0 = basis.interpolate(self._u_at_current).grad
+            g = basis.interpolate(delta).grad
+            F = deformation_gradient(G0 + g)
+            self._check_orientation(F)
+            E = strain_increment(G0, g).total
+            S, D = self.material.stress(E)
+            return _State(basis, F, S, D, self.material.out_of_plane_stress(E))
+        basis = self.current_basis
+        h = basis.interpolate(delta).grad
+        f = deformation_gradient(h)
+        self._check_orientation(f)
+        E_pseudo = updated_strain_increment(h, self.pseudo_strain).total
+        S, D, S33 = self._pushed_material(E_pseudo)
+        return _State(basis, f, S, D, S33)
+
+    def _pushed_material(self, E_pseudo: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stress and tangent conjugate to the pseudo-strain in ``C_1``, per unit volume of ``C_1``.
+
+        With ``F_1`` the deformation gradient of ``C_1`` the material sees the Green–Lagrange
+        strain ``E = F_1^T E_pseudo F_1`` (eq. 2.8.9 read backwards) and the conjugate stress in
+        ``C_1`` is ``J_1^-1 F_1 S F_1^T``, the tangent ``J_1^-1 F_1 F_1 F_1 F_1 : D``. Isotropy lets
+        ``V_1 = b_1^(1/2)``, ``b_1 = (I - 2 11_1E)^-1``, stand for ``F_1``.
+        """
+        V, J1 = self._left_stretch()
+        E = mul(V, mul(E_pseudo, V))
+        S, D = self.material.stress(E)
+        S_c = mul(V, mul(S, V)) / J1
+        D_c = np.einsum("iI...,jJ...,IJKL...,kK...,lL...->ijkl...", V, V, D, V, V) / J1
+        return S_c, D_c, self.material.out_of_plane_stress(E) / J1
+
+    def _left_stretch(self) -> tuple[np.ndarray, np.ndarray]:
+        """``V_1 = b_1^(1/2)`` and ``J_1 = det V_1`` from the carried pseudo-strain (Almansi).
+
+        ``11_1E = (I - b_1^-1)/2`` so ``b_1^-1 = I - 2 11_1E``; the square root of a symmetric
+        positive-definite 2x2 matrix ``M`` is ``(M + sqrt(det M) I) / sqrt(tr M + 2 sqrt(det M))``.
+        """
+        if self._stretch_cache is not None:
+            return self._stretch_cache
+        b_inv = -2.0 * self.pseudo_strain
+        b_inv[0, 0] += 1.0
+        b_inv[1, 1] += 1.0
+        b = inverse(b_inv)
+        s = np.sqrt(determinant(b))  # = J_1
+        V = b.copy()
+        V[0, 0] += s
+        V[1, 1] += s
+        V /= np.sqrt(b[0, 0] + b[1, 1] + 2.0 * s)
+        self._stretch_cache = (V, s)
+        return V, s
+
+    def _check_orientation(self, F: np.ndarray) -> None:
+        J = determinant(F)
+        if np.any(J <= 0.0):
+            raise _Inverted(f"{self.name}: an element turned inside out (det F = "
+                            f"{float(J.min()):.3g}); use smaller load steps")
+
+    # -- assembled quantities ---------------------------------------------------------------------
+
+    def _internal(self, state: _State) -> np.ndarray:
+        return asm(_internal_force_form, state.basis, P=state.first_piola())
+
+    def _tangent(self, state: _State):
+        return asm(_tangent_form, state.basis, A=state.tangent_moduli()).tocsr()
+
+    def internal_force(self) -> np.ndarray:
+        """Internal nodal forces ``int grad(v) : P`` at the current state (ndofs)."""
+        return self._internal(self._state(np.zeros(self.ndofs)))
+
+    def tangent_stiffness(self):
+        """Tangent stiffness (material + geometric) at the current state, all dofs, CSR.
+
+        In the updated formulation it is taken with respect to the displacement from the current
+        configuration; both formulations give the same matrix at a converged state.
+        """
+        return self._tangent(self._state(np.zeros(self.ndofs)))
+
+    def reactions(self) -> np.ndarray:
+        """``f_int - load_factor f_ext`` (ndofs): on the prescribed dofs the forces the supports
+        apply to the body (equilibrium: ``f_int = f_ext + reactions``); round-off elsewhere after
+        a converged step."""
+        return self.internal_force() - self.load_factor * self.nodal_forces
+
+    # -- Newton ---------------------------------------------------------------------------------
+
+    def solve(self, load_factor_steps: Sequence[float] | int, tol: float = 1e-10,
+              max_iter: int = 25) -> list[NewtonStep]:
+        """Apply the load in steps, Newton's method in each; return the steps' records.
+
+        Args:
+            load_factor_steps: the load factors to reach in turn (e.g. ``[0.25, 0.5, 1.0]``), or
+                a number of equal steps to 1.
+            tol: converged when ``|R_free| <= tol * reference_force`` (see :class:`NewtonStep`),
+                or when a Newton correction falls to round-off (``1e-13 L``).
+            max_iter: Newton corrections allowed per step.
+
+        Raises:
+            AnalysisError: a step did not converge or an element turned inside out; the body keeps
+                the last converged state.
+        """
+        if isinstance(load_factor_steps, int):
+            load_factor_steps = [(i + 1) / load_factor_steps for i in range(load_factor_steps)]
+        records = []
+        for lf in load_factor_steps:
+            records.append(self._step(float(lf), tol, max_iter))
+        return records
+
+    @property
+    def history(self) -> list[list[float]]:
+        """Residual norms per step (see :attr:`NewtonStep.residuals`), all steps so far."""
+        return [s.residuals for s in self.steps]
+
+    def _step(self, load_factor: float, tol: float, max_iter: int) -> NewtonStep:
+        """One load step: Newton's method from the last converged state.
+
+        The step's increment of the prescribed displacements enters through the first Newton
+        correction (``K_ff d_f = -R_f - K_fD d_D``) rather than by moving those nodes alone first,
+        which would crush the elements next to them before the rest of the body follows.
+        """
+        t0 = time.perf_counter()
+        record = NewtonStep(load_factor)
+        D, uD = self._dirichlet(load_factor)
+        free = np.setdiff1d(np.arange(self.ndofs), D)
+        delta = np.zeros(self.ndofs)  # displacement since the last converged state
+        pending = np.zeros(self.ndofs)  # prescribed increment not yet applied
+        pending[D] = uD - self._u_at_current[D]
+        f_ext = load_factor * self.nodal_forces
+        floor = 1e-6 * self.material.youngs_modulus * self.length
+        last_correction = math.inf
+        previous = None
+        state = self._state(delta)
+        for k in range(max_iter + 1):
+            f_int = self._internal(state)
+            R = f_int - f_ext
+            r = float(np.linalg.norm(R[free]))
+            ref = max(float(np.linalg.norm(f_ext)), float(np.linalg.norm(f_int)), floor)
+            record.residuals.append(r)
+            record.reference_force = max(record.reference_force, ref)
+            ratio = (r / ref) / (previous / ref) ** 2 if previous else math.nan
+            log.info("%s: step to load factor %.6g, iteration %d: |R| = %.3e (relative %.3e), "
+                     "r_k+1/r_k^2 = %.3g", self.name, load_factor, k, r, r / ref, ratio)
+            previous = r
+            if not pending.any() and (r <= tol * ref or last_correction <= 1e-13 * self.length):
+                record.converged = True
+                break
+            if k == max_iter:
+                break
+            K = self._tangent(state)
+            correction = solve(*condense(K, -R, D=D, x=pending))
+            # A full Newton correction far from the solution can turn elements inside out (the
+            # linearised rotation of a slender part stretches it); halve it until none is. Near
+            # the solution the full correction is always taken, so convergence stays quadratic.
+            # What a halving leaves of the prescribed increment stays pending for the next one.
+            fraction = 1.0
+            for halvings in range(_MAX_HALVINGS + 1):
+                try:
+                    state = self._state(delta + fraction * correction)
+                    break
+                except _Inverted:
+                    if halvings == _MAX_HALVINGS:
+                        raise
+                    fraction *= 0.5
+                    log.info("%s: correction halved (an element would turn inside out)",
+                             self.name)
+            correction *= fraction
+            pending *= 1.0 - fraction
+            last_correction = float(np.abs(correction).max())
+            delta += correction
+        record.seconds = time.perf_counter() - t0
+        if not record.converged:
+            self.steps.append(record)
+            raise AnalysisError(f"{self.name}: Newton did not converge in {max_iter} iterations "
+                                f"at load factor {load_factor:g} (|R| = {record.residuals[-1]:.3e}"
+                                f", reference {record.reference_force:.3e})")
+        self._accept(delta)
+        self.load_factor = load_factor
+        self.steps.append(record)
+        log.info("%s: load factor %.6g converged in %d iterations (%.3f s)", self.name,
+                 load_factor, record.iterations, record.seconds)
+        return record
+
+    def _accept(self, delta: np.ndarray) -> None:
+        """Make the converged iterate the new state.
+
+        Updated: ``C_2`` becomes the configuration of transformation and reference. The carried
+        pseudo-strain ``21_1 E = 11_1 E + E2 + E3`` is transformed to ``C_2`` by eq. 2.8.9 with
+        ``F = I + h`` (eq. 2.8.15), and the mesh nodes move by the increment.
+        """
+        if self.formulation == UPDATED:
+            h = self.current_basis.interpolate(delta).grad
+            E_pseudo = updated_strain_increment(h, self.pseudo_strain).total
+            self.pseudo_strain = change_reference(E_pseudo, h)
+            self._stretch_cache = None
+            moved = self.current_mesh.doflocs + np.vstack([delta[0::2], delta[1::2]])
+            self.current_mesh = replace(self.current_mesh, doflocs=moved)
+            self.current_basis = Basis(self.current_mesh, self.current_basis.elem,
+                                       quadrature=(self.basis0.X, self.basis0.W))
+        self._u_at_current = self._u_at_current + delta
+        self.displacement = self._u_at_current.copy()
+
+    # -- results --------------------------------------------------------------------------------
+
+    def deformed_points(self) -> np.ndarray:
+        """(2, npoints) current positions of the mesh nodes (``mesh.doflocs`` + displacement)."""
+        return self.mesh.doflocs + np.vstack([self.displacement[0::2], self.displacement[1::2]])
+
+    def deformed_mesh(self) -> Mesh:
+        """The mesh in the current configuration (what contact search runs on)."""
+        return replace(self.mesh, doflocs=self.deformed_points())
+
+    def green_lagrange_strain(self) -> np.ndarray:
+        """(2, 2, nelems, nqp) Green–Lagrange strain relative to the initial mesh."""
+        return green_lagrange(self.basis0.interpolate(self.displacement).grad)
+
+    def second_piola_kirchhoff(self) -> np.ndarray:
+        """(2, 2, nelems, nqp) 2nd Piola–Kirchhoff stress relative to the initial mesh."""
+        return self.material.stress(self.green_lagrange_strain())[0]
+
+    def cauchy_stress_at_points(self) -> tuple[np.ndarray, np.ndarray]:
+        """Cauchy stress ``J^-1 F S F^T`` (2, 2, nelems, nqp) and the current volume weights
+        (nelems, nqp), from the formulation's own state (for the updated formulation: the
+        carried pseudo-strain)."""
+        state = self._state(np.zeros(self.ndofs))
+        J = determinant(state.F)
+        return push_forward_stress(state.S, state.F), state.basis.dx * J
+
+    def stress(self) -> np.ndarray:
+        """(nelems, 2, 2) element averages (over the current volume) of the Cauchy stress."""
+        sig, w = self.cauchy_stress_at_points()
+        avg = (sig * w).sum(axis=-1) / w.sum(axis=-1)
+        return np.moveaxis(avg, -1, 0)
+
+    def out_of_plane_stress(self) -> np.ndarray:
+        """(nelems,) element averages of the Cauchy ``sigma_zz = S_33 / J`` (plane strain)."""
+        state = self._state(np.zeros(self.ndofs))
+        J = determinant(state.F)
+        w = state.basis.dx * J
+        return (state.S33 / J * w).sum(axis=-1) / w.sum(axis=-1)
+
+
+__all__ = ["NonlinearBody", "NewtonStep", "TOTAL", "UPDATED"]
