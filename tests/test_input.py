@@ -90,7 +90,7 @@ def test_the_example_in_docs_input_runs_and_is_exact(tmp_path):
 def test_docs_input_holds_the_generated_key_reference():
     text = (ROOT / "docs" / "input.md").read_text(encoding="utf-8")
     generated = text.split("<!-- generated: begin -->\n")[1].split("<!-- generated: end -->")[0]
-    assert generated == reference(), "regenerate: python3 -m vfem.io.input"
+    assert generated == reference(), "regenerate: vfem reference"
 
 
 def test_every_key_has_help_text():

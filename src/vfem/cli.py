@@ -126,33 +126,56 @@ def _load_input(path: str):
     return load_input(path)
 
 
+def _example(name: str, alternatives: str = ""):
+    """The module of a built-in example; an unknown name is refused with the closest one."""
+    if name not in EXAMPLES:
+        close = difflib.get_close_matches(name, EXAMPLES, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise InputError(f"unknown example {name!r}{hint}; available: {', '.join(EXAMPLES)}"
+                         + alternatives)
+    return load(name)
+
+
 def cmd_run(args) -> int:
     if _is_input_file(args.example):
         return run_input_file(args)
-    if args.example not in EXAMPLES:
-        close = difflib.get_close_matches(args.example, EXAMPLES, n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise InputError(f"unknown example {args.example!r}{hint}; "
-                         f"available: {', '.join(EXAMPLES)}, or an input file (.toml)")
-    example = load(args.example)
+    example = _example(args.example, ", or an input file (.toml)")
     params = build_parameters(args.example, args.set or [])
     if hasattr(example, "validate"):
         example.validate(params)  # bad input is reported before anything is written
     out = Path(args.out or Path("results") / args.example)
-    progress = Progress(None, not args.quiet)
     if not args.quiet:
         print(f"vfem: {args.example}, results in {out}/", flush=True)
+    progress = Progress(None, not args.quiet)
+    return _solve_and_report(lambda: example.run(params, out, on_step=progress), progress,
+                             example.report, args.quiet)
+
+
+def _solve_and_report(solve, progress: Progress, report, quiet: bool) -> int:
+    """Run ``solve()`` (-> summary) under the progress display, print ``report(summary)``;
+    exit status 1 if the analysis did not converge."""
     try:
-        summary = example.run(params, out, on_step=progress)
+        summary = solve()
     finally:
         progress.close()
-    if not args.quiet:
-        print("\n".join(example.report(summary)))
+    if not quiet:
+        print("\n".join(report(summary)))
     if not summary["converged"]:
         print(f"vfem: the analysis did not converge: {summary.get('message', '')}",
               file=sys.stderr)
         return 1
     return 0
+
+
+def _checked_model(path: str):
+    """The input file's description and its model, every check done (nothing solved)."""
+    from .config import check
+
+    config = _load_input(path)
+    try:
+        return config, check(config, Path(path).parent)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
 
 
 def run_input_file(args) -> int:
@@ -161,41 +184,20 @@ def run_input_file(args) -> int:
     if args.set:
         raise InputError("--set changes a built-in example's parameters; edit the input file "
                          "instead")
-    from .config import check
-
-    config = _load_input(args.example)
-    base = Path(args.example).parent
-    try:
-        model = check(config, base)  # bad input is reported before anything is written
-    except InputError as exc:
-        raise InputError(f"{args.example}: {exc}") from None
+    config, model = _checked_model(args.example)  # bad input reported before anything written
     out = Path(args.out or config.output.directory or Path("results") / config.name)
+    factors = config.steps.factors()
     if not args.quiet:
-        n = len(config.steps.factors())
-        print(f"vfem: {config.name} ({args.example}), {n} step{'s' if n > 1 else ''}, "
-              f"results in {out}/", flush=True)
-    progress = Progress(config.steps.factors(), not args.quiet)
-    try:
-        summary = runner.run(config, out, model=model, on_step=progress, source=args.example)
-    finally:
-        progress.close()
-    if not args.quiet:
-        print("\n".join(runner.report(summary, out)))
-    if not summary["converged"]:
-        print(f"vfem: the analysis did not converge: {summary.get('message', '')}",
-              file=sys.stderr)
-        return 1
-    return 0
+        print(f"vfem: {config.name} ({args.example}), {len(factors)} "
+              f"step{'s' if len(factors) > 1 else ''}, results in {out}/", flush=True)
+    progress = Progress(factors, not args.quiet)
+    return _solve_and_report(
+        lambda: runner.run(config, out, model=model, on_step=progress, source=args.example),
+        progress, lambda summary: runner.report(summary, out), args.quiet)
 
 
 def cmd_check(args) -> int:
-    from .config import check
-
-    config = _load_input(args.file)
-    try:
-        model = check(config, Path(args.file).parent)
-    except InputError as exc:
-        raise InputError(f"{args.file}: {exc}") from None
+    config, model = _checked_model(args.file)
     if not args.quiet:
         print(f"vfem: {args.file}: model {config.name!r} is valid — "
               f"{len(model.bodies)} bodies ("
@@ -206,11 +208,7 @@ def cmd_check(args) -> int:
 
 def example_configs(name: str, assignments: list[str]) -> dict:
     """The built-in example's model(s) as configurations, by key."""
-    if name not in EXAMPLES:
-        close = difflib.get_close_matches(name, EXAMPLES, n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise InputError(f"unknown example {name!r}{hint}; available: {', '.join(EXAMPLES)}")
-    example = load(name)
+    example = _example(name)
     params = build_parameters(name, assignments)
     if hasattr(example, "configs"):
         return example.configs(params)
@@ -252,6 +250,13 @@ def cmd_export(args) -> int:
             written.append(path)
     if not args.quiet:
         print(f"vfem: wrote {', '.join(str(p) for p in written)}")
+    return 0
+
+
+def cmd_reference(args) -> int:
+    from .io.input import reference
+
+    print(reference(), end="")
     return 0
 
 
@@ -321,6 +326,7 @@ def main(argv: list[str] | None = None) -> int:
                                       "example of several models")
     export.add_argument("--set", action="append", metavar="KEY=VALUE",
                         help="change a parameter of the example first (repeatable)")
+    sub.add_parser("reference", help="print the input-file key reference (docs/input.md)")
     plot = sub.add_parser("plot", help="redraw the figures of a results folder without solving")
     plot.add_argument("results", help="the results folder (holding results.pvd)")
     bench = sub.add_parser("bench", help="time an example at several refinements")
@@ -345,6 +351,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("skfem").setLevel(max(logging.WARNING, level))
     try:
         command = {"run": cmd_run, "check": cmd_check, "export": cmd_export, "plot": cmd_plot,
+                   "reference": cmd_reference,
                    "bench": cmd_bench, "study": cmd_study}[args.command]
         return command(args)
     except InputError as exc:

@@ -17,8 +17,6 @@ description into a :class:`~vfem.solver.Model`.
 
 from __future__ import annotations
 
-import inspect
-import math
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -130,11 +128,6 @@ def _shape_mesh(shape: str, parameters: tuple[tuple[str, Any], ...]):
         return SHAPES[shape](**dict(parameters))
     except (ValueError, TypeError) as exc:
         raise InputError(f"mesh shape {shape!r}: {exc}") from None
-
-
-def shape_parameters(shape: str) -> dict[str, inspect.Parameter]:
-    """The keyword parameters of a built-in shape (name -> inspect.Parameter)."""
-    return dict(inspect.signature(SHAPES[shape]).parameters)
 
 
 @dataclass(frozen=True)
@@ -254,11 +247,6 @@ def check(config: ModelConfig, base: Path | None = None) -> Model:
     for body in model.bodies:
         body.check_supports()
     return model
-
-
-def finite(value: float) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(
-        value)
 
 
 def as_parameters(**kwargs) -> tuple[tuple[str, Any], ...]:

@@ -1,7 +1,9 @@
 """Built-in examples: each reproduces a result of Underhill's thesis (see ``docs/examples.md``).
 
 Every example module provides ``Parameters`` (a frozen dataclass of its settings), ``run(params,
-out, on_step=None) -> summary`` and ``report(summary) -> lines`` (what the CLI prints).
+out, on_step=None) -> summary`` and ``report(summary) -> lines`` (what the CLI prints). Those with
+bodies also describe their model as data, ``config(params)`` (or ``configs(params)`` for several
+models): that is what ``build`` solves and what ``vfem export`` writes as ``examples/*.toml``.
 """
 
 from __future__ import annotations

@@ -8,7 +8,8 @@ execute anything; nothing here evaluates text.
 
 ``dumps(config)`` writes a configuration back as TOML (keys at their defaults left out), which is
 how the built-in examples' input files under ``examples/`` are made (``vfem export``).
-``reference()`` is the key reference of ``docs/input.md``, generated from the same classes.
+``reference()`` is the key reference of ``docs/input.md``, generated from the same classes
+(``vfem reference`` prints it).
 """
 
 from __future__ import annotations
@@ -92,7 +93,7 @@ def from_data(cls, data: Any, where: str):
     for name, f in fields.items():
         if name not in data:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
-                meaning = _help(cls).get(name, "").rstrip(".")
+                meaning = help_texts(cls).get(name, "").rstrip(".")
                 raise _Problem(where, f"missing key {name!r}" + (f" ({meaning})" if meaning
                                                                  else ""))
             continue
@@ -140,8 +141,8 @@ def _mesh_spec(data: dict, where: str) -> MeshSpec:
         params = []
         for name, par in signature.items():
             if name in data:
-                params.append((name, _plain(_convert(hints.get(name, Any), data[name],
-                                                     _join(where, name)))))
+                params.append((name, _convert(hints.get(name, Any), data[name],
+                                              _join(where, name))))
             elif par.default is inspect.Parameter.empty:
                 raise _Problem(where, f"shape {shape!r} needs {name!r}")
         params = tuple(params)
@@ -230,10 +231,6 @@ def _kind(value) -> str:
     return type(value).__name__
 
 
-def _plain(v):
-    return tuple(_plain(x) for x in v) if isinstance(v, (list, tuple)) else v
-
-
 # -- writing -------------------------------------------------------------------------------------
 
 def to_data(obj) -> dict:
@@ -320,10 +317,6 @@ def _value(v) -> str:
 
 def help_texts(cls) -> dict[str, str]:
     """Each attribute's help text, from the ``Attributes:`` section of the class docstring."""
-    return _help(cls)
-
-
-def _help(cls) -> dict[str, str]:
     doc = inspect.cleandoc(cls.__doc__ or "")
     out: dict[str, str] = {}
     lines = doc.splitlines()
@@ -393,7 +386,7 @@ def reference() -> str:
         out += [f"### `{SECTIONS[cls.__name__]}`", "", doc, "",
                 "| key | type | default | meaning |", "|---|---|---|---|"]
         hints = typing.get_type_hints(cls)
-        helps = _help(cls)
+        helps = help_texts(cls)
         for f in dataclasses.fields(cls):
             if cls is MeshSpec and f.name == "parameters":
                 continue
@@ -420,6 +413,3 @@ def reference() -> str:
             out += [named[0].replace(":func:", ""), ""]
     return "\n".join(out).rstrip() + "\n"
 
-
-if __name__ == "__main__":  # python3 -m vfem.io.input: the key reference of docs/input.md
-    print(reference(), end="")
