@@ -10,7 +10,7 @@ import pytest
 
 import vfem
 from vfem.cli import main
-from vfem.examples import block, gasket, hertz, patch, wedge
+from vfem.examples import block, gasket, hertz, patch, sliding, wedge
 from vfem.io.input import dumps, load, loads, reference
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -23,6 +23,7 @@ def example_files():
     yield EXAMPLES / "hertz.toml", hertz.config(hertz.HertzParameters())
     yield EXAMPLES / "block.toml", block.config(block.Parameters())
     yield EXAMPLES / "gasket.toml", gasket.config(gasket.GasketParameters())
+    yield EXAMPLES / "sliding.toml", sliding.config(sliding.Parameters())
     for key, config in patch.configs(patch.Parameters()).items():
         yield EXAMPLES / "patch" / f"{key}.toml", config
     for key, config in wedge.configs(wedge.WedgeParameters()).items():
@@ -37,7 +38,7 @@ def test_example_files_describe_the_built_in_models(path, config):
 
 
 def test_every_example_with_bodies_has_its_files():
-    assert len(list(example_files())) == 3 + 12 + 5
+    assert len(list(example_files())) == 4 + 12 + 5
     assert sorted(p.name for p in (EXAMPLES / "patch").glob("*.toml")) == sorted(
         f"{k}.toml" for k in patch.configs(patch.Parameters()))
 
@@ -131,7 +132,7 @@ def test_the_bad_input_deck_is_large_enough():
 def test_check_accepts_every_example_file(capsys):
     for path, _ in example_files():
         assert main(["check", str(path)]) == 0
-    assert capsys.readouterr().out.count("is valid") == 20
+    assert capsys.readouterr().out.count("is valid") == 21
 
 
 def test_missing_input_file(capsys):

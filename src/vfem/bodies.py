@@ -66,11 +66,23 @@ class PrescribedDisplacement:
         boundary: the boundary's name.
         component: ``"x"`` or ``"y"``.
         value: the displacement at load factor 1.
+        amplitude: ``[[load_factor, multiplier], ...]`` points (load factors increasing): the
+            displacement is ``value`` times the multiplier interpolated linearly at the load
+            factor (constant beyond the ends), instead of ``value`` times the load factor. For
+            loads that are not proportional, e.g. press then slide; large kinematics only.
     """
 
     boundary: str
     component: str
     value: float
+    amplitude: tuple[tuple[float, float], ...] | None = None
+
+    def at(self, load_factor: float) -> float:
+        """The prescribed displacement at ``load_factor``."""
+        if self.amplitude is None:
+            return load_factor * self.value
+        lf, mult = np.asarray(self.amplitude, dtype=float).T
+        return self.value * float(np.interp(load_factor, lf, mult))
 
 
 @dataclass(frozen=True)
@@ -122,6 +134,11 @@ class Body:
             on which no displacement is prescribed (symmetry planes and supports cannot touch).
         order: 1 for linear elements (3-node triangles, 4-node quadrilaterals), 2 for quadratic
             ones (6-node triangles, 9-node quadrilaterals) on the same mesh.
+        kinematics: ``"small"`` (default: small displacements and strains, linear elasticity)
+            or large displacements and strains, by the ``"total"`` or ``"updated"`` Lagrangian
+            formulation (thesis Chapters 2-3; plane strain, linear elements).
+        law: under large kinematics, the hyperelastic law whose small-strain constants are the
+            material's: ``"saint-venant-kirchhoff"`` (default) or ``"neo-hookean"``.
 
     Points: the nodes of the elements. For linear elements they are the mesh vertices; quadratic
     elements add one point at the middle of each facet (numbered after the vertices, in facet
@@ -138,6 +155,13 @@ class Body:
     platen: Platen | None = None
     contact_boundaries: tuple[str, ...] | None = None
     order: int = 1
+    kinematics: str = "small"
+    law: str = "saint-venant-kirchhoff"
+
+    @property
+    def large(self) -> bool:
+        """Whether the body is analysed under large displacements (see ``kinematics``)."""
+        return self.kinematics != "small"
 
     # -- set-up ---------------------------------------------------------------------------------
 
@@ -199,10 +223,102 @@ class Body:
             # a body that only contact holds moves rigidly with its platen: zero up to round-off
             scale = float(self.K.diagonal()[platen_dofs].sum())
             self.platen_stiffness = stiffness if abs(stiffness) > 1e-9 * scale else 0.0
+        if self.large:
+            self._setup_large(fixed)
         self.timings = {"assemble_s": t1 - t0, "constraints_s": t2 - t1, "factorize_s": t3 - t2,
                         "load_cases_s": time.perf_counter() - t3}
         log.info("body %s: %d points, %d dofs (%d fixed)", self.name, self.ndofs // 2,
                  self.ndofs, len(self.fixed_dofs))
+
+    # -- large displacements ----------------------------------------------------------------------
+
+    def _setup_large(self, fixed: dict[int, float]) -> None:
+        """The hyperelastic body behind a large-kinematics body (:mod:`vfem.nonlinear`).
+
+        Its supports and prescribed displacements are prescribed dofs scaled by the load factor,
+        its tractions dead nodal forces (per undeformed length, as for small kinematics), and a
+        platen's dofs follow the platen displacement the contact iteration sets. The linear
+        quantities set up above are the tangent ones at rest, which is where the first step
+        starts from.
+        """
+        from .materials import NeoHookean, SaintVenantKirchhoff
+        from .nonlinear import NonlinearBody
+
+        law = {"saint-venant-kirchhoff": SaintVenantKirchhoff, "neo-hookean": NeoHookean}[self.law]
+        material = law(self.material.youngs_modulus, self.material.poissons_ratio)
+        nl = NonlinearBody(self.mesh, material, formulation=self.kinematics, name=self.name)
+        dofs = np.array(sorted(fixed), dtype=int)
+        if len(dofs):
+            nl.prescribe(dofs, np.array([fixed[d] for d in dofs.tolist()]))
+        for pd in self.prescribed:  # later ones win, as in _constraints
+            dofs = self._boundary_dofs(pd.boundary, pd.component)
+            nl.prescribe(dofs, _ramp(pd, len(dofs)))
+        self._platen_value = 0.0
+        if len(self.platen_dofs):
+            nl.prescribe(self.platen_dofs,
+                         lambda lf: np.full(len(self.platen_dofs), self._platen_value))
+        nl.add_nodal_forces(np.arange(self.ndofs), self.f_load)
+        self.nonlinear = nl
+        self._equilibrated: tuple | None = None
+
+    def equilibrate(self, load_factor: float, platen_displacement: float,
+                    contact_force: np.ndarray) -> np.ndarray:
+        """Large kinematics: the equilibrium displacement (ndofs) under the loads at
+        ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
+        (a trial state of the step, see :meth:`commit_step`). Repeated calls with the same
+        arguments cost nothing."""
+        f = np.asarray(contact_force, dtype=float)
+        key = (float(load_factor), float(platen_displacement), f.tobytes())
+        if self._equilibrated != key:
+            self._platen_value = float(platen_displacement)
+            self.nonlinear.equilibrate(load_factor, f)
+            self._equilibrated = key
+        return self.nonlinear.trial_displacement()
+
+    def tangent_flexibility(self, tracked_dofs: np.ndarray, candidate_dofs: np.ndarray,
+                            backend: str = "superlu") -> tuple[np.ndarray, np.ndarray, float]:
+        """Large kinematics, at the trial state: the tangent flexibility rows of the tracked dofs
+        for the candidate dofs (supports kept), the tracked dofs' motion per unit platen motion
+        and the platen's tangent stiffness (as :meth:`setup` gives them at rest)."""
+        K = self.nonlinear.trial_tangent()
+        factor = factorize(K[self.free_dofs][:, self.free_dofs].tocsc(), backend)
+        free = self.free_dofs
+        pos = np.searchsorted(free, candidate_dofs)
+        is_free = free[np.minimum(pos, len(free) - 1)] == candidate_dofs
+        cols = np.flatnonzero(is_free)
+        rhs = np.zeros((len(free), len(cols)))
+        rhs[pos[cols], np.arange(len(cols))] = 1.0
+        full = np.zeros((self.ndofs, len(candidate_dofs)))
+        if len(cols):
+            full[np.ix_(free, cols)] = factor.solve(rhs)
+        u_platen = np.zeros(self.ndofs)
+        stiffness = 0.0
+        if len(self.platen_dofs):
+            u_platen[self.platen_dofs] = 1.0
+            u_platen[free] = factor.solve(-(K[free][:, self.platen_dofs] @ np.ones(
+                len(self.platen_dofs))))
+            stiffness = float((K @ u_platen)[self.platen_dofs].sum())
+            scale = float(K.diagonal()[self.platen_dofs].sum())
+            stiffness = stiffness if abs(stiffness) > 1e-9 * scale else 0.0
+        return full[tracked_dofs], u_platen[tracked_dofs], stiffness
+
+    def platen_reaction_now(self) -> float:
+        """Large kinematics: the platen's reaction (force on the body along its component) at
+        the trial state."""
+        return float(self.nonlinear.trial_reactions()[self.platen_dofs].sum())
+
+    def commit_step(self) -> None:
+        """A step converged: its trial state becomes the start of the next (large kinematics;
+        nothing to do for small)."""
+        if self.large:
+            self.nonlinear.accept()
+            self._equilibrated = None
+
+    def discard_step(self) -> None:
+        """A step failed: go back to the last converged state (large kinematics)."""
+        if self.large:
+            self.nonlinear.discard()
+            self._equilibrated = None
 
     def check_supports(self) -> None:
         """Without assembling anything: raise :class:`InputError` if the body is invalid or
@@ -288,6 +404,15 @@ class Body:
             raise InputError(f"{where}: order must be 1 (linear) or 2 (quadratic elements), "
                              f"got {self.order!r}")
         self.material.validate(f"{where}, material")
+        if self.kinematics not in ("small", "total", "updated"):
+            raise InputError(f"{where}: kinematics must be 'small', 'total' or 'updated', "
+                             f"got {self.kinematics!r}")
+        if self.law not in ("saint-venant-kirchhoff", "neo-hookean"):
+            raise InputError(f"{where}: law must be 'saint-venant-kirchhoff' or 'neo-hookean', "
+                             f"got {self.law!r}")
+        if self.large and (self.order != 1 or self.material.plane != "strain"):
+            raise InputError(f"{where}: large kinematics ({self.kinematics!r}) needs linear "
+                             "elements (order 1) and plane strain")
         names = set((self.mesh.boundaries or {}).keys())
         for bc in (*self.supports, *self.prescribed, *self.tractions,
                    *((self.platen,) if self.platen else ()), *(self.contact_boundaries or ())):
@@ -301,6 +426,19 @@ class Body:
         for c in comps:
             if c not in COMPONENTS:
                 raise InputError(f"{where}: component must be 'x' or 'y', got {c!r}")
+        for pd in self.prescribed:
+            if pd.amplitude is None:
+                continue
+            if not self.large:
+                raise InputError(f"{where}: prescribed displacement on {pd.boundary!r} has an "
+                                 "amplitude, which needs large kinematics (small kinematics "
+                                 "superposes loads proportional to the load factor)")
+            pts = np.asarray(pd.amplitude, dtype=float)
+            if (pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 1
+                    or not np.all(np.isfinite(pts)) or np.any(np.diff(pts[:, 0]) <= 0)):
+                raise InputError(f"{where}: amplitude of the prescribed displacement on "
+                                 f"{pd.boundary!r} must be [load factor, multiplier] pairs with "
+                                 "finite numbers and increasing load factors")
         values = [pd.value for pd in self.prescribed] + [v for t in self.tractions for v in t.value]
         values += [self.platen.force] if self.platen else []
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
@@ -377,6 +515,8 @@ class Body:
     def displacement(self, load_factor: float, platen_displacement: float,
                      contact_force: np.ndarray) -> np.ndarray:
         """Full displacement vector (ndofs) for the given state."""
+        if self.large:
+            return self.equilibrate(load_factor, platen_displacement, contact_force).copy()
         return (load_factor * self.u_load + platen_displacement * self.u_platen
                 + self.response(contact_force))
 
@@ -385,13 +525,19 @@ class Body:
         """Total force the supports (or prescribed displacements) on ``boundary`` apply to the
         body along ``component``, for displacement ``u`` (ndofs) under the body's loads at
         ``load_factor`` and the nodal ``contact_force`` (ndofs)."""
-        r = self.K @ u - load_factor * self.f_load
+        Ku = self.nonlinear.internal_force_at(u) if self.large else self.K @ u
+        r = Ku - load_factor * self.f_load
         if contact_force is not None:
             r -= contact_force
         return float(r[self._boundary_dofs(boundary, component)].sum())
 
     def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
-        """Element-average stresses: sxx, syy, sxy, szz and von Mises (per element)."""
+        """Element-average stresses: sxx, syy, sxy, szz and von Mises (per element); Cauchy
+        stresses in the deformed configuration under large kinematics."""
+        if self.large:
+            sig, szz = self.nonlinear.cauchy_stress_at(u)
+            avg = {"sxx": sig[:, 0, 0], "syy": sig[:, 1, 1], "sxy": sig[:, 0, 1], "szz": szz}
+            return _with_von_mises(avg)
         lam, mu = self.material.lame()
         ui = self.basis.interpolate(u)
         eps = sym_grad(ui)
@@ -405,10 +551,19 @@ class Body:
         nu = self.material.poissons_ratio
         avg["szz"] = (nu * (avg["sxx"] + avg["syy"]) if self.material.plane == "strain"
                       else np.zeros_like(avg["sxx"]))
-        sxx, syy, sxy, szz = avg["sxx"], avg["syy"], avg["sxy"], avg["szz"]
-        avg["von_mises"] = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
-                                   + 3 * sxy**2)
-        return avg
+        return _with_von_mises(avg)
+
+
+def _ramp(pd: PrescribedDisplacement, n: int):
+    """The values of ``n`` dofs under ``pd`` as a function of the load factor."""
+    return lambda load_factor: np.full(n, pd.at(load_factor))
+
+
+def _with_von_mises(avg: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    sxx, syy, sxy, szz = avg["sxx"], avg["syy"], avg["sxy"], avg["szz"]
+    avg["von_mises"] = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
+                               + 3 * sxy**2)
+    return avg
 
 
 __all__ = ["Body", "Support", "PrescribedDisplacement", "Traction", "Platen"]

@@ -43,6 +43,7 @@ SHAPES = {
     "wedge_grid": shapes.wedge_grid,
     "wedge_plate_grid": shapes.wedge_plate_grid,
     "gasket": shapes.gasket,
+    "rounded_punch": shapes.rounded_punch,
 }
 
 
@@ -146,6 +147,11 @@ class BodyConfig:
         platen: a rigid, force-controlled platen on a named boundary.
         contact_boundaries: the boundaries that may touch other bodies. Default: every
             exterior facet on which no displacement is prescribed.
+        kinematics: ``"small"`` (small displacements, linear elasticity), or large
+            displacements and strains by the ``"total"`` or ``"updated"`` Lagrangian
+            formulation (plane strain, linear elements).
+        law: under large kinematics, the hyperelastic law whose small-strain constants are the
+            material's: ``"saint-venant-kirchhoff"`` or ``"neo-hookean"``.
     """
 
     name: str
@@ -157,6 +163,8 @@ class BodyConfig:
     tractions: tuple[Traction, ...] = ()
     platen: Platen | None = None
     contact_boundaries: tuple[str, ...] | None = None
+    kinematics: str = "small"
+    law: str = "saint-venant-kirchhoff"
 
     def build(self, base: Path | None = None) -> Body:
         try:
@@ -167,7 +175,8 @@ class BodyConfig:
             raise InputError(f"body {self.name!r}: its mesh has no elements")
         return Body(self.name, mesh, self.material, supports=self.supports,
                     prescribed=self.prescribed, tractions=self.tractions, platen=self.platen,
-                    contact_boundaries=self.contact_boundaries, order=self.order)
+                    contact_boundaries=self.contact_boundaries, order=self.order,
+                    kinematics=self.kinematics, law=self.law)
 
 
 @dataclass(frozen=True)

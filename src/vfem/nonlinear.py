@@ -255,6 +255,9 @@ class NonlinearBody:
         self.pseudo_strain = np.zeros((2, 2, self.mesh.nelements, nq))
         self._u_at_current = np.zeros(self.ndofs)
         self._stretch_cache: tuple[np.ndarray, np.ndarray] | None = None
+        self._delta = np.zeros(self.ndofs)  # trial displacement since the converged state
+        self._trial_state: _State | None = None
+        self._trial_converged = False
 
     def boundary_dofs(self, boundary: str | np.ndarray, component: str | None = None
                       ) -> np.ndarray:
@@ -436,24 +439,53 @@ class NonlinearBody:
         return [s.residuals for s in self.steps]
 
     def _step(self, load_factor: float, tol: float, max_iter: int) -> NewtonStep:
-        """One load step: Newton's method from the last converged state.
+        """One load step: Newton's method from the last converged state, then accepted."""
+        self.discard()
+        record = self.equilibrate(load_factor, tol=tol, max_iter=max_iter)
+        self.accept()
+        log.info("%s: load factor %.6g converged in %d iterations (%.3f s)", self.name,
+                 load_factor, record.iterations, record.seconds)
+        return record
+
+    def equilibrate(self, load_factor: float, extra_force: np.ndarray | None = None,
+                    tol: float = 1e-10, max_iter: int = 25) -> NewtonStep:
+        """Newton's method for equilibrium at ``load_factor`` with ``extra_force`` (ndofs, dead
+        nodal forces, e.g. contact forces) added to the loads, *without* accepting the result.
+
+        It starts from the last trial iterate of the current step (the last converged state
+        after :meth:`accept` or :meth:`discard`), so a contact iteration that changes the
+        contact forces a little is re-equilibrated in one or two corrections. The trial state is
+        what :meth:`trial_displacement`, :meth:`trial_tangent` and :meth:`trial_reactions` see;
+        :meth:`accept` makes it the new converged state (the updated formulation then moves its
+        reference), :meth:`discard` goes back to the last converged one.
 
         The step's increment of the prescribed displacements enters through the first Newton
         correction (``K_ff d_f = -R_f - K_fD d_D``) rather than by moving those nodes alone first,
         which would crush the elements next to them before the rest of the body follows.
+
+        Raises:
+            AnalysisError: no convergence in ``max_iter`` corrections, or an element turned
+                inside out; the trial state is left at the last converged one.
         """
         t0 = time.perf_counter()
         record = NewtonStep(load_factor)
         D, uD = self._dirichlet(load_factor)
         free = np.setdiff1d(np.arange(self.ndofs), D)
-        delta = np.zeros(self.ndofs)  # displacement since the last converged state
+        delta = self._delta.copy()  # displacement since the last converged state
         pending = np.zeros(self.ndofs)  # prescribed increment not yet applied
-        pending[D] = uD - self._u_at_current[D]
+        pending[D] = uD - (self._u_at_current + delta)[D]
         f_ext = load_factor * self.nodal_forces
+        if extra_force is not None:
+            f_ext = f_ext + extra_force
         floor = 1e-6 * self.material.youngs_modulus * self.length
         last_correction = math.inf
         previous = None
-        state = self._state(delta)
+        self._trial_converged = False
+        try:
+            state = self._state(delta)
+        except _Inverted:
+            self.discard()
+            raise
         for k in range(max_iter + 1):
             f_int = self._internal(state)
             R = f_int - f_ext
@@ -462,8 +494,8 @@ class NonlinearBody:
             record.residuals.append(r)
             record.reference_force = max(record.reference_force, ref)
             ratio = (r / ref) / (previous / ref) ** 2 if previous else math.nan
-            log.info("%s: step to load factor %.6g, iteration %d: |R| = %.3e (relative %.3e), "
-                     "r_k+1/r_k^2 = %.3g", self.name, load_factor, k, r, r / ref, ratio)
+            log.debug("%s: load factor %.6g, iteration %d: |R| = %.3e (relative %.3e), "
+                      "r_k+1/r_k^2 = %.3g", self.name, load_factor, k, r, r / ref, ratio)
             previous = r
             if not pending.any() and (r <= tol * ref or last_correction <= 1e-13 * self.length):
                 record.converged = True
@@ -483,6 +515,7 @@ class NonlinearBody:
                     break
                 except _Inverted:
                     if halvings == _MAX_HALVINGS:
+                        self.discard()
                         raise
                     fraction *= 0.5
                     log.info("%s: correction halved (an element would turn inside out)",
@@ -494,15 +527,74 @@ class NonlinearBody:
         record.seconds = time.perf_counter() - t0
         if not record.converged:
             self.steps.append(record)
+            self.discard()
             raise AnalysisError(f"{self.name}: Newton did not converge in {max_iter} iterations "
                                 f"at load factor {load_factor:g} (|R| = {record.residuals[-1]:.3e}"
                                 f", reference {record.reference_force:.3e})")
-        self._accept(delta)
-        self.load_factor = load_factor
+        if record.iterations > 1:
+            log.info("%s: load factor %.6g, residuals %s (quadratic ratios r_k+1/r_k^2 %s)",
+                     self.name, load_factor,
+                     ", ".join(f"{r:.2e}" for r in record.relative_residuals),
+                     ", ".join(f"{q:.3g}" for q in record.quadratic_ratios))
+        self._delta = delta
+        self._trial_state = state
+        self._trial_load_factor = load_factor
+        self._trial_f_int = f_int
+        self._trial_f_ext = f_ext
+        self._trial_converged = True
         self.steps.append(record)
-        log.info("%s: load factor %.6g converged in %d iterations (%.3f s)", self.name,
-                 load_factor, record.iterations, record.seconds)
         return record
+
+    def accept(self) -> None:
+        """Make the last trial state (see :meth:`equilibrate`) the converged state."""
+        if not self._trial_converged:
+            raise AnalysisError(f"{self.name}: no converged trial state to accept")
+        self._accept(self._delta)
+        self.load_factor = self._trial_load_factor
+        self.discard()
+        log.debug("%s: load factor %.6g accepted", self.name, self.load_factor)
+
+    def discard(self) -> None:
+        """Forget the trial state: the next :meth:`equilibrate` starts from the converged one."""
+        self._delta = np.zeros(self.ndofs)
+        self._trial_state = None
+        self._trial_converged = False
+
+    def trial_displacement(self) -> np.ndarray:
+        """Total displacement (ndofs) of the trial state (the converged one without a trial)."""
+        return self._u_at_current + self._delta
+
+    def trial_tangent(self):
+        """Tangent stiffness dR/du (material + geometric) at the trial state, all dofs, CSR.
+
+        In both formulations the derivative of the internal nodal forces with respect to the
+        nodal displacements: the same matrix at the same state.
+        """
+        state = self._trial_state if self._trial_state is not None else self._state(self._delta)
+        return self._tangent(state)
+
+    def trial_reactions(self) -> np.ndarray:
+        """``f_int - f_ext`` (ndofs) at the trial state, ``f_ext`` including the extra force: on
+        the prescribed dofs the forces the supports apply to the body."""
+        if self._trial_state is None:
+            state = self._state(self._delta)
+            return self._internal(state) - self.load_factor * self.nodal_forces
+        return self._trial_f_int - self._trial_f_ext
+
+    def internal_force_at(self, u: np.ndarray) -> np.ndarray:
+        """Internal nodal forces (ndofs) at the total displacement ``u``."""
+        return self._internal(self._state(np.asarray(u, dtype=float) - self._u_at_current))
+
+    def cauchy_stress_at(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Element averages over the current volume at the total displacement ``u``: the
+        in-plane Cauchy stress (nelems, 2, 2) and ``sigma_zz`` (nelems,)."""
+        state = self._state(np.asarray(u, dtype=float) - self._u_at_current)
+        J = determinant(state.F)
+        w = state.basis.dx * J
+        sig = push_forward_stress(state.S, state.F)
+        avg = (sig * w).sum(axis=-1) / w.sum(axis=-1)
+        szz = (state.S33 / J * w).sum(axis=-1) / w.sum(axis=-1)
+        return np.moveaxis(avg, -1, 0), szz
 
     def _accept(self, delta: np.ndarray) -> None:
         """Make the converged iterate the new state.

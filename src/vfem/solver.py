@@ -77,6 +77,9 @@ class Model:
                 raise InputError(f"model {self.name!r}, body {b.name!r}: the thesis variant "
                                  "supports linear elements only (order 1); use the paired "
                                  "variant for quadratic elements")
+        if any(b.large for b in self.bodies) and self.contact.variant != "paired":
+            raise InputError(f"model {self.name!r}: large kinematics needs the paired contact "
+                             "variant")
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
         self.contact.validate()
@@ -143,6 +146,9 @@ class Analysis:
         if distance is None:
             diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in bodies]
             distance = 0.02 * min(diag)
+        if any(b.large for b in bodies):
+            # bodies may slide far: every facet that may touch is a candidate
+            distance = np.inf
         facets = select_candidate_facets(bodies, pairs, distance)
         self.surfaces = [ContactSurface.build(b, f) for b, f in zip(bodies, facets)]
         t1 = time.perf_counter()
@@ -152,7 +158,12 @@ class Analysis:
         for s in self.surfaces:
             s.compute_flexibility()
             log.info("body %s: %d contact candidate nodes", s.body.name, s.nc)
-        if self.model.contact.variant == "paired":
+        if any(b.large for b in bodies):
+            from .contact.large import LargeDeformationContact
+
+            self.contact = LargeDeformationContact(self.surfaces, pairs, self.model.contact,
+                                                   self.backend)
+        elif self.model.contact.variant == "paired":
             from .contact.paired import PairedContact
 
             self.contact = PairedContact(self.surfaces, pairs, self.model.contact)
@@ -206,6 +217,8 @@ class Analysis:
             try:
                 new, res = self.solve_step(state, lf, history)
             except AnalysisError as exc:
+                for b in self.model.bodies:
+                    b.discard_step()
                 prev = state.load_factor
                 if cuts >= self.model.contact.max_step_cuts:
                     converged = False
@@ -218,6 +231,8 @@ class Analysis:
                 targets.insert(0, (0.5 * (prev + lf), cuts + 1))
                 continue
             targets.pop(0)
+            for b in self.model.bodies:
+                b.commit_step()
             state = self.state = new
             iterations = sum(1 for h in history if h.iteration > 0) or 0
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=iterations,

@@ -8,6 +8,9 @@ the other undeformed surface, the outward normal there, and the gap
 ``g0 + n . (u_node - u_other(closest point))``; where the closest point is a vertex (a corner),
 n is the direction from it to the node. Nodes whose closest point is an end of the other surface
 (beyond its edge) are left out.
+
+When any body is analysed under large displacements the same measure is taken on the deformed
+surfaces: each node's current position against the other surface as it now lies.
 """
 
 from __future__ import annotations
@@ -32,21 +35,27 @@ def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
         if s.nc == 0:
             out[s.body.name] = best
             continue
+        large = any(b.large for b in result.model.bodies)
         u = step.bodies[s.body.name].displacement[s.nodes[: s.nc]]
+        x = s.X[: s.nc] + u if large else s.X[: s.nc]
         for so in surfaces:
             if so is s or so.nc == 0:
                 continue
-            seg, t, dist, n = so.project(s.X[: s.nc])
-            pos, _ = so.curve(seg, t)
+            xo = so.X + step.bodies[so.body.name].displacement[so.nodes] if large else so.X
+            seg, t, dist, n = so.project(x, xo)
+            pos, _ = so.curve(seg, t, xo)
             # closest to a vertex (a corner of the other surface): measure along the line from
             # that vertex to the node, not along a facet normal that does not reach it
             at_vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * max(so.lengths.max(), 1e-300))
             n = np.where(at_vertex[:, None],
-                         (s.X[: s.nc] - pos) / np.maximum(dist, 1e-300)[:, None], n)
-            uo = step.bodies[so.body.name].displacement[so.nodes[: so.nc]]
-            uv = np.einsum("nk,nkd->nd", so.shape(t), uo[so.facets[seg]])
-            pen = -(np.einsum("ij,ij->i", s.X[: s.nc] - pos, n)
-                    + np.einsum("ij,ij->i", u - uv, n))
+                         (x - pos) / np.maximum(dist, 1e-300)[:, None], n)
+            if large:
+                pen = -np.einsum("ij,ij->i", x - pos, n)
+            else:
+                uo = step.bodies[so.body.name].displacement[so.nodes[: so.nc]]
+                uv = np.einsum("nk,nkd->nd", so.shape(t), uo[so.facets[seg]])
+                pen = -(np.einsum("ij,ij->i", x - pos, n)
+                        + np.einsum("ij,ij->i", u - uv, n))
             ends = so.facets[seg]
             off = (((t <= 0) & so.surface_ends[ends[:, 0]])
                    | ((t >= 1) & so.surface_ends[ends[:, 1]]))

@@ -150,7 +150,8 @@ class PairedContact(VirtualElementContact):
         return best
 
     @staticmethod
-    def _transfer(sf: ContactSurface, sc: ContactSurface, gap: float = 0.0) -> np.ndarray:
+    def _transfer(sf: ContactSurface, sc: ContactSurface, gap: float = 0.0,
+                  xf: np.ndarray | None = None, xc: np.ndarray | None = None) -> np.ndarray:
         """Coarse nodal forces from a fine traction: T[c, f] = int phi_c(proj(y)) phi_f(y) dy.
 
         Integrated over the fine facets, split where the projection onto the coarse surface
@@ -159,9 +160,15 @@ class PairedContact(VirtualElementContact):
         straight facets, so a uniform traction crosses exactly and the total force is conserved.
         On curved (quadratic) facets the points and weights follow the curve; the splits are
         found on the chords.
+
+        With ``xf`` and ``xc`` (tracked positions of the two surfaces in a deformed
+        configuration) the overlap is found on the deformed surfaces, while the measure stays
+        the fine side's undeformed length: the traction is nominal.
         """
-        fa, fb = sf.segments(sf.X)
-        ca, cb = sc.segments(sc.X)
+        xf = sf.X if xf is None else xf
+        xc = sc.X if xc is None else xc
+        fa, fb = sf.segments(xf)
+        ca, cb = sc.segments(xc)
         d = fb - fa
         # coarse facet ends seen along their (vertex) normal: where they split the fine facets
         ends = np.unique(sc.facets[:, :2])
@@ -170,7 +177,7 @@ class PairedContact(VirtualElementContact):
         np.add.at(vn, sc.facets[:, 0], cn)
         np.add.at(vn, sc.facets[:, 1], cn)
         vn = vn[ends] / np.maximum(np.linalg.norm(vn[ends], axis=1), 1e-300)[:, None]
-        P = sc.X[ends]
+        P = xc[ends]
         # solve fa + s d = P + tau vn for every (facet, coarse node)
         det = d[:, None, 0] * (-vn[None, :, 1]) - d[:, None, 1] * (-vn[None, :, 0])
         rx = P[None, :, 0] - fa[:, None, 0]
@@ -194,9 +201,10 @@ class PairedContact(VirtualElementContact):
             sloc.append(sq)
         wts = np.concatenate(wts)
         fac, sloc = np.concatenate(fac), np.concatenate(sloc)
-        pts, tangent = sf.curve(fac, sloc)
+        _, tangent = sf.curve(fac, sloc)
         wts = wts * np.linalg.norm(tangent, axis=1)
-        seg, tt, dist, _ = sc.project(pts)
+        pts, _ = sf.curve(fac, sloc, xf)
+        seg, tt, dist, _ = sc.project(pts, xc)
         cend = sc.facets[seg]
         beyond = (((tt <= 0) & sc.surface_ends[cend[:, 0]])
                   | ((tt >= 1) & sc.surface_ends[cend[:, 1]]))

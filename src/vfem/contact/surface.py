@@ -227,25 +227,27 @@ class ContactSurface:
         tangent = np.einsum("nk,nkd->nd", facet_shape_derivative(t, self.order), nodes)
         return pos, tangent
 
-    def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                   np.ndarray]:
-        """Closest point on the undeformed candidate surface for each point.
+    def project(self, points: np.ndarray, x: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Closest point on the candidate surface (undeformed, or at tracked positions ``x``)
+        for each point.
 
         Returns (facet, t, distance, outward normal there). The chords give the facet and a
         first t; on curved facets a few Newton steps then find the closest point on the curve.
         """
-        a, b = self.segments(self.X)
+        x = self.X if x is None else x
+        a, b = self.segments(x)
         seg, t, dist = project_points(points, a, b)
-        pos, tangent = self.curve(seg, t)
+        pos, tangent = self.curve(seg, t, x)
         if self.order == 2:
             for _ in range(4):
                 second = np.einsum("k,nkd->nd", _SECOND[:, 0],
-                                   self.X[self.facets[seg]])  # d2x/dt2, constant on a facet
+                                   x[self.facets[seg]])  # d2x/dt2, constant on a facet
                 r = pos - points
                 f = np.einsum("nd,nd->n", r, tangent)
                 df = np.einsum("nd,nd->n", tangent, tangent) + np.einsum("nd,nd->n", r, second)
                 t = np.clip(t - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
-                pos, tangent = self.curve(seg, t)
+                pos, tangent = self.curve(seg, t, x)
             dist = np.linalg.norm(points - pos, axis=1)
         normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
         normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]

@@ -27,6 +27,7 @@ h_max)`` of the distance ``d`` from the point of first contact.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
@@ -382,6 +383,46 @@ def rectangle(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: floa
         "left": lambda p: p[0] < x0 + tol,
         "right": lambda p: p[0] > x0 + width - tol,
     })
+
+
+def rounded_punch(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: float = 1.0,
+                  radius: float = 1.0, nx: int = 16, ny: int = 8) -> MeshQuad:
+    """A punch with a circular face: ``nx`` x ``ny`` quadrilaterals between the arc of radius
+    ``radius`` whose lowest point is ``(x0, y0)`` and the flat top ``y = y0 + height``, for
+    ``|x - x0| <= width / 2``. Columns are equally spaced in x; rows are graded towards the face
+    (each twice as close to the face as the one above is, in ratio 1.25).
+
+    Named boundaries: ``face`` (the arc), ``top``, ``left`` and ``right``.
+    """
+    half = 0.5 * width
+    if width <= 0 or radius < half or nx < 1 or ny < 1:
+        raise ValueError("need width > 0, radius >= width / 2 and nx, ny >= 1")
+    sag = radius - np.sqrt(radius**2 - half**2)
+    if height <= sag:
+        raise ValueError(f"height must exceed the arc's sag {sag:.6g}")
+    xi = np.linspace(-half, half, int(nx) + 1)
+    g = 1.25 ** np.arange(int(ny))
+    eta = np.concatenate([[0.0], np.cumsum(g) / g.sum()])
+    bottom = radius - np.sqrt(radius**2 - xi**2)
+    X, E = np.meshgrid(xi, eta, indexing="ij")
+    Y = bottom[:, None] + (height - bottom[:, None]) * E
+    grid = MeshQuad.init_tensor(xi, eta)  # connectivity of the (nx+1) x (ny+1) grid
+    # init_tensor numbers points x-fastest or y-fastest: map each grid point to (X, Y) by value
+    ix = np.rint(np.interp(grid.p[0], xi, np.arange(len(xi)))).astype(int)
+    iy = np.rint(np.interp(grid.p[1], eta, np.arange(len(eta)))).astype(int)
+    pts = np.vstack([x0 + X[ix, iy], y0 + Y[ix, iy]])
+    t = _counter_clockwise(pts, grid.t)
+    mesh = MeshQuad(pts, t)
+    tol = 1e-9 * max(width, height)
+    mesh = mesh.with_boundaries({
+        "top": lambda p: p[1] > y0 + height - tol,
+        "left": lambda p: p[0] < x0 - half + tol,
+        "right": lambda p: p[0] > x0 + half - tol,
+    })
+    on_face = iy == 0  # the arc's points (chord midpoints are off the arc)
+    bnd = mesh.boundary_facets()
+    face = bnd[on_face[mesh.facets[0, bnd]] & on_face[mesh.facets[1, bnd]]]
+    return replace(mesh, _boundaries={**mesh.boundaries, "face": face})
 
 
 def _grid_line(a: float, b: float, h: float, h_fine: float | None, growth: float,

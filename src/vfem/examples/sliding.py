@@ -1,0 +1,248 @@
+"""Large sliding: a rounded punch pressed into a long block, then slid along it (ironing).
+
+The method's claim (thesis abstract and §4.5) is that virtual nodes allow "any amount of sliding of
+the touching surfaces without requiring rediscretization". This example slides a punch 40 of the
+block's facet lengths along it at constant indentation, with both bodies under large
+displacements (:mod:`vfem.contact.large`), and records the reactions.
+
+Plane strain, our dimensions (the thesis has no such example):
+
+* **block**: 6 x 1 (x from -3 to 3), 120 x 16 quadrilaterals (facets 0.05 long on its top),
+  neo-Hookean with E = 1000, nu = 0.3, its base fixed;
+* **punch**: a circular face of radius 1 (lowest point at x = -1 on the block's top), 1.2 wide
+  and 0.6 high, 48 x 8 quadrilaterals, neo-Hookean ten times stiffer than the block; its top is
+  moved down by ``depth`` (0.05) over the first ``press_steps`` steps (load factor 0 to 1), then
+  along x by ``slide`` (2.0, 40 block facets) over ``slide_steps`` steps (load factor 1 to 2) with
+  the depth held: non-proportional loading through the prescribed displacements' ``amplitude``.
+
+Frictionless sliding over an elastic block stores no energy in the motion, so once the punch is
+away from the block's ends the normal reaction is constant and the tangential one nearly zero:
+any jump when a node of one surface passes a vertex of the other is a defect of the
+discretisation. The checks (``evaluate``): every step converged, the normal reaction's largest
+deviation from its mean over the steady part of the slide, the tangential reaction, and the
+penetration of every candidate node of either body into the other, measured on the deformed
+surfaces.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..bodies import PrescribedDisplacement, Support
+from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from ..contact.check import largest_penetrations
+from ..contact.settings import ContactSettings
+from ..errors import InputError
+from ..materials import LinearElastic
+from ..solver import AnalysisResult, Model
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """Parameters of the sliding example (our dimensions; see the module docstring)."""
+
+    block_length: float = 6.0
+    block_height: float = 1.0
+    block_columns: int = 120
+    block_rows: int = 16
+    block_youngs_modulus: float = 1000.0
+    punch_radius: float = 1.0
+    punch_width: float = 1.2
+    punch_height: float = 0.6
+    punch_columns: int = 48
+    punch_rows: int = 8
+    stiffness_ratio: float = 10.0  # punch modulus / block modulus
+    poissons_ratio: float = 0.3
+    law: str = "neo-hookean"
+    kinematics: str = "total"
+    start: float = -1.0  # x of the punch's lowest point before sliding
+    depth: float = 0.05
+    slide: float = 2.0
+    press_steps: int = 4
+    slide_steps: int = 20
+    steady_after: float = 0.1  # the first part of the slide (fraction) is not steady
+
+
+def load_factors(p: Parameters) -> tuple[float, ...]:
+    """0 to 1: pressing in; 1 to 2: sliding."""
+    press = tuple((k + 1) / p.press_steps for k in range(p.press_steps))
+    return press + tuple(1.0 + (k + 1) / p.slide_steps for k in range(p.slide_steps))
+
+
+def config(p: Parameters | None = None) -> ModelConfig:
+    """The model as data (what ``examples/sliding.toml`` holds for the defaults)."""
+    p = p or Parameters()
+    block = BodyConfig(
+        "block",
+        MeshSpec(shape="rectangle", parameters=as_parameters(
+            x0=-0.5 * p.block_length, y0=0.0, width=p.block_length, height=p.block_height,
+            nx=p.block_columns, ny=p.block_rows)),
+        LinearElastic(p.block_youngs_modulus, p.poissons_ratio),
+        supports=(Support("bottom", ("x", "y")),), contact_boundaries=("top",),
+        kinematics=p.kinematics, law=p.law)
+    punch = BodyConfig(
+        "punch",
+        MeshSpec(shape="rounded_punch", parameters=as_parameters(
+            x0=p.start, y0=p.block_height, width=p.punch_width, height=p.punch_height,
+            radius=p.punch_radius, nx=p.punch_columns, ny=p.punch_rows)),
+        LinearElastic(p.block_youngs_modulus * p.stiffness_ratio, p.poissons_ratio),
+        prescribed=(PrescribedDisplacement("top", "y", -p.depth, ((0.0, 0.0), (1.0, 1.0))),
+                    PrescribedDisplacement("top", "x", p.slide, ((1.0, 0.0), (2.0, 1.0)))),
+        contact_boundaries=("face",), kinematics=p.kinematics, law=p.law)
+    return ModelConfig("sliding", (block, punch), ContactSettings(),
+                       Steps(load_factors=load_factors(p)))
+
+
+def build(p: Parameters | None = None) -> Model:
+    return config(p).build()
+
+
+def validate(p: Parameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    if p.press_steps < 1 or p.slide_steps < 1:
+        raise InputError("sliding: press_steps and slide_steps must be at least 1")
+    half = 0.5 * p.block_length
+    if not -half + p.punch_width < p.start < p.start + p.slide < half - p.punch_width:
+        raise InputError("sliding: the punch must stay over the block, a punch width from "
+                         "its ends (start, slide, block_length, punch_width)")
+    if p.kinematics == "small":
+        raise InputError("sliding: needs large kinematics ('total' or 'updated')")
+    build(p).validate()
+
+
+def reactions(result: AnalysisResult) -> dict[str, list[float]]:
+    """Per converged step: the slide so far and the force the punch's top support applies to
+    it (the punch's reaction), along x (tangential) and y (normal, negative: pressing down)."""
+    punch = next(b for b in result.model.bodies if b.name == "punch")
+    surface = next(s for s in result.surfaces if s.body is punch)
+    rows: dict[str, list[float]] = {"load_factor": [], "slide": [], "normal": [],
+                                    "tangential": []}
+    for step in result.steps:
+        r = step.bodies["punch"]
+        f = np.zeros(punch.ndofs)
+        f[surface.candidate_dofs] = r.contact_force[surface.nodes[: surface.nc]].ravel()
+        u = r.displacement.ravel()
+        top = punch.boundary_points("top")
+        rows["load_factor"].append(step.load_factor)
+        rows["slide"].append(float(np.mean(r.displacement[top, 0])))
+        rows["normal"].append(punch.reaction(u, "top", "y", step.load_factor, f))
+        rows["tangential"].append(punch.reaction(u, "top", "x", step.load_factor, f))
+    return rows
+
+
+def evaluate(result: AnalysisResult, p: Parameters) -> dict:
+    """The acceptance numbers of a run (see the module docstring)."""
+    rows = reactions(result)
+    lf = np.asarray(rows["load_factor"])
+    normal = -np.asarray(rows["normal"])  # the force pressing the punch down, > 0
+    tangential = np.asarray(rows["tangential"])
+    steady = lf >= 1.0 + p.steady_after - 1e-12
+    out: dict = {"slide": float(rows["slide"][-1]) if rows["slide"] else 0.0,
+                 "block_facet_length": p.block_length / p.block_columns}
+    out["slide_in_facets"] = out["slide"] / out["block_facet_length"]
+    if steady.any():
+        mean = float(normal[steady].mean())
+        out["steady_steps"] = int(steady.sum())
+        out["normal_reaction_mean"] = mean
+        out["normal_reaction_max_deviation"] = float(np.abs(normal[steady] / mean - 1).max())
+        out["tangential_reaction_max"] = float(np.abs(tangential[steady]).max())
+    worst = 0.0
+    for step in result.steps:
+        both = largest_penetrations(result, step)
+        worst = max(worst, max(v["penetration"] for v in both.values()))
+    out["largest_penetration_any_node"] = worst
+    out["largest_residual_penetration"] = max(s.history[-1].max_penetration
+                                              for s in result.steps) if result.steps else 0.0
+    out["penetration_tolerance"] = result.penetration_tolerance
+    out["reactions"] = rows
+    return out
+
+
+def summarize(result: AnalysisResult, p: Parameters) -> dict:
+    from ..io.results import step_record
+
+    summary = {
+        "example": "sliding",
+        "converged": result.converged and len(result.steps) >= len(load_factors(p)),
+        "message": result.message,
+        "steps": [step_record(s) for s in result.steps],
+        "dofs": int(sum(b.ndofs for b in result.model.bodies)),
+        "parameters": dataclasses.asdict(p),
+        "timings": result.timings,
+    }
+    if result.steps:
+        summary["sliding"] = evaluate(result, p)
+    return summary
+
+
+def run(p: Parameters, out, on_step=None, figures: bool = True) -> dict:
+    """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
+    from ..io.results import run_writing, write_summary
+
+    out = Path(out)
+    model = build(p)
+    _, result = run_writing(model, out, on_step)
+    summary = summarize(result, p)
+    if figures and result.steps:
+        summary["figures"] = _figures(out, model, result, p)
+    write_summary(out, summary)
+    return summary
+
+
+def _figures(out: Path, model: Model, result: AnalysisResult, p: Parameters) -> list[str]:
+    """The reactions against the slide, and the deformed bodies at three moments."""
+    from ..io.plots import configurations, history_panels
+
+    rows = reactions(result)
+    slide = np.asarray(rows["slide"])
+    sliding = np.asarray(rows["load_factor"]) >= 1.0
+    panels = [("normal reaction (pressing down)",
+               {"punch": (slide[sliding], -np.asarray(rows["normal"])[sliding])}, False),
+              ("tangential reaction",
+               {"punch": (slide[sliding], np.asarray(rows["tangential"])[sliding])}, False)]
+    history_panels(out / "reactions.png", panels, "slide (punch top displacement along x)",
+                   "Sliding: the punch's reactions at constant depth")
+    names = ["reactions.png"]
+    picks = {"pressed in": next((s for s in result.steps if s.load_factor >= 1.0), None),
+             "half way": next((s for s in result.steps if s.load_factor >= 1.5), None),
+             "slid": result.steps[-1]}
+    half = 0.5 * p.punch_width
+    for (label, step), name in zip(picks.items(), ("pressed.png", "halfway.png", "slid.png")):
+        if step is None:
+            continue
+        frame = [(b.name, b.mesh.p.T, b.mesh.t.T, step.bodies[b.name].displacement)
+                 for b in model.bodies]
+        x = p.start + float(np.mean(step.bodies["punch"].displacement[
+            model.bodies[1].boundary_points("top"), 0]))
+        window = (x - 2.5 * half, x + 2.5 * half, p.block_height - 0.6, p.block_height + 0.4)
+        configurations(out / name, [(label, frame)],
+                       f"Sliding: {label} (load factor {step.load_factor:g}), true scale",
+                       window)
+        names.append(name)
+    return names
+
+
+def report(s: dict) -> list[str]:
+    steps = s["steps"]
+    lines = [f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(steps)} "
+             f"step(s), {sum(x['iterations'] for x in steps)} contact iterations, "
+             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+    if "sliding" in s:
+        e = s["sliding"]
+        lines.append(f"  slid {e['slide']:.4g} ({e['slide_in_facets']:.1f} block facets) at "
+                     "constant depth, no remeshing")
+        if "normal_reaction_mean" in e:
+            lines.append(f"  normal reaction {e['normal_reaction_mean']:.6g}, largest deviation "
+                         f"over {e['steady_steps']} steady steps "
+                         f"{100 * e['normal_reaction_max_deviation']:.3f} %; tangential "
+                         f"reaction at most {e['tangential_reaction_max']:.3g}")
+        lines.append(f"  largest penetration of any node into the other body (deformed "
+                     f"surfaces): {e['largest_penetration_any_node']:.2e} (tolerance "
+                     f"{e['penetration_tolerance']:.1e})")
+    lines.append("  results: summary.json, results.pvd (ParaView), reactions.png, pressed.png, "
+                 "halfway.png, slid.png")
+    return lines
