@@ -59,16 +59,6 @@ def test_the_platen_carries_its_scheduled_force_under_large_kinematics(small_loa
     assert -flat[:, 1].sum() == pytest.approx(15.3, rel=1e-6)
 
 
-def test_the_flexibility_is_reused_while_the_tangent_does_not_change(small_load_hertz):
-    """At 1 % load the contact strains stay below the refresh threshold for most of the
-    loading; at the thesis's load (3 % strain) the tangent flexibility is recomputed."""
-    small = small_load_hertz["total"][0].contact.flexibility_updates
-    config = _with_kinematics(hertz.config(hertz.HertzParameters(steps=2)), "total")
-    analysis = Analysis(config.build())
-    assert analysis.run().converged
-    assert analysis.contact.flexibility_updates > small
-
-
 @pytest.fixture(scope="module")
 def slide():
     """A coarse version of ``vfem run sliding``: 10 block facets of slide in 5 steps."""

@@ -15,6 +15,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -96,6 +97,37 @@ class Traction:
 
     boundary: str
     value: tuple[float, float]
+
+
+@dataclass
+class Linearization:
+    """Newton's system of a large-kinematics body at its trial state (:meth:`Body.linearize`).
+
+    Attributes:
+        residual: norm of the out-of-balance force ``f_int - f_ext`` on the free dofs.
+        reference: the force it is measured against (:class:`vfem.nonlinear.NewtonStep`).
+        correction: (ndofs) Newton's correction with the contact forces held, the prescribed
+            displacements' increments included.
+        flexibility: (tracked, candidate) the tangent flexibility rows of the tracked dofs for
+            the candidate dofs (supports kept).
+        platen_motion: (ndofs) the motion per unit motion of the platen (1 on its dofs).
+        platen_stiffness: the platen's reaction per unit platen motion.
+        platen_reaction: the platen's reaction after ``correction``, linearised.
+        prescribed_met: whether the prescribed displacements (the platen's included) have
+            their values (else ``correction`` applies what they lack).
+        solve: the tangent flexibility applied to nodal forces (ndofs, or ndofs x k): the
+            displacements (zero on the fixed dofs).
+    """
+
+    residual: float
+    reference: float
+    correction: np.ndarray
+    flexibility: np.ndarray
+    platen_motion: np.ndarray
+    platen_stiffness: float
+    platen_reaction: float
+    prescribed_met: bool
+    solve: Callable[[np.ndarray], np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -275,37 +307,56 @@ class Body:
             self._equilibrated = key
         return self.nonlinear.trial_displacement()
 
-    def tangent_flexibility(self, tracked_dofs: np.ndarray, candidate_dofs: np.ndarray,
-                            backend: str = "superlu") -> tuple[np.ndarray, np.ndarray, float]:
-        """Large kinematics, at the trial state: the tangent flexibility rows of the tracked dofs
-        for the candidate dofs (supports kept), the tracked dofs' motion per unit platen motion
-        and the platen's tangent stiffness (as :meth:`setup` gives them at rest)."""
-        K = self.nonlinear.trial_tangent()
-        factor = factorize(K[self.free_dofs][:, self.free_dofs].tocsc(), backend)
-        free = self.free_dofs
-        pos = np.searchsorted(free, candidate_dofs)
-        is_free = free[np.minimum(pos, len(free) - 1)] == candidate_dofs
-        cols = np.flatnonzero(is_free)
-        rhs = np.zeros((len(free), len(cols)))
-        rhs[pos[cols], np.arange(len(cols))] = 1.0
-        full = np.zeros((self.ndofs, len(candidate_dofs)))
-        if len(cols):
-            full[np.ix_(free, cols)] = factor.solve(rhs)
-        u_platen = np.zeros(self.ndofs)
-        stiffness = 0.0
-        if len(self.platen_dofs):
-            u_platen[self.platen_dofs] = 1.0
-            u_platen[free] = factor.solve(-(K[free][:, self.platen_dofs] @ np.ones(
-                len(self.platen_dofs))))
-            stiffness = float((K @ u_platen)[self.platen_dofs].sum())
-            scale = float(K.diagonal()[self.platen_dofs].sum())
-            stiffness = stiffness if abs(stiffness) > 1e-9 * scale else 0.0
-        return full[tracked_dofs], u_platen[tracked_dofs], stiffness
+    def linearize(self, load_factor: float, platen_displacement: float,
+                  contact_force: np.ndarray, tracked_dofs: np.ndarray,
+                  candidate_dofs: np.ndarray, backend: str = "superlu") -> Linearization:
+        """Large kinematics: Newton's system at the trial state under the loads at
+        ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
+        (held), factorized once (see :class:`Linearization`). Move the trial state with
+        :meth:`move`."""
+        self._platen_value = float(platen_displacement)
+        self._equilibrated = None
+        R, ref, K, D, pending = self.nonlinear.linearize(load_factor, contact_force)
+        free = np.setdiff1d(np.arange(self.ndofs), D)
+        factor = factorize(K[free][:, free].tocsc(), backend)
 
-    def platen_reaction_now(self) -> float:
-        """Large kinematics: the platen's reaction (force on the body along its component) at
-        the trial state."""
-        return float(self.nonlinear.trial_reactions()[self.platen_dofs].sum())
+        def solve(f: np.ndarray) -> np.ndarray:
+            out = np.zeros((self.ndofs,) + f.shape[1:])
+            out[free] = factor.solve(f[free])
+            return out
+
+        correction = pending.copy()
+        correction[free] = factor.solve(-R[free] - K[free] @ pending)
+        # flexibility rows of the tracked dofs for the candidate dofs (supports kept)
+        pos = np.searchsorted(free, candidate_dofs)
+        cols = np.flatnonzero(free[np.minimum(pos, len(free) - 1)] == candidate_dofs)
+        unit = np.zeros((self.ndofs, len(cols)))
+        unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
+        flexibility = np.zeros((len(tracked_dofs), len(candidate_dofs)))
+        if len(cols):
+            flexibility[:, cols] = solve(unit)[tracked_dofs]
+        platen_motion = np.zeros(self.ndofs)
+        stiffness = reaction = 0.0
+        P = self.platen_dofs
+        if len(P):
+            platen_motion[P] = 1.0
+            platen_motion[free] = factor.solve(-(K[free][:, P] @ np.ones(len(P))))
+            stiffness = float((K @ platen_motion)[P].sum())
+            scale = float(K.diagonal()[P].sum())
+            stiffness = stiffness if abs(stiffness) > 1e-9 * scale else 0.0
+            reaction = float((R + K @ correction)[P].sum())
+        met = float(np.abs(pending).max(initial=0.0)) <= 1e-13 * self.nonlinear.length
+        return Linearization(float(np.linalg.norm(R[free])), ref, correction, flexibility,
+                             platen_motion, stiffness, reaction, met, solve)
+
+    def move(self, correction: np.ndarray) -> None:
+        """Large kinematics: add ``correction`` (ndofs) to the trial displacement.
+
+        Raises:
+            AnalysisError: an element would turn inside out; the trial state is unchanged.
+        """
+        self.nonlinear.move(correction)
+        self._equilibrated = None
 
     def commit_step(self) -> None:
         """A step converged: its trial state becomes the start of the next (large kinematics;
@@ -566,4 +617,4 @@ def _with_von_mises(avg: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return avg
 
 
-__all__ = ["Body", "Support", "PrescribedDisplacement", "Traction", "Platen"]
+__all__ = ["Body", "Support", "PrescribedDisplacement", "Traction", "Platen", "Linearization"]

@@ -581,6 +581,40 @@ class NonlinearBody:
             return self._internal(state) - self.load_factor * self.nodal_forces
         return self._trial_f_int - self._trial_f_ext
 
+    def linearize(self, load_factor: float, extra_force: np.ndarray | None = None):
+        """Newton's system at the trial state, for a caller that solves it together with other
+        unknowns (the contact iteration of :mod:`vfem.contact.large`) instead of
+        :meth:`equilibrate`.
+
+        Returns ``(R, ref, K, D, pending)``: the residual ``f_int - f_ext`` (ndofs; ``f_ext``
+        the loads at ``load_factor`` plus ``extra_force``), the reference force of the
+        convergence test (see :class:`NewtonStep`), the tangent stiffness (CSR), the prescribed
+        dofs and what their prescribed values at ``load_factor`` still lack (ndofs, zero off
+        ``D``). Move the trial state with :meth:`move`.
+        """
+        D, uD = self._dirichlet(load_factor)
+        state = self._trial_state if self._trial_state is not None else self._state(self._delta)
+        f_ext = load_factor * self.nodal_forces
+        if extra_force is not None:
+            f_ext = f_ext + extra_force
+        f_int = self._internal(state)
+        pending = np.zeros(self.ndofs)
+        pending[D] = uD - (self._u_at_current + self._delta)[D]
+        ref = max(float(np.linalg.norm(f_ext)), float(np.linalg.norm(f_int)),
+                  1e-6 * self.material.youngs_modulus * self.length)
+        return f_int - f_ext, ref, self._tangent(state), D, pending
+
+    def move(self, correction: np.ndarray) -> None:
+        """Add ``correction`` (ndofs) to the trial displacement (see :meth:`linearize`).
+
+        Raises:
+            AnalysisError: an element would turn inside out; the trial state is unchanged.
+        """
+        state = self._state(self._delta + correction)
+        self._delta = self._delta + correction
+        self._trial_state = state
+        self._trial_converged = False
+
     def internal_force_at(self, u: np.ndarray) -> np.ndarray:
         """Internal nodal forces (ndofs) at the total displacement ``u``."""
         return self._internal(self._state(np.asarray(u, dtype=float) - self._u_at_current))

@@ -71,6 +71,8 @@ class GasketParameters:
     penetration_tolerance: float | None = None
     equilibrium_tolerance: float = 1e-3
     swap_bodies: bool = False  # list the stiff gasket first
+    # "total" or "updated": large displacements (then order 1, e.g. n_through 3; docs/examples.md)
+    kinematics: str = "small"
 
 
 Parameters = GasketParameters
@@ -139,6 +141,7 @@ def config(p: GasketParameters | None = None) -> ModelConfig:
             prescribed=(PrescribedDisplacement("back", "x", direction[name] * p.back_motion),),
             contact_boundaries=("outer",),
             order=p.order,
+            kinematics=p.kinematics,
         ))
     if p.swap_bodies:
         bodies.reverse()

@@ -1,0 +1,71 @@
+"""Contact under large displacements (``vfem.contact.large``): the linearised complementarity
+problem, and the gasket crushed by backs moving 0.5 each, loaded and unloaded, by the total and
+the updated Lagrangian formulations."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+
+import numpy as np
+import pytest
+
+from vfem.contact.large import linear_complementarity
+from vfem.examples import gasket
+from vfem.solver import Analysis
+
+
+def test_linear_complementarity_finds_the_touching_set():
+    """Against every candidate set: the one with q >= 0 that leaves no node penetrating."""
+    rng = np.random.default_rng(3)
+    n = 7
+    L = rng.normal(size=(n, n))
+    W = L @ L.T + n * np.eye(n) + 0.2 * rng.normal(size=(n, n))  # nonsymmetric, P-matrix
+    q0 = np.abs(rng.normal(size=n)) * (rng.random(n) < 0.5)
+    p = rng.normal(size=n)
+    q, d = linear_complementarity(W, q0, p, 1e-12)
+    pen = p - W @ (q - q0)
+    assert d == 0.0
+    assert np.all(q >= 0) and np.all(pen <= 1e-10) and np.allclose(q * pen, 0.0, atol=1e-10)
+    for bits in itertools.product([False, True], repeat=n):  # the solution is unique
+        a = np.flatnonzero(bits)
+        z = np.zeros(n)
+        z[a] = np.linalg.solve(W[np.ix_(a, a)], p[a] + (W @ q0)[a]) if len(a) else []
+        if np.all(z >= -1e-12) and np.all(p - W @ (z - q0) <= 1e-10):
+            assert np.allclose(z, q, atol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def crushed():
+    """Backs moving 0.5 each (the soft half ring crushed into an S), ten steps each way."""
+    p = gasket.Parameters(order=1, n_through=2, n_around=40, back_motion=0.5, steps=10)
+    cfg = gasket.config(p)
+    out = {}
+    for kin in ("total", "updated"):
+        bodies = tuple(dataclasses.replace(b, kinematics=kin) for b in cfg.bodies)
+        out[kin] = Analysis(dataclasses.replace(cfg, bodies=bodies).build()).run()
+    return out
+
+
+def test_large_kinematics_gasket_runs_without_cuts(crushed):
+    for result in crushed.values():
+        assert result.converged, result.message
+        assert len(result.steps) == 20 and all(s.cuts == 0 for s in result.steps)
+        forces = [np.linalg.norm(s.bodies["soft"].contact_force.sum(axis=0))
+                  for s in result.steps]
+        assert max(forces) > 1000.0  # the contact carries the whole crushing
+        # the two gaskets' forces balance, and the unloading retraces the loading
+        for s in result.steps:
+            total = s.bodies["soft"].contact_force.sum(axis=0)
+            assert np.allclose(total, -s.bodies["stiff"].contact_force.sum(axis=0),
+                               atol=1e-9 * max(forces))
+        assert np.allclose(forces[:9], forces[-2:-11:-1], rtol=1e-8)
+        assert max(np.abs(r.displacement).max() for r in result.steps[-1].bodies.values()) < 1e-10
+
+
+def test_total_and_updated_lagrangian_agree(crushed):
+    for a, b in zip(crushed["total"].steps, crushed["updated"].steps):
+        assert a.load_factor == b.load_factor
+        for name in a.bodies:
+            u, v = a.bodies[name].displacement, b.bodies[name].displacement
+            assert np.abs(u - v).max() <= 1e-8 * max(np.abs(u).max(), 1e-3)
