@@ -251,10 +251,7 @@ class Body:
             u_unit[platen_dofs] = 1.0
             self.u_platen = self._solve_with(np.zeros(self.ndofs), u_unit)
             self.platen_load_reaction = float((self.K @ self.u_load - f)[platen_dofs].sum())
-            stiffness = float((self.K @ self.u_platen)[platen_dofs].sum())
-            # a body that only contact holds moves rigidly with its platen: zero up to round-off
-            scale = float(self.K.diagonal()[platen_dofs].sum())
-            self.platen_stiffness = stiffness if abs(stiffness) > 1e-9 * scale else 0.0
+            self.platen_stiffness = _platen_stiffness(self.K, self.u_platen, platen_dofs)
         if self.large:
             self._setup_large(fixed)
         self.timings = {"assemble_s": t1 - t0, "constraints_s": t2 - t1, "factorize_s": t3 - t2,
@@ -341,9 +338,7 @@ class Body:
         if len(P):
             platen_motion[P] = 1.0
             platen_motion[free] = factor.solve(-(K[free][:, P] @ np.ones(len(P))))
-            stiffness = float((K @ platen_motion)[P].sum())
-            scale = float(K.diagonal()[P].sum())
-            stiffness = stiffness if abs(stiffness) > 1e-9 * scale else 0.0
+            stiffness = _platen_stiffness(K, platen_motion, P)
             reaction = float((R + K @ correction)[P].sum())
         met = float(np.abs(pending).max(initial=0.0)) <= 1e-13 * self.nonlinear.length
         return Linearization(float(np.linalg.norm(R[free])), ref, correction, flexibility,
@@ -603,6 +598,17 @@ class Body:
         avg["szz"] = (nu * (avg["sxx"] + avg["syy"]) if self.material.plane == "strain"
                       else np.zeros_like(avg["sxx"]))
         return _with_von_mises(avg)
+
+
+def _platen_stiffness(K, motion: np.ndarray, platen_dofs: np.ndarray) -> float:
+    """The platen's reaction per unit platen motion (``motion``: the body's response to it).
+
+    A body that only contact holds moves rigidly with its platen: zero up to round-off, which
+    is cleaned to exactly zero (the platen's equations then know nothing else holds the body).
+    """
+    stiffness = float((K @ motion)[platen_dofs].sum())
+    scale = float(K.diagonal()[platen_dofs].sum())
+    return stiffness if abs(stiffness) > 1e-9 * scale else 0.0
 
 
 def _ramp(pd: PrescribedDisplacement, n: int):

@@ -2,10 +2,11 @@
 
 This is the geometrically (and materially) nonlinear counterpart of :class:`vfem.bodies.Body`:
 plane strain, a hyperelastic material (:mod:`vfem.materials.hyperelastic`), prescribed
-displacements and dead nodal forces scaled by a load factor. Contact is not wired here; what the
-contact algorithm will need from a body (its current geometry, internal force and tangent
-stiffness at the current state) is exposed by :meth:`NonlinearBody.deformed_mesh`,
-:meth:`NonlinearBody.internal_force` and :meth:`NonlinearBody.tangent_stiffness`.
+displacements and dead nodal forces scaled by a load factor. A large-kinematics
+:class:`~vfem.bodies.Body` wraps one; the contact iteration (:mod:`vfem.contact.large`) drives it
+through a trial state: :meth:`NonlinearBody.linearize` and :meth:`NonlinearBody.move` for its
+Newton corrections, :meth:`NonlinearBody.equilibrate` under the converged contact forces, then
+:meth:`NonlinearBody.accept` (or :meth:`NonlinearBody.discard` when a step is cut).
 
 Equilibrium (thesis eq. 3.10.8, the configurational derivative of the potential energy vanishes)
 in referential form is the residual
@@ -455,9 +456,9 @@ class NonlinearBody:
         It starts from the last trial iterate of the current step (the last converged state
         after :meth:`accept` or :meth:`discard`), so a contact iteration that changes the
         contact forces a little is re-equilibrated in one or two corrections. The trial state is
-        what :meth:`trial_displacement`, :meth:`trial_tangent` and :meth:`trial_reactions` see;
-        :meth:`accept` makes it the new converged state (the updated formulation then moves its
-        reference), :meth:`discard` goes back to the last converged one.
+        what :meth:`trial_displacement` and :meth:`linearize` see; :meth:`accept` makes it the
+        new converged state (the updated formulation then moves its reference), :meth:`discard`
+        goes back to the last converged one.
 
         The step's increment of the prescribed displacements enters through the first Newton
         correction (``K_ff d_f = -R_f - K_fD d_D``) rather than by moving those nodes alone first,
@@ -474,10 +475,7 @@ class NonlinearBody:
         delta = self._delta.copy()  # displacement since the last converged state
         pending = np.zeros(self.ndofs)  # prescribed increment not yet applied
         pending[D] = uD - (self._u_at_current + delta)[D]
-        f_ext = load_factor * self.nodal_forces
-        if extra_force is not None:
-            f_ext = f_ext + extra_force
-        floor = 1e-6 * self.material.youngs_modulus * self.length
+        f_ext = self._loads(load_factor, extra_force)
         last_correction = math.inf
         previous = None
         self._trial_converged = False
@@ -490,7 +488,7 @@ class NonlinearBody:
             f_int = self._internal(state)
             R = f_int - f_ext
             r = float(np.linalg.norm(R[free]))
-            ref = max(float(np.linalg.norm(f_ext)), float(np.linalg.norm(f_int)), floor)
+            ref = self._reference_force(f_ext, f_int)
             record.residuals.append(r)
             record.reference_force = max(record.reference_force, ref)
             ratio = (r / ref) / (previous / ref) ** 2 if previous else math.nan
@@ -539,8 +537,6 @@ class NonlinearBody:
         self._delta = delta
         self._trial_state = state
         self._trial_load_factor = load_factor
-        self._trial_f_int = f_int
-        self._trial_f_ext = f_ext
         self._trial_converged = True
         self.steps.append(record)
         return record
@@ -564,23 +560,6 @@ class NonlinearBody:
         """Total displacement (ndofs) of the trial state (the converged one without a trial)."""
         return self._u_at_current + self._delta
 
-    def trial_tangent(self):
-        """Tangent stiffness dR/du (material + geometric) at the trial state, all dofs, CSR.
-
-        In both formulations the derivative of the internal nodal forces with respect to the
-        nodal displacements: the same matrix at the same state.
-        """
-        state = self._trial_state if self._trial_state is not None else self._state(self._delta)
-        return self._tangent(state)
-
-    def trial_reactions(self) -> np.ndarray:
-        """``f_int - f_ext`` (ndofs) at the trial state, ``f_ext`` including the extra force: on
-        the prescribed dofs the forces the supports apply to the body."""
-        if self._trial_state is None:
-            state = self._state(self._delta)
-            return self._internal(state) - self.load_factor * self.nodal_forces
-        return self._trial_f_int - self._trial_f_ext
-
     def linearize(self, load_factor: float, extra_force: np.ndarray | None = None):
         """Newton's system at the trial state, for a caller that solves it together with other
         unknowns (the contact iteration of :mod:`vfem.contact.large`) instead of
@@ -594,15 +573,23 @@ class NonlinearBody:
         """
         D, uD = self._dirichlet(load_factor)
         state = self._trial_state if self._trial_state is not None else self._state(self._delta)
-        f_ext = load_factor * self.nodal_forces
-        if extra_force is not None:
-            f_ext = f_ext + extra_force
+        f_ext = self._loads(load_factor, extra_force)
         f_int = self._internal(state)
         pending = np.zeros(self.ndofs)
         pending[D] = uD - (self._u_at_current + self._delta)[D]
-        ref = max(float(np.linalg.norm(f_ext)), float(np.linalg.norm(f_int)),
-                  1e-6 * self.material.youngs_modulus * self.length)
-        return f_int - f_ext, ref, self._tangent(state), D, pending
+        return (f_int - f_ext, self._reference_force(f_ext, f_int), self._tangent(state), D,
+                pending)
+
+    def _loads(self, load_factor: float, extra_force: np.ndarray | None) -> np.ndarray:
+        """External nodal forces: the dead loads at ``load_factor`` plus ``extra_force``."""
+        f_ext = load_factor * self.nodal_forces
+        return f_ext if extra_force is None else f_ext + extra_force
+
+    def _reference_force(self, f_ext: np.ndarray, f_int: np.ndarray) -> float:
+        """What residuals are measured against (:class:`NewtonStep`): the larger force norm,
+        not below a load that strains the body by 1e-6."""
+        return max(float(np.linalg.norm(f_ext)), float(np.linalg.norm(f_int)),
+                   1e-6 * self.material.youngs_modulus * self.length)
 
     def move(self, correction: np.ndarray) -> None:
         """Add ``correction`` (ndofs) to the trial displacement (see :meth:`linearize`).
@@ -667,26 +654,13 @@ class NonlinearBody:
         """(2, 2, nelems, nqp) 2nd Piola–Kirchhoff stress relative to the initial mesh."""
         return self.material.stress(self.green_lagrange_strain())[0]
 
-    def cauchy_stress_at_points(self) -> tuple[np.ndarray, np.ndarray]:
-        """Cauchy stress ``J^-1 F S F^T`` (2, 2, nelems, nqp) and the current volume weights
-        (nelems, nqp), from the formulation's own state (for the updated formulation: the
-        carried pseudo-strain)."""
-        state = self._state(np.zeros(self.ndofs))
-        J = determinant(state.F)
-        return push_forward_stress(state.S, state.F), state.basis.dx * J
-
     def stress(self) -> np.ndarray:
         """(nelems, 2, 2) element averages (over the current volume) of the Cauchy stress."""
-        sig, w = self.cauchy_stress_at_points()
-        avg = (sig * w).sum(axis=-1) / w.sum(axis=-1)
-        return np.moveaxis(avg, -1, 0)
+        return self.cauchy_stress_at(self.displacement)[0]
 
     def out_of_plane_stress(self) -> np.ndarray:
         """(nelems,) element averages of the Cauchy ``sigma_zz = S_33 / J`` (plane strain)."""
-        state = self._state(np.zeros(self.ndofs))
-        J = determinant(state.F)
-        w = state.basis.dx * J
-        return (state.S33 / J * w).sum(axis=-1) / w.sum(axis=-1)
+        return self.cauchy_stress_at(self.displacement)[1]
 
 
 __all__ = ["NonlinearBody", "NewtonStep", "TOTAL", "UPDATED"]

@@ -72,7 +72,7 @@ import numpy as np
 from ..errors import AnalysisError, InputError
 from .algorithm import ContactState, IterationRecord, SolveResult, closing_motion
 from .paired import PairedContact
-from .search import outward_normals, project_points
+from .search import project_points
 from .surface import ContactSurface
 
 log = logging.getLogger(__name__)
@@ -184,23 +184,18 @@ class LargeDeformationContact(PairedContact):
     # -- pairing in the current configuration ---------------------------------------------------
 
     @staticmethod
-    def _smooth_normals(sc: ContactSurface, A: np.ndarray, B: np.ndarray, seg: np.ndarray,
-                        t: np.ndarray) -> np.ndarray:
+    def _smooth_normals(sc: ContactSurface, x: np.ndarray, seg: np.ndarray, t: np.ndarray
+                        ) -> np.ndarray:
         """The opposing surface's normal at the virtual nodes, continuous along the surface.
 
         Facet normals jump at every vertex of a faceted curved surface, so a node sliding past
         a vertex would turn its force abruptly (by the angle between the facets) and a node
         right under a vertex would take one facet's normal or the other's. The normal here is
-        interpolated between the nodal normals (the mean of the adjacent facets' normals) with
-        the facet's shape functions: continuous, and the facet normal itself on a flat surface.
+        interpolated between the nodal normals (the mean of the adjacent facets' normals, at the
+        surface's tracked positions ``x``) with the facet's shape functions: continuous, and the
+        facet normal itself on a flat surface.
         """
-        fn = outward_normals(A, B)
-        nodal = np.zeros((sc.nc, 2))
-        for col in sc.facets.T:
-            np.add.at(nodal, col, fn)
-        nodal /= np.maximum(np.linalg.norm(nodal, axis=1), 1e-300)[:, None]
-        ends = sc.facets[seg]
-        n = (1 - t)[:, None] * nodal[ends[:, 0]] + t[:, None] * nodal[ends[:, 1]]
+        n = sc.interpolation(seg, t) @ sc.node_normals(x)
         return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
 
     def penetrations(self, state: ContactState) -> list[np.ndarray]:
@@ -213,13 +208,10 @@ class LargeDeformationContact(PairedContact):
             pts = x[pair.fine][pair.nodes]
             A, B = sc.segments(x[pair.coarse])
             seg, t, _ = project_points(pts, A, B)
-            normal = self._smooth_normals(sc, A, B, seg, t)
+            normal = self._smooth_normals(sc, x[pair.coarse], seg, t)
             closest = A[seg] + t[:, None] * (B[seg] - A[seg])
             gap = np.einsum("ij,ij->i", pts - closest, normal)
-            interp = np.zeros((len(pair.nodes), sc.nc))
-            rows = np.arange(len(pair.nodes))
-            for col, phi in zip(sc.facets[seg].T, sc.shape(t).T):
-                interp[rows, col] += phi
+            interp = sc.interpolation(seg, t)
             pair.normal, pair.interp, pair.rind_depth = normal, interp, sc.rind_depth[seg]
             pair.transfer = self._transfer(sf, sc, 0.0, x[pair.fine], x[pair.coarse])
             out.append(-gap)
@@ -326,7 +318,7 @@ class LargeDeformationContact(PairedContact):
             sc = self.surfaces[pair.coarse]
             A, B = sc.segments(x[pair.coarse])
             seg, t, _ = project_points(x[pair.fine][pair.nodes[on]], A, B)
-            qn = q[on, None] * self._smooth_normals(sc, A, B, seg, t)
+            qn = q[on, None] * self._smooth_normals(sc, x[pair.coarse], seg, t)
             out[pair.fine] += pair.mass[:, pair.nodes[on]] @ qn
             out[pair.coarse] -= pair.transfer[:, pair.nodes[on]] @ qn
         return np.concatenate([F.ravel() for F in out])

@@ -105,10 +105,7 @@ class PairedContact(VirtualElementContact):
         seg, t, _, n = sc.project(sf.X[nodes])
         closest, _ = sc.curve(seg, t)
         gap0 = np.einsum("ij,ij->i", sf.X[nodes] - closest, n)
-        interp = np.zeros((len(nodes), sc.nc))
-        rows = np.arange(len(nodes))
-        for col, phi in zip(sc.facets[seg].T, sc.shape(t).T):
-            interp[rows, col] += phi
+        interp = sc.interpolation(seg, t)
         mass = sf.mass_matrix(np.ones(len(sf.facets))).toarray()
         log.info("contact pair: %s (compatibility, %d nodes) against %s (equilibrium)",
                  sf.body.name, len(nodes), sc.body.name)

@@ -27,7 +27,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
 from ..bodies import Body
-from .search import project_points
+from .search import outward_normals, project_points
 
 log = logging.getLogger(__name__)
 
@@ -122,6 +122,15 @@ class ContactSurface:
         """1: two-node facets (linear elements); 2: three-node facets (quadratic elements)."""
         return self.facets.shape[1] - 1
 
+    def interpolation(self, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """(len(seg), nc) the values of the candidate nodes' shape functions at local
+        coordinates ``t`` of facets ``seg``: row k @ nodal values = the value at point k."""
+        out = np.zeros((len(seg), self.nc))
+        rows = np.arange(len(seg))
+        for col, phi in zip(self.facets[seg].T, self.shape(t).T):
+            out[rows, col] += phi
+        return out
+
     def shape(self, t: np.ndarray) -> np.ndarray:
         """(n, 2 or 3) facet shape functions at local coordinates t (0 at the first node, 1 at
         the second), in the column order of ``facets``."""
@@ -157,11 +166,10 @@ class ContactSurface:
             self.G = cols[self.tracked_dofs]
         self.platen_row = -body.u_platen[self.candidate_dofs]
 
-    def node_normals(self) -> np.ndarray:
-        """(nc, 2) outward unit normals at the candidate nodes (mean of the adjacent facets)."""
-        a, b = self.X[self.facets[:, 0]], self.X[self.facets[:, 1]]
-        t = b - a
-        n = np.column_stack([t[:, 1], -t[:, 0]]) / self.lengths[:, None]
+    def node_normals(self, x: np.ndarray | None = None) -> np.ndarray:
+        """(nc, 2) outward unit normals at the candidate nodes (mean of the adjacent facets'),
+        undeformed or at tracked positions ``x``."""
+        n = outward_normals(*self.segments(self.X if x is None else x))
         out = np.zeros((self.nc, 2))
         for col in self.facets.T:
             np.add.at(out, col, n)

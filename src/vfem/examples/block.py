@@ -25,7 +25,6 @@ and the same answer with the bodies listed in the other order.
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -130,17 +129,9 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
-    from ..io.results import step_record
+    from ..io.results import example_summary
 
-    summary = {
-        "example": "block",
-        "converged": result.converged,
-        "message": result.message,
-        "steps": [step_record(s) for s in result.steps],
-        "dofs": int(sum(b.ndofs for b in result.model.bodies)),
-        "parameters": dataclasses.asdict(p),
-        "timings": result.timings,
-    }
+    summary = example_summary("block", result, p)
     if result.converged:
         summary["block"] = evaluate(result, p)
     return summary

@@ -26,7 +26,6 @@ surfaces.
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -121,12 +120,12 @@ def reactions(result: AnalysisResult) -> dict[str, list[float]]:
     surface = next(s for s in result.surfaces if s.body is punch)
     rows: dict[str, list[float]] = {"load_factor": [], "slide": [], "normal": [],
                                     "tangential": []}
+    top = punch.boundary_points("top")
     for step in result.steps:
         r = step.bodies["punch"]
         f = np.zeros(punch.ndofs)
         f[surface.candidate_dofs] = r.contact_force[surface.nodes[: surface.nc]].ravel()
         u = r.displacement.ravel()
-        top = punch.boundary_points("top")
         rows["load_factor"].append(step.load_factor)
         rows["slide"].append(float(np.mean(r.displacement[top, 0])))
         rows["normal"].append(punch.reaction(u, "top", "y", step.load_factor, f))
@@ -163,17 +162,9 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
-    from ..io.results import step_record
+    from ..io.results import example_summary
 
-    summary = {
-        "example": "sliding",
-        "converged": result.converged and len(result.steps) >= len(load_factors(p)),
-        "message": result.message,
-        "steps": [step_record(s) for s in result.steps],
-        "dofs": int(sum(b.ndofs for b in result.model.bodies)),
-        "parameters": dataclasses.asdict(p),
-        "timings": result.timings,
-    }
+    summary = example_summary("sliding", result, p)
     if result.steps:
         summary["sliding"] = evaluate(result, p)
     return summary
@@ -211,13 +202,13 @@ def _figures(out: Path, model: Model, result: AnalysisResult, p: Parameters) -> 
              "half way": next((s for s in result.steps if s.load_factor >= 1.5), None),
              "slid": result.steps[-1]}
     half = 0.5 * p.punch_width
+    top = next(b for b in model.bodies if b.name == "punch").boundary_points("top")
     for (label, step), name in zip(picks.items(), ("pressed.png", "halfway.png", "slid.png")):
         if step is None:
             continue
         frame = [(b.name, b.mesh.p.T, b.mesh.t.T, step.bodies[b.name].displacement)
                  for b in model.bodies]
-        x = p.start + float(np.mean(step.bodies["punch"].displacement[
-            model.bodies[1].boundary_points("top"), 0]))
+        x = p.start + float(np.mean(step.bodies["punch"].displacement[top, 0]))
         window = (x - 2.5 * half, x + 2.5 * half, p.block_height - 0.6, p.block_height + 0.4)
         configurations(out / name, [(label, frame)],
                        f"Sliding: {label} (load factor {step.load_factor:g}), true scale",

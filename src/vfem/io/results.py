@@ -26,6 +26,7 @@ analysis that fails later never damages what was already written.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import json
 import os
@@ -164,6 +165,14 @@ def step_record(step: StepResult) -> dict:
             "stopped_at_fixed_point": step.fixed_point,
             "max_penetration": last.max_penetration if last else 0.0,
             "max_equilibrium_error": last.max_equilibrium_error if last else 0.0}
+
+
+def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
+    """The keys every example's ``summary.json`` starts with (its own evaluation follows)."""
+    return {"example": name, "converged": result.converged, "message": result.message,
+            "steps": [step_record(s) for s in result.steps],
+            "dofs": int(sum(b.ndofs for b in result.model.bodies)),
+            "parameters": dataclasses.asdict(parameters), "timings": result.timings}
 
 
 def write_summary(out: Path, summary: dict) -> Path:
