@@ -126,7 +126,10 @@ def test_step_cutting_is_bounded_and_reported():
     model.contact = dataclasses.replace(model.contact, max_iterations=3, max_step_cuts=3)
     result = Analysis(model).run()
     assert not result.converged
-    assert "failed after 3 cuts" in result.message
+    assert "failed with the increment cut 3 times" in result.message
     assert all(s.cuts <= 3 for s in result.steps)
-    # the smallest increment tried is the scheduled one (0.2) over 2**3
-    assert "load factor 0.025 " in result.message
+    # the smallest increment tried is the scheduled one (0.2) over 2**3; the message says
+    # where the error is and what to change
+    assert "(load factor 0 -> 0.025)" in result.message
+    assert " of body 'cylinder'" in result.message
+    assert "What to change: allow more iterations (contact.max_iterations = 3)" in result.message

@@ -366,6 +366,20 @@ class Body:
             self.nonlinear.discard()
             self._equilibrated = None
 
+    def saved_state(self) -> dict[str, np.ndarray]:
+        """The converged state as arrays (empty for small kinematics: a linear body's state is
+        the contact forces, platen and load factor, which the contact state holds)."""
+        if not self.large:
+            return {}
+        return {**self.nonlinear.saved_state(), "platen_value": np.array(self._platen_value)}
+
+    def restore_state(self, state: dict[str, np.ndarray]) -> None:
+        """Put back a state from :meth:`saved_state` exactly (step cutting, ``--resume``)."""
+        if self.large:
+            self.nonlinear.restore_state(state)
+            self._platen_value = float(state["platen_value"])
+            self._equilibrated = None
+
     def check_supports(self) -> None:
         """Without assembling anything: raise :class:`InputError` if the body is invalid or
         its supports leave it free to move as a rigid body (``vfem check``)."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import difflib
+import inspect
 import json
 import logging
 import sys
@@ -143,12 +144,31 @@ def cmd_run(args) -> int:
     params = build_parameters(args.example, args.set or [])
     if hasattr(example, "validate"):
         example.validate(params)  # bad input is reported before anything is written
-    out = Path(args.out or Path("results") / args.example)
+    out = _results_directory(args, Path("results") / args.example)
+    resume = {}
+    if args.resume:
+        if "resume" not in inspect.signature(example.run).parameters:
+            raise InputError(f"--resume: the {args.example} example runs in one go and cannot "
+                             "be resumed; run it again")
+        resume = {"resume": True}
     if not args.quiet:
         print(f"vfem: {args.example}, results in {out}/", flush=True)
     progress = Progress(None, not args.quiet)
-    return _solve_and_report(lambda: example.run(params, out, on_step=progress), progress,
-                             example.report, args.quiet)
+    return _solve_and_report(lambda: example.run(params, out, on_step=progress, **resume),
+                             progress, example.report, args.quiet)
+
+
+def _results_directory(args, default: Path) -> Path:
+    """Where a run writes: ``--resume DIR`` (which must hold an earlier run), else ``--out``,
+    else ``default``."""
+    if not args.resume:
+        return Path(args.out or default)
+    if args.out and Path(args.out) != Path(args.resume):
+        raise InputError("--resume continues in its own results directory; leave out --out")
+    if not any(Path(args.resume).glob("**/checkpoint")):
+        raise InputError(f"--resume {args.resume}: no checkpoints there (a results directory "
+                         "written by vfem run holds a checkpoint folder)")
+    return Path(args.resume)
 
 
 def _solve_and_report(solve, progress: Progress, report, quiet: bool) -> int:
@@ -185,14 +205,15 @@ def run_input_file(args) -> int:
         raise InputError("--set changes a built-in example's parameters; edit the input file "
                          "instead")
     config, model = _checked_model(args.example)  # bad input reported before anything written
-    out = Path(args.out or config.output.directory or Path("results") / config.name)
+    out = _results_directory(args, Path(config.output.directory or Path("results") / config.name))
     factors = config.steps.factors()
     if not args.quiet:
         print(f"vfem: {config.name} ({args.example}), {len(factors)} "
               f"step{'s' if len(factors) > 1 else ''}, results in {out}/", flush=True)
     progress = Progress(factors, not args.quiet)
     return _solve_and_report(
-        lambda: runner.run(config, out, model=model, on_step=progress, source=args.example),
+        lambda: runner.run(config, out, model=model, on_step=progress, source=args.example,
+                           resume=bool(args.resume)),
         progress, lambda summary: runner.report(summary, out), args.quiet)
 
 
@@ -318,6 +339,9 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--out", help="results directory (default results/<name>)")
     run.add_argument("--set", action="append", metavar="KEY=VALUE",
                      help="change a parameter of a built-in example (repeatable)")
+    run.add_argument("--resume", metavar="RESULTS_DIR",
+                     help="continue an interrupted run of the same model from the last step "
+                          "completed in RESULTS_DIR (its results directory)")
     check = sub.add_parser("check", help="check an input file without solving")
     check.add_argument("file", help="the input file (.toml)")
     export = sub.add_parser("export", help="write a built-in example as an input file")

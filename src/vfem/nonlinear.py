@@ -556,6 +556,27 @@ class NonlinearBody:
         self._trial_state = None
         self._trial_converged = False
 
+    def saved_state(self) -> dict[str, np.ndarray]:
+        """The converged state as arrays (step cutting restores it, checkpoints store it):
+        everything the next step depends on; :meth:`restore_state` puts it back exactly."""
+        state = {"load_factor": np.array(self.load_factor), "u": self._u_at_current.copy()}
+        if self.formulation == UPDATED:
+            state["pseudo_strain"] = self.pseudo_strain.copy()
+            state["current_doflocs"] = self.current_mesh.doflocs.copy()
+        return state
+
+    def restore_state(self, state: dict[str, np.ndarray]) -> None:
+        """Make ``state`` (from :meth:`saved_state`) the converged state, with no trial."""
+        self._reset_updated_state()
+        if self.formulation == UPDATED:
+            self.pseudo_strain = np.array(state["pseudo_strain"], dtype=float)
+            self.current_mesh = replace(self.mesh, doflocs=np.array(state["current_doflocs"]))
+            self.current_basis = Basis(self.current_mesh, self.basis0.elem,
+                                       quadrature=(self.basis0.X, self.basis0.W))
+        self._u_at_current = np.array(state["u"], dtype=float)
+        self.displacement = self._u_at_current.copy()
+        self.load_factor = float(state["load_factor"])
+
     def trial_displacement(self) -> np.ndarray:
         """Total displacement (ndofs) of the trial state (the converged one without a trial)."""
         return self._u_at_current + self._delta

@@ -9,11 +9,13 @@ For each step (an increment of the load factor):
    (:class:`~vfem.contact.paired.PairedContact` by default, or the thesis's
    :class:`~vfem.contact.algorithm.VirtualElementContact`) iterates check -> correct until
    converged, moving a force-controlled platen as it goes;
-3. a step that fails (no convergence, or a node pushed past the rind of another body) is cut in
-   half and retried from the last converged state (vfem-method §3.2, *Reading*).
+3. a step that fails (no convergence, a cycling contact set, a node pushed past the rind of
+   another body) is cut in half and retried from exactly the last converged state, and the
+   increment grows back after easy steps (vfem-method §3.2, *Reading*; docs/method.md §7).
 
 Results of converged steps are kept in :class:`AnalysisResult` and handed to a callback as soon
-as each step converges, so a later failure never loses them.
+as each step converges, so a later failure never loses them; :meth:`Analysis.checkpoint` is the
+complete state after a step, from which :meth:`Analysis.run` can continue (``--resume``).
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from .contact.algorithm import (
 )
 from .contact.settings import ContactSettings
 from .contact.surface import ContactSurface, select_candidate_facets
-from .errors import AnalysisError, InputError
+from .errors import AnalysisError, InputError, RindViolation
 
 log = logging.getLogger(__name__)
 
@@ -120,6 +122,49 @@ class AnalysisResult:
     penetration_tolerance: float = 0.0  # the one the contact iteration used
 
 
+#: steps in a row that must converge easily before a cut increment doubles again
+EASY_STEPS = 2
+
+
+def easy_iterations(settings: ContactSettings) -> int:
+    """A step converged "easily" in at most this many contact iterations."""
+    return max(3, settings.max_iterations // 10)
+
+
+def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
+              settings: ContactSettings) -> str:
+    """The message of an analysis that stops: which step, what failed (the error names the
+    bodies and nodes), and what the user can change."""
+    text = str(exc)
+    if isinstance(exc, RindViolation):
+        remedy = ("take smaller steps ([steps] count), or give the bodies deeper surface "
+                  "elements so a step's overlap stays inside them")
+    elif "cycles" in text:
+        remedy = ("the nodes named switch between contact states: refine the mesh there, take "
+                  "smaller steps, or check for a sharp corner meeting the other surface")
+    elif "inside out" in text:
+        remedy = "take smaller steps, or refine the mesh where the elements distort"
+    else:
+        remedy = (f"allow more iterations (contact.max_iterations = {settings.max_iterations}), "
+                  f"more cuts (contact.max_step_cuts = {settings.max_step_cuts}) or smaller "
+                  "steps; check that every body is held the way you expect")
+    return (f"step {step} (load factor {start:.6g} -> {target:.6g}) failed with the increment "
+            f"cut {cuts} times: {text}. What to change: {remedy}")
+
+
+@dataclass
+class Checkpoint:
+    """Everything a run needs to continue after a converged step: the steps so far, the
+    contact state, each body's saved state (:meth:`Body.saved_state`) and the step control."""
+
+    steps: list[StepResult]
+    state: ContactState
+    bodies: dict[str, dict[str, np.ndarray]]
+    target: int = 1  # the next scheduled load factor: model.load_factors[target - 1]
+    level: int = 0  # halvings of the scheduled increment now in use
+    easy: int = 0  # easy steps in a row at that level
+
+
 class Analysis:
     """Set up the bodies and their contact surfaces, then run the steps of a :class:`Model`."""
 
@@ -195,62 +240,100 @@ class Analysis:
 
     # -- the steps ------------------------------------------------------------------------------
 
-    def run(self, on_step: Callable[[StepResult], None] | None = None) -> AnalysisResult:
+    def run(self, on_step: Callable[[StepResult], None] | None = None,
+            start: Checkpoint | None = None) -> AnalysisResult:
         """Run the steps; ``on_step(step)`` after each converged one. If ``on_step`` also has
         an ``iteration`` attribute, it is called with every contact iteration's record (a
-        progress display shows the current errors with it)."""
+        progress display shows the current errors with it).
+
+        ``start``: a :class:`Checkpoint` (from :meth:`checkpoint` of an earlier run of the same
+        model, e.g. read back by ``--resume``) to continue from instead of the unloaded state.
+
+        Step control: a step that fails (no convergence within ``max_iterations``, a contact
+        set that cycles, a node pushed past a rind, an element turned inside out) is discarded
+        — every body goes back to the last converged state exactly — and retried with half the
+        increment, down to 1 / 2**``max_step_cuts`` of the scheduled one; after
+        :data:`EASY_STEPS` steps in a row that converge in at most :func:`easy_iterations`
+        iterations the increment doubles again, up to the scheduled one. Scheduled load factors
+        are always reached exactly.
+        """
         if not hasattr(self, "contact"):
             self.setup()
         self.contact.on_iteration = getattr(on_step, "iteration", None)
         t_setup = time.perf_counter()
-        state = self.contact.new_state()
-        steps: list[StepResult] = []
-        # (load factor, halvings of the scheduled increment that led to it): a step is never
-        # cut below 1 / 2**max_step_cuts of its scheduled increment, so a load factor at which
-        # the iteration cannot converge ends the analysis instead of being crept up on forever
-        targets = [(lf, 0) for lf in self.model.load_factors]
+        settings = self.model.contact
+        easy_limit = easy_iterations(settings)
+        if start is None:
+            state = self.contact.new_state()
+            steps: list[StepResult] = []
+            self.target, self.level, self.easy = 1, 0, 0
+        else:
+            state, steps = start.state.copy(), list(start.steps)
+            self.target, self.level, self.easy = start.target, start.level, start.easy
+            for b in self.model.bodies:
+                b.restore_state(start.bodies.get(b.name, {}))
+        self.state, self.steps = state, steps
+        schedule = [0.0, *self.model.load_factors]
         message = ""
         converged = True
-        while targets:
-            lf, cuts = targets[0]
+        while self.target < len(schedule):
+            k = self.target
+            target, full = schedule[k], schedule[k] - schedule[k - 1]
+            increment = full / 2**self.level
+            remaining = target - state.load_factor
+            lf = target if abs(remaining) <= abs(increment) * (1 + 1e-9) else (
+                state.load_factor + increment)
             history: list[IterationRecord] = []
             try:
                 new, res = self.solve_step(state, lf, history)
             except AnalysisError as exc:
                 for b in self.model.bodies:
                     b.discard_step()
-                prev = state.load_factor
-                if cuts >= self.model.contact.max_step_cuts:
+                self.easy = 0
+                if self.level >= settings.max_step_cuts:
                     converged = False
-                    message = f"step to load factor {lf:.6g} failed after {cuts} cuts: {exc}"
+                    message = diagnosis(len(steps) + 1, state.load_factor, lf, self.level, exc,
+                                        settings)
                     log.error(message)
                     break
-                log.warning("step to load factor %.6g failed (%s); cutting it to %.6g", lf, exc,
-                            0.5 * (prev + lf))
-                targets[0] = (lf, cuts + 1)  # the rest of this increment, as deeply cut
-                targets.insert(0, (0.5 * (prev + lf), cuts + 1))
+                self.level += 1
+                log.warning("step to load factor %.6g failed (%s); cutting the increment to "
+                            "%.6g", lf, exc, full / 2**self.level)
                 continue
-            targets.pop(0)
             for b in self.model.bodies:
                 b.commit_step()
             state = self.state = new
             iterations = sum(1 for h in history if h.iteration > 0) or 0
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=iterations,
                               converged=True, history=history,
-                              platen_displacement=state.platen_displacement, cuts=cuts,
+                              platen_displacement=state.platen_displacement, cuts=self.level,
                               fixed_point=res.fixed_point)
             step.bodies = self._fields(state, res.pairings)
             steps.append(step)
             log.info("step %d (load factor %.4g) converged in %d iterations", step.step, lf,
                      iterations)
+            if lf == target:
+                self.target += 1
+            self.easy = self.easy + 1 if iterations <= easy_limit else 0
+            if self.level > 0 and self.easy >= EASY_STEPS:
+                self.level -= 1
+                self.easy = 0
+                log.info("the increment grows back to %.6g", full / 2**self.level)
             if on_step is not None:
                 on_step(step)
         self.timings["steps_s"] = time.perf_counter() - t_setup
-        self.timings["total_s"] = sum(self.timings[k] for k in
+        self.timings["total_s"] = sum(self.timings[key] for key in
                                       ("search_s", "assemble_factorize_s", "flexibility_s",
                                        "steps_s"))
         return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
                               self.surfaces, self.contact.penetration_tolerance)
+
+    def checkpoint(self) -> Checkpoint:
+        """The last converged state, complete, with the steps so far: what :meth:`run` needs
+        to continue from it (and what step cutting goes back to)."""
+        return Checkpoint(list(self.steps), self.state.copy(),
+                          {b.name: b.saved_state() for b in self.model.bodies},
+                          self.target, self.level, self.easy)
 
     def _fields(self, state: ContactState, pairings: list[Pairing]) -> dict[str, BodyStepResult]:
         """Full-mesh results of a converged state (one back-substitution per body)."""

@@ -105,6 +105,51 @@ class SolveResult:
     fixed_point: bool = False  # stopped where corrections cancel, errors above tolerance
 
 
+class CycleWatch:
+    """Notices a contact iteration that cycles, so the step is cut instead of iterated to its
+    limit: the same contact set coming back after others (not merely staying the same, which is
+    how an iteration converges) without the error having fallen since it was last seen there.
+
+    Call once per iteration with the in-contact masks; returns a message naming the nodes that
+    keep switching once that has happened ``limit`` times, else None.
+    """
+
+    def __init__(self, limit: int = 3):
+        self.limit = limit
+        self.seen: dict[bytes, float] = {}  # contact set -> the smallest error seen with it
+        self.last: bytes | None = None
+        self.last_sets: list[np.ndarray] | None = None
+        self.flipping: list[set[int]] = []
+        self.count = 0
+
+    def __call__(self, sets: list[tuple[str, np.ndarray, np.ndarray]], error: float,
+                 iteration: int) -> str | None:
+        """``sets``: per side (body name, its node numbers, bool in-contact mask)."""
+        masks = [np.asarray(m, dtype=bool) for _, _, m in sets]
+        key = b"|".join(np.packbits(m).tobytes() + len(m).to_bytes(4, "little") for m in masks)
+        if self.last_sets is not None and key != self.last:
+            if not self.flipping:
+                self.flipping = [set() for _ in sets]
+            for k, (m0, m1) in enumerate(zip(self.last_sets, masks)):
+                self.flipping[k].update(np.flatnonzero(m0 != m1).tolist())
+            if key in self.seen and error >= self.seen[key]:
+                self.count += 1
+        self.seen[key] = min(error, self.seen.get(key, np.inf))
+        self.last, self.last_sets = key, masks
+        if self.count < self.limit:
+            return None
+        names = []
+        for (body, nodes, _), flips in zip(sets, self.flipping):
+            if flips:
+                listed = ", ".join(str(int(nodes[i])) for i in sorted(flips)[:8])
+                more = f" and {len(flips) - 8} more" if len(flips) > 8 else ""
+                names.append(f"node{'s' if len(flips) > 1 else ''} {listed}{more} of body "
+                             f"{body!r}")
+        return (f"the contact iteration cycles: {'; '.join(names) or 'some nodes'} keep "
+                f"switching in and out of contact while the error stays at {error:.3g} "
+                f"(iteration {iteration})")
+
+
 def closing_motion(penetration: np.ndarray, rate: np.ndarray, need: float) -> float:
     """The platen motion that just closes the smallest gap when nothing touches yet.
 
@@ -485,6 +530,7 @@ class VirtualElementContact:
         history: list[IterationRecord] = []
         max_df = max_du = 0.0
         pen = eq = 0.0
+        watch = CycleWatch()
         for k in range(cfg.max_iterations + 1):
             pairings = self.detect(state)
             pen, eq, eq_tol, contact, tension = self.errors(pairings)
@@ -498,6 +544,11 @@ class VirtualElementContact:
                 return SolveResult(True, k, history, pairings)
             if k == cfg.max_iterations:
                 break
+            sets = [(s.body.name, s.nodes[: s.nc], p.participating & (p.force > 0))
+                    for s, p in zip(self.surfaces, pairings)]
+            cycling = watch(sets, max(pen, eq), k)
+            if cycling:
+                return SolveResult(False, k, history, pairings, cycling)
             dF, d_platen = self.corrections(state, pairings, k)
             dU = [(s.C @ d.ravel()).reshape(-1, 2) for s, d in zip(self.surfaces, dF)]
             if d_platen:

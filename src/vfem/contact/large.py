@@ -70,7 +70,13 @@ import logging
 import numpy as np
 
 from ..errors import AnalysisError, InputError
-from .algorithm import ContactState, IterationRecord, SolveResult, closing_motion
+from .algorithm import (
+    ContactState,
+    CycleWatch,
+    IterationRecord,
+    SolveResult,
+    closing_motion,
+)
 from .paired import PairedContact
 from .search import project_points
 from .surface import ContactSurface
@@ -230,19 +236,13 @@ class LargeDeformationContact(PairedContact):
         history: list[IterationRecord] = []
         pen_err = body_err = 0.0
         tension = 0
+        watch = CycleWatch()
         for it in range(cfg.max_iterations + 1):
             pens = self.penetrations(state)
             self.assemble_forces(state)  # the tractions along the current normals
             lins = self._linearize(state)
-            pen_err = 0.0
-            tension = contact = 0
-            for k, p in enumerate(pens):
-                lam = self._q(state, k)
-                touching = (lam > 0) | (p > tol)
-                if touching.any():
-                    pen_err = max(pen_err, float(np.abs(p[touching]).max()))
-                tension += int((lam < 0).sum())
-                contact += int((lam > 0).sum())
+            lams = [self._q(state, k) for k in range(len(pens))]
+            errs, pen_err, contact, tension = self.compatibility_errors(pens, lams)
             body_err = max((lin.residual / lin.reference for lin in lins if lin is not None),
                            default=0.0)
             # a body whose prescribed displacements still lack their step's increment (the
@@ -261,13 +261,16 @@ class LargeDeformationContact(PairedContact):
                 return SolveResult(True, it, history, self.pairings(state, pens))
             if it == cfg.max_iterations:
                 break
+            cycling = watch(self.contact_sets(lams), max(pen_err, body_err), it)
+            if cycling:
+                return SolveResult(False, it, history, self.pairings(state, pens), cycling)
             if it > 0:  # the first iterate is the last converged state, at the new loads
                 self._check_rind(pens)
             self._correct_all(state, pens, lins)
         return SolveResult(False, cfg.max_iterations, history, self.pairings(state, pens),
                            f"no convergence in {cfg.max_iterations} iterations (penetration "
-                           f"{pen_err:.3g}, body residual {body_err:.3g}, {tension} nodes in "
-                           "tension)")
+                           f"{pen_err:.3g}{self.worst_node(errs)}, body residual "
+                           f"{body_err:.3g}, {tension} nodes in tension)")
 
     def _linearize(self, state: ContactState) -> list:
         """Newton's system of every large-kinematics body (None for the others)."""

@@ -44,6 +44,7 @@ from skfem.refdom import RefLine
 from ..errors import RindViolation
 from .algorithm import (
     ContactState,
+    CycleWatch,
     IterationRecord,
     Pairing,
     SolveResult,
@@ -251,19 +252,13 @@ class PairedContact(VirtualElementContact):
         cfg = self.settings
         tol = self.penetration_tolerance
         history: list[IterationRecord] = []
+        watch = CycleWatch()
         self.assemble_forces(state)
         for it in range(cfg.max_iterations + 1):
             pens = self.penetrations(state)
             lams = [self._q(state, k) for k in range(len(self.contact_pairs))]
             self._check_rind(pens)
-            pen_err = 0.0
-            tension = contact = 0
-            for p, lam in zip(pens, lams):
-                touching = (lam > 0) | (p > tol)
-                if touching.any():
-                    pen_err = max(pen_err, float(np.abs(p[touching]).max()))
-                tension += int((lam < 0).sum())
-                contact += int((lam > 0).sum())
+            errs, pen_err, contact, tension = self.compatibility_errors(pens, lams)
             platen_error = self.platen_reaction(state) - state.platen_force
             platen_ok = self.platen_met(state)
             history.append(IterationRecord(it, pen_err, 0.0, contact, tension,
@@ -274,11 +269,45 @@ class PairedContact(VirtualElementContact):
                 return SolveResult(True, it, history, self.pairings(state, pens))
             if it == cfg.max_iterations:
                 break
+            cycling = watch(self.contact_sets(lams), pen_err, it)
+            if cycling:
+                return SolveResult(False, it, history, self.pairings(state, pens), cycling)
             self._correct(state, pens, it, platen_ok)
             self.assemble_forces(state)
         return SolveResult(False, cfg.max_iterations, history, self.pairings(state, pens),
                            f"no convergence in {cfg.max_iterations} iterations "
-                           f"(penetration {pen_err:.3g}, {tension} nodes in tension)")
+                           f"(penetration {pen_err:.3g}{self.worst_node(errs)}, {tension} "
+                           "nodes in tension)")
+
+    def compatibility_errors(self, pens: list[np.ndarray], lams: list[np.ndarray]
+                             ) -> tuple[list[np.ndarray], float, int, int]:
+        """Per pair the compatibility error of each node (|penetration| where the node touches
+        or carries force, else 0); the largest; the nodes carrying force; those in tension."""
+        tol = self.penetration_tolerance
+        errs = [np.where((lam > 0) | (p > tol), np.abs(p), 0.0) for p, lam in zip(pens, lams)]
+        largest = max((float(e.max()) for e in errs if len(e)), default=0.0)
+        return (errs, largest, sum(int((lam > 0).sum()) for lam in lams),
+                sum(int((lam < 0).sum()) for lam in lams))
+
+    def worst_node(self, errs: list[np.ndarray]) -> str:
+        """Where the largest of ``errs`` (per pair, over its nodes) is, for messages:
+        ' at node N of body B'."""
+        worst = max(((float(e.max()), k) for k, e in enumerate(errs) if len(e)), default=None)
+        if worst is None or worst[0] <= 0:
+            return ""
+        pair = self.contact_pairs[worst[1]]
+        sf = self.surfaces[pair.fine]
+        node = int(sf.nodes[pair.nodes[int(np.argmax(errs[worst[1]]))]])
+        return f" at node {node} of body {sf.body.name!r}"
+
+    def contact_sets(self, lams: list[np.ndarray]) -> list[tuple[str, np.ndarray, np.ndarray]]:
+        """Per pair, the compatibility side's (body name, node numbers, carrying-force mask):
+        what :class:`~vfem.contact.algorithm.CycleWatch` compares between iterations."""
+        out = []
+        for pair, lam in zip(self.contact_pairs, lams):
+            sf = self.surfaces[pair.fine]
+            out.append((sf.body.name, sf.nodes[pair.nodes], lam > 0))
+        return out
 
     def _check_rind(self, pens: list[np.ndarray]) -> None:
         for pair, p in zip(self.contact_pairs, pens):

@@ -137,13 +137,14 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
     return summary
 
 
-def run(p: Parameters, out, on_step=None, figures: bool = True) -> dict:
+def run(p: Parameters, out, on_step=None, figures: bool = True,
+        resume: bool = False) -> dict:
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
     from ..io.results import run_writing, write_summary
 
     out = Path(out)
     model = build(p)
-    _, result = run_writing(model, out, on_step)
+    _, result = run_writing(model, out, on_step, resume)
     summary = summarize(result, p)
     if figures and result.steps:
         _figures(out, model, result, p)

@@ -368,7 +368,8 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
 
 # -- running ------------------------------------------------------------------------------------
 
-def run(p: GasketParameters, out, on_step=None, figures: bool = True) -> dict:
+def run(p: GasketParameters, out, on_step=None, figures: bool = True,
+        resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
     from pathlib import Path
 
@@ -376,7 +377,7 @@ def run(p: GasketParameters, out, on_step=None, figures: bool = True) -> dict:
 
     out = Path(out)
     model = build(p)
-    _, result = run_writing(model, out, on_step)
+    _, result = run_writing(model, out, on_step, resume)
     summary = summarize(result, p)
     if figures:
         summary["figures"] = draw(result, p, out)

@@ -221,7 +221,8 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
     return summary
 
 
-def run(p: HertzParameters, out, on_step=None, figures: bool = True) -> dict:
+def run(p: HertzParameters, out, on_step=None, figures: bool = True,
+        resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
     from pathlib import Path
 
@@ -230,7 +231,7 @@ def run(p: HertzParameters, out, on_step=None, figures: bool = True) -> dict:
 
     out = Path(out)
     model = build(p)
-    _, result = run_writing(model, out, on_step)
+    _, result = run_writing(model, out, on_step, resume)
     summary = summarize(result, p)
     if figures and "hertz" in summary:
         th = summary["hertz"]

@@ -261,14 +261,14 @@ def tip(body: Body) -> int:
     return int(np.argmin(np.hypot(*body.points)))
 
 
-def solve_case(model: Model, out: Path | None = None, on_step=None
+def solve_case(model: Model, out: Path | None = None, on_step=None, resume: bool = False
                ) -> tuple[AnalysisResult, str | None]:
     """Run one case's model, writing its VTU files into ``out`` if given: (result, the body
     whose surface carries compatibility in the paired variant, else None). A case that does not
     converge ends with the solver's message once its step cuts run out (``max_step_cuts``)."""
     from ..io.results import run_writing
 
-    analysis, result = run_writing(model, out, on_step)
+    analysis, result = run_writing(model, out, on_step, resume)
     pairs = getattr(analysis.contact, "contact_pairs", None)
     compatibility = model.bodies[pairs[0].fine].name if pairs else None
     return result, compatibility
@@ -348,7 +348,7 @@ def summarize_case(p: WedgeParameters, case: int, model: Model, steps: list[Step
 
 # -- the run ------------------------------------------------------------------------------------
 
-def run(p: WedgeParameters, out=None, on_step=None) -> dict:
+def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False) -> dict:
     """Run the cases, writing ``out/caseN/`` (VTU/PVD), the figures and ``summary.json``."""
     from ..io.results import write_summary
 
@@ -359,7 +359,7 @@ def run(p: WedgeParameters, out=None, on_step=None) -> dict:
         t0 = time.perf_counter()
         model = build(p, case)
         result, compatibility = solve_case(model, out / f"case{case}" if out else None,
-                                           on_step)
+                                           on_step, resume)
         steps, message = result.steps, result.message
         converged = result.converged
         entries.append(summarize_case(p, case, model, steps, converged, message,

@@ -20,7 +20,10 @@ contact), ``status`` ``contact`` or ``free``. Numbers are written with 17 signif
 (round-trip exact).
 
 Files are written as each step converges, into a temporary name first and then renamed, so an
-analysis that fails later never damages what was already written.
+analysis that fails or is killed later never damages what was already written; with them come
+the step's checkpoint (:mod:`vfem.io.checkpoint`, for ``--resume``) and a ``summary.json`` of the
+steps so far (``"status": "running"``), which the example's or input file's own summary replaces
+at the end.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ import csv
 import dataclasses
 import io
 import json
+import logging
 import os
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -39,6 +43,8 @@ import numpy as np
 from ..contact.surface import ContactSurface
 from ..errors import InputError
 from ..solver import Analysis, AnalysisResult, Model, StepResult
+
+log = logging.getLogger(__name__)
 
 # Body.stress keys -> the VTU's cell field names
 _CELL_FIELD = {"sxx": "stress_xx", "syy": "stress_yy", "sxy": "stress_xy", "szz": "stress_zz"}
@@ -73,6 +79,19 @@ class ResultsWriter:
                                  f"{', '.join(map(repr, missing))}")
         self.contact_rows: list[list[str]] = []
 
+    def restore(self, steps: list[StepResult]) -> None:
+        """Take up the series of an earlier run whose ``steps`` are already on disk (their
+        VTU files are kept; the PVD and contact.csv are rebuilt from them)."""
+        for step in steps:
+            for body in self.model.bodies:
+                self.entries.append((step.load_factor, body.name, self._vtu_name(body, step)))
+            if self.surfaces is not None:
+                self.add_contact_rows(step)
+
+    @staticmethod
+    def _vtu_name(body, step: StepResult) -> str:
+        return f"{_safe(body.name)}_step{step.step:04d}.vtu"
+
     def write_step(self, step: StepResult) -> None:
         for body in self.model.bodies:
             r = step.bodies[body.name]
@@ -80,7 +99,7 @@ class ResultsWriter:
             npts = body.npoints
             u = np.column_stack([r.displacement, np.zeros(len(r.displacement))])
             stress = body.stress(r.displacement.ravel())
-            name = f"{_safe(body.name)}_step{step.step:04d}.vtu"
+            name = self._vtu_name(body, step)
             m = meshio.Mesh(
                 points=np.column_stack([body.points.T, np.zeros(npts)]),
                 cells=[(cell_type, conn)],
@@ -137,24 +156,57 @@ class ResultsWriter:
                       lambda p: p.write_text("\n".join(lines), encoding="utf-8"))
 
 
-def run_writing(model: Model, out: Path | None, on_step=None) -> tuple[Analysis, AnalysisResult]:
-    """Solve ``model``, writing each converged step's VTU files (and the PVD) into ``out`` as
-    it converges (nothing written when ``out`` is None), then calling ``on_step``.
+def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = False
+                ) -> tuple[Analysis, AnalysisResult]:
+    """Solve ``model``, writing into ``out`` (nothing when None) as each step converges: its
+    VTU files, the PVD and contact.csv, its checkpoint (:mod:`vfem.io.checkpoint`) and a
+    ``summary.json`` of the steps done so far; then call ``on_step``. A run stopped at any
+    moment leaves every completed step readable.
 
-    ``contact.csv`` is written too, with the candidate nodes of the analysis's contact surfaces.
+    ``resume``: continue from the last checkpoint in ``out`` (written by an earlier run of the
+    same model) instead of from the start; the steps already there are kept as they are.
     """
+    from . import checkpoint
+
     analysis = Analysis(model)
     analysis.setup()
     writer = ResultsWriter(out, model, analysis.surfaces) if out is not None else None
+    start = None
+    if writer is not None:
+        if resume:
+            start = checkpoint.read(out, model)
+            if start is not None:
+                writer.restore(start.steps)
+                log.info("resuming %s after step %d (load factor %.6g)", out,
+                         len(start.steps), start.state.load_factor)
+        else:
+            checkpoint.clear(out)
 
     def step_done(step: StepResult) -> None:
         if writer is not None:
             writer.write_step(step)
+            checkpoint.write(out, model, analysis.checkpoint())
+            write_summary(out, progress_summary(model, analysis.steps, "running"))
         if on_step is not None:
             on_step(step)
 
     step_done.iteration = getattr(on_step, "iteration", None)  # see Analysis.run
-    return analysis, analysis.run(step_done)
+    result = analysis.run(step_done, start=start)
+    if writer is not None:
+        write_summary(out, progress_summary(model, result.steps,
+                                            "complete" if result.converged else "stopped",
+                                            result.message))
+    return analysis, result
+
+
+def progress_summary(model: Model, steps: list[StepResult], status: str, message: str = ""
+                     ) -> dict:
+    """The ``summary.json`` of an analysis while it runs (and after, until the example or input
+    file's own summary replaces it): valid JSON describing the steps done so far."""
+    return {"model": model.name, "status": status,
+            "converged": {"running": None, "complete": True, "stopped": False}[status],
+            "message": message or f"{len(steps)} steps done so far",
+            "steps": [step_record(s) for s in steps]}
 
 
 def step_record(step: StepResult) -> dict:

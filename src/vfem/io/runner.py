@@ -72,14 +72,14 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
 
 
 def run(config: ModelConfig, out: Path, base: Path | None = None, on_step=None,
-        source: str | None = None, figures: bool | None = None, model: Model | None = None
-        ) -> dict:
+        source: str | None = None, figures: bool | None = None, model: Model | None = None,
+        resume: bool = False) -> dict:
     """Solve ``config`` (mesh files relative to ``base``; or its ``model`` already built),
     writing VTU/PVD and contact.csv per converged step, then ``summary.json`` and the figures
     into ``out``."""
     out = Path(out)
     model = model or config.build(base)
-    _, result = run_writing(model, out, on_step)
+    _, result = run_writing(model, out, on_step, resume)
     summary = summarize(result, config, source)
     write_summary(out, summary)
     if (config.output.figures if figures is None else figures) and result.steps:

@@ -1,0 +1,137 @@
+"""Checkpoints: each converged step saved so that an interrupted run can be continued.
+
+After every converged step the results directory gets ``checkpoint/stepNNNN.npz``, written to a
+temporary name and renamed (so a file there is always whole). It holds the step's results (the
+fields its VTU files were written from, its iteration history) and the complete state after it:
+contact forces and traction values, platen, load factor, the state of each large-kinematics body
+and the step control (:class:`vfem.solver.Checkpoint`). ``vfem run ... --resume DIR`` reads them
+back — NumPy arrays and one JSON text, never pickles — and continues from the last one, to the
+same answer as a run that was never interrupted.
+
+A fingerprint of the model (meshes, materials, boundary conditions, contact settings, load
+schedule) is stored in every file; resuming a different model is refused.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from ..contact.algorithm import ContactState, IterationRecord
+from ..errors import InputError
+from ..solver import BodyStepResult, Checkpoint, Model, StepResult
+
+FOLDER = "checkpoint"
+_FIELDS = [f.name for f in dataclasses.fields(BodyStepResult)]
+
+
+def fingerprint(model: Model) -> str:
+    """A hash of everything that defines the model's answer (not its name or output)."""
+    h = hashlib.sha256()
+    h.update(repr((model.load_factors, model.contact, model.contact_pairs)).encode())
+    for b in model.bodies:
+        h.update(repr((b.name, type(b.mesh).__name__, b.material, b.supports, b.prescribed,
+                       b.tractions, b.platen, b.contact_boundaries, b.order, b.kinematics,
+                       b.law)).encode())
+        for a in (b.mesh.p, b.mesh.t):
+            h.update(np.ascontiguousarray(a).tobytes())
+        for name in sorted(b.mesh.boundaries or {}):
+            h.update(name.encode() + np.asarray(b.mesh.boundaries[name]).tobytes())
+    return h.hexdigest()
+
+
+def write(out: Path, model: Model, checkpoint: Checkpoint) -> Path:
+    """Save the last step of ``checkpoint`` (its results and the state after it)."""
+    step = checkpoint.steps[-1]
+    state = checkpoint.state
+    arrays: dict[str, np.ndarray] = {}
+    for i, b in enumerate(model.bodies):
+        r = step.bodies[b.name]
+        for f in _FIELDS:
+            arrays[f"field_{i}_{f}"] = getattr(r, f)
+        for key, value in checkpoint.bodies.get(b.name, {}).items():
+            arrays[f"body_{i}_{key}"] = np.asarray(value)
+    for i, (F, rel) in enumerate(zip(state.forces, state.released)):
+        arrays[f"force_{i}"], arrays[f"released_{i}"] = F, rel
+    for k, lam in state.multipliers.items():
+        arrays[f"multiplier_{int(k)}"] = lam
+    meta = {
+        "fingerprint": fingerprint(model),
+        "step": {"step": step.step, "load_factor": step.load_factor,
+                 "iterations": step.iterations, "converged": step.converged,
+                 "platen_displacement": step.platen_displacement, "cuts": step.cuts,
+                 "fixed_point": step.fixed_point,
+                 "history": [dataclasses.asdict(h) for h in step.history]},
+        "state": {"load_factor": state.load_factor,
+                  "platen_displacement": state.platen_displacement,
+                  "platen_force": state.platen_force,
+                  "multipliers": sorted(int(k) for k in state.multipliers)},
+        "bodies": {b.name: sorted(checkpoint.bodies.get(b.name, {})) for b in model.bodies},
+        "control": {"target": checkpoint.target, "level": checkpoint.level,
+                    "easy": checkpoint.easy},
+    }
+    arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    folder = Path(out) / FOLDER
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"step{step.step:04d}.npz"
+    tmp = folder / f"step{step.step:04d}.part.npz"
+    np.savez(tmp, **arrays)
+    os.replace(tmp, path)
+    return path
+
+
+def read(out: Path, model: Model) -> Checkpoint | None:
+    """The checkpoint of the last complete step in ``out`` (None if there is none), with the
+    results of every step before it. Raises :class:`InputError` when the files were written by
+    another model or cannot be read."""
+    folder = Path(out) / FOLDER
+    files = sorted(folder.glob("step[0-9][0-9][0-9][0-9].npz")) if folder.is_dir() else []
+    if not files:
+        return None
+    expected = fingerprint(model)
+    steps: list[StepResult] = []
+    for n, path in enumerate(files, start=1):
+        if path.name != f"step{n:04d}.npz":
+            raise InputError(f"{path}: checkpoint of step {n} missing before it; cannot resume "
+                             f"from {out}")
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                arrays = {k: data[k] for k in data.files}
+            meta = json.loads(arrays.pop("meta").tobytes().decode())
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+            raise InputError(f"{path}: not a readable vfem checkpoint ({exc})") from None
+        if meta.get("fingerprint") != expected:
+            raise InputError(f"{out}: its results were written by a different model (meshes, "
+                             "materials, loads or settings differ); run without --resume, or "
+                             "choose another results directory with --out")
+        steps.append(_step(meta["step"], arrays, model))
+    state = ContactState(
+        meta["state"]["load_factor"], meta["state"]["platen_displacement"],
+        [arrays[f"force_{i}"] for i in range(len(model.bodies))],
+        [arrays[f"released_{i}"] for i in range(len(model.bodies))],
+        meta["state"]["platen_force"],
+        {k: arrays[f"multiplier_{k}"] for k in meta["state"]["multipliers"]})
+    bodies = {b.name: {key: arrays[f"body_{i}_{key}"] for key in meta["bodies"][b.name]}
+              for i, b in enumerate(model.bodies)}
+    return Checkpoint(steps, state, bodies, **meta["control"])
+
+
+def _step(meta: dict, arrays: dict[str, np.ndarray], model: Model) -> StepResult:
+    step = StepResult(**{**meta, "history": [IterationRecord(**h) for h in meta["history"]]})
+    step.bodies = {b.name: BodyStepResult(**{f: arrays[f"field_{i}_{f}"] for f in _FIELDS})
+                   for i, b in enumerate(model.bodies)}
+    return step
+
+
+def clear(out: Path) -> None:
+    """Remove the checkpoints of an earlier run in ``out`` (a fresh run starts from step 1)."""
+    folder = Path(out) / FOLDER
+    if folder.is_dir():
+        for path in folder.glob("step*.npz"):
+            path.unlink()
