@@ -92,7 +92,7 @@ class ContactSettings:
         for name in ("tension_release_iterations", "max_iterations", "quadrature_order"):
             v = getattr(self, name)
             if v is not None and int(v) < 1:
-                raise InputError(f"contact.{name} must be >= 1")
+                raise InputError(f"contact.{name} must be >= 1, got {v!r}")
 
     @property
     def release_iterations(self) -> int:

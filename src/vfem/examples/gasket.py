@@ -96,18 +96,18 @@ def closure_at_first_touch(p: GasketParameters) -> float:
 def validate(p: GasketParameters) -> None:
     """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
     if not (isinstance(p.steps, int) and p.steps >= 1):
-        raise InputError(f"steps must be an integer >= 1, got {p.steps!r}")
+        raise InputError(f"gasket: steps must be an integer >= 1, got {p.steps!r}")
     if not 0.0 < p.thickness < p.radius:
-        raise InputError(f"need 0 < thickness < radius, got thickness {p.thickness!r} and "
+        raise InputError(f"gasket: need 0 < thickness < radius, got thickness {p.thickness!r} and "
                          f"radius {p.radius!r}")
     if not 0.0 <= p.offset < 2.0 * p.radius:
-        raise InputError(f"offset must lie in [0, 2 radius), got {p.offset!r}")
+        raise InputError(f"gasket: offset must lie in [0, 2 radius), got {p.offset!r}")
     if p.separation <= 0.0:
-        raise InputError(f"separation must be > 0, got {p.separation!r}")
+        raise InputError(f"gasket: separation must be > 0, got {p.separation!r}")
     if p.stiffness_ratio <= 0.0:
-        raise InputError(f"stiffness_ratio must be > 0, got {p.stiffness_ratio!r}")
+        raise InputError(f"gasket: stiffness_ratio must be > 0, got {p.stiffness_ratio!r}")
     if p.n_around < 2 or p.n_through < 1:
-        raise InputError("need n_around >= 2 and n_through >= 1")
+        raise InputError("gasket: need n_around >= 2 and n_through >= 1")
     build(p).validate()
 
 

@@ -93,7 +93,7 @@ def from_data(cls, data: Any, where: str):
     for name, f in fields.items():
         if name not in data:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
-                meaning = help_texts(cls).get(name, "").rstrip(".")
+                meaning = help_texts(cls).get(name, "").rstrip(".").replace("``", "")
                 raise _Problem(where, f"missing key {name!r}" + (f" ({meaning})" if meaning
                                                                  else ""))
             continue
@@ -144,7 +144,7 @@ def _mesh_spec(data: dict, where: str) -> MeshSpec:
                 params.append((name, _convert(hints.get(name, Any), data[name],
                                               _join(where, name))))
             elif par.default is inspect.Parameter.empty:
-                raise _Problem(where, f"shape {shape!r} needs {name!r}")
+                raise _Problem(where, f"shape {shape!r} needs the parameter {name!r}")
         params = tuple(params)
     hints = typing.get_type_hints(MeshSpec)
     values = {k: _convert(hints[k], data[k], _join(where, k)) for k in own if k in data}
