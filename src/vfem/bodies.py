@@ -275,7 +275,8 @@ class Body:
 
         law = {"saint-venant-kirchhoff": SaintVenantKirchhoff, "neo-hookean": NeoHookean}[self.law]
         material = law(self.material.youngs_modulus, self.material.poissons_ratio)
-        nl = NonlinearBody(self.mesh, material, formulation=self.kinematics, name=self.name)
+        nl = NonlinearBody(self.mesh, material, formulation=self.kinematics,
+                           name=f"body {self.name!r}")
         dofs = np.array(sorted(fixed), dtype=int)
         if len(dofs):
             nl.prescribe(dofs, np.array([fixed[d] for d in dofs.tolist()]))

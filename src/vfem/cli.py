@@ -13,6 +13,7 @@ import difflib
 import inspect
 import json
 import logging
+import signal
 import sys
 from pathlib import Path
 
@@ -155,7 +156,7 @@ def cmd_run(args) -> int:
         print(f"vfem: {args.example}, results in {out}/", flush=True)
     progress = Progress(None, not args.quiet)
     return _solve_and_report(lambda: example.run(params, out, on_step=progress, **resume),
-                             progress, example.report, args.quiet)
+                             progress, example.report, args.quiet, args, out)
 
 
 def _results_directory(args, default: Path) -> Path:
@@ -171,17 +172,26 @@ def _results_directory(args, default: Path) -> Path:
     return Path(args.resume)
 
 
-def _solve_and_report(solve, progress: Progress, report, quiet: bool) -> int:
+def _solve_and_report(solve, progress: Progress, report, quiet: bool, args=None,
+                      out: Path | None = None) -> int:
     """Run ``solve()`` (-> summary) under the progress display, print ``report(summary)``;
-    exit status 1 if the analysis did not converge."""
+    exit status 1 if the analysis did not converge. Interrupted (Ctrl-C, SIGTERM): say where
+    the completed steps are and how to continue, exit status 130."""
     try:
         summary = solve()
+    except KeyboardInterrupt:
+        progress.close()
+        sets = "".join(f" --set {a}" for a in (args.set or [])) if args else ""
+        print(f"vfem: interrupted; the steps completed are in {out}/. Continue with: vfem run "
+              f"{args.example}{sets} --resume {out}", file=sys.stderr)
+        return 130
     finally:
         progress.close()
     if not quiet:
         print("\n".join(report(summary)))
     if not summary["converged"]:
-        print(f"vfem: the analysis did not converge: {summary.get('message', '')}",
+        print(f"vfem: the analysis did not converge: "
+              f"{summary.get('message') or 'see summary.json for each case'}",
               file=sys.stderr)
         return 1
     return 0
@@ -214,7 +224,7 @@ def run_input_file(args) -> int:
     return _solve_and_report(
         lambda: runner.run(config, out, model=model, on_step=progress, source=args.example,
                            resume=bool(args.resume)),
-        progress, lambda summary: runner.report(summary, out), args.quiet)
+        progress, lambda summary: runner.report(summary, out), args.quiet, args, out)
 
 
 def cmd_check(args) -> int:
@@ -326,6 +336,11 @@ def cmd_study(args) -> int:
     return 0
 
 
+def _terminated(signum, frame) -> None:
+    """SIGTERM (a job scheduler, ``kill``): stop as Ctrl-C does, between two file writes."""
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="vfem", description=(
         "Contact between deformable bodies by the virtual finite element method."))
@@ -374,6 +389,10 @@ def main(argv: list[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     logging.getLogger("skfem").setLevel(max(logging.WARNING, level))
     try:
+        previous = signal.signal(signal.SIGTERM, _terminated)
+    except ValueError:  # not the main thread (vfem.cli.main called from a worker): no handler
+        previous = None
+    try:
         command = {"run": cmd_run, "check": cmd_check, "export": cmd_export, "plot": cmd_plot,
                    "reference": cmd_reference,
                    "bench": cmd_bench, "study": cmd_study}[args.command]
@@ -389,6 +408,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("vfem: interrupted", file=sys.stderr)
         return 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

@@ -79,9 +79,15 @@ class Model:
                 raise InputError(f"model {self.name!r}, body {b.name!r}: the thesis variant "
                                  "supports linear elements only (order 1); use the paired "
                                  "variant for quadratic elements")
-        if any(b.large for b in self.bodies) and self.contact.variant != "paired":
-            raise InputError(f"model {self.name!r}: large kinematics needs the paired contact "
-                             "variant")
+        if any(b.large for b in self.bodies):
+            if self.contact.variant != "paired":
+                raise InputError(f"model {self.name!r}: large kinematics needs the paired "
+                                 "contact variant")
+            quadratic = [b.name for b in self.bodies if b.order != 1]
+            if quadratic:
+                raise InputError(f"model {self.name!r}, body {quadratic[0]!r}: contact with a "
+                                 "large-kinematics body needs linear elements (order 1) on every "
+                                 "body")
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
         self.contact.validate()
@@ -144,12 +150,16 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
                   "smaller steps, or check for a sharp corner meeting the other surface")
     elif "inside out" in text:
         remedy = "take smaller steps, or refine the mesh where the elements distort"
+    elif "Newton did not converge" in text:
+        remedy = (f"take smaller steps or allow more cuts (contact.max_step_cuts = "
+                  f"{settings.max_step_cuts}); check the body's supports and material")
     else:
         remedy = (f"allow more iterations (contact.max_iterations = {settings.max_iterations}), "
                   f"more cuts (contact.max_step_cuts = {settings.max_step_cuts}) or smaller "
                   "steps; check that every body is held the way you expect")
+    times = "once" if cuts == 1 else f"{cuts} times"
     return (f"step {step} (load factor {start:.6g} -> {target:.6g}) failed with the increment "
-            f"cut {cuts} times: {text}. What to change: {remedy}")
+            f"cut {times}: {text}. What to change: {remedy}")
 
 
 @dataclass
@@ -294,7 +304,7 @@ class Analysis:
                     converged = False
                     message = diagnosis(len(steps) + 1, state.load_factor, lf, self.level, exc,
                                         settings)
-                    log.error(message)
+                    log.info(message)  # the caller reports it (AnalysisResult.message)
                     break
                 self.level += 1
                 log.warning("step to load factor %.6g failed (%s); cutting the increment to "

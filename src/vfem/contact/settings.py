@@ -93,6 +93,10 @@ class ContactSettings:
             v = getattr(self, name)
             if v is not None and int(v) < 1:
                 raise InputError(f"contact.{name} must be >= 1, got {v!r}")
+        for name in ("max_step_cuts", "relaxed_iterations"):
+            v = getattr(self, name)
+            if int(v) < 0:
+                raise InputError(f"contact.{name} must be >= 0, got {v!r}")
 
     @property
     def release_iterations(self) -> int:

@@ -108,8 +108,9 @@ def read(out: Path, model: Model) -> Checkpoint | None:
             raise InputError(f"{path}: not a readable vfem checkpoint ({exc})") from None
         if meta.get("fingerprint") != expected:
             raise InputError(f"{out}: its results were written by a different model (meshes, "
-                             "materials, loads or settings differ); run without --resume, or "
-                             "choose another results directory with --out")
+                             "materials, loads or settings differ); give the same model and "
+                             "options as the run that wrote them, or run afresh without "
+                             "--resume")
         steps.append(_step(meta["step"], arrays, model))
     state = ContactState(
         meta["state"]["load_factor"], meta["state"]["platen_displacement"],

@@ -290,9 +290,9 @@ def _triangulate(q: np.ndarray, p: np.ndarray) -> np.ndarray:
     area = _polygon_areas(p.T, t.T)
     t[area < 0] = t[area < 0][:, [0, 2, 1]]
     if np.any(np.abs(area) <= 1e-12 * np.ptp(p, axis=0).max() ** 2):
-        raise RuntimeError("degenerate triangle in the mapped triangulation")
+        raise ValueError("degenerate triangle in the mapped triangulation")
     if len(np.unique(t)) != len(p):
-        raise RuntimeError("a mesh node belongs to no triangle")
+        raise ValueError("a mesh node belongs to no triangle")
     return t
 
 
