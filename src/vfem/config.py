@@ -17,9 +17,10 @@ description into a :class:`~vfem.solver.Model`.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from functools import lru_cache
-from pathlib import Path
+from pathlib import Path, PureWindowsPath
 from typing import Any
 
 import numpy as np
@@ -214,6 +215,32 @@ class Output:
     directory: str | None = None
     figures: bool = True
 
+    def __post_init__(self):
+        if self.directory is not None:
+            check_inside(self.directory, "output.directory")
+
+
+def check_inside(directory: str, key: str) -> None:
+    """Refuse a results folder named in an input file that is not a relative path staying
+    inside the working directory: absolute, with a drive, climbing out with ``..``, or empty.
+    An input file from someone else must not make vfem write elsewhere; the command line's
+    ``--out`` is the user's own choice and is not checked. Backslashes count as separators
+    (a file written on Windows). Symbolic links inside the working directory are not followed
+    here."""
+    text = os.fspath(directory) if isinstance(directory, (str, os.PathLike)) else None
+    if not isinstance(text, str):
+        raise InputError(f"{key}: expected a folder name, got {directory!r}")
+    depth, climbs = 0, False
+    for part in text.replace("\\", "/").split("/"):
+        if part not in ("", "."):
+            depth += -1 if part == ".." else 1
+            climbs |= depth < 0
+    if (not text.strip() or "\0" in text or text.startswith(("/", "\\"))
+            or PureWindowsPath(text).drive or climbs):
+        raise InputError(f"{key}: {text!r} is not a folder inside the working directory; give "
+                         "a relative path such as 'results/model' (no leading '/', drive or "
+                         "'..' that climbs out), or choose any folder with --out")
+
 
 @dataclass(frozen=True)
 class ModelConfig:
@@ -250,11 +277,14 @@ class ModelConfig:
 
 
 def check(config: ModelConfig, base: Path | None = None) -> Model:
-    """Everything that can be checked without solving: build the model and each body's
-    constraints (a body that could move freely is named with its free motion)."""
+    """Everything that can be checked without solving: build the model (meshes checked by
+    :func:`vfem.mesh.checks.check_mesh`), each body's constraints (a body that could move freely
+    is named with its free motion) and the contact surfaces (bodies that start deeper into each
+    other than the outer layer of elements are refused)."""
     model = config.build(base)
     for body in model.bodies:
         body.check_supports()
+    model.contact_surfaces()
     return model
 
 

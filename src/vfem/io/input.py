@@ -104,8 +104,9 @@ def from_data(cls, data: Any, where: str):
             values[name] = _convert(hints[name], data[name], here)
     try:
         return cls(**values)
-    except (TypeError, ValueError) as exc:
-        raise _Problem(where, str(exc)) from None
+    except (TypeError, ValueError) as exc:  # a class's own check: it may name the key itself
+        message = str(exc)
+        raise _Problem("" if message.startswith(f"{where}.") else where, message) from None
 
 
 def _bodies(data: Any, where: str) -> tuple[BodyConfig, ...]:
