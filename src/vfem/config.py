@@ -126,9 +126,14 @@ def _shape_mesh(shape: str, parameters: tuple[tuple[str, Any], ...]):
     if shape not in SHAPES:
         raise InputError(f"mesh: unknown shape {shape!r}; built-in shapes: "
                          f"{', '.join(SHAPES)}")
+    from .io.input import check_shape_parameters  # (here: the loader imports this module)
+
+    check_shape_parameters(shape, parameters)  # as an input file's: types, pairs, finite
     try:
         return SHAPES[shape](**dict(parameters))
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, ArithmeticError) as exc:
+        # a shape refuses parameters it cannot mesh with a ValueError; numbers out of range
+        # may also surface as TypeError (a count that is a float) or OverflowError
         raise InputError(f"mesh shape {shape!r}: {exc}") from None
 
 
@@ -207,8 +212,9 @@ class Output:
     """What a run writes.
 
     Attributes:
-        directory: the results folder, relative to where vfem runs. Default:
-            ``results/<name>``. The command line's ``--out`` overrides it.
+        directory: the results folder, a relative path inside the folder where vfem runs
+            (no absolute path, drive or ``..`` that climbs out). Default: ``results/<name>``.
+            The command line's ``--out`` overrides it and may be any folder.
         figures: draw the figures (deformed shape, contact pressure, history) at the end.
     """
 

@@ -37,7 +37,8 @@ def exterior_facets(body: Body) -> np.ndarray:
     """Facets of the body that may take part in contact (indices into ``mesh.facets``)."""
     mesh = body.mesh
     if body.contact_boundaries is not None:
-        return np.unique(np.concatenate([mesh.boundaries[b] for b in body.contact_boundaries]))
+        return np.unique(np.concatenate([np.zeros(0, dtype=np.int64)] + [
+            mesh.boundaries[b] for b in body.contact_boundaries])).astype(np.int64)
     bnd = mesh.boundary_facets()
     excluded = [mesh.boundaries[s.boundary] for s in body.supports]
     excluded += [mesh.boundaries[p.boundary] for p in body.prescribed]

@@ -91,14 +91,18 @@ def _reference_lattice(tri: bool, n: int = 4) -> np.ndarray:
 def _check_elements(mesh: Mesh, p: np.ndarray, t: np.ndarray, where: str) -> None:
     """Degenerate elements (no area somewhere) and elements inverted within themselves."""
     corners = p[:, t]  # (2, nodes, ne)
-    edge2 = np.max([np.sum((corners[:, (i + 1) % len(t)] - corners[:, i]) ** 2, axis=0)
-                    for i in range(len(t))], axis=0)
-    if type(mesh).__name__ == "MeshTri1":  # affine: one determinant per element
-        a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
-        det = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))[:, None]
-    else:  # a bilinear quadrilateral's determinant is linear in x and y: its corners do
-        lattice = 1 if type(mesh).__name__ == "MeshQuad1" else 4
-        det = mesh._mapping().detDF(_reference_lattice(isinstance(mesh, MeshTri), lattice))
+    with np.errstate(invalid="ignore", over="ignore"):  # coordinates near overflow
+        edge2 = np.max([np.sum((corners[:, (i + 1) % len(t)] - corners[:, i]) ** 2, axis=0)
+                        for i in range(len(t))], axis=0)
+        if type(mesh).__name__ == "MeshTri1":  # affine: one determinant per element
+            a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+            det = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))[:, None]
+        else:  # a bilinear quadrilateral's determinant is linear in x and y: its corners do
+            lattice = 1 if type(mesh).__name__ == "MeshQuad1" else 4
+            X = _reference_lattice(isinstance(mesh, MeshTri), lattice)
+            J = mesh._mapping().J  # (scikit-fem's own detDF refuses a zero determinant)
+            det = J(0, 0, X) * J(1, 1, X) - J(0, 1, X) * J(1, 0, X)
+    det = np.where(np.isfinite(det), det, 0.0)  # overflowed: no usable geometry either
     small = np.abs(det) <= DEGENERATE_TOLERANCE * edge2[:, None]
     flips = (det.min(axis=1) < 0) & (det.max(axis=1) > 0)
     degenerate = np.flatnonzero(small.any(axis=1) & ~flips)
