@@ -109,3 +109,30 @@ def test_a_boundary_that_holds_no_facet_is_refused():
     body = Body("b", mesh, STEEL, supports=(Support("left"), Support("nowhere")))
     with pytest.raises(InputError, match="boundary 'nowhere' holds no facet"):
         body.validate()
+
+
+@pytest.mark.parametrize("shape, parameters, words", [
+    ("rectangle", {"nx": 10**9, "ny": 10**9}, "more than the 2,000,000"),
+    ("gasket", {"n_around": 0}, "n_around, n_through >= 1"),
+    ("wedge_plate", {"h_contact": -0.05}, "element sizes must be positive"),
+    ("graded_layer", {"width": 5.0, "thickness": 1.0, "h_contact": 1e-12, "h_max": 1e-12},
+     "too small for a line"),
+    ("wedge_plate_grid", {"columns": 10**18}, "more than the 2,000,000"),
+    ("gasket", {"centre": ()}, "centre: expected 2 values"),
+    ("rectangle", {"width": float("nan")}, "width: must be a finite number"),
+])
+def test_shape_parameters_that_cannot_make_a_mesh_are_refused_at_once(shape, parameters, words):
+    """Sizes that are not positive, counts past the limit (instead of a hang or an allocation
+    of exabytes), parameters of the wrong shape given in Python."""
+    import time
+
+    from vfem.config import MeshSpec, as_parameters
+
+    start = time.perf_counter()
+    with pytest.raises(InputError, match=f"mesh shape {shape!r}"):
+        try:
+            MeshSpec(shape=shape, parameters=as_parameters(**parameters)).make()
+        except InputError as exc:
+            assert words in str(exc), str(exc)
+            raise
+    assert time.perf_counter() - start < 2.0

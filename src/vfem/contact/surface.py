@@ -16,6 +16,7 @@ The contact algorithm never sees a body's full mesh. It sees, per body:
 
 from __future__ import annotations
 
+import itertools
 import logging
 from dataclasses import dataclass
 
@@ -323,7 +324,8 @@ def locate_in_triangles(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> n
 
     Uses scikit-fem's affine mapping of the triangles: the inverse map gives a point's local
     coordinates in a triangle. Nearby triangles (by centroid) are tried first; points they do
-    not contain are tried against every triangle, since elements may be long and thin.
+    not contain are tried against every triangle whose centroid is close enough for it to hold
+    them, since elements may be long and thin.
     """
     found = np.full(len(points), -1)
     if len(points) == 0 or len(tri) == 0:
@@ -336,20 +338,28 @@ def locate_in_triangles(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> n
         eps = 1e-12
         return (loc[0] >= -eps) & (loc[1] >= -eps) & (1 - loc[0] - loc[1] >= -eps)
 
+    centres = x[tri].mean(axis=1)
+    tree = cKDTree(centres)
     k = min(6, len(tri))
-    _, near = cKDTree(x[tri].mean(axis=1)).query(points, k)
+    _, near = tree.query(points, k)
     near = near.reshape(len(points), k)
     for j in range(k):
         hit = inside(near[:, j], points) & (found < 0)
         found[hit] = near[hit, j]
+    # the rest: every triangle whose centre is close enough for it to hold the point (within
+    # the largest centre-to-corner distance of any triangle), a few points at a time
+    reach = float(np.linalg.norm(x[tri] - centres[:, None], axis=2).max()) * (1 + 1e-9)
     rest = np.flatnonzero(found < 0)
-    nt = len(tri)
-    for lo in range(0, len(rest), max(1, 200_000 // nt)):
-        idx = rest[lo:lo + max(1, 200_000 // nt)]
-        hit = inside(np.tile(np.arange(nt), len(idx)),
-                     np.repeat(points[idx], nt, axis=0)).reshape(len(idx), nt)
-        ok = hit.any(axis=1)
-        found[idx[ok]] = hit[ok].argmax(axis=1)
+    for lo in range(0, len(rest), 16):
+        idx = rest[lo:lo + 16]
+        lists = tree.query_ball_point(points[idx], reach)
+        counts = np.fromiter(map(len, lists), dtype=int, count=len(idx))
+        cand = np.fromiter(itertools.chain.from_iterable(lists), dtype=int,
+                           count=int(counts.sum()))
+        owner = np.repeat(idx, counts)
+        if len(cand):
+            hit = inside(cand, points[owner])
+            found[owner[hit]] = cand[hit]  # any triangle that holds the point
     return found
 
 
