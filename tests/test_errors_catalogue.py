@@ -54,10 +54,9 @@ _WRAPPERS_AS_WRITTEN = {
         "names the body in front of a mesh error (mesh shape, mesh file, mesh.curve)",
     ("io/input.py", 'f"{source}: {exc}"'):
         "names the input file in front of a _Problem message (catalogued at each _Problem)",
-    ("io/input.py", "str(exc)"):
-        "_Problem(where, str(exc)): a safety net for a configuration class whose constructor "
-        "refuses its values (none does today: their checks run when the model is built and are "
-        "catalogued where they raise)",
+    ("io/input.py", "message"):
+        "_Problem(where, str(exc)): a configuration class whose constructor refuses its values "
+        "(the shape-parameter checks of config.py, catalogued where they raise)",
     ("examples/wedge.py", 'f"wedge: {message}"'):
         "prefixes 'wedge: ' to the need(...) messages of wedge.validate (catalogued there)",
     ("examples/wedge.py", 'f"wedge: {exc}"'):

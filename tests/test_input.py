@@ -206,3 +206,21 @@ def test_progress_on_a_terminal_shows_each_contact_iteration(tmp_path):
     assert text.count("\r") == sum(len(s.history) for s in result.steps) + len(result.steps)
     assert "step   5  iteration   4  penetration" in text
     assert "[####################] step   5  load factor  1.0000" in text
+
+
+@pytest.mark.parametrize("directory", ["/etc/vfem", "../elsewhere", "results/../../up", "C:\\out",
+                                       "..\\up", "\\\\server\\share", "", "a\0b"])
+def test_output_directory_of_an_input_file_must_stay_inside_the_working_directory(directory):
+    from vfem.config import Output
+    from vfem.errors import InputError
+
+    with pytest.raises(InputError, match="output.directory: .* is not a folder inside the "
+                                         "working directory"):
+        Output(directory)
+
+
+@pytest.mark.parametrize("directory", ["results/model", ".", "a/../b", "results/./x"])
+def test_relative_output_directories_stay_allowed(directory):
+    from vfem.config import Output
+
+    assert Output(directory).directory == directory

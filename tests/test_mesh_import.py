@@ -357,3 +357,26 @@ def test_hertz_gmsh_peak_pressure(tmp_path):
     assert result.converged
     p_max = result.steps[-1].bodies["cylinder"].contact_pressure.max()
     assert abs(p_max / 31847.7 - 1) < 0.01
+
+
+def test_a_node_set_off_the_outline_is_no_boundary_and_naming_it_is_refused(tmp_path):
+    """NSET ``corner`` holds one node, so it covers no facet of the lower body's outline: the
+    body has no such boundary, and a support on it is refused with the names it has."""
+    from vfem import Body, LinearElastic, Support
+
+    lower = read_mesh(write_inp(tmp_path / "two.inp"), "lower")
+    assert "corner" not in lower.boundaries
+    body = Body("lower", lower, LinearElastic(1.0, 0.3), supports=(Support("corner"),))
+    with pytest.raises(InputError, match="no boundary named 'corner'; the mesh has bottom, "
+                                         "symmetry"):
+        body.validate()
+
+
+@pytest.mark.parametrize("name, words", [
+    ("unmerged", ("3 pair(s) of nodes at the same position", "(0, 1)")),
+    ("pieces", ("2 separate pieces",)),
+    ("inverted", ("inverted", "(1.6, 0.3)")),
+])
+def test_mesh_checks_name_the_file(name, words):
+    raises(Path(__file__).parent / "data" / "meshes" / f"{name}.inp", "body", *words)
+

@@ -40,6 +40,7 @@ from skfem.models.elasticity import linear_elasticity
 from .errors import InputError
 from .linalg import factorize
 from .materials import LinearElastic
+from .mesh.checks import check_mesh
 
 log = logging.getLogger(__name__)
 
@@ -461,6 +462,10 @@ class Body:
         ):
             raise InputError(f"{where}: mesh must be triangles or quadrilaterals, "
                              f"got {type(self.mesh).__name__}")
+        # validate runs before every use of the body; the mesh is checked once
+        if getattr(self, "_checked_mesh", None) is not self.mesh:
+            check_mesh(self.mesh, where)
+            self._checked_mesh = self.mesh
         if self.order not in (1, 2):
             raise InputError(f"{where}: order must be 1 (linear) or 2 (quadratic elements), "
                              f"got {self.order!r}")
@@ -481,6 +486,10 @@ class Body:
             if name not in names:
                 raise InputError(f"{where}: no boundary named {name!r}; the mesh has "
                                  f"{', '.join(sorted(names)) or 'no named boundaries'}")
+            if len(self.mesh.boundaries[name]) == 0:
+                raise InputError(f"{where}: boundary {name!r} holds no facet of the mesh's "
+                                 "outline; check how it is defined (a shape's parameters, or "
+                                 "the mesh file's group)")
         comps = [c for s in self.supports for c in s.components]
         comps += [pd.component for pd in self.prescribed]
         comps += [self.platen.component] if self.platen else []

@@ -17,9 +17,10 @@ description into a :class:`~vfem.solver.Model`.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from functools import lru_cache
-from pathlib import Path
+from pathlib import Path, PureWindowsPath
 from typing import Any
 
 import numpy as np
@@ -125,9 +126,14 @@ def _shape_mesh(shape: str, parameters: tuple[tuple[str, Any], ...]):
     if shape not in SHAPES:
         raise InputError(f"mesh: unknown shape {shape!r}; built-in shapes: "
                          f"{', '.join(SHAPES)}")
+    from .io.input import check_shape_parameters  # (here: the loader imports this module)
+
+    check_shape_parameters(shape, parameters)  # as an input file's: types, pairs, finite
     try:
         return SHAPES[shape](**dict(parameters))
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, ArithmeticError) as exc:
+        # a shape refuses parameters it cannot mesh with a ValueError; numbers out of range
+        # may also surface as TypeError (a count that is a float) or OverflowError
         raise InputError(f"mesh shape {shape!r}: {exc}") from None
 
 
@@ -206,13 +212,40 @@ class Output:
     """What a run writes.
 
     Attributes:
-        directory: the results folder, relative to where vfem runs. Default:
-            ``results/<name>``. The command line's ``--out`` overrides it.
+        directory: the results folder, a relative path inside the folder where vfem runs
+            (no absolute path, drive or ``..`` that climbs out). Default: ``results/<name>``.
+            The command line's ``--out`` overrides it and may be any folder.
         figures: draw the figures (deformed shape, contact pressure, history) at the end.
     """
 
     directory: str | None = None
     figures: bool = True
+
+    def __post_init__(self):
+        if self.directory is not None:
+            check_inside(self.directory, "output.directory")
+
+
+def check_inside(directory: str, key: str) -> None:
+    """Refuse a results folder named in an input file that is not a relative path staying
+    inside the working directory: absolute, with a drive, climbing out with ``..``, or empty.
+    An input file from someone else must not make vfem write elsewhere; the command line's
+    ``--out`` is the user's own choice and is not checked. Backslashes count as separators
+    (a file written on Windows). Symbolic links inside the working directory are not followed
+    here."""
+    text = os.fspath(directory) if isinstance(directory, (str, os.PathLike)) else None
+    if not isinstance(text, str):
+        raise InputError(f"{key}: expected a folder name, got {directory!r}")
+    depth, climbs = 0, False
+    for part in text.replace("\\", "/").split("/"):
+        if part not in ("", "."):
+            depth += -1 if part == ".." else 1
+            climbs |= depth < 0
+    if (not text.strip() or "\0" in text or text.startswith(("/", "\\"))
+            or PureWindowsPath(text).drive or climbs):
+        raise InputError(f"{key}: {text!r} is not a folder inside the working directory; give "
+                         "a relative path such as 'results/model' (no leading '/', drive or "
+                         "'..' that climbs out), or choose any folder with --out")
 
 
 @dataclass(frozen=True)
@@ -250,11 +283,14 @@ class ModelConfig:
 
 
 def check(config: ModelConfig, base: Path | None = None) -> Model:
-    """Everything that can be checked without solving: build the model and each body's
-    constraints (a body that could move freely is named with its free motion)."""
+    """Everything that can be checked without solving: build the model (meshes checked by
+    :func:`vfem.mesh.checks.check_mesh`), each body's constraints (a body that could move freely
+    is named with its free motion) and the contact surfaces (bodies that start deeper into each
+    other than the outer layer of elements are refused)."""
     model = config.build(base)
     for body in model.bodies:
         body.check_supports()
+    model.contact_surfaces()
     return model
 
 

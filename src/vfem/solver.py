@@ -36,8 +36,9 @@ from .contact.algorithm import (
     VirtualElementContact,
 )
 from .contact.settings import ContactSettings
-from .contact.surface import ContactSurface, select_candidate_facets
+from .contact.surface import ContactSurface, check_initial_overlap, select_candidate_facets
 from .errors import AnalysisError, InputError, RindViolation
+from .memory import check_memory, memory_guard
 
 log = logging.getLogger(__name__)
 
@@ -91,6 +92,32 @@ class Model:
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
         self.contact.validate()
+
+    def contact_surfaces(self) -> tuple[set[frozenset[int]], list[ContactSurface]]:
+        """The pairs of bodies (by index) that may touch (``contact_pairs``, or every pair) and
+        each body's contact surface: candidate facets within ``contact.search_distance`` of a
+        body it may touch (every facet that may touch under large kinematics, where bodies may
+        slide far).
+
+        Depends on the meshes only, so it is also part of ``vfem check``: bodies that start
+        deeper into each other than the outer layer of elements are refused here
+        (:func:`~vfem.contact.surface.check_initial_overlap`).
+        """
+        index = {b.name: i for i, b in enumerate(self.bodies)}
+        if self.contact_pairs is None:
+            pairs = {frozenset((i, j)) for i in range(len(self.bodies)) for j in range(i)}
+        else:
+            pairs = {frozenset((index[a], index[b])) for a, b in self.contact_pairs}
+        distance = self.contact.search_distance
+        if distance is None:
+            diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in self.bodies]
+            distance = 0.02 * min(diag)
+        if any(b.large for b in self.bodies):
+            distance = np.inf
+        facets = select_candidate_facets(self.bodies, pairs, distance)
+        surfaces = [ContactSurface.build(b, f) for b, f in zip(self.bodies, facets)]
+        check_initial_overlap(surfaces, pairs)
+        return pairs, surfaces
 
 
 @dataclass
@@ -188,47 +215,42 @@ class Analysis:
         """Find each body's contact candidates, then assemble and factorize every body.
 
         Candidates come first (they depend on the meshes only), so that each body's single
-        factorization can also deliver its flexibility on them.
+        factorization can also deliver its flexibility on them. Bodies that start deeply
+        interpenetrated are refused (:class:`InputError`) and the memory the set-up needs is
+        estimated before anything is factorized (:mod:`vfem.memory`): a model that cannot fit
+        is refused, and running out of memory anyway is an :class:`AnalysisError` that says so.
         """
         t0 = time.perf_counter()
         bodies = self.model.bodies
-        index = {b.name: i for i, b in enumerate(bodies)}
-        if self.model.contact_pairs is None:
-            pairs = {frozenset((i, j)) for i in range(len(bodies)) for j in range(i)}
-        else:
-            pairs = {frozenset((index[a], index[b])) for a, b in self.model.contact_pairs}
-        distance = self.model.contact.search_distance
-        if distance is None:
-            diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in bodies]
-            distance = 0.02 * min(diag)
-        if any(b.large for b in bodies):
-            # bodies may slide far: every facet that may touch is a candidate
-            distance = np.inf
-        facets = select_candidate_facets(bodies, pairs, distance)
-        self.surfaces = [ContactSurface.build(b, f) for b, f in zip(bodies, facets)]
+        pairs, self.surfaces = self.model.contact_surfaces()
         t1 = time.perf_counter()
-        for b, s in zip(bodies, self.surfaces):
-            b.setup(self.backend, tracked_dofs=s.tracked_dofs)
-        t2 = time.perf_counter()
-        for s in self.surfaces:
-            s.compute_flexibility()
-            log.info("body %s: %d contact candidate nodes", s.body.name, s.nc)
-        if any(b.large for b in bodies):
-            from .contact.large import LargeDeformationContact
-
-            self.contact = LargeDeformationContact(self.surfaces, pairs, self.model.contact,
-                                                   self.backend)
-        elif self.model.contact.variant == "paired":
-            from .contact.paired import PairedContact
-
-            self.contact = PairedContact(self.surfaces, pairs, self.model.contact)
-        else:
-            self.contact = VirtualElementContact(self.surfaces, pairs, self.model.contact)
+        check_memory(self.surfaces, pairs)
+        with memory_guard("factorizing the bodies and computing their flexibility"):
+            for b, s in zip(bodies, self.surfaces):
+                b.setup(self.backend, tracked_dofs=s.tracked_dofs)
+            t2 = time.perf_counter()
+            for s in self.surfaces:
+                s.compute_flexibility()
+                log.info("body %s: %d contact candidate nodes", s.body.name, s.nc)
+            self.contact = self._contact(pairs)
         t3 = time.perf_counter()
         self.timings.update(search_s=t1 - t0, assemble_factorize_s=t2 - t1,
                             flexibility_s=t3 - t2)
         for key in ("assemble_s", "factorize_s"):
             self.timings[key] = sum(b.timings[key] for b in bodies)
+
+    def _contact(self, pairs: set[frozenset[int]]):
+        """The contact iteration for the model's variant and kinematics."""
+        if any(b.large for b in self.model.bodies):
+            from .contact.large import LargeDeformationContact
+
+            return LargeDeformationContact(self.surfaces, pairs, self.model.contact,
+                                           self.backend)
+        if self.model.contact.variant == "paired":
+            from .contact.paired import PairedContact
+
+            return PairedContact(self.surfaces, pairs, self.model.contact)
+        return VirtualElementContact(self.surfaces, pairs, self.model.contact)
 
     def solve_step(self, start: ContactState, load_factor: float, history_out: list
                    ) -> tuple[ContactState, SolveResult]:

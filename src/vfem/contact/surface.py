@@ -16,6 +16,7 @@ The contact algorithm never sees a body's full mesh. It sees, per body:
 
 from __future__ import annotations
 
+import itertools
 import logging
 from dataclasses import dataclass
 
@@ -27,6 +28,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
 from ..bodies import Body
+from ..errors import InputError
 from .search import outward_normals, project_points
 
 log = logging.getLogger(__name__)
@@ -36,7 +38,8 @@ def exterior_facets(body: Body) -> np.ndarray:
     """Facets of the body that may take part in contact (indices into ``mesh.facets``)."""
     mesh = body.mesh
     if body.contact_boundaries is not None:
-        return np.unique(np.concatenate([mesh.boundaries[b] for b in body.contact_boundaries]))
+        return np.unique(np.concatenate([np.zeros(0, dtype=np.int64)] + [
+            mesh.boundaries[b] for b in body.contact_boundaries])).astype(np.int64)
     bnd = mesh.boundary_facets()
     excluded = [mesh.boundaries[s.boundary] for s in body.supports]
     excluded += [mesh.boundaries[p.boundary] for p in body.prescribed]
@@ -102,15 +105,13 @@ class ContactSurface:
         nodes = np.concatenate([cand, rind_nodes])
         local = np.full(body.npoints, -1)
         local[nodes] = np.arange(len(nodes))
-        t_rind = mesh.t[:, rind_elems]
-        if t_rind.shape[0] == 4:  # quadrilaterals: two triangles each, for point location
-            t_rind = np.hstack([t_rind[[0, 1, 3]], t_rind[[1, 2, 3]]])
+        t_rind = triangles(mesh.t[:, rind_elems])
         X = body.points[:, nodes].T.copy()
         facets = local[fn]
         lengths = np.linalg.norm(X[facets[:, 1]] - X[facets[:, 0]], axis=1)
         surface = cls(body=body, facet_ids=np.asarray(facet_ids), facets=facets, nodes=nodes,
                       nc=len(cand), X=X, lengths=lengths, tributary=np.zeros(len(cand)),
-                      rind=local[t_rind].T.copy())
+                      rind=local[t_rind])
         if len(facets):
             # a unit pressure's consistent nodal forces: the integral of each shape function
             ones = np.ones(len(facets))
@@ -262,39 +263,9 @@ class ContactSurface:
         return seg, t, dist, normal
 
     def locate(self, x_tracked: np.ndarray, points: np.ndarray) -> np.ndarray:
-        """Rind element containing each point (current configuration), or -1.
-
-        Uses scikit-fem's affine mapping of the rind triangles in their current position: the
-        inverse map gives a point's local coordinates in a triangle. Nearby triangles (by
-        centroid) are tried first; points they do not contain are tried against every rind
-        triangle, since the rind's elements may be long and thin.
-        """
-        found = np.full(len(points), -1)
-        if len(points) == 0 or len(self.rind) == 0:
-            return found
-        mesh = MeshTri(x_tracked.T.copy(), self.rind.T.copy(), sort_t=False, validate=False)
-        mapping = mesh._mapping()
-
-        def inside(tind, pts):
-            loc = mapping.invF(pts.T[:, :, None], tind=tind)[:, :, 0]
-            eps = 1e-12
-            return (loc[0] >= -eps) & (loc[1] >= -eps) & (1 - loc[0] - loc[1] >= -eps)
-
-        k = min(6, len(self.rind))
-        _, near = cKDTree(x_tracked[self.rind].mean(axis=1)).query(points, k)
-        near = near.reshape(len(points), k)
-        for j in range(k):
-            hit = inside(near[:, j], points) & (found < 0)
-            found[hit] = near[hit, j]
-        rest = np.flatnonzero(found < 0)
-        nt = len(self.rind)
-        for lo in range(0, len(rest), max(1, 200_000 // nt)):
-            idx = rest[lo:lo + max(1, 200_000 // nt)]
-            hit = inside(np.tile(np.arange(nt), len(idx)),
-                         np.repeat(points[idx], nt, axis=0)).reshape(len(idx), nt)
-            ok = hit.any(axis=1)
-            found[idx[ok]] = hit[ok].argmax(axis=1)
-        return found
+        """Rind triangle containing each point (current configuration), or -1
+        (:func:`locate_in_triangles`)."""
+        return locate_in_triangles(x_tracked, self.rind, points)
 
     def quadrature(self, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Gauss points of the virtual elements on each candidate facet.
@@ -338,6 +309,110 @@ class ContactSurface:
         local[self.nodes[: self.nc]] = np.arange(self.nc)
         rows, cols = local[ones.indices[0][keep]], local[ones.indices[1][keep]]
         return facet, rows, cols, ones.data[keep]
+
+
+def triangles(t: np.ndarray) -> np.ndarray:
+    """(n, 3) triangles of elements ``t`` (vertices, n): quadrilaterals split in two."""
+    if t.shape[0] == 4:
+        t = np.hstack([t[[0, 1, 3]], t[[1, 2, 3]]])
+    return t.T.copy()
+
+
+def locate_in_triangles(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The triangle (row of ``tri``, (nt, 3) numbers of the positions ``x`` (n, 2)) containing
+    each of ``points`` (m, 2), or -1 (points on an edge count as inside).
+
+    Uses scikit-fem's affine mapping of the triangles: the inverse map gives a point's local
+    coordinates in a triangle. Nearby triangles (by centroid) are tried first; points they do
+    not contain are tried against every triangle whose centroid is close enough for it to hold
+    them, since elements may be long and thin.
+    """
+    found = np.full(len(points), -1)
+    if len(points) == 0 or len(tri) == 0:
+        return found
+    mesh = MeshTri(x.T.copy(), tri.T.copy(), sort_t=False, validate=False)
+    mapping = mesh._mapping()
+
+    def inside(tind, pts):
+        loc = mapping.invF(pts.T[:, :, None], tind=tind)[:, :, 0]
+        eps = 1e-12
+        return (loc[0] >= -eps) & (loc[1] >= -eps) & (1 - loc[0] - loc[1] >= -eps)
+
+    centres = x[tri].mean(axis=1)
+    tree = cKDTree(centres)
+    k = min(6, len(tri))
+    _, near = tree.query(points, k)
+    near = near.reshape(len(points), k)
+    for j in range(k):
+        hit = inside(near[:, j], points) & (found < 0)
+        found[hit] = near[hit, j]
+    # the rest: every triangle whose centre is close enough for it to hold the point (within
+    # the largest centre-to-corner distance of any triangle), a few points at a time
+    reach = float(np.linalg.norm(x[tri] - centres[:, None], axis=2).max()) * (1 + 1e-9)
+    rest = np.flatnonzero(found < 0)
+    for lo in range(0, len(rest), 16):
+        idx = rest[lo:lo + 16]
+        lists = tree.query_ball_point(points[idx], reach)
+        counts = np.fromiter(map(len, lists), dtype=int, count=len(idx))
+        cand = np.fromiter(itertools.chain.from_iterable(lists), dtype=int,
+                           count=int(counts.sum()))
+        owner = np.repeat(idx, counts)
+        if len(cand):
+            hit = inside(cand, points[owner])
+            found[owner[hit]] = cand[hit]  # any triangle that holds the point
+    return found
+
+
+def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[int]]) -> None:
+    """Refuse bodies that start deeper into each other than the outer layer of elements.
+
+    The contact iteration finds a node's partner on the other surface only while the node is
+    within that body's rind (thesis §5.6): :class:`~vfem.contact.paired.PairedContact` stops a
+    step whose penetration passes the depth of the element behind the facet it is measured
+    against (``rind_depth``), and cuts it; an overlap that deep at the start cannot be cut away,
+    so every step would fail. The same rule is applied here to the undeformed bodies: for each
+    pair of bodies that may touch, each candidate node of one is projected onto the other's
+    candidate surface; a node behind it by more than the ``rind_depth`` of the facet there, and
+    inside that body's elements (not behind a thin body, beyond its far side), is refused. An
+    overlap within the rind is allowed: the first step resolves it.
+
+    Raises:
+        InputError: naming both bodies, the node, its position and depth, and the rind there.
+    """
+    worst, count = None, 0
+    for i, si in enumerate(surfaces):
+        if si.nc == 0:
+            continue
+        x = si.X[: si.nc]
+        for j, sj in enumerate(surfaces):
+            if j == i or frozenset((i, j)) not in pairs or len(sj.facets) == 0:
+                continue
+            seg, t, _, n = sj.project(x)
+            pos, _ = sj.curve(seg, t)
+            depth = -np.einsum("ij,ij->i", x - pos, n)
+            rind = sj.rind_depth[seg]
+            deep = np.flatnonzero(depth > rind)
+            if deep.size:
+                mesh = sj.body.mesh
+                deep = deep[locate_in_triangles(mesh.p[:, : mesh.nvertices].T,
+                                                triangles(mesh.t), x[deep]) >= 0]
+            if not deep.size:
+                continue
+            count += deep.size
+            k = int(deep[np.argmax(depth[deep])])
+            if worst is None or depth[k] > worst[0]:
+                worst = (float(depth[k]), float(rind[k]), si, sj, k)
+    if worst is not None:
+        depth, rind, si, sj, k = worst
+        a, b = si.body.name, sj.body.name
+        x = si.X[k]
+        raise InputError(
+            f"bodies {a!r} and {b!r} start deeply interpenetrated: node {int(si.nodes[k])} of "
+            f"{a!r}, at ({x[0]:.6g}, {x[1]:.6g}), lies {depth:.3g} inside {b!r}, deeper than "
+            f"its outer layer of elements there ({rind:.3g}; {count} such node(s) in all); "
+            "contact cannot resolve an overlap that deep. Move the bodies apart (mesh.translate) "
+            "so that they start touching, and apply the overlap as a prescribed displacement or "
+            "a platen force")
 
 
 def facet_shape(t: np.ndarray, order: int) -> np.ndarray:

@@ -46,8 +46,9 @@ SECTIONS = {
 }
 
 
-class _Problem(Exception):
-    """A problem at a place in the file; turned into an InputError naming the file."""
+class _Problem(InputError):
+    """A problem at a place in the file; turned into an InputError naming the file (an
+    InputError itself, so that :func:`from_data` called on its own raises one too)."""
 
     def __init__(self, where: str, message: str):
         super().__init__(f"{where}: {message}" if where else message)
@@ -104,8 +105,9 @@ def from_data(cls, data: Any, where: str):
             values[name] = _convert(hints[name], data[name], here)
     try:
         return cls(**values)
-    except (TypeError, ValueError) as exc:
-        raise _Problem(where, str(exc)) from None
+    except (TypeError, ValueError) as exc:  # a class's own check: it may name the key itself
+        message = str(exc)
+        raise _Problem("" if message.startswith(f"{where}.") else where, message) from None
 
 
 def _bodies(data: Any, where: str) -> tuple[BodyConfig, ...]:
@@ -136,19 +138,32 @@ def _mesh_spec(data: dict, where: str) -> MeshSpec:
         if "file" in data:
             raise _Problem(where, "give either 'shape' or 'file', not both")
         signature = inspect.signature(SHAPES[shape]).parameters
-        hints = typing.get_type_hints(SHAPES[shape])
         _reject_unknown(data, own + list(signature), where, f"shape {shape!r}")
         params = []
         for name, par in signature.items():
             if name in data:
-                params.append((name, _convert(hints.get(name, Any), data[name],
-                                              _join(where, name))))
+                params.append((name, _shape_parameter(shape, name, data[name],
+                                                      _join(where, name))))
             elif par.default is inspect.Parameter.empty:
                 raise _Problem(where, f"shape {shape!r} needs the parameter {name!r}")
         params = tuple(params)
     hints = typing.get_type_hints(MeshSpec)
     values = {k: _convert(hints[k], data[k], _join(where, k)) for k in own if k in data}
     return MeshSpec(parameters=params, **values)
+
+
+def _shape_parameter(shape: str, name: str, value, where: str):
+    """A built-in shape's parameter checked against the shape function's type hint."""
+    return _convert(typing.get_type_hints(SHAPES[shape]).get(name, Any), value, where)
+
+
+def check_shape_parameters(shape: str, parameters: Sequence[tuple[str, Any]]) -> None:
+    """Check the parameters of a built-in shape given in Python (``MeshSpec.parameters``) as an
+    input file's are checked: types, the length of pairs, finite numbers. (Unknown names are
+    left to the shape function, which refuses them.)"""
+    for name, value in parameters:
+        if name in inspect.signature(SHAPES[shape]).parameters:
+            _shape_parameter(shape, name, _listify(value), f"mesh shape {shape!r}: {name}")
 
 
 def _convert(tp, value, where: str):

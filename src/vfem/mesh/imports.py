@@ -37,7 +37,9 @@ Boundaries
 Errors
     Every problem with the file is an :class:`~vfem.errors.InputError` naming the file: missing,
     unreadable, no such group (with the names available and a "did you mean"), a group without 2D
-    elements, unsupported or mixed element types, z not zero, degenerate elements.
+    elements, unsupported or mixed element types, z not zero, and whatever
+    :func:`~vfem.mesh.checks.check_mesh` finds (degenerate, inverted or overlapping elements,
+    duplicate nodes, several pieces).
 
 Limits of meshio 5.3 that show here: a Gmsh file saved with ``Mesh.SaveAll = 1`` that has
 elements outside every physical group cannot be read (meshio's tags do not line up; save the
@@ -61,6 +63,7 @@ import numpy as np
 from skfem import Mesh, MeshQuad1, MeshQuad2, MeshTri1, MeshTri2
 
 from ..errors import InputError
+from .checks import check_mesh
 
 log = logging.getLogger(__name__)
 
@@ -360,24 +363,10 @@ def _build(raw, selected: tuple[str, np.ndarray], what: str) -> tuple[Mesh, np.n
             raise InputError(f"{what}: the mesh is not planar (|z| up to {z.max():.3g}); vfem "
                              f"reads 2D meshes in the plane z = 0")
 
-    area = _signed_area(xy, t[:, :nv])
-    edge = np.max([np.sum((xy[t[:, (i + 1) % nv]] - xy[t[:, i]]) ** 2, axis=1)
-                   for i in range(nv)], axis=0)
-    degenerate = np.flatnonzero(np.abs(area) <= 1e-10 * edge)
-    if degenerate.size:
-        raise InputError(f"{what}: {degenerate.size} element(s) of zero area (the first: "
-                         f"element {degenerate[0]} of the selection, nodes at "
-                         f"{xy[t[degenerate[0], :nv]].round(6).tolist()})")
-    clockwise = area < 0
+    clockwise = _signed_area(xy, t[:, :nv]) < 0
     if clockwise.any():
         t[clockwise] = t[clockwise][:, reverse]
         log.debug("%s: %d clockwise elements reordered", what, int(clockwise.sum()))
-    if nv == 4:
-        corner = _corner_turns(xy, t[:, :4])
-        bad = np.flatnonzero((corner <= 0).any(axis=1))
-        if bad.size:
-            raise InputError(f"{what}: {bad.size} quadrilateral(s) not convex or twisted (the "
-                             f"first at {xy[t[bad[0], :4]].round(6).tolist()})")
 
     p = np.ascontiguousarray(xy.T)
     if mesh_type is MeshTri1:
@@ -392,6 +381,9 @@ def _build(raw, selected: tuple[str, np.ndarray], what: str) -> tuple[Mesh, np.n
     if mesh.nvertices != len(vertices) or not same:
         raise InputError(f"{what}: the elements do not form a valid mesh (the quadratic nodes "
                          f"are not shared between neighbouring elements)")
+    # degenerate, inverted or overlapping elements, duplicate nodes, several pieces (element
+    # numbers are those of the selection, in the file's order)
+    check_mesh(mesh, what)
     old_to_vertex = np.full(len(raw.points), -1, dtype=np.int64)
     old_to_vertex[used] = new_to_vertex
     return mesh, old_to_vertex
@@ -401,14 +393,6 @@ def _signed_area(xy: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Signed areas (shoelace) of the polygons ``t`` (n, corners): positive counter-clockwise."""
     x, y = xy[t, 0], xy[t, 1]
     return 0.5 * np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
-
-
-def _corner_turns(xy: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Cross products of the two edges at each corner: all positive for a convex CCW polygon."""
-    a = xy[t]
-    before = a - np.roll(a, 1, axis=1)
-    after = np.roll(a, -1, axis=1) - a
-    return before[..., 0] * after[..., 1] - before[..., 1] * after[..., 0]
 
 
 # -- boundaries ------------------------------------------------------------------------------------

@@ -11,24 +11,55 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.spatial import Delaunay, cKDTree
+from scipy.spatial import Delaunay, QhullError, cKDTree
 from skfem import MeshQuad, MeshTri
+
+#: The most nodes a built-in shape makes. Far more is a slip in its parameters (a size of 1e-9,
+#: a count of 1e9) much more often than a wish, and would take minutes or all the memory just to
+#: mesh; what the solver can afford is estimated separately (:mod:`vfem.memory`).
+MAX_NODES = 2_000_000
+#: The most nodes :func:`march` puts on one line (it steps in Python: about a second).
+MAX_LINE_NODES = 200_000
+
+
+def check_count(count: float, what: str) -> None:
+    """Refuse (``ValueError``) parameters that would make more than :data:`MAX_NODES` nodes."""
+    if not count <= MAX_NODES:  # also NaN
+        raise ValueError(f"{what} would make about {count:.3g} nodes, more than the "
+                         f"{MAX_NODES:,} a built-in shape may have; check its sizes and counts")
 
 
 def size_function(h_contact: float, growth: float, h_max: float, plateau: float = 0.0
                   ) -> Callable:
-    """h(d): ``h_contact`` up to distance ``plateau``, then growing linearly up to ``h_max``."""
+    """h(d): ``h_contact`` up to distance ``plateau``, then growing linearly up to ``h_max``.
+
+    Raises ``ValueError`` unless the sizes are positive and ``growth`` and ``plateau`` are not
+    negative: a size that shrinks to zero would never finish a mesh."""
+    if not (h_contact > 0 and h_max > 0):
+        raise ValueError(f"element sizes must be positive, got h_contact = {h_contact}, "
+                         f"h_max = {h_max}")
+    if not (growth >= 0 and plateau >= 0):
+        raise ValueError(f"growth and plateau must not be negative, got growth = {growth}, "
+                         f"plateau = {plateau}")
     return lambda d: np.minimum(
         h_contact + growth * np.maximum(np.asarray(d, dtype=float) - plateau, 0.0), h_max)
 
 
 def march(length: float, h: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-    """Positions 0 = s_0 < ... < s_n = length with spacing following ``h(s)``.
+    """Positions 0 = s_0 < ... < s_n = length with spacing following ``h(s)`` (positive).
 
     The spacing is stretched uniformly so the last interval ends exactly at ``length``.
     """
+    if not 0 < length < np.inf:
+        raise ValueError(f"lengths must be positive, got {length}")
+    if not float(h(0.0)) >= 1e-9 * length:  # a size round-off cannot resolve, or NaN
+        raise ValueError(f"element size {float(h(0.0)):.3g} is too small for a line of length "
+                         f"{length:.6g} (less than 1e-9 of it); check the sizes")
     s = [0.0]
     while s[-1] < length:
+        if len(s) > MAX_LINE_NODES:
+            raise ValueError(f"the element sizes would put more than {MAX_LINE_NODES:,} nodes "
+                             f"on a line of length {length:.6g}; check the sizes")
         s.append(s[-1] + float(h(s[-1])))
     s = np.array(s)
     if len(s) > 2 and (s[-1] - length) > 0.5 * (s[-1] - s[-2]):
@@ -44,6 +75,8 @@ def graded_quarter_disk(radius: float, h_contact: float, h_max: float,
     boundaries: ``contact`` (the arc), ``symmetry`` (x = 0) and ``top`` (y = radius).
     """
     R = radius
+    if not R > 0:
+        raise ValueError(f"radius must be positive, got {R}")
     h = size_function(h_contact, growth, h_max, plateau)
 
     # Boundary points, spaced by h of their distance from the origin.
@@ -60,11 +93,13 @@ def graded_quarter_disk(radius: float, h_contact: float, h_max: float,
 
     # Interior points on half rings around the origin, clipped to the domain.
     interior = []
-    rho = float(h(0.0))
+    rho, count = float(h(0.0)), len(s_arc) + len(ys) + len(xs)
     while rho < np.sqrt(2) * R:
         lo = np.arccos(min(1.0, R / rho))  # below the top edge y = R
         hi = np.arccos(min(1.0, rho / (2 * R)))  # above the arc
         if hi > lo:
+            count += rho * (hi - lo) / float(h(rho))
+            check_count(count, "graded_quarter_disk")
             n = max(1, int(round(rho * (hi - lo) / float(h(rho)))))
             phi = lo + (hi - lo) * np.arange(1, n) / n
             interior.append(np.column_stack([rho * np.sin(phi), rho * np.cos(phi)]))
@@ -89,7 +124,10 @@ def graded_layer(width: float, thickness: float, h_contact: float, h_max: float,
 
     Named boundaries: ``contact`` (top, y = 0), ``bottom``, ``symmetry`` (x = 0), ``right``.
     """
+    if not (thickness > 0 and layers >= 1):
+        raise ValueError(f"need thickness > 0 and layers >= 1, got {thickness} and {layers}")
     x = march(width, size_function(h_contact, growth, h_max, plateau))
+    check_count(len(x) * (layers + 1.0), "graded_layer")
     y = np.linspace(-thickness, 0.0, layers + 1)
     mesh = MeshQuad.init_tensor(x, y)
     tol = 1e-9 * max(width, thickness)
@@ -102,8 +140,13 @@ def graded_layer(width: float, thickness: float, h_contact: float, h_max: float,
 
 
 def _delaunay(p: np.ndarray) -> np.ndarray:
-    """Delaunay triangles of a convex point set, without degenerate ones, counter-clockwise."""
-    t = Delaunay(p).simplices
+    """Delaunay triangles of a convex point set, without degenerate ones, counter-clockwise
+    (``ValueError`` if the points make none: sizes that leave too few of them)."""
+    try:
+        t = Delaunay(p).simplices
+    except QhullError as exc:
+        raise ValueError(f"the nodes cannot be triangulated ({str(exc).splitlines()[0]})"
+                         ) from None
     a, b, c = p[t[:, 0]], p[t[:, 1]], p[t[:, 2]]
     area = 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1])
                   - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))

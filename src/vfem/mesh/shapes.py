@@ -30,10 +30,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 
 import numpy as np
-from scipy.spatial import Delaunay, cKDTree
+from scipy.spatial import Delaunay, QhullError, cKDTree
 from skfem import MeshQuad, MeshTri
 
-from .parametric import march, size_function
+from .parametric import check_count, march, size_function
 
 __all__ = [
     "block", "gasket", "gasket_pair", "graded_nodes", "rectangle", "wedge", "wedge_grid",
@@ -63,6 +63,8 @@ def wedge_plate(half_width: float = 5.0, thickness: float = 1.0, h_contact: floa
     thesis), ``symmetry`` (x = 0) and ``right`` (x = half_width).
     """
     W, T = float(half_width), float(thickness)
+    if not (W > 0 and T > 0):
+        raise ValueError(f"need half_width > 0 and thickness > 0, got {W} and {T}")
     h = size_function(h_contact, growth, h_max, plateau)
     mesh = _graded_trapezoid(W, lower=(-T, -T), upper=(0.0, 0.0), focus=(0.0, 0.0), h=h)
     tol = 1e-9 * max(W, T)
@@ -124,6 +126,8 @@ def wedge_plate_grid(half_width: float = 5.0, thickness: float = 1.0, columns: i
     Fig. 5.4. Named boundaries as :func:`wedge_plate`.
     """
     W, T = float(half_width), float(thickness)
+    if not (W > 0 and T > 0):
+        raise ValueError(f"need half_width > 0 and thickness > 0, got {W} and {T}")
     x = _wedge_columns(W, loaded_width, columns)
     tol = 1e-9 * max(W, T)
     return _mapped_quads(x, lambda s: -T + 0 * s, lambda s: 0 * s, rows).with_boundaries({
@@ -161,6 +165,10 @@ def _wedge_columns(W: float, loaded_width: float | None, n: int) -> np.ndarray:
     b = W / 5.0 if loaded_width is None else float(loaded_width)
     if not 0.0 < b <= W:
         raise ValueError(f"loaded_width must lie in (0, half_width], got {b}")
+    check_count(n + 1.0, "columns")
+    if n < 1 or (b < W and n < 2):
+        raise ValueError(f"columns must be at least {1 if b == W else 2} (one on each side of "
+                         f"loaded_width), got {n}")
     if b < W:
         n1 = min(max(1, round(n * b / W)), n - 1)  # columns under the loaded part
         return np.concatenate([np.linspace(0.0, b, n1 + 1), np.linspace(b, W, n - n1 + 1)[1:]])
@@ -170,6 +178,9 @@ def _wedge_columns(W: float, loaded_width: float | None, n: int) -> np.ndarray:
 def _mapped_quads(x: np.ndarray, lower, upper, rows: int) -> MeshQuad:
     """Quadrilaterals between y = lower(x) and y = upper(x) on the columns ``x``, counter-
     clockwise, ``rows`` of them evenly spaced at each x."""
+    if rows < 1:
+        raise ValueError(f"rows must be at least 1, got {rows}")
+    check_count(len(x) * (rows + 1.0), "columns x rows")
     s = np.linspace(0.0, 1.0, rows + 1)
     X, S = np.meshgrid(x, s, indexing="ij")
     Y = lower(X) + S * (upper(X) - lower(X))
@@ -218,9 +229,11 @@ def _graded_trapezoid(width: float, lower: tuple[float, float], upper: tuple[flo
 
     # Interior nodes on rings about the focus, kept if well inside the domain.
     reach = np.max(np.linalg.norm(corners - f, axis=1))
-    rings, rho = [], float(h(0.0))
+    rings, rho, count = [], float(h(0.0)), float(len(bnd))
     while rho < reach:
         hr = float(h(rho))
+        count += 2.0 * np.pi * rho / hr
+        check_count(count, "the element sizes")
         n = max(2, int(np.ceil(2.0 * np.pi * rho / hr)))
         phi = 2.0 * np.pi * np.arange(n) / n
         rings.append(f + rho * np.column_stack([np.cos(phi), np.sin(phi)]))
@@ -282,9 +295,14 @@ def _triangulate(q: np.ndarray, p: np.ndarray) -> np.ndarray:
 
     ``q`` are the points in the coordinates used for the connectivity, ``p`` the same points
     where the mesh lives. Degenerate triangles (zero area in ``q``) are dropped; every point
-    must still belong to some triangle.
+    must still belong to some triangle. Raises ``ValueError`` where the parameters make no
+    such triangulation (e.g. a body too thin for its element sizes).
     """
-    t = Delaunay(q).simplices
+    try:
+        t = Delaunay(q).simplices
+    except QhullError as exc:
+        raise ValueError(f"the nodes cannot be triangulated ({str(exc).splitlines()[0]})"
+                         ) from None
     keep = np.abs(_polygon_areas(q.T, t.T)) > 1e-12 * np.ptp(q, axis=0).max() ** 2
     t = t[keep]
     area = _polygon_areas(p.T, t.T)
@@ -319,6 +337,7 @@ def graded_nodes(a: float, b: float, h: Callable[[np.ndarray], np.ndarray]) -> n
     xs = np.linspace(a, b, 4001)
     inv = 1.0 / np.asarray(h(xs), dtype=float)
     N = np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(xs))])
+    check_count(N[-1], "the element sizes along a line")
     n = max(1, int(np.ceil(N[-1] - 1e-6)))
     x = np.interp(np.arange(n + 1) * N[-1] / n, N, xs)
     x[0], x[-1] = a, b
@@ -347,6 +366,7 @@ def block(x0: float, y0: float, width: float, height: float, h: float, *,
         raise ValueError(f"symmetry must be None, 'left' or 'right', got {symmetry!r}")
     x = _grid_line(x0, x1, h, h_fine, growth, fine_x)
     y = _grid_line(y0, y1, h, h_fine, growth, fine_y)
+    check_count(float(len(x)) * len(y), "block")
     grid = (MeshTri if triangles else MeshQuad).init_tensor(x, y)
     t = _counter_clockwise(grid.p, grid.t)  # init_tensor's quadrilaterals are clockwise
     mesh = MeshTri(grid.p, t, sort_t=False) if triangles else MeshQuad(grid.p, t)
@@ -371,6 +391,7 @@ def rectangle(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: floa
     """
     if width <= 0 or height <= 0 or nx < 1 or ny < 1:
         raise ValueError("need width, height > 0 and nx, ny >= 1")
+    check_count((nx + 1.0) * (ny + 1.0), "rectangle")
     x = np.linspace(x0, x0 + width, int(nx) + 1)
     y = np.linspace(y0, y0 + height, int(ny) + 1)
     grid = (MeshTri if triangles else MeshQuad).init_tensor(x, y)
@@ -397,6 +418,7 @@ def rounded_punch(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: 
     half = 0.5 * width
     if width <= 0 or radius < half or nx < 1 or ny < 1:
         raise ValueError("need width > 0, radius >= width / 2 and nx, ny >= 1")
+    check_count((nx + 1.0) * (ny + 1.0), "rounded_punch")
     sag = radius - np.sqrt(radius**2 - half**2)
     if height <= sag:
         raise ValueError(f"height must exceed the arc's sag {sag:.6g}")
@@ -428,7 +450,10 @@ def rounded_punch(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: 
 def _grid_line(a: float, b: float, h: float, h_fine: float | None, growth: float,
                fine: Sequence[float]) -> np.ndarray:
     """Grid positions on [a, b]: uniform (spacing <= h), or graded towards ``fine``."""
+    if not h > 0:
+        raise ValueError(f"the element size h must be positive, got {h}")
     if h_fine is None or len(fine) == 0:
+        check_count((b - a) / h, "the element size h")
         return np.linspace(a, b, max(1, int(np.ceil((b - a) / h - 1e-9))) + 1)
     f = np.asarray(fine, dtype=float)
     size = size_function(h_fine, growth, h)
@@ -476,6 +501,9 @@ def gasket(centre: tuple[float, float] = (0.0, 0.0), radius: float = 1.0,
         raise ValueError(f"opening must be one of {sorted(OPENINGS)}, got {opening!r}")
     if not 0.0 < thickness < radius:
         raise ValueError("need 0 < thickness < radius")
+    if n_around < 1 or n_through < 1:
+        raise ValueError(f"need n_around, n_through >= 1, got {n_around} and {n_through}")
+    check_count((n_around + 1.0) * (n_through + 1.0), "gasket")
     c = np.asarray(centre, dtype=float)
     o = np.asarray(OPENINGS[opening])
     middle = np.arctan2(-o[1], -o[0])

@@ -1,0 +1,188 @@
+"""How much memory an analysis needs, estimated before anything is factorized.
+
+A model too large for the machine should stop at once with a message saying so, not after
+minutes of swapping or with the operating system's out-of-memory killer. :func:`check_memory`
+estimates the peak memory of setting the bodies up (:meth:`vfem.solver.Analysis.setup`: assembly,
+SuperLU factorization, the flexibility on the contact surfaces) from the meshes and the contact
+surfaces alone, logs it, and raises :class:`~vfem.errors.AnalysisError` when it exceeds the
+memory available (:func:`available_memory`). :func:`memory_guard` turns a ``MemoryError`` that
+gets through anyway into the same kind of message.
+
+The model (bytes), per body, summed over the bodies:
+
+    FACTOR_BYTES * nnz(L + U)  +  DENSE_BYTES * m**2  +  STIFFNESS_BYTES * nnz(K)
+
+plus ``BASE_BYTES``, plus ``PAIR_BYTES * nc_i * nc_j`` per pair of contact surfaces that may
+touch, plus ``LARGE_BYTES * ndofs * 2 nc`` per large-kinematics body (its tangent flexibility
+for the candidate dofs is dense, ndofs x 2 nc, built in each Newton iteration). Here
+
+* ``nnz(K)`` is its structural count, from the mesh: 4 (points + 2 pairs of points sharing an
+  element), the pairs being C(k, 2) per element of k points less those counted twice on shared
+  edges;
+* ``m = 2 nt`` is the number of tracked dofs (candidate and rind nodes: ``ContactSurface.nodes``),
+  ordered last in the factorization; the dense inverse on them (and its few temporaries) is
+  what grows fastest when a contact surface is long;
+* ``nnz(L + U)`` is SuperLU's fill with vfem's ordering (minimum degree on the node graph, the
+  tracked dofs last), modelled as ``ndofs * max(20, 22 log2(ndofs) - 140) + 0.6 m**2``: the
+  n log n growth of a minimum-degree factor of a 2D mesh plus the trailing block.
+
+The constants were fitted (``benchmarks/memory_model.py`` repeats the measurements) to the peak
+resident memory of ``Analysis.setup`` and SuperLU's nnz(L + U) on two rectangular bodies in
+contact, linear and quadratic triangles and quadrilaterals, 460 to 103,000 dofs a body, and on
+two long thin strips whose whole faces are candidates (up to 4,000 tracked dofs a body): the fill
+model gives 1.0 to 1.5 times SuperLU's nnz(L + U), and the whole estimate 1.05 to 1.85 times the
+measured peak (1.05 to 1.5 above 100 MiB), so it errs on the side of caution. Other backends or
+far more irregular meshes fill differently; the estimate is a guide, not a bound.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from .errors import AnalysisError
+
+log = logging.getLogger(__name__)
+
+#: Bytes per entry of SuperLU's factors: values and indices, and the transient copies of L and U
+#: the trailing block is read from.
+FACTOR_BYTES = 28
+#: Bytes per entry of the square of the tracked dofs: the dense Schur complement, its inverse,
+#: the flexibility kept by the body and by its contact surface.
+DENSE_BYTES = 28
+#: Bytes per stiffness entry: the assembled matrix, its free block, the reordered copy that is
+#: factorized, and scikit-fem's element-by-element assembly arrays.
+STIFFNESS_BYTES = 64
+#: Bytes per product of two contact surfaces' candidate counts (the paired variant's transfer
+#: and mass matrices and its condensed flexibility).
+PAIR_BYTES = 32
+#: Bytes per entry of a large-kinematics body's dense tangent flexibility (ndofs x 2 nc) and its
+#: right-hand sides.
+LARGE_BYTES = 24
+#: What Python, NumPy and scikit-fem hold besides (measured: about 15 MB).
+BASE_BYTES = 16 * 2**20
+
+
+def factor_entries(ndofs: int, tracked: int) -> float:
+    """Estimated nnz(L + U) of a body's SuperLU factors with ``tracked`` dofs ordered last."""
+    if ndofs <= 0:
+        return 0.0
+    per_dof = max(20.0, 22.0 * math.log2(max(ndofs, 2)) - 140.0)
+    return ndofs * per_dof + 0.6 * float(tracked) ** 2
+
+
+def stiffness_entries(body) -> int:
+    """Structural nnz of a body's stiffness, from its mesh (nothing assembled)."""
+    mesh = body.mesh
+    k = body.element().doflocs.shape[0]  # points per element
+    per_facet = 1 if body.order == 1 else 3  # pairs of points on a shared edge
+    interior = int((mesh.f2t[1] >= 0).sum())
+    pairs = k * (k - 1) // 2 * mesh.nelements - per_facet * interior
+    return 4 * (body.npoints + 2 * pairs)
+
+
+def estimate(surfaces, pairs=()) -> dict[str, float]:
+    """Estimated peak bytes of the set-up, by part: ``{"total", "factors", "dense", "stiffness",
+    "pairs", "large"}`` (see the module docstring for the model)."""
+    parts = dict.fromkeys(("factors", "dense", "stiffness", "pairs", "large"), 0.0)
+    for s in surfaces:
+        body = s.body
+        ndofs = 2 * body.npoints
+        m = 2 * len(s.nodes)
+        parts["factors"] += FACTOR_BYTES * factor_entries(ndofs, m)
+        parts["dense"] += DENSE_BYTES * float(m) ** 2
+        parts["stiffness"] += STIFFNESS_BYTES * stiffness_entries(body)
+        if body.large:
+            parts["large"] += LARGE_BYTES * ndofs * 2.0 * s.nc
+    for pair in pairs:
+        i, j = sorted(pair)
+        parts["pairs"] += PAIR_BYTES * float(surfaces[i].nc) * surfaces[j].nc
+    parts["total"] = BASE_BYTES + sum(parts.values())
+    return parts
+
+
+def available_memory() -> int | None:
+    """Bytes this process may still use, or None if it cannot be told.
+
+    The kernel's ``MemAvailable`` (free memory plus the caches it can drop; Linux), capped by
+    the memory limit of the process's control group (containers, batch schedulers) where there
+    is one; else free physical pages (``sysconf``).
+    """
+    available = None
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                available = int(line.split()[1]) * 1024
+                break
+    except (OSError, ValueError, IndexError):
+        pass
+    if available is None:
+        try:
+            available = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES")
+        except (AttributeError, ValueError, OSError):
+            return None
+    for limit_file, usage_file in (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+                                   ("/sys/fs/cgroup/memory/memory.limit_in_bytes",
+                                    "/sys/fs/cgroup/memory/memory.usage_in_bytes")):
+        try:
+            limit = Path(limit_file).read_text().strip()
+            usage = int(Path(usage_file).read_text().strip())
+        except (OSError, ValueError):
+            continue
+        if limit.isdigit() and int(limit) < 2**60:  # "max" or a huge number: no limit
+            available = min(available, max(0, int(limit) - usage))
+        break
+    return available
+
+
+def _size(n: float) -> str:
+    return f"{n / 2**30:.2f} GiB" if n >= 2**30 else f"{n / 2**20:.0f} MiB"
+
+
+def _advice(parts: dict[str, float]) -> str:
+    """What to change, from the part of the estimate that dominates."""
+    if parts["dense"] + parts["pairs"] + parts["large"] > parts["factors"] + parts["stiffness"]:
+        return ("the contact surfaces dominate: fewer contact candidates (contact_boundaries, "
+                "a smaller contact.search_distance) or coarser elements along them")
+    return "the bodies' meshes dominate: coarser meshes away from the contact"
+
+
+def check_memory(surfaces, pairs=()) -> dict[str, float]:
+    """Log the estimated memory of the set-up and refuse a model that cannot fit.
+
+    Raises:
+        AnalysisError: the estimate exceeds :func:`available_memory`; the message gives both
+            and what to change.
+    """
+    parts = estimate(surfaces, pairs)
+    available = available_memory()
+    log.info("estimated memory for the set-up: %s (factors %s, dense contact matrices %s, "
+             "stiffness %s); available: %s", _size(parts["total"]), _size(parts["factors"]),
+             _size(parts["dense"] + parts["pairs"] + parts["large"]), _size(parts["stiffness"]),
+             "unknown" if available is None else _size(available))
+    if available is not None and parts["total"] > available:
+        raise AnalysisError(
+            f"the analysis needs about {_size(parts['total'])} of memory (estimated before "
+            f"factorizing: factors {_size(parts['factors'])}, dense contact matrices "
+            f"{_size(parts['dense'] + parts['pairs'] + parts['large'])}, stiffness "
+            f"{_size(parts['stiffness'])}) but only {_size(available)} is available; "
+            f"{_advice(parts)}")
+    return parts
+
+
+@contextmanager
+def memory_guard(what: str) -> Iterator[None]:
+    """Turn a ``MemoryError`` raised while doing ``what`` into an :class:`AnalysisError`."""
+    try:
+        yield
+    except MemoryError:
+        available = available_memory()
+        raise AnalysisError(
+            f"out of memory while {what}"
+            + ("" if available is None else f" ({_size(available)} available now)")
+            + "; use coarser meshes or fewer contact candidates (contact_boundaries, a smaller "
+            "contact.search_distance)") from None

@@ -1,0 +1,180 @@
+"""Checks of a body's mesh before anything is assembled, whatever made the mesh.
+
+A mesh can be wrong in ways that the solver would only show much later, or not at all: a
+stiffness that will not factorize (a node in no element, a piece with nothing holding it), a
+crack no one asked for (two nodes at one position, left unmerged by a mesher), elements that
+overlap or turn inside out (negative Jacobian). :func:`check_mesh` finds these for any body —
+parametric shapes with user parameters, imported files, meshes built in Python — and raises one
+:class:`~vfem.errors.InputError` naming the body, the problem, the first offending element or
+node with its coordinates, and what to do. :meth:`vfem.bodies.Body.validate` calls it, so
+``vfem check``, ``vfem run`` and :meth:`vfem.solver.Model.validate` all go through it.
+
+Node numbers in messages are the body's (as in its results files; an imported mesh keeps only
+the body's nodes, numbered in their order in the file); the coordinates locate them in any
+numbering. The checks, in the order they run (the first failure is reported):
+
+1. coordinates are finite numbers;
+2. every node belongs to an element;
+3. no element is degenerate (zero area) or inverted within itself (its Jacobian determinant,
+   sampled on a lattice of points that holds the corners, changes sign: a twisted or
+   non-convex quadrilateral, a curved edge bowed past the element's other side);
+4. no two nodes share a position (within 1e-12 of the mesh's size);
+5. no element overlaps a neighbour: the two elements of an interior edge lie on opposite sides
+   of it (an element folded over its neighbour, e.g. a node moved past the opposite edge, is
+   inverted relative to the mesh even when it is fine by itself). Orientation-independent, so
+   scikit-fem meshes whose element nodes are sorted (mixed orientation) pass;
+6. the elements form one piece (connected through shared nodes).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+from skfem import Mesh, MeshTri
+
+from ..errors import InputError
+
+#: Two nodes closer than this times the mesh's size are one position (an unmerged mesh).
+DUPLICATE_TOLERANCE = 1e-12
+#: An element whose Jacobian determinant is below this times its longest edge squared has
+#: (locally) no area: a collapsed edge, three corners in a line.
+DEGENERATE_TOLERANCE = 1e-10
+
+
+def check_mesh(mesh: Mesh, where: str) -> None:
+    """Raise :class:`InputError` (prefixed ``where``, e.g. ``"body 'flat'"``) at the first
+    problem of ``mesh``: see the module docstring for the checks and their order."""
+    nv = mesh.nvertices
+    p = np.asarray(mesh.p[:, :nv], dtype=float)
+    t = np.asarray(mesh.t)
+    bad = np.flatnonzero(~np.isfinite(mesh.doflocs).all(axis=0))
+    if bad.size:
+        raise InputError(f"{where}: node {bad[0]} has coordinates that are not finite numbers "
+                         f"({_xy(mesh.doflocs[:, bad[0]])}); check the mesh's parameters or file")
+    used = np.zeros(nv, dtype=bool)
+    used[t.ravel()] = True
+    if not used.all():
+        k = int(np.flatnonzero(~used)[0])
+        raise InputError(f"{where}: {int((~used).sum())} node(s) belong to no element (the first: "
+                         f"node {k} at {_xy(p[:, k])}), so their stiffness is zero; remove them "
+                         "from the mesh")
+    _check_elements(mesh, p, t, where)
+    _check_duplicates(p, where)
+    _check_folds(mesh, p, where)
+    _check_pieces(p, t, where)
+
+
+def _xy(point) -> str:
+    """A point as the messages print it: ``(x, y)``, 6 significant digits."""
+    return f"({float(point[0]):.6g}, {float(point[1]):.6g})"
+
+
+def _corners(p: np.ndarray, t: np.ndarray, e: int) -> str:
+    return "[" + ", ".join(_xy(p[:, v]) for v in t[:, e]) + "]"
+
+
+def _reference_lattice(tri: bool, n: int = 4) -> np.ndarray:
+    """(2, k) points of the reference element where the Jacobian is sampled: the corners, the
+    edge midpoints and a lattice inside (degree ``n``); scikit-fem's reference triangle is
+    (0,0), (1,0), (0,1) and its square [0, 1]^2."""
+    s = np.arange(n + 1) / n
+    X, Y = np.meshgrid(s, s, indexing="ij")
+    X, Y = X.ravel(), Y.ravel()
+    if tri:
+        keep = X + Y <= 1 + 1e-12
+        X, Y = X[keep], Y[keep]
+    return np.vstack([X, Y])
+
+
+def _check_elements(mesh: Mesh, p: np.ndarray, t: np.ndarray, where: str) -> None:
+    """Degenerate elements (no area somewhere) and elements inverted within themselves."""
+    corners = p[:, t]  # (2, nodes, ne)
+    with np.errstate(invalid="ignore", over="ignore"):  # coordinates near overflow
+        edge2 = np.max([np.sum((corners[:, (i + 1) % len(t)] - corners[:, i]) ** 2, axis=0)
+                        for i in range(len(t))], axis=0)
+        if type(mesh).__name__ == "MeshTri1":  # affine: one determinant per element
+            a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+            det = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))[:, None]
+        else:  # a bilinear quadrilateral's determinant is linear in x and y: its corners do
+            lattice = 1 if type(mesh).__name__ == "MeshQuad1" else 4
+            X = _reference_lattice(isinstance(mesh, MeshTri), lattice)
+            J = mesh._mapping().J  # (scikit-fem's own detDF refuses a zero determinant)
+            det = J(0, 0, X) * J(1, 1, X) - J(0, 1, X) * J(1, 0, X)
+    det = np.where(np.isfinite(det), det, 0.0)  # overflowed: no usable geometry either
+    small = np.abs(det) <= DEGENERATE_TOLERANCE * edge2[:, None]
+    flips = (det.min(axis=1) < 0) & (det.max(axis=1) > 0)
+    degenerate = np.flatnonzero(small.any(axis=1) & ~flips)
+    inverted = np.flatnonzero(flips)
+    if inverted.size:
+        e = int(inverted[0])
+        raise InputError(
+            f"{where}: {inverted.size} element(s) are inverted: the Jacobian changes sign inside "
+            f"them (the first: element {e}, corners at {_corners(p, t, e)}): a twisted or "
+            "non-convex quadrilateral, or a curved edge bowed past the element's other side; "
+            "fix the mesh or the shape's parameters")
+    if degenerate.size:
+        e = int(degenerate[0])
+        raise InputError(
+            f"{where}: {degenerate.size} element(s) have zero area (the first: element {e}, "
+            f"corners at {_corners(p, t, e)}): corners that coincide or lie in a line; fix the "
+            "mesh or the shape's parameters")
+
+
+def _check_duplicates(p: np.ndarray, where: str) -> None:
+    """Two nodes at one position: elements on either side of them are not connected."""
+    size = float(np.max(np.ptp(p, axis=1))) if p.shape[1] else 0.0
+    pairs = cKDTree(p.T).query_pairs(DUPLICATE_TOLERANCE * max(size, 1e-300),
+                                     output_type="ndarray")
+    if len(pairs):
+        pairs = np.sort(pairs, axis=1)
+        i, j = (int(v) for v in pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))][0])
+        raise InputError(
+            f"{where}: {len(pairs)} pair(s) of nodes at the same position (the first: nodes {i} "
+            f"and {j}, at {_xy(p[:, i])}): an unmerged mesh, with a crack between the elements "
+            "on either side; merge the duplicate nodes (gmsh: Coherence) or give each piece its "
+            "own body")
+
+
+def _check_folds(mesh: Mesh, p: np.ndarray, where: str) -> None:
+    """Neighbours on the same side of their shared edge: one of them is folded over the other."""
+    f2t = mesh.f2t
+    interior = np.flatnonzero(f2t[1] >= 0)
+    if not interior.size:
+        return
+    a, b = p[:, mesh.facets[0, interior]], p[:, mesh.facets[1, interior]]
+    centre = p[:, mesh.t].mean(axis=1)  # (2, ne)
+
+    def side(e):
+        c = centre[:, e]
+        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+    folded = np.flatnonzero(side(f2t[0, interior]) * side(f2t[1, interior]) > 0)
+    if folded.size:
+        f = int(interior[folded[0]])
+        e1, e2 = (int(e) for e in f2t[:, f])
+        raise InputError(
+            f"{where}: {folded.size} pair(s) of neighbouring elements overlap: an inverted "
+            f"(folded) element (the first: elements {e1} and {e2} lie on the same side of their "
+            f"shared edge from {_xy(p[:, mesh.facets[0, f]])} to {_xy(p[:, mesh.facets[1, f]])}); "
+            "fix the mesh or the shape's parameters")
+
+
+def _check_pieces(p: np.ndarray, t: np.ndarray, where: str) -> None:
+    """Elements not connected through shared nodes: a body must be one piece."""
+    nv, ne = p.shape[1], t.shape[1]
+    rows = np.repeat(np.arange(ne), t.shape[0])
+    incidence = sp.csr_matrix((np.ones(rows.size), (rows, t.T.ravel())), shape=(ne, nv))
+    graph = sp.bmat([[None, incidence], [incidence.T, None]], format="csr")
+    count, labels = connected_components(graph, directed=False)
+    if count > 1:
+        element_label = labels[:ne]
+        sizes = np.bincount(element_label, minlength=count)
+        smallest = int(np.argmin(np.where(sizes > 0, sizes, ne + 1)))
+        node = int(np.flatnonzero(labels[ne:] == smallest)[0])
+        raise InputError(
+            f"{where}: the mesh is {count} separate pieces (elements not connected through "
+            f"shared nodes); the smallest, {int(sizes[smallest])} element(s), has node {node} at "
+            f"{_xy(p[:, node])}. A piece that nothing holds makes the stiffness singular: give "
+            "each piece its own body, or merge the nodes where the pieces should join")

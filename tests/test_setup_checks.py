@@ -1,0 +1,157 @@
+"""Checks before the first step: bodies that start interpenetrated, and the memory estimate."""
+
+import numpy as np
+import pytest
+
+import vfem.memory
+from vfem import Body, LinearElastic, Model, PrescribedDisplacement, Support
+from vfem.cli import main
+from vfem.errors import AnalysisError, InputError
+from vfem.mesh import rectangle
+from vfem.solver import Analysis
+
+E = 1000.0
+
+
+def blocks(overlap: float, lower_rows: int = 4, refine: int = 1, triangles: bool = False,
+           nu: float = 0.0) -> Model:
+    """A unit block pressed into another by starting ``overlap`` deep in it, both held at their
+    far faces; nu = 0, so the answer is one-dimensional: p = E overlap / (H_lower + H_upper).
+    The lower block's elements are 1 / (``lower_rows`` ``refine``) deep (its rind); ``nu`` other
+    than 0 for a stiffness without entries that cancel."""
+    mat = LinearElastic(E, nu)
+    n = refine
+    lower = Body("lower", rectangle(0.0, -1.0, 1.0, 1.0, nx=2 * n, ny=lower_rows * n,
+                                    triangles=triangles), mat,
+                 supports=(Support("bottom"),), contact_boundaries=("top",))
+    upper = Body("upper", rectangle(0.0, -overlap, 1.0, 1.0, nx=3 * n, ny=3 * n,
+                                    triangles=triangles), mat,
+                 supports=(Support("top"),), contact_boundaries=("bottom",))
+    return Model("start", [lower, upper])
+
+
+def test_an_overlap_within_the_rind_is_resolved_by_the_first_step():
+    result = Analysis(blocks(0.05)).run()
+    assert result.converged
+    upper = result.steps[-1].bodies["upper"]
+    on = upper.contact_status == 1
+    assert on.sum() == 4  # the whole bottom face
+    assert np.allclose(upper.contact_pressure[on], E * 0.05 / 2.0, rtol=1e-6)
+
+
+def test_an_overlap_deeper_than_the_rind_is_refused_before_anything_is_factorized():
+    analysis = Analysis(blocks(0.3))  # rows 0.25 deep
+    with pytest.raises(InputError) as info:
+        analysis.setup()
+    message = str(info.value)
+    assert "bodies 'upper' and 'lower' start deeply interpenetrated" in message
+    assert "lies 0.3 inside 'lower'" in message and "(0.25;" in message
+    assert "Move the bodies apart" in message
+    assert not hasattr(analysis.model.bodies[0], "factor")
+    # the same overlap with deeper surface elements is within their rind: allowed
+    Analysis(blocks(0.3, lower_rows=2)).setup()
+
+
+def test_a_body_behind_a_thin_one_is_not_inside_it():
+    """Depth is measured to the candidate surface, but only nodes inside the other body count:
+    a block under a thin plate whose lower face is not a contact candidate starts apart."""
+    mat = LinearElastic(E, 0.3)
+    plate = Body("plate", rectangle(0.0, 0.0, 3.0, 0.1, nx=6, ny=1), mat,
+                 supports=(Support("left"),), contact_boundaries=("top",))
+    below = Body("below", rectangle(1.0, -1.05, 1.0, 1.0, nx=2, ny=2), mat,
+                 supports=(Support("bottom"),), prescribed=(
+                     PrescribedDisplacement("top", "y", 0.0),))
+    from vfem.contact.settings import ContactSettings
+
+    Model("m", [plate, below], ContactSettings(search_distance=1.0)).contact_surfaces()
+
+
+# -- memory -------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("triangles", [False, True], ids=["quadrilaterals", "triangles"])
+def test_fill_model_is_close_to_superlus_factors(triangles):
+    """The documented model of nnz(L + U) against SuperLU itself (vfem.memory's docstring):
+    cautious, within twice the actual fill, on bodies of about 2,000 dofs."""
+    analysis = Analysis(blocks(0.01, refine=12, triangles=triangles, nu=0.3))
+    analysis.setup()
+    for s in analysis.surfaces:
+        b = s.body
+        structural = vfem.memory.stiffness_entries(b)  # entries that cancel are not stored
+        assert b.K.nnz <= structural <= 1.2 * b.K.nnz
+        lu = b.factor._lu
+        actual = lu.L.nnz + lu.U.nnz
+        assert actual <= vfem.memory.factor_entries(b.ndofs, len(s.tracked_dofs)) <= 2 * actual
+
+
+def test_a_model_larger_than_the_memory_available_is_refused(monkeypatch, caplog):
+    monkeypatch.setattr(vfem.memory, "available_memory", lambda: 2**20)
+    analysis = Analysis(blocks(0.05))
+    with caplog.at_level("INFO", logger="vfem.memory"):
+        with pytest.raises(AnalysisError) as info:
+            analysis.setup()
+    message = str(info.value)
+    assert "the analysis needs about" in message and "only 1 MiB is available" in message
+    assert "coarser meshes" in message
+    assert "estimated memory for the set-up" in caplog.text
+    assert not hasattr(analysis.model.bodies[0], "factor")  # stopped before factorizing
+
+
+def test_unknown_available_memory_skips_the_check(monkeypatch):
+    monkeypatch.setattr(vfem.memory, "available_memory", lambda: None)
+    Analysis(blocks(0.05)).setup()
+
+
+def test_available_memory_is_a_positive_number_here():
+    available = vfem.memory.available_memory()
+    assert available is None or available > 0
+
+
+def test_running_out_of_memory_anyway_is_a_clear_analysis_error(monkeypatch):
+    def no_memory(self, *args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(Body, "setup", no_memory)
+    with pytest.raises(AnalysisError, match="out of memory while factorizing the bodies"):
+        Analysis(blocks(0.05)).setup()
+
+
+def test_the_command_line_reports_it_without_a_traceback(monkeypatch, tmp_path, capsys):
+    monkeypatch.setattr(vfem.memory, "available_memory", lambda: 2**20)
+    path = tmp_path / "model.toml"
+    path.write_text("""
+name = "two blocks"
+[[bodies]]
+name = "lower"
+contact_boundaries = ["top"]
+[bodies.mesh]
+shape = "rectangle"
+y0 = -1.0
+nx = 2
+ny = 2
+[bodies.material]
+youngs_modulus = 1000.0
+poissons_ratio = 0.0
+[[bodies.supports]]
+boundary = "bottom"
+[[bodies]]
+name = "upper"
+contact_boundaries = ["bottom"]
+[bodies.mesh]
+shape = "rectangle"
+nx = 3
+ny = 3
+[bodies.material]
+youngs_modulus = 1000.0
+poissons_ratio = 0.0
+[[bodies.supports]]
+boundary = "left"
+components = ["x"]
+[[bodies.prescribed]]
+boundary = "top"
+component = "y"
+value = -1e-3
+""")
+    assert main(["-q", "run", str(path), "--out", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert "needs about" in err and "Traceback" not in err
