@@ -177,14 +177,14 @@ def test_random_bytes_in_a_file_are_refused_or_read(tmp_path, content):
     accepted(lambda: load(path))
 
 
-@settings(FUZZ, max_examples=2000)
+@settings(FUZZ, max_examples=300)
 @given(mutated_example())
 def test_mutated_example_files_are_checked_or_refused(case):
     path, data = case
     accepted(lambda: check(from_data(ModelConfig, data, ""), path.parent))
 
 
-@settings(FUZZ, max_examples=200)
+@settings(FUZZ, max_examples=50)
 @given(mutated_example())
 def test_command_line_check_exits_0_or_2_without_a_traceback(tmp_path, capsys, case):
     path, data = case
@@ -224,7 +224,7 @@ def shape_parameters(draw):
     return shape, params
 
 
-@settings(FUZZ, max_examples=1500)
+@settings(FUZZ, max_examples=400)
 @given(shape_parameters())
 def test_random_shape_parameters_make_a_sound_mesh_or_are_refused(case):
     shape, params = case
@@ -331,7 +331,7 @@ def mesh_file(draw):
     return suffix, "\n".join(lines) + "\n"
 
 
-@settings(FUZZ, max_examples=1500)
+@settings(FUZZ, max_examples=300)
 @given(mesh_file(), st.sampled_from(["body", None, "bottom", "nothing"]))
 def test_random_mesh_files_are_read_and_checked_or_refused(tmp_path, case, cells):
     suffix, text = case
