@@ -185,6 +185,11 @@ class BodyConfig:
                     kinematics=self.kinematics, law=self.law)
 
 
+#: The most equal steps ``steps.count`` may ask for: each step is a contact solve, so more is a
+#: slip of the keyboard, not a plan.
+MAX_STEPS = 1_000_000
+
+
 @dataclass(frozen=True)
 class Steps:
     """The load history. Every load, prescribed displacement and platen force is scaled by the
@@ -204,6 +209,8 @@ class Steps:
             return tuple(float(f) for f in self.load_factors)
         if self.count < 1:
             raise InputError(f"steps.count must be at least 1, got {self.count}")
+        if self.count > MAX_STEPS:  # (a count of 2**63 would fill the memory)
+            raise InputError(f"steps.count must be at most {MAX_STEPS:,}, got {self.count}")
         return tuple((k + 1) / self.count for k in range(self.count))
 
 
