@@ -196,7 +196,8 @@ class Steps:
     load factor (proportional loading); each step ends at the next load factor.
 
     Attributes:
-        count: that many equal steps from 0 to 1 (used when ``load_factors`` is not given).
+        count: that many equal steps from 0 to 1 (used when ``load_factors`` is not given; at
+            most 1,000,000).
         load_factors: the load factor at the end of each step, e.g. ``[0.5, 1.0, 0.5, 0.0]``
             to load and unload; each differs from the one before, the first from 0.
     """
