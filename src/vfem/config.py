@@ -185,13 +185,19 @@ class BodyConfig:
                     kinematics=self.kinematics, law=self.law)
 
 
+#: The most equal steps ``steps.count`` may ask for: each step is a contact solve, so more is a
+#: slip of the keyboard, not a plan.
+MAX_STEPS = 1_000_000
+
+
 @dataclass(frozen=True)
 class Steps:
     """The load history. Every load, prescribed displacement and platen force is scaled by the
     load factor (proportional loading); each step ends at the next load factor.
 
     Attributes:
-        count: that many equal steps from 0 to 1 (used when ``load_factors`` is not given).
+        count: that many equal steps from 0 to 1 (used when ``load_factors`` is not given; at
+            most 1,000,000).
         load_factors: the load factor at the end of each step, e.g. ``[0.5, 1.0, 0.5, 0.0]``
             to load and unload; each differs from the one before, the first from 0.
     """
@@ -204,6 +210,8 @@ class Steps:
             return tuple(float(f) for f in self.load_factors)
         if self.count < 1:
             raise InputError(f"steps.count must be at least 1, got {self.count}")
+        if self.count > MAX_STEPS:  # (a count of 2**63 would fill the memory)
+            raise InputError(f"steps.count must be at most {MAX_STEPS:,}, got {self.count}")
         return tuple((k + 1) / self.count for k in range(self.count))
 
 
