@@ -37,12 +37,14 @@ def load(path: str | Path) -> ModelConfig:
 
 
 def solve(model: Model | ModelConfig | str | Path, out: str | Path | None = None,
-          on_step=None) -> AnalysisResult:
+          on_step=None, resume: bool = False) -> AnalysisResult:
     """Solve a model: a :class:`Model`, a :class:`ModelConfig` or the path of an input file.
 
     With ``out``, each converged step is written there as it converges (VTU files for ParaView,
-    ``results.pvd``, ``contact.csv``). ``on_step(step)`` is called after each converged step.
-    An analysis that does not converge returns with ``converged = False`` and the steps done.
+    ``results.pvd``, ``contact.csv``, a checkpoint, ``summary.json`` of the steps so far);
+    ``resume=True`` continues from the last checkpoint in ``out`` of an earlier run of the same
+    model. ``on_step(step)`` is called after each converged step. An analysis that does not
+    converge returns with ``converged = False`` and the steps done.
     """
     base = None
     if isinstance(model, (str, Path)):
@@ -54,7 +56,7 @@ def solve(model: Model | ModelConfig | str | Path, out: str | Path | None = None
         return Analysis(model).run(on_step)
     from .io.results import run_writing
 
-    return run_writing(model, Path(out), on_step)[1]
+    return run_writing(model, Path(out), on_step, resume)[1]
 
 
 __all__ = [

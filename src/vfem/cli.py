@@ -172,21 +172,21 @@ def _results_directory(args, default: Path) -> Path:
     return Path(args.resume)
 
 
-def _solve_and_report(solve, progress: Progress, report, quiet: bool, args=None,
-                      out: Path | None = None) -> int:
+def _solve_and_report(solve, progress: Progress, report, quiet: bool, args, out: Path) -> int:
     """Run ``solve()`` (-> summary) under the progress display, print ``report(summary)``;
     exit status 1 if the analysis did not converge. Interrupted (Ctrl-C, SIGTERM): say where
     the completed steps are and how to continue, exit status 130."""
     try:
         summary = solve()
     except KeyboardInterrupt:
+        summary = None
+    finally:
         progress.close()
-        sets = "".join(f" --set {a}" for a in (args.set or [])) if args else ""
+    if summary is None:
+        sets = "".join(f" --set {a}" for a in (args.set or []))
         print(f"vfem: interrupted; the steps completed are in {out}/. Continue with: vfem run "
               f"{args.example}{sets} --resume {out}", file=sys.stderr)
         return 130
-    finally:
-        progress.close()
     if not quiet:
         print("\n".join(report(summary)))
     if not summary["converged"]:
@@ -337,7 +337,8 @@ def cmd_study(args) -> int:
 
 
 def _terminated(signum, frame) -> None:
-    """SIGTERM (a job scheduler, ``kill``): stop as Ctrl-C does, between two file writes."""
+    """SIGTERM (a job scheduler, ``kill``): stop as Ctrl-C does (every file is written under a
+    temporary name and renamed, so an interrupted write leaves the completed steps whole)."""
     raise KeyboardInterrupt
 
 

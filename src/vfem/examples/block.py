@@ -140,16 +140,14 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
 def run(p: Parameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
-    from ..io.results import run_writing, write_summary
+    from ..io.results import run_example
 
-    out = Path(out)
-    model = build(p)
-    _, result = run_writing(model, out, on_step, resume)
-    summary = summarize(result, p)
-    if figures and result.steps:
-        _figures(out, model, result, p)
-    write_summary(out, summary)
-    return summary
+    def draw(model, result, summary):
+        if result.steps:
+            _figures(Path(out), model, result, p)
+
+    return run_example(build(p), out, lambda r: summarize(r, p), draw if figures else None,
+                       on_step, resume)
 
 
 def _figures(out: Path, model: Model, result: AnalysisResult, p: Parameters) -> None:

@@ -371,18 +371,11 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
 def run(p: GasketParameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
-    from pathlib import Path
+    from ..io.results import run_example
 
-    from ..io.results import run_writing, write_summary
-
-    out = Path(out)
-    model = build(p)
-    _, result = run_writing(model, out, on_step, resume)
-    summary = summarize(result, p)
-    if figures:
-        summary["figures"] = draw(result, p, out)
-    write_summary(out, summary)
-    return summary
+    return run_example(build(p), out, lambda r: summarize(r, p),
+                       (lambda model, r, summary: draw(r, p, out)) if figures else None,
+                       on_step, resume)
 
 
 def draw(result: AnalysisResult, p: GasketParameters, out) -> list[str]:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -224,39 +225,42 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
 def run(p: HertzParameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
-    from pathlib import Path
+    from ..io.results import run_example
 
+    def draw(model, result, summary):
+        if "hertz" in summary:
+            _figures(Path(out), model, result, summary, p)
+
+    return run_example(build(p), out, lambda r: summarize(r, p), draw if figures else None,
+                       on_step, resume)
+
+
+def _figures(out, model: Model, result: AnalysisResult, summary: dict,
+             p: HertzParameters) -> None:
+    """The pressure against Hertz's ellipse on both bodies, and the deformed contact region."""
     from ..io.plots import configurations, hertz_pressure
-    from ..io.results import run_writing, write_summary
 
-    out = Path(out)
-    model = build(p)
-    _, result = run_writing(model, out, on_step, resume)
-    summary = summarize(result, p)
-    if figures and "hertz" in summary:
-        th = summary["hertz"]
-        a, p0 = th["a_theory"], th["p0_theory"]
-        last = result.steps[-1]
-        xa, pp = {}, {}
-        for s in result.surfaces:
-            nodes = s.nodes[: s.nc]
-            x = s.body.points[0, nodes]
-            keep = x < 1.4 * a
-            xa[s.body.name] = x[keep] / a
-            pp[s.body.name] = last.bodies[s.body.name].contact_pressure[nodes[keep]] / p0
-        hertz_pressure(out / "pressure.png", xa, pp,
-                       f"Hertz, {summary['dofs']} dofs: p_max {th['p_max_error']:+.2%} vs p0, "
-                       f"RMS {th['rms_error_over_p0']:.2%}")
-        cyl_mesh = next(b.mesh for b in model.bodies if b.name == "cylinder")
-        tip = int(np.argmin(np.hypot(*cyl_mesh.p)))  # the first point of contact
-        y0 = float(last.bodies["cylinder"].displacement[tip, 1])
-        meshes = [(b.name, b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
-                   last.bodies[b.name].displacement[: b.mesh.nvertices]) for b in model.bodies]
-        configurations(out / "deformed.png", [("deformed", meshes)],
-                       f"Hertz: contact region at load {p.force:g}, true scale (a = {a:.4f})",
-                       window=(0.0, 2.0 * a, y0 - 0.5 * a, y0 + 0.7 * a))
-    write_summary(out, summary)
-    return summary
+    th = summary["hertz"]
+    a, p0 = th["a_theory"], th["p0_theory"]
+    last = result.steps[-1]
+    xa, pp = {}, {}
+    for s in result.surfaces:
+        nodes = s.nodes[: s.nc]
+        x = s.body.points[0, nodes]
+        keep = x < 1.4 * a
+        xa[s.body.name] = x[keep] / a
+        pp[s.body.name] = last.bodies[s.body.name].contact_pressure[nodes[keep]] / p0
+    hertz_pressure(out / "pressure.png", xa, pp,
+                   f"Hertz, {summary['dofs']} dofs: p_max {th['p_max_error']:+.2%} vs p0, "
+                   f"RMS {th['rms_error_over_p0']:.2%}")
+    cyl_mesh = next(b.mesh for b in model.bodies if b.name == "cylinder")
+    tip = int(np.argmin(np.hypot(*cyl_mesh.p)))  # the first point of contact
+    y0 = float(last.bodies["cylinder"].displacement[tip, 1])
+    meshes = [(b.name, b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
+               last.bodies[b.name].displacement[: b.mesh.nvertices]) for b in model.bodies]
+    configurations(out / "deformed.png", [("deformed", meshes)],
+                   f"Hertz: contact region at load {p.force:g}, true scale (a = {a:.4f})",
+                   window=(0.0, 2.0 * a, y0 - 0.5 * a, y0 + 0.7 * a))
 
 
 def report(s: dict) -> list[str]:

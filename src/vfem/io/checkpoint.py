@@ -46,8 +46,9 @@ def fingerprint(model: Model) -> str:
     return h.hexdigest()
 
 
-def write(out: Path, model: Model, checkpoint: Checkpoint) -> Path:
-    """Save the last step of ``checkpoint`` (its results and the state after it)."""
+def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: str) -> Path:
+    """Save the last step of ``checkpoint`` (its results and the state after it);
+    ``model_fingerprint``: :func:`fingerprint` of ``model``, computed once per run."""
     step = checkpoint.steps[-1]
     state = checkpoint.state
     arrays: dict[str, np.ndarray] = {}
@@ -62,7 +63,7 @@ def write(out: Path, model: Model, checkpoint: Checkpoint) -> Path:
     for k, lam in state.multipliers.items():
         arrays[f"multiplier_{int(k)}"] = lam
     meta = {
-        "fingerprint": fingerprint(model),
+        "fingerprint": model_fingerprint,
         "step": {"step": step.step, "load_factor": step.load_factor,
                  "iterations": step.iterations, "converged": step.converged,
                  "platen_displacement": step.platen_displacement, "cuts": step.cuts,

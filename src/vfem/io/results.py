@@ -173,6 +173,7 @@ def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = Fal
     writer = ResultsWriter(out, model, analysis.surfaces) if out is not None else None
     start = None
     if writer is not None:
+        model_fingerprint = checkpoint.fingerprint(model)
         if resume:
             start = checkpoint.read(out, model)
             if start is not None:
@@ -185,7 +186,7 @@ def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = Fal
     def step_done(step: StepResult) -> None:
         if writer is not None:
             writer.write_step(step)
-            checkpoint.write(out, model, analysis.checkpoint())
+            checkpoint.write(out, model, analysis.checkpoint(), model_fingerprint)
             write_summary(out, progress_summary(model, analysis.steps, "running"))
         if on_step is not None:
             on_step(step)
@@ -197,6 +198,23 @@ def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = Fal
                                             "complete" if result.converged else "stopped",
                                             result.message))
     return analysis, result
+
+
+def run_example(model: Model, out: Path, summarize, draw=None, on_step=None,
+                resume: bool = False) -> dict:
+    """What a built-in example's ``run`` does: solve ``model`` writing each step into ``out``
+    (:func:`run_writing`), ``summarize(result)`` into its summary, ``draw(model, result,
+    summary)`` its figures (if ``draw`` is given; a list of the files' names, if it returns one,
+    goes into the summary as ``figures``), and write ``summary.json``."""
+    out = Path(out)
+    _, result = run_writing(model, out, on_step, resume)
+    summary = summarize(result)
+    if draw is not None:
+        names = draw(model, result, summary)
+        if names is not None:
+            summary["figures"] = names
+    write_summary(out, summary)
+    return summary
 
 
 def progress_summary(model: Model, steps: list[StepResult], status: str, message: str = ""

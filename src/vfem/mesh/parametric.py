@@ -129,7 +129,12 @@ def graded_layer(width: float, thickness: float, h_contact: float, h_max: float,
     x = march(width, size_function(h_contact, growth, h_max, plateau))
     check_count(len(x) * (layers + 1.0), "graded_layer")
     y = np.linspace(-thickness, 0.0, layers + 1)
-    mesh = MeshQuad.init_tensor(x, y)
+    return layer_boundaries(MeshQuad.init_tensor(x, y), width, thickness)
+
+
+def layer_boundaries(mesh, width: float, thickness: float):
+    """Name the sides of a layer [0, width] x [-thickness, 0]: ``contact`` (top, y = 0),
+    ``bottom``, ``symmetry`` (x = 0) and ``right`` (x = width)."""
     tol = 1e-9 * max(width, thickness)
     return mesh.with_boundaries({
         "contact": lambda p: p[1] > -tol,

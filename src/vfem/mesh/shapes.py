@@ -33,7 +33,7 @@ import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 from skfem import MeshQuad, MeshTri
 
-from .parametric import check_count, march, size_function
+from .parametric import check_count, layer_boundaries, march, size_function
 
 __all__ = [
     "block", "gasket", "gasket_pair", "graded_nodes", "rectangle", "wedge", "wedge_grid",
@@ -67,13 +67,7 @@ def wedge_plate(half_width: float = 5.0, thickness: float = 1.0, h_contact: floa
         raise ValueError(f"need half_width > 0 and thickness > 0, got {W} and {T}")
     h = size_function(h_contact, growth, h_max, plateau)
     mesh = _graded_trapezoid(W, lower=(-T, -T), upper=(0.0, 0.0), focus=(0.0, 0.0), h=h)
-    tol = 1e-9 * max(W, T)
-    return mesh.with_boundaries({
-        "contact": lambda x: x[1] > -tol,
-        "bottom": lambda x: x[1] < -T + tol,
-        "symmetry": lambda x: x[0] < tol,
-        "right": lambda x: x[0] > W - tol,
-    })
+    return layer_boundaries(mesh, W, T)
 
 
 def wedge(half_width: float = 5.0, edge_thickness: float = 1.0, centre_thickness: float = 1.3,
