@@ -48,10 +48,14 @@ class SuperLUFactorization:
     name = "superlu"
 
     def __init__(self, A: sp.spmatrix, trailing: np.ndarray | None = None,
-                 groups: np.ndarray | None = None):
+                 groups: np.ndarray | None = None, spd: bool = True):
         self.shape = A.shape
         A = sp.csc_matrix(A)
         self.trailing_inverse = None
+        self.order = None
+        if not spd:  # symmetric indefinite (a saddle point): general pivoting
+            self._lu = spla.splu(A, permc_spec="COLAMD")
+            return
         if trailing is None or len(trailing) == 0:
             self.order = None
             self._lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A",
@@ -93,8 +97,11 @@ BACKENDS = {"superlu": SuperLUFactorization}
 
 
 def factorize(A: sp.spmatrix, backend: str = "superlu", trailing: np.ndarray | None = None,
-              groups: np.ndarray | None = None):
-    """Factorize the sparse matrix ``A`` with the named backend (see the module docstring)."""
+              groups: np.ndarray | None = None, spd: bool = True):
+    """Factorize the sparse matrix ``A`` with the named backend (see the module docstring).
+
+    ``spd=False``: ``A`` is symmetric but indefinite (a saddle-point system of Lagrange
+    multipliers); ``trailing`` is then not supported."""
     try:
         cls = BACKENDS[backend]
     except KeyError:
@@ -103,4 +110,4 @@ def factorize(A: sp.spmatrix, backend: str = "superlu", trailing: np.ndarray | N
         raise InputError(
             f"unknown linear solver {backend!r}; available: {', '.join(sorted(BACKENDS))}"
         ) from None
-    return cls(A, trailing=trailing, groups=groups)
+    return cls(A, trailing=trailing, groups=groups, spd=spd)
