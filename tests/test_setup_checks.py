@@ -73,7 +73,7 @@ def test_a_body_behind_a_thin_one_is_not_inside_it():
 def test_fill_model_is_close_to_superlus_factors(triangles):
     """The documented model of nnz(L + U) against SuperLU itself (vfem.memory's docstring):
     cautious, within twice the actual fill, on bodies of about 2,000 dofs."""
-    analysis = Analysis(blocks(0.01, refine=12, triangles=triangles, nu=0.3))
+    analysis = Analysis(blocks(0.01, refine=12, triangles=triangles, nu=0.3), "superlu")
     analysis.setup()
     for s in analysis.surfaces:
         b = s.body

@@ -1,82 +1,233 @@
 """Benchmarks: what a contact solve costs against one plain linear solve of the same bodies.
 
-``vfem bench hertz`` (and ``benchmarks/hertz.py``) runs the Hertz example at several refinements
-and prints, per level: dofs, contact candidate dofs, vfem's analysis time (assembly,
-factorization with the flexibility, all contact steps; mesh generation and file output
-excluded), the time of one plain linear solve of the same bodies with the same backend (factor +
-solve, assembly excluded), their ratio, the same ratio with the assembly left out of vfem's time
-too, the parts of vfem's time, the contact iterations and the p_max error. Both are measured in
-the same process, one after the other.
+``vfem bench hertz`` (and ``benchmarks/hertz.py``) solves the Hertz example at several sizes,
+with each linear-algebra backend and each contact method asked for, and prints per case: dofs,
+contact candidate dofs, vfem's analysis time (candidate search, assembly, factorization with the
+flexibility, load cases, every contact step with its full-field back-substitution; mesh
+generation and file output excluded), the time of one **plain linear solve** of the same bodies
+with the same backend (assembly, supports, factorization, one solve: what a linear analysis
+without contact costs), their ratio, the ratio with assembly left out of both, the contact
+iterations, the p_max error against Hertz and the peak memory of the process.
+
+Each case runs in a fresh Python process (:func:`run_isolated`), so that its peak memory is its
+own and one case's garbage does not slow the next; vfem and the plain solve of a case run in the
+same process one after the other, so their ratio is measured under the same conditions.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import json
+import math
+import resource
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 
 import numpy as np
+from skfem import Basis, ElementVector, asm
+from skfem.models.elasticity import linear_elasticity
 
 from .examples.hertz import HertzParameters, build, evaluate
-from .linalg import factorize
+from .linalg import factorize, resolve
 from .solver import Analysis
 
-HEADER = (f"{'level':>5} {'dofs':>8} {'contact':>8} {'vfem s':>8} {'plain s':>8} {'ratio':>6} "
-          f"{'w/o asm':>7} {'asm s':>7} {'factor s':>8} {'steps s':>8} {'iters':>6} "
-          f"{'p_max err':>10}")
+#: named sizes of ``vfem bench hertz --dofs``
+SIZES = {"10k": 10_000, "100k": 100_000, "1M": 1_000_000}
+
+#: level 3 of the Hertz example (96 facets across a, largest element 0.05 / 8): 77k dofs
+_LEVEL3_DOFS = 77_000
 
 
-def plain_solve_time(model) -> float:
-    """Factor and solve each body of ``model`` once (its supports, its loads); seconds."""
-    total = 0.0
+def parse_size(text: str) -> int:
+    """``"100k"``, ``"1M"`` or a number of dofs."""
+    if text in SIZES:
+        return SIZES[text]
+    scale = {"k": 1_000, "m": 1_000_000}.get(text[-1:].lower(), 1)
+    number = text[:-1] if scale > 1 else text
+    try:
+        value = int(float(number) * scale)
+    except ValueError:
+        from .errors import InputError
+
+        raise InputError(f"--dofs: expected a number of dofs such as 10k, 100k or 1M, got "
+                         f"{text!r}") from None
+    return value
+
+
+def hertz_parameters(dofs: int | None = None, level: int | None = None,
+                     variant: str = "paired", order: int = 1) -> HertzParameters:
+    """The Hertz example at about ``dofs`` degrees of freedom (contact facets and largest
+    element scaled together, as the refinement levels do), or at refinement ``level``."""
+    if level is not None:
+        return HertzParameters(refinement=level, variant=variant, order=order)
+    s = 8.0 * math.sqrt(dofs / _LEVEL3_DOFS)
+    return HertzParameters(facets_per_half_width=max(4, round(12 * s)),
+                           max_element_size=0.05 / s, variant=variant, order=order)
+
+
+def plain_solve(model, backend: str) -> dict[str, float]:
+    """One plain linear analysis of each body of ``model``: assemble its stiffness, remove its
+    supported dofs, factorize, solve once. Seconds, by part."""
+    times = {"assemble_s": 0.0, "factorize_s": 0.0, "solve_s": 0.0}
     for body in model.bodies:
-        K = body.K_ff
-        rhs = np.ones(K.shape[0])
         t0 = time.perf_counter()
-        factorize(K).solve(rhs)
-        total += time.perf_counter() - t0
-    return total
+        basis = Basis(body.mesh, ElementVector(body.element()))
+        K = asm(linear_elasticity(*body.material.lame()), basis).tocsr()
+        fixed = np.zeros(K.shape[0], dtype=bool)
+        fixed[np.asarray(body.fixed_dofs, dtype=int)] = True
+        free = np.flatnonzero(~fixed)
+        K_ff = K[free][:, free].tocsc()
+        t1 = time.perf_counter()
+        factor = factorize(K_ff, backend)
+        t2 = time.perf_counter()
+        factor.solve(np.ones(len(free)))
+        t3 = time.perf_counter()
+        times["assemble_s"] += t1 - t0
+        times["factorize_s"] += t2 - t1
+        times["solve_s"] += t3 - t2
+    times["total_s"] = sum(times.values())
+    return times
+
+
+def _peak_mib() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def hertz_case(p: HertzParameters, backend: str | None = None, method: str = "vfem") -> dict:
+    """Solve the Hertz example ``p`` with ``backend`` and contact ``method``, then one plain
+    linear solve of the same bodies with the same backend; one row of the benchmark."""
+    backend = resolve(backend)
+    model = build(p)
+    if method != "vfem":
+        model.contact = dataclasses.replace(model.contact, method=method)
+    t0 = time.perf_counter()
+    result = Analysis(model, backend).run()
+    vfem_s = time.perf_counter() - t0
+    peak = _peak_mib()
+    plain = plain_solve(model, backend)
+    h = evaluate(result, p) if result.converged else {}
+    t = result.timings
+    assemble = t.get("assemble_s", 0.0)
+    return {
+        "method": method, "variant": p.variant, "order": p.order, "backend": backend,
+        "level": p.refinement, "facets_across_a": p.facets_per_half_width * 2**p.refinement,
+        "dofs": int(sum(b.ndofs for b in model.bodies)),
+        "contact_dofs": int(sum(2 * s.nc for s in result.surfaces)),
+        "vfem_s": vfem_s, "plain_solve_s": plain["total_s"],
+        "ratio": vfem_s / plain["total_s"],
+        "ratio_without_assembly": (vfem_s - assemble)
+        / (plain["total_s"] - plain["assemble_s"]),
+        "plain_assemble_s": plain["assemble_s"], "plain_factorize_s": plain["factorize_s"],
+        "plain_solve_only_s": plain["solve_s"],
+        "search_s": t.get("search_s", 0.0), "assemble_s": assemble,
+        "factorize_s": t.get("factorize_s", 0.0), "steps_s": t.get("steps_s", 0.0),
+        "iterations": int(sum(s.iterations for s in result.steps)),
+        "converged": result.converged, "message": result.message,
+        "peak_mib": peak,
+        "p_max_error": h.get("p_max_error", float("nan")),
+        "rms_error_over_p0": h.get("rms_error_over_p0", float("nan")),
+        "rms_error_averaged": h.get("rms_error_averaged", float("nan")),
+        "p_max_flat_error": (h["p_max_flat"] / h["p0_theory"] - 1) if h else float("nan"),
+    }
+
+
+def patch_case(method: str = "vfem", backend: str | None = None) -> dict:
+    """The patch test (every case of the patch example) with contact ``method``: the largest
+    deviation of the contact pressure from the exact uniform one, over the cases."""
+    from .examples import patch
+
+    p = patch.Parameters()
+    worst, iterations = 0.0, 0
+    for n_lower, n_upper, nu in patch.cases():
+        model = patch.build(p, n_lower, n_upper, nu)
+        if method != "vfem":
+            model.contact = dataclasses.replace(model.contact, method=method)
+        case = patch.measure(model, Analysis(model, backend).run(), p)
+        worst = max(worst, case.get("pressure_deviation", float("inf")))
+        iterations += sum(case["iterations"])
+    return {"method": method, "patch_error": worst, "patch_iterations": iterations}
+
+
+def run_isolated(kind: str, **kwargs) -> dict:
+    """Run :func:`hertz_case` (``kind="hertz"``, ``kwargs``: ``dofs`` or ``level``,
+    ``variant``, ``order``, ``backend``, ``method``) or :func:`patch_case` (``"patch"``) in a
+    fresh Python process; its row."""
+    out = subprocess.run([sys.executable, "-m", "vfem.bench", json.dumps([kind, kwargs])],
+                         capture_output=True, text=True, check=False)
+    if out.returncode != 0:
+        from .errors import AnalysisError
+
+        tail = (out.stderr or out.stdout).strip().splitlines()[-3:]
+        raise AnalysisError(f"benchmark case {kind} {kwargs} failed: {' | '.join(tail)}")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _warm_up(backend: str | None, method: str) -> None:
+    """Solve a tiny Hertz model first, so that the timed case does not pay for this process's
+    one-time costs (imports, loading a backend's library, first calls into NumPy and
+    scikit-fem) that the plain solve after it would not pay."""
+    hertz_case(HertzParameters(facets_per_half_width=4, max_element_size=0.2, steps=1),
+               backend, method)
+
+
+def _case(kind: str, kwargs: dict) -> dict:
+    _warm_up(kwargs.get("backend"), kwargs.get("method", "vfem"))
+    if kind == "patch":
+        return patch_case(kwargs.get("method", "vfem"), kwargs.get("backend"))
+    p = hertz_parameters(kwargs.get("dofs"), kwargs.get("level"),
+                         kwargs.get("variant", "paired"), kwargs.get("order", 1))
+    return hertz_case(p, kwargs.get("backend"), kwargs.get("method", "vfem"))
+
+
+HEADER = (f"{'dofs':>9} {'contact':>7} {'method':>10} {'backend':>8} {'vfem s':>8} "
+          f"{'plain s':>8} {'ratio':>6} {'w/o asm':>7} {'iters':>6} {'p_max err':>10} "
+          f"{'peak MiB':>9}")
+
+
+def format_row(r: dict) -> str:
+    return (f"{r['dofs']:>9} {r['contact_dofs']:>7} {r['method']:>10} {r['backend']:>8} "
+            f"{r['vfem_s']:>8.2f} {r['plain_solve_s']:>8.2f} {r['ratio']:>6.2f} "
+            f"{r['ratio_without_assembly']:>7.2f} {r['iterations']:>6} "
+            f"{r['p_max_error']:>+10.4%} {r['peak_mib']:>9.0f}")
+
+
+def speed_benchmark(sizes: list[dict], backends: list[str], methods: list[str],
+                    variant: str = "paired", isolate: bool = True,
+                    print_row: Callable[[str], None] | None = None) -> list[dict]:
+    """Every size (``{"dofs": n}`` or ``{"level": L}``) x backend x method; rows."""
+    rows = []
+    if print_row:
+        print_row(HEADER)
+    for size in sizes:
+        for method in methods:
+            for backend in backends:
+                kwargs = dict(size, variant=variant, backend=backend, method=method)
+                row = run_isolated("hertz", **kwargs) if isolate else _case("hertz", kwargs)
+                rows.append(row)
+                if print_row:
+                    print_row(format_row(row))
+    return rows
 
 
 def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None = None,
                     variant: str = "paired", order: int = 1) -> list[dict]:
+    """Refinement levels of the Hertz example, in this process, with the chosen backend (the
+    convergence study, ``vfem study hertz``)."""
     rows = []
     if print_row:
         print_row(HEADER)
     for level in levels:
-        p = HertzParameters(refinement=level, variant=variant, order=order)
-        model = build(p)
-        t0 = time.perf_counter()
-        analysis = Analysis(model)
-        result = analysis.run()
-        vfem_s = time.perf_counter() - t0
-        plain_s = plain_solve_time(model)
-        h = evaluate(result, p) if result.converged else {}
-        row = {
-            "level": level,
-            "variant": variant,
-            "order": order,
-            "dofs": int(sum(b.ndofs for b in model.bodies)),
-            "facets_across_a": p.facets_per_half_width * 2**level,
-            "contact_dofs": int(sum(2 * s.nc for s in result.surfaces)),
-            "vfem_s": vfem_s,
-            "plain_solve_s": plain_s,
-            "ratio": vfem_s / plain_s,
-            "ratio_without_assembly": (vfem_s - result.timings["assemble_s"]) / plain_s,
-            "assemble_s": result.timings["assemble_s"],
-            "factorize_s": result.timings["factorize_s"],
-            "steps_s": result.timings["steps_s"],
-            "iterations": int(sum(s.iterations for s in result.steps)),
-            "converged": result.converged,
-            "p_max_error": h.get("p_max_error", float("nan")),
-            "rms_error_over_p0": h.get("rms_error_over_p0", float("nan")),
-            "rms_error_averaged": h.get("rms_error_averaged", float("nan")),
-            "p_max_flat_error": (h["p_max_flat"] / h["p0_theory"] - 1) if h else float("nan"),
-        }
-        rows.append(row)
+        rows.append(hertz_case(hertz_parameters(level=level, variant=variant, order=order)))
         if print_row:
-            print_row(f"{level:>5} {row['dofs']:>8} {row['contact_dofs']:>8} "
-                      f"{vfem_s:>8.2f} {plain_s:>8.2f} {row['ratio']:>6.1f} "
-                      f"{row['ratio_without_assembly']:>7.1f} {row['assemble_s']:>7.2f} "
-                      f"{row['factorize_s']:>8.2f} {row['steps_s']:>8.2f} {row['iterations']:>6} "
-                      f"{row['p_max_error']:>+10.4%}")
+            print_row(format_row(rows[-1]))
     return rows
+
+
+if __name__ == "__main__":  # one isolated case: python -m vfem.bench '["hertz", {...}]'
+    import logging
+
+    logging.basicConfig(level=logging.WARNING)
+    kind, kwargs = json.loads(sys.argv[1])
+    print(json.dumps(_case(kind, kwargs)))

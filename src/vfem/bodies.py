@@ -198,7 +198,7 @@ class Body:
 
     # -- set-up ---------------------------------------------------------------------------------
 
-    def setup(self, backend: str = "superlu", tracked_dofs: np.ndarray | None = None) -> None:
+    def setup(self, backend: str | None = None, tracked_dofs: np.ndarray | None = None) -> None:
         """Validate, assemble the stiffness, factorize it and solve the unit load cases.
 
         With ``tracked_dofs`` (the dofs contact follows), the factorization also yields the
@@ -225,7 +225,7 @@ class Body:
             trailing = pos[free]
         t2 = time.perf_counter()
         self.factor = factorize(self.K_ff, backend, trailing=trailing,
-                                groups=self.free_dofs // 2)
+                                groups=self.free_dofs // 2, what=f"body {self.name!r}")
         t3 = time.perf_counter()
         self.tracked_flexibility = None
         if tracked_dofs is not None:
@@ -308,7 +308,7 @@ class Body:
 
     def linearize(self, load_factor: float, platen_displacement: float,
                   contact_force: np.ndarray, tracked_dofs: np.ndarray,
-                  candidate_dofs: np.ndarray, backend: str = "superlu") -> Linearization:
+                  candidate_dofs: np.ndarray, backend: str | None = None) -> Linearization:
         """Large kinematics: Newton's system at the trial state under the loads at
         ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
         (held), factorized once (see :class:`Linearization`). Move the trial state with
@@ -317,7 +317,9 @@ class Body:
         self._equilibrated = None
         R, ref, K, D, pending = self.nonlinear.linearize(load_factor, contact_force)
         free = np.setdiff1d(np.arange(self.ndofs), D)
-        factor = factorize(K[free][:, free].tocsc(), backend)
+        # a tangent may be indefinite (geometric stiffness under compression)
+        factor = factorize(K[free][:, free].tocsc(), backend, spd=False,
+                           what=f"body {self.name!r} (tangent)")
 
         def solve(f: np.ndarray) -> np.ndarray:
             out = np.zeros((self.ndofs,) + f.shape[1:])

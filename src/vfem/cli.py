@@ -17,6 +17,7 @@ import signal
 import sys
 from pathlib import Path
 
+from . import linalg
 from .errors import InputError, VfemError
 from .examples import EXAMPLES, load
 
@@ -138,7 +139,13 @@ def _example(name: str, alternatives: str = ""):
     return load(name)
 
 
+SOLVER_HELP = ("linear-algebra backend: auto (the fastest installed), superlu, pardiso, cholmod "
+               "or mumps (docs/benchmarks.md)")
+
+
 def cmd_run(args) -> int:
+    chosen = linalg.use(args.solver)
+    log.info("linear solver %s -> %s", args.solver, chosen)
     if _is_input_file(args.example):
         return run_input_file(args)
     example = _example(args.example, ", or an input file (.toml)")
@@ -301,13 +308,36 @@ def cmd_plot(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from .bench import hertz_benchmark
+    from . import bench
 
     if args.example != "hertz":
         raise InputError(f"no benchmark for {args.example!r}; available: hertz")
-    rows = hertz_benchmark(args.levels, print_row=print, variant=args.variant)
+    solvers = args.solver or ["auto"]
+    backends = linalg.available() if "all" in solvers else [linalg.resolve(s) for s in solvers]
+    if args.levels:
+        sizes = [{"level": level} for level in args.levels]
+    else:
+        sizes = [{"dofs": bench.parse_size(d)} for d in (args.dofs or ["10k", "100k"])]
+    say = None if args.quiet else print
+    rows = bench.speed_benchmark(sizes, backends, args.methods, variant=args.variant,
+                                 isolate=not args.in_process, print_row=say)
+    table = {"hertz": rows}
+    if args.patch:
+        if say:
+            say(f"{'method':>10} {'patch error':>12} {'iterations':>10}")
+        table["patch"] = []
+        for method in args.methods:
+            row = bench.run_isolated("patch", method=method, backend=backends[0])
+            table["patch"].append(row)
+            if say:
+                say(f"{method:>10} {row['patch_error']:>12.2e} {row['patch_iterations']:>10}")
     if args.json:
-        Path(args.json).write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+        Path(args.json).write_text(json.dumps(table if args.patch else rows, indent=2) + "\n",
+                                   encoding="utf-8")
+    if args.plot:
+        from .io.plots import benchmark_times
+
+        benchmark_times(Path(args.plot), rows, "Hertz: time against dofs")
     return 0
 
 
@@ -355,6 +385,7 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--out", help="results directory (default results/<name>)")
     run.add_argument("--set", action="append", metavar="KEY=VALUE",
                      help="change a parameter of a built-in example (repeatable)")
+    run.add_argument("--solver", default="auto", metavar="NAME", help=SOLVER_HELP)
     run.add_argument("--resume", metavar="RESULTS_DIR",
                      help="continue an interrupted run of the same model from the last step "
                           "completed in RESULTS_DIR (its results directory)")
@@ -371,7 +402,20 @@ def main(argv: list[str] | None = None) -> int:
     plot.add_argument("results", help="the results folder (holding results.pvd)")
     bench = sub.add_parser("bench", help="time an example at several refinements")
     bench.add_argument("example", help="hertz")
-    bench.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3, 4])
+    bench.add_argument("--dofs", nargs="+", metavar="SIZE",
+                       help="about this many dofs: 10k, 100k, 1M or a number (default 10k 100k)")
+    bench.add_argument("--levels", type=int, nargs="+",
+                       help="refinement levels of the example instead of --dofs")
+    bench.add_argument("--solver", nargs="+", metavar="NAME",
+                       help="backends to compare: all, auto (default) or names")
+    bench.add_argument("--methods", nargs="+", default=["vfem"],
+                       choices=("vfem", "penalty", "lagrange", "augmented"),
+                       help="contact methods to compare (default vfem)")
+    bench.add_argument("--patch", action="store_true",
+                       help="also the patch-test error of each method")
+    bench.add_argument("--plot", help="draw time against dofs to this PNG")
+    bench.add_argument("--in-process", action="store_true",
+                       help="run every case in this process (no peak memory per case)")
     bench.add_argument("--json", help="also write the table to this JSON file")
     bench.add_argument("--variant", default="paired", choices=("paired", "thesis"),
                        help="contact variant (default paired)")

@@ -38,6 +38,7 @@ from .contact.algorithm import (
 from .contact.settings import ContactSettings
 from .contact.surface import ContactSurface, check_initial_overlap, select_candidate_facets
 from .errors import AnalysisError, InputError, RindViolation
+from .linalg import resolve as resolve_backend
 from .memory import check_memory, memory_guard
 
 log = logging.getLogger(__name__)
@@ -153,6 +154,7 @@ class AnalysisResult:
     message: str = ""
     surfaces: list[ContactSurface] = field(default_factory=list)
     penetration_tolerance: float = 0.0  # the one the contact iteration used
+    backend: str = ""  # the linear-algebra backend that factorized the bodies (vfem.linalg)
 
 
 #: steps in a row that must converge easily before a cut increment doubles again
@@ -205,10 +207,10 @@ class Checkpoint:
 class Analysis:
     """Set up the bodies and their contact surfaces, then run the steps of a :class:`Model`."""
 
-    def __init__(self, model: Model, backend: str = "superlu"):
+    def __init__(self, model: Model, backend: str | None = None):
         model.validate()
         self.model = model
-        self.backend = backend
+        self.backend = resolve_backend(backend)  # None: the one chosen (--solver), else auto
         self.timings: dict[str, float] = {}
 
     def setup(self) -> None:
@@ -221,6 +223,7 @@ class Analysis:
         is refused, and running out of memory anyway is an :class:`AnalysisError` that says so.
         """
         t0 = time.perf_counter()
+        log.info("linear solver: %s", self.backend)
         bodies = self.model.bodies
         pairs, self.surfaces = self.model.contact_surfaces()
         t1 = time.perf_counter()
@@ -358,7 +361,7 @@ class Analysis:
                                       ("search_s", "assemble_factorize_s", "flexibility_s",
                                        "steps_s"))
         return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
-                              self.surfaces, self.contact.penetration_tolerance)
+                              self.surfaces, self.contact.penetration_tolerance, self.backend)
 
     def checkpoint(self) -> Checkpoint:
         """The last converged state, complete, with the steps so far: what :meth:`run` needs

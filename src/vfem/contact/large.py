@@ -160,7 +160,7 @@ class LargeDeformationContact(PairedContact):
     """Frictionless contact with large displacements and sliding (see the module docstring)."""
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
-                 backend: str = "superlu"):
+                 backend: str | None = None):
         for s in surfaces:
             if s.order != 1:
                 raise InputError(f"body {s.body.name!r}: large-displacement contact needs "

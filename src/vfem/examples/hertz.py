@@ -216,6 +216,7 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
         "pressure_measure": "nominal: nodal contact force / undeformed tributary length",
         "parameters": asdict(p),
         "timings": result.timings,
+        "linear_solver": result.backend,
     }
     if result.steps and result.steps[-1].load_factor == 1.0:
         summary["hertz"] = evaluate(result, p)

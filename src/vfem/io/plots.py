@@ -216,3 +216,31 @@ def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarra
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+def benchmark_times(path: Path, rows: list[dict], title: str) -> None:
+    """Wall time against dofs, log-log: each (method, backend) solve next to the plain linear
+    solve of the same mesh with the same backend (dashed), from ``vfem bench`` rows."""
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    series: dict[tuple[str, str], list[dict]] = {}
+    for r in rows:
+        series.setdefault((r["method"], r["backend"]), []).append(r)
+    colours = {}
+    for (method, backend), rs in series.items():
+        rs = sorted(rs, key=lambda r: r["dofs"])
+        n = [r["dofs"] for r in rs]
+        colour = colours.setdefault(backend, f"C{len(colours)}")
+        marker = {"vfem": "o", "penalty": "s", "lagrange": "^", "augmented": "v"}.get(method, "x")
+        ax.loglog(n, [r["vfem_s"] for r in rs], marker + "-", color=colour,
+                  label=f"{method}, {backend}")
+        if method == "vfem":
+            ax.loglog(n, [r["plain_solve_s"] for r in rs], marker + "--", color=colour,
+                      alpha=0.6, mfc="none", label=f"plain linear solve, {backend}")
+    ax.set_xlabel("dofs (both bodies)")
+    ax.set_ylabel("wall time (s)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)

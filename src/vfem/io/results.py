@@ -242,7 +242,8 @@ def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
     return {"example": name, "converged": result.converged, "message": result.message,
             "steps": [step_record(s) for s in result.steps],
             "dofs": int(sum(b.ndofs for b in result.model.bodies)),
-            "parameters": dataclasses.asdict(parameters), "timings": result.timings}
+            "parameters": dataclasses.asdict(parameters), "timings": result.timings,
+            "linear_solver": result.backend}
 
 
 def write_summary(out: Path, summary: dict) -> Path:

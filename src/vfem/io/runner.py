@@ -68,6 +68,7 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
         "pressure_measure": "nominal: nodal contact force / undeformed tributary length",
         "config": to_data(config),
         "timings": result.timings,
+        "linear_solver": result.backend,
     }
 
 

@@ -1,113 +1,118 @@
 """Sparse factorization behind one small interface.
 
-``factorize(A)`` returns an object with ``solve(b)`` for a vector or a block of columns. SciPy's
-SuperLU is always there; faster backends plug in here (issue: speed) without the rest of vfem
-knowing which one runs.
+``factorize(A, backend)`` returns an object with ``solve(b)`` for a vector or a block of columns.
+Every body is factorized once (per tangent, under large kinematics) and the factorization is
+reused for every solve after that.
 
 ``factorize(A, trailing=dofs, groups=node_of_dof)`` also returns the inverse of ``A`` restricted to
-``dofs`` (``trailing_inverse``), which is what contact needs (the flexibility on the contact dofs).
-It orders those dofs last, so that the trailing blocks of the factors multiply to the Schur
-complement S on them, and ``(A^-1)[dofs, dofs] = S^-1``: one factorization and a dense inverse of
-the size of the contact surface, instead of one back-substitution per contact dof. The
-fill-reducing order of the rest is the minimum-degree order of the node graph (one vertex per node,
-so a quarter of the matrix), computed by SuperLU itself.
+``dofs`` (``trailing_inverse``): what contact needs, the flexibility on the contact dofs. Each
+backend gets it from one factorization with those dofs eliminated last, as the dense inverse of
+the Schur complement on them — never one back-substitution per contact dof.
+
+Backends (docs/benchmarks.md compares them):
+
+* ``superlu`` — SciPy's SuperLU, always there (:mod:`.superlu`);
+* ``pardiso`` — MKL PARDISO, from the ``pypardiso`` package (:mod:`.pardiso`);
+* ``cholmod`` — SuiteSparse CHOLMOD, from ``scikit-sparse`` (:mod:`.cholmod`);
+* ``mumps`` — MUMPS, from ``python-mumps`` (:mod:`.mumps`).
+
+``"auto"`` (the default) picks the first installed in :data:`PREFERENCE`, the order measured
+fastest on the Hertz benchmark. ``vfem run --solver NAME`` (or :func:`use`) chooses one.
 """
 
 from __future__ import annotations
 
+import importlib
 import logging
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 log = logging.getLogger(__name__)
 
+#: backend name -> (module, class)
+BACKENDS = {
+    "superlu": ("superlu", "SuperLUFactorization"),
+    "pardiso": ("pardiso", "PardisoFactorization"),
+    "cholmod": ("cholmod", "CholmodFactorization"),
+    "mumps": ("mumps", "MumpsFactorization"),
+}
 
-def _node_graph_order(A: sp.spmatrix, groups: np.ndarray) -> np.ndarray:
-    """A fill-reducing order of the rows of ``A``, from the graph of the groups (nodes)."""
-    n, ng = A.shape[0], int(groups.max()) + 1
-    D = sp.csr_matrix((np.ones(n), (np.arange(n), groups)), shape=(n, ng))
-    P = sp.csr_matrix(A, copy=True)
-    P.data[:] = 1.0
-    M = (D.T @ P @ D).tocsr()
-    M.data[:] = -1.0
-    M.setdiag(0.0)
-    M.eliminate_zeros()
-    degree = -np.asarray(M.sum(axis=1)).ravel()
-    M = (M + sp.diags(degree + 1.0)).tocsc()  # diagonally dominant: a symmetric M-matrix
-    perm = spla.splu(M, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).perm_c
-    rank = np.empty(ng, dtype=int)
-    rank[np.argsort(perm)] = np.arange(ng)
-    return np.argsort(rank[groups], kind="stable")
+#: what "auto" tries, fastest first (measured: docs/benchmarks.md, "Linear-algebra backends")
+PREFERENCE = ("pardiso", "cholmod", "superlu", "mumps")
+
+_chosen: str | None = None
+_available: dict[str, bool] = {}
 
 
-class SuperLUFactorization:
-    """SciPy SuperLU with a symmetric ordering (the stiffness is symmetric positive definite)."""
-
-    name = "superlu"
-
-    def __init__(self, A: sp.spmatrix, trailing: np.ndarray | None = None,
-                 groups: np.ndarray | None = None, spd: bool = True):
-        self.shape = A.shape
-        A = sp.csc_matrix(A)
-        self.trailing_inverse = None
-        self.order = None
-        if not spd:  # symmetric indefinite (a saddle point): general pivoting
-            self._lu = spla.splu(A, permc_spec="COLAMD")
-            return
-        if trailing is None or len(trailing) == 0:
-            self.order = None
-            self._lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A",
-                                 options={"SymmetricMode": True})
-            return
-        trailing = np.asarray(trailing, dtype=int)
-        groups = np.arange(A.shape[0]) if groups is None else np.asarray(groups)
-        order = _node_graph_order(A, groups)
-        last = np.zeros(A.shape[0], dtype=bool)
-        last[trailing] = True
-        order = np.concatenate([order[~last[order]], trailing])
-        self.order = order
-        self._lu = spla.splu(A[order][:, order].tocsc(), permc_spec="NATURAL",
-                             diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-        n, m = A.shape[0], len(trailing)
-        k = n - m
-        kept = (np.array_equal(self._lu.perm_c[k:], np.arange(k, n))
-                and np.array_equal(self._lu.perm_r[k:], np.arange(k, n)))
-        if kept:
-            S = self._lu.L[k:, k:].toarray() @ self._lu.U[k:, k:].toarray()
-            inv = np.linalg.inv(S)
-        else:  # SuperLU moved the trailing block: fall back to one solve per trailing dof
-            log.info("trailing block not kept by SuperLU; flexibility by back-substitution")
-            E = np.zeros((n, m))
-            E[trailing, np.arange(m)] = 1.0
-            inv = self.solve(E)[trailing]
-        self.trailing_inverse = 0.5 * (inv + inv.T)
-
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        b = np.asarray(b, dtype=float)
-        if self.order is None:
-            return self._lu.solve(b)
-        x = np.empty_like(b)
-        x[self.order] = self._lu.solve(b[self.order])
-        return x
+def is_available(name: str) -> bool:
+    """Whether the backend's package (and the library under it) loads here."""
+    if name not in _available:
+        if name == "superlu":
+            _available[name] = True
+        else:
+            module = importlib.import_module(f".{BACKENDS[name][0]}", __name__)
+            _available[name] = bool(module.available())
+    return _available[name]
 
 
-BACKENDS = {"superlu": SuperLUFactorization}
+def available() -> list[str]:
+    """The installed backends, in order of preference."""
+    return [name for name in PREFERENCE if is_available(name)]
 
 
-def factorize(A: sp.spmatrix, backend: str = "superlu", trailing: np.ndarray | None = None,
-              groups: np.ndarray | None = None, spd: bool = True):
+def resolve(name: str | None = None) -> str:
+    """The backend a name stands for: ``None`` -> the one chosen with :func:`use`, else
+    ``"auto"``; ``"auto"`` -> the fastest installed. Raises InputError for an unknown or
+    uninstalled backend, naming the ones there are."""
+    from ..errors import InputError
+
+    name = name or _chosen or "auto"
+    if name == "auto":
+        return available()[0]
+    if name not in BACKENDS:
+        raise InputError(f"unknown linear solver {name!r}; choose auto or one of: "
+                         f"{', '.join(BACKENDS)} (installed here: {', '.join(available())})")
+    if not is_available(name):
+        hint = {"pardiso": "pip install pypardiso",
+                "cholmod": "apt install libsuitesparse-dev, then pip install "
+                           "scikit-sparse==0.4.16",
+                "mumps": "apt install libmumps-seq-dev, then pip install python-mumps"}[name]
+        raise InputError(f"linear solver {name!r} is not installed ({hint}); installed here: "
+                         f"{', '.join(available())}")
+    return name
+
+
+def use(name: str) -> str:
+    """Make ``name`` (or ``"auto"``) the backend of every later factorization in this process
+    that does not name its own; returns the backend it resolves to."""
+    global _chosen
+    resolved = resolve(name)
+    _chosen = name
+    return resolved
+
+
+def factorize(A: sp.spmatrix, backend: str | None = None, trailing: np.ndarray | None = None,
+              groups: np.ndarray | None = None, spd: bool = True, what: str = "a matrix"):
     """Factorize the sparse matrix ``A`` with the named backend (see the module docstring).
 
     ``spd=False``: ``A`` is symmetric but indefinite (a saddle-point system of Lagrange
-    multipliers); ``trailing`` is then not supported."""
-    try:
-        cls = BACKENDS[backend]
-    except KeyError:
-        from ..errors import InputError
+    multipliers); ``trailing`` is then not supported, and a backend that factorizes positive
+    definite matrices only (CHOLMOD) hands the matrix to SuperLU.
 
-        raise InputError(
-            f"unknown linear solver {backend!r}; available: {', '.join(sorted(BACKENDS))}"
-        ) from None
-    return cls(A, trailing=trailing, groups=groups, spd=spd)
+    A backend that fails (a singular matrix, a library error) raises AnalysisError naming
+    ``what`` (e.g. ``"body 'flat'"``), the backend and its reason."""
+    from ..errors import AnalysisError
+
+    name = resolve(backend)
+    if not spd and name == "cholmod":
+        log.info("cholmod factorizes positive definite matrices only: superlu for this one")
+        name = "superlu"
+    module, cls = BACKENDS[name]
+    factory = getattr(importlib.import_module(f".{module}", __name__), cls)
+    try:
+        return factory(A, trailing=trailing, groups=groups, spd=spd)
+    except (np.linalg.LinAlgError, RuntimeError, ValueError) as exc:
+        raise AnalysisError(f"{what}: factorizing its stiffness ({A.shape[0]} dofs) with {name} "
+                            f"failed: {exc}; check that it is held against every rigid-body "
+                            "motion, or try --solver superlu") from exc

@@ -1,0 +1,125 @@
+"""Intel MKL PARDISO (found through the ``pypardiso`` package, which ships MKL).
+
+Called directly through ctypes rather than through pypardiso's own solver class, for two
+features that class does not expose: the symmetric positive definite matrix type (half the
+matrix, Cholesky) and PARDISO's Schur complement (``iparm[35]``). With ``trailing`` dofs,
+PARDISO factorizes the whole matrix and returns the dense Schur complement on the trailing dofs in
+the same pass (``iparm[35] = 2``; with ``1`` it skips the trailing block and its solves are good
+to only about 1e-5); the Schur complement's inverse is the flexibility contact needs.
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+import scipy.sparse as sp
+
+from .common import spd_inverse
+
+_P64 = ctypes.POINTER(ctypes.c_int64)
+_P32 = ctypes.POINTER(ctypes.c_int32)
+_pardiso = None
+
+#: PARDISO's error codes (MKL reference, "pardiso"), for messages
+ERRORS = {-1: "input inconsistent", -2: "not enough memory", -3: "reordering problem",
+          -4: "zero pivot (the matrix is singular or not positive definite)",
+          -5: "unclassified internal error", -6: "reordering failed", -7: "diagonal matrix "
+          "is singular", -8: "32-bit integer overflow", -9: "not enough memory for OOC",
+          -10: "error opening OOC files", -11: "read/write error with OOC files"}
+
+
+def _library():
+    """PARDISO's entry point in MKL's runtime library (located by pypardiso)."""
+    global _pardiso
+    if _pardiso is None:
+        import pypardiso
+
+        f = pypardiso.PyPardisoSolver().libmkl.pardiso
+        f.argtypes = [_P64, _P32, _P32, _P32, _P32, _P32, ctypes.c_void_p, _P32, _P32, _P32,
+                      _P32, _P32, _P32, ctypes.c_void_p, ctypes.c_void_p, _P32]
+        f.restype = None
+        _pardiso = f
+    return _pardiso
+
+
+def available() -> bool:
+    try:
+        _library()
+    except Exception:  # noqa: BLE001 - not installed, or MKL not loadable: not available
+        return False
+    return True
+
+
+def _i32(value: int):
+    return np.array([value], dtype=np.int32)
+
+
+class PardisoFactorization:
+    """MKL PARDISO: Cholesky for the stiffness, Bunch-Kaufman for saddle points (``spd=False``)."""
+
+    name = "pardiso"
+
+    def __init__(self, A: sp.spmatrix, trailing: np.ndarray | None = None,
+                 groups: np.ndarray | None = None, spd: bool = True):
+        self.shape = A.shape
+        U = sp.triu(A, format="csr")
+        U.sort_indices()
+        self.n = U.shape[0]
+        self._a = np.ascontiguousarray(U.data, dtype=float)
+        self._ia = U.indptr.astype(np.int32)
+        self._ja = U.indices.astype(np.int32)
+        self._pt = np.zeros(64, dtype=np.int64)
+        self._mtype = 2 if spd else -2
+        iparm = np.zeros(64, dtype=np.int32)
+        iparm[0] = 1  # these values, not the defaults
+        iparm[1] = 2  # METIS nested dissection
+        iparm[9] = 8  # pivot perturbation 1e-8 (indefinite only)
+        iparm[10] = iparm[12] = 0 if spd else 1  # scaling and matching for saddle points
+        iparm[34] = 1  # zero-based indices
+        self._iparm = iparm
+        self._perm = np.zeros(self.n, dtype=np.int32)
+        self.trailing_inverse = None
+        m = 0
+        if trailing is not None and len(trailing) and spd:
+            trailing = np.asarray(trailing, dtype=int)
+            self._perm[trailing] = 1
+            iparm[35] = 2  # Schur complement on the marked dofs, returned dense in x
+            m = len(trailing)
+        x = np.zeros(max(self.n, m * m))
+        self._call(12, np.zeros(self.n), x, 1)
+        if m:
+            # rows and columns of the Schur complement in increasing dof order
+            rank = np.argsort(np.argsort(trailing))
+            S = x[: m * m].reshape(m, m)
+            S = np.triu(S) + np.triu(S, 1).T
+            inv = spd_inverse(S)[np.ix_(rank, rank)]
+            self.trailing_inverse = inv
+
+    def _call(self, phase: int, b: np.ndarray, x: np.ndarray, nrhs: int) -> None:
+        err = np.zeros(1, dtype=np.int32)
+        _library()(self._pt.ctypes.data_as(_P64), _i32(1).ctypes.data_as(_P32),
+                   _i32(1).ctypes.data_as(_P32), _i32(self._mtype).ctypes.data_as(_P32),
+                   _i32(phase).ctypes.data_as(_P32), _i32(self.n).ctypes.data_as(_P32),
+                   self._a.ctypes.data, self._ia.ctypes.data_as(_P32),
+                   self._ja.ctypes.data_as(_P32), self._perm.ctypes.data_as(_P32),
+                   _i32(nrhs).ctypes.data_as(_P32), self._iparm.ctypes.data_as(_P32),
+                   _i32(0).ctypes.data_as(_P32), b.ctypes.data, x.ctypes.data,
+                   err.ctypes.data_as(_P32))
+        if err[0] != 0:
+            what = ERRORS.get(int(err[0]), "unknown error")
+            raise np.linalg.LinAlgError(f"PARDISO phase {phase} failed: {what} (error "
+                                        f"{int(err[0])})")
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        b = np.asfortranarray(b, dtype=float)
+        nrhs = 1 if b.ndim == 1 else b.shape[1]
+        x = np.zeros_like(b)
+        self._call(33, b, x, nrhs)
+        return x
+
+    def __del__(self):
+        try:
+            self._call(-1, np.zeros(1), np.zeros(1), 1)  # release PARDISO's memory
+        except Exception:  # noqa: BLE001 - interpreter shutting down, or never factorized
+            pass

@@ -1,0 +1,117 @@
+"""The linear-algebra backends (vfem.linalg): every installed backend solves, gives the
+flexibility on trailing dofs, and gives the same contact answer; choosing one by name.
+
+SuperLU is always installed; PARDISO, CHOLMOD and MUMPS are tested where installed (their
+parametrized cases are then absent, not skipped silently: ``test_superlu_is_always_there``
+checks the list)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from vfem import linalg
+from vfem.cli import main
+from vfem.errors import AnalysisError, InputError
+from vfem.examples.hertz import HertzParameters, build
+from vfem.mesh import rectangle
+from vfem.solver import Analysis
+
+INSTALLED = linalg.available()
+
+
+def stiffness() -> sp.csc_matrix:
+    """A small plane-strain stiffness, held on one side: symmetric positive definite."""
+    from skfem import Basis, ElementQuad1, ElementVector, asm
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    mesh = rectangle(0.0, 0.0, 2.0, 1.0, nx=12, ny=6)
+    basis = Basis(mesh, ElementVector(ElementQuad1()))
+    K = asm(linear_elasticity(*lame_parameters(1000.0, 0.3)), basis).tocsr()
+    fixed = basis.get_dofs(mesh.boundaries["left"]).all()
+    free = np.setdiff1d(np.arange(K.shape[0]), fixed)
+    return K[free][:, free].tocsc()
+
+
+def test_superlu_is_always_there():
+    assert "superlu" in INSTALLED
+    assert linalg.resolve("superlu") == "superlu"
+    assert linalg.resolve("auto") == INSTALLED[0]
+
+
+@pytest.mark.parametrize("backend", INSTALLED)
+def test_every_backend_solves_and_gives_the_flexibility(backend):
+    K = stiffness()
+    dense = np.linalg.inv(K.toarray())
+    rng = np.random.default_rng(0)
+    b = rng.standard_normal((K.shape[0], 3))
+    trailing = rng.choice(K.shape[0], size=20, replace=False)  # unsorted, like contact dofs
+    for tr in (None, trailing):
+        f = linalg.factorize(K, backend, trailing=tr, groups=np.arange(K.shape[0]) // 2)
+        x = f.solve(b)
+        assert np.linalg.norm(K @ x - b) <= 1e-10 * np.linalg.norm(b)
+        assert np.allclose(f.solve(b[:, 1]), x[:, 1], rtol=1e-12, atol=1e-14)
+    G = f.trailing_inverse
+    ref = dense[np.ix_(trailing, trailing)]
+    assert np.abs(G - ref).max() <= 1e-10 * np.abs(ref).max()
+    assert np.array_equal(G, G.T)
+
+
+@pytest.mark.parametrize("backend", INSTALLED)
+def test_every_backend_solves_a_saddle_point(backend):
+    """``spd=False``: symmetric indefinite (a stiffness bordered by a constraint row)."""
+    K = stiffness()
+    n = K.shape[0]
+    B = sp.csr_matrix((np.ones(2), ([0, 0], [n - 1, n - 3])), shape=(1, n))
+    A = sp.bmat([[K, B.T], [B, None]]).tocsc()
+    b = np.r_[np.ones(n), 0.5]
+    x = linalg.factorize(A, backend, spd=False).solve(b)
+    assert np.linalg.norm(A @ x - b) <= 1e-9 * np.linalg.norm(b)
+
+
+@pytest.mark.parametrize("backend", INSTALLED)
+def test_the_contact_answer_does_not_depend_on_the_backend(backend):
+    p = HertzParameters(steps=1)
+    reference = Analysis(build(p), "superlu").run()
+    result = Analysis(build(p), backend).run()
+    assert result.backend == backend and result.converged
+    for name, r in reference.steps[-1].bodies.items():
+        other = result.steps[-1].bodies[name]
+        scale = np.abs(r.contact_force).max()
+        assert np.abs(other.contact_force - r.contact_force).max() <= 1e-8 * scale
+        assert np.abs(other.displacement - r.displacement).max() <= (
+            1e-8 * np.abs(r.displacement).max())
+
+
+def test_a_singular_stiffness_is_named_not_a_traceback():
+    K = stiffness().tolil()
+    K[0, :] = 0.0
+    K[:, 0] = 0.0
+    K = K.tocsc()
+    for backend in INSTALLED:
+        with pytest.raises(AnalysisError, match=f"body 'block': factorizing its stiffness "
+                                                f"\\({K.shape[0]} dofs\\) with {backend} failed"):
+            linalg.factorize(K, backend, what="body 'block'")
+
+
+def test_unknown_and_missing_solvers_are_input_errors(tmp_path, capsys):
+    with pytest.raises(InputError, match="unknown linear solver 'fastest'"):
+        linalg.resolve("fastest")
+    missing = [name for name in linalg.BACKENDS if name not in INSTALLED]
+    for name in missing:
+        with pytest.raises(InputError, match=f"linear solver '{name}' is not installed"):
+            linalg.resolve(name)
+    assert main(["run", "hertz", "--solver", "fastest", "--out", str(tmp_path)]) == 2
+    assert "unknown linear solver" in capsys.readouterr().err
+
+
+def test_the_solver_is_chosen_on_the_command_line_and_recorded(tmp_path):
+    try:
+        assert main(["-q", "run", "hertz", "--solver", "superlu", "--set", "steps=1",
+                     "--out", str(tmp_path)]) == 0
+    finally:
+        linalg.use("auto")
+    assert json.loads((tmp_path / "summary.json").read_text())["linear_solver"] == "superlu"
