@@ -38,6 +38,7 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
@@ -370,38 +371,54 @@ class PairedContact(VirtualElementContact):
         """W = d(penetration reduction)/d(traction value) over the active fine nodes of all pairs.
 
         Also the penetration change per unit platen motion and the platen reaction per unit
-        traction value. Each body's motion comes from its own flexibility C.
+        traction value: rows and columns of :meth:`_full_flexibility` (the pairs' geometry is
+        fixed under small kinematics, so it is computed once).
         """
-        m = sum(len(a) for a in active)
-        dF = [np.zeros((s.nc, 2, m)) for s in self.surfaces]  # body forces per unit traction
-        col = 0
-        for k, a in enumerate(active):
-            pair = self.contact_pairs[k]
-            cols = slice(col, col + len(a))
-            n = pair.normal[a]  # (|a|, 2)
-            rows = pair.nodes[a]
-            dF[pair.fine][:, :, cols] += pair.mass[:, rows][:, None, :] * n.T[None, :, :]
-            dF[pair.coarse][:, :, cols] -= pair.transfer[:, rows][:, None, :] * n.T[None, :, :]
-            col += len(a)
-        du = [(s.C @ f.reshape(2 * s.nc, m)).reshape(s.nc, 2, m)
+        if not hasattr(self, "_full"):
+            self._full = self._full_flexibility()
+        W, dp_dplaten, dR, offsets = self._full
+        index = np.concatenate([offsets[k] + a for k, a in enumerate(active)])
+        return W[np.ix_(index, index)], dp_dplaten[index], dR[index]
+
+    def _full_flexibility(self):
+        """W, the penetration change per unit platen motion and the platen reaction per unit
+        traction value over every node of every pair (stacked pair by pair, with the offsets).
+
+        The body forces per unit traction value are sparse (a node's traction reaches the few
+        nodes of its facets and of the opposing facets under it), so each body's motion is its
+        flexibility C times a sparse matrix, computed once.
+        """
+        offsets = np.cumsum([0] + [len(p.nodes) for p in self.contact_pairs])
+        m = int(offsets[-1])
+        parts: list[list] = [[] for _ in self.surfaces]  # (rows, cols, values) per body
+        for k, pair in enumerate(self.contact_pairs):
+            for body, per_node, sign in ((pair.fine, pair.mass, 1.0),
+                                         (pair.coarse, pair.transfer, -1.0)):
+                r, c = np.nonzero(per_node[:, pair.nodes])
+                v = sign * per_node[r, pair.nodes[c]]
+                for d in range(2):  # the force along the normal's components
+                    parts[body].append((2 * r + d, offsets[k] + c, v * pair.normal[c, d]))
+        dF = [sp.csr_matrix((np.concatenate([p[2] for p in ps]) if ps else [],
+                             (np.concatenate([p[0] for p in ps]) if ps else [],
+                              np.concatenate([p[1] for p in ps]) if ps else [])),
+                            shape=(2 * s.nc, m))
+              for s, ps in zip(self.surfaces, parts)]  # body forces per unit traction value
+        du = [np.asarray((f.T @ s.C.T).T).reshape(s.nc, 2, m)
               for s, f in zip(self.surfaces, dF)]
         W = np.zeros((m, m))
         dp_dplaten = np.zeros(m)
-        row = 0
-        for k, a in enumerate(active):
-            pair = self.contact_pairs[k]
-            n = pair.normal[a]
-            uf = du[pair.fine][pair.nodes[a]]  # (|a|, 2, m)
-            uc = np.einsum("ic,cdm->idm", pair.interp[a], du[pair.coarse])
+        for k, pair in enumerate(self.contact_pairs):
+            rows = slice(offsets[k], offsets[k + 1])
+            uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
+            uc = np.einsum("ic,cdm->idm", pair.interp, du[pair.coarse])
             # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dlam
-            W[row:row + len(a)] = np.einsum("id,idm->im", n, uf - uc)
-            dp_dplaten[row:row + len(a)] = pair.platen_rate[a]
-            row += len(a)
+            W[rows] = np.einsum("id,idm->im", pair.normal, uf - uc)
+            dp_dplaten[rows] = pair.platen_rate
         dR = np.zeros(m)
         if self.platen_body is not None:
             s = self.surfaces[self.platen_body]
-            dR = s.platen_row @ dF[self.platen_body].reshape(2 * s.nc, m)
-        return W, dp_dplaten, dR
+            dR = np.asarray(dF[self.platen_body].T @ s.platen_row).ravel()
+        return W, dp_dplaten, dR, offsets
 
     def _close_gap(self, state: ContactState, pens: list[np.ndarray]) -> None:
         """Nothing touches: move the platen just far enough to close the smallest gap."""
