@@ -42,6 +42,11 @@ class Parameters:
     variant: str = "paired"
     order: int = 1  # 2: quadratic elements (9-node quadrilaterals)
     swap_bodies: bool = False  # list the upper block first
+    # the contact method: vfem, or a classical baseline and its parameters (ContactSettings)
+    method: str = "vfem"
+    penalty: float | None = None
+    penalty_factor: float = ContactSettings.penalty_factor
+    augmented_tolerance: float = ContactSettings.augmented_tolerance
 
 
 def block(y0: float, n: int) -> MeshSpec:
@@ -51,12 +56,15 @@ def block(y0: float, n: int) -> MeshSpec:
 
 
 def settings(p: Parameters) -> ContactSettings:
+    method = dict(method=p.method, penalty=p.penalty, penalty_factor=p.penalty_factor,
+                  augmented_tolerance=p.augmented_tolerance)
     if p.tight:
         # near round-off; the stationary rule still stops (and flags) a fixed point where the
         # corrections cancel, so the residual errors it leaves are reported
         return ContactSettings(variant=p.variant, penetration_tolerance=1e-13,
-                               equilibrium_tolerance=1e-11, max_iterations=2000, max_step_cuts=0)
-    return ContactSettings(variant=p.variant)
+                               equilibrium_tolerance=1e-11, max_iterations=2000, max_step_cuts=0,
+                               **method)
+    return ContactSettings(variant=p.variant, **method)
 
 
 def config(p: Parameters, n_lower: int, n_upper: int, nu: float) -> ModelConfig:
