@@ -157,7 +157,9 @@ def run(p: Parameters, out=None, on_step=None) -> dict:
 
 
 def report(summary: dict) -> list[str]:
-    lines = ["vfem: contact patch test — uniform pressure across non-matching meshes",
+    method = summary["parameters"].get("method", "vfem")
+    lines = ["vfem: contact patch test — uniform pressure across non-matching meshes"
+             + ("" if method == "vfem" else f", contact method {method!r}"),
              f"  {'lower/upper':>11} {'nu':>4} {'iters':>5} {'pressure dev':>12} "
              f"{'sigma_y dev':>11} {'penetration':>11} {'eq. error':>9}"]
     for c in summary["cases"]:
