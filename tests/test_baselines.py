@@ -182,3 +182,12 @@ def test_cli_runs_hertz_with_a_baseline(tmp_path, capsys):
     assert abs(summary["hertz"]["p_max_error"]) < 2e-3
     assert (out / "cylinder_step0002.vtu").stat().st_size > 0
     assert (out / "contact.csv").stat().st_size > 0
+
+
+def test_a_body_only_contact_could_hold_but_none_can_touch_is_refused():
+    """The cylinder 0.2 above the flat: no candidates, so nothing holds it (singular)."""
+    result = Analysis(hertz.build(hertz.HertzParameters(method="penalty",
+                                                        initial_gap=0.2))).run()
+    assert not result.converged
+    assert "body 'cylinder' is held along y only by its platen and by contact" in result.message
+    assert "within contact.search_distance of each other" in result.message

@@ -277,6 +277,7 @@ class GlobalContact:
         only support that way), the constraint rows that touch it: one of them must stay active
         or the global matrix is singular."""
         out = []
+        self.unheld = []  # such bodies without any constraint row: the matrix is singular
         for i, b in enumerate(self.model.bodies):
             if b.platen is None:
                 continue
@@ -286,6 +287,8 @@ class GlobalContact:
             rows = np.flatnonzero((self.c.slave == i) | (self.c.master == i))
             if len(rows):
                 out.append(rows)
+            else:
+                self.unheld.append(b)
         return out
 
     def _seeded(self, active: np.ndarray, gap: np.ndarray) -> np.ndarray:
@@ -308,14 +311,22 @@ class GlobalContact:
         A = np.flatnonzero(active)
         Ba = self.Br[A]
         t0 = time.perf_counter()
-        with memory_guard(f"factorizing the global system ({self.method})"):
-            if self.method == "lagrange":
-                M = sp.bmat([[self.K, Ba.T], [Ba, None]], format="csc")
-                self._factor = _Refined(M, factorize(M, self.backend, spd=False))
-            else:
-                ew = self.c.penalty[A] * self.c.weight[A]
-                M = (self.K + Ba.T @ sp.diags(ew) @ Ba).tocsc()
-                self._factor = factorize(M, self.backend)
+        try:
+            with memory_guard(f"factorizing the global system ({self.method})"):
+                if self.method == "lagrange":
+                    M = sp.bmat([[self.K, Ba.T], [Ba, None]], format="csc")
+                    self._factor = _Refined(M, factorize(M, self.backend, spd=False))
+                else:
+                    ew = self.c.penalty[A] * self.c.weight[A]
+                    M = (self.K + Ba.T @ sp.diags(ew) @ Ba).tocsc()
+                    self._factor = factorize(M, self.backend)
+        except RuntimeError as exc:  # SuperLU: a zero pivot
+            if isinstance(exc, AnalysisError):
+                raise
+            raise AnalysisError(
+                f"the global matrix of the {self.method} method is singular with "
+                f"{len(A)} nodes in contact ({exc}): a body is held by nothing but contact and "
+                "no node of it can touch (no candidate facets near it?)") from None
         self.timings["factorize_s"] += time.perf_counter() - t0
         self.factorizations += 1
         self._factor_key = key
@@ -332,6 +343,12 @@ class GlobalContact:
                 comes back to one it had left.
         """
         settings = self.model.contact
+        if self.unheld:
+            b = self.unheld[0]
+            raise AnalysisError(
+                f"body {b.name!r} is held along {b.platen.component} only by its platen and by "
+                "contact, and none of its nodes can touch another body (no contact candidates "
+                "within contact.search_distance), so the global matrix is singular")
         f = load_factor * self.f1
         gp = self.c.g0 + load_factor * self.g_prescribed  # gaps with the loads' motion only
         c, Br = self.c, self.Br
@@ -366,6 +383,11 @@ class GlobalContact:
                 Lam[A] = c.weight[A] * trial[A]
                 new = trial > 0
             self.timings["solve_s"] += time.perf_counter() - t0
+            if not np.all(np.isfinite(q)):
+                raise AnalysisError(
+                    f"the {self.method} method's linear solve gave non-finite displacements "
+                    f"with {len(A)} nodes in contact: the global matrix is singular (a body "
+                    "held by nothing but contact, with no node of it in contact)")
             new = self._seeded(new, gp)
             penetration = float(np.maximum(-g, 0.0).max(initial=0.0))
             history.append(IterationRecord(it, penetration, 0.0, int((Lam > 0).sum()), tension))
@@ -476,10 +498,13 @@ class GlobalContact:
                 q, Lam, g, active, lam, history = self.solve_step(lf, active, lam)
             except AnalysisError as exc:
                 converged = False
+                remedy = ("bring the bodies within contact.search_distance of each other, or "
+                          "support the body" if "singular" in str(exc) else
+                          f"allow more linear solves (contact.max_iterations = "
+                          f"{model.contact.max_iterations}) or take smaller steps; check that "
+                          "every body is held the way you expect")
                 message = (f"step {len(steps) + 1} (load factor {state.load_factor:.6g} -> "
-                           f"{lf:.6g}) failed: {exc}. What to change: allow more linear solves "
-                           f"(contact.max_iterations = {model.contact.max_iterations}) or take "
-                           "smaller steps; check that every body is held the way you expect")
+                           f"{lf:.6g}) failed: {exc}. What to change: {remedy}")
                 log.info(message)
                 break
             fields, forces = self.fields(lf, q, Lam, g)
