@@ -198,11 +198,15 @@ class Body:
 
     # -- set-up ---------------------------------------------------------------------------------
 
-    def setup(self, backend: str | None = None, tracked_dofs: np.ndarray | None = None) -> None:
-        """Validate, assemble the stiffness, factorize it and solve the unit load cases.
+    def assemble(self) -> dict[int, float]:
+        """Validate and assemble, without factorizing anything: the basis, the stiffness ``K``
+        (all dofs), the constrained dofs (``fixed_dofs``, ``platen_dofs``, ``free_dofs``), the
+        load vector ``f_load`` and ``u_prescribed`` (the constrained dofs' values, 0 on supports
+        and the platen's dofs), both at load factor 1. Refuses a body free to move as a rigid
+        body. Returns the prescribed value of every supported or prescribed dof.
 
-        With ``tracked_dofs`` (the dofs contact follows), the factorization also yields the
-        inverse stiffness among them (``tracked_flexibility``, supports kept: zero on fixed dofs).
+        :meth:`setup` starts with it; the classical baselines (:mod:`vfem.contact.baselines`),
+        which solve every body in one global system, need only this part.
         """
         self.validate()
         t0 = time.perf_counter()
@@ -212,10 +216,29 @@ class Body:
         self.ndofs = self.K.shape[0]
         t1 = time.perf_counter()
         fixed = self._constraints()
-        platen_dofs = self.platen_dofs
         self._check_supported()
-
         self.free_dofs = np.setdiff1d(np.arange(self.ndofs), self.fixed_dofs)
+        f = np.zeros(self.ndofs)
+        for tr in self.tractions:
+            f += self._traction_vector(tr)
+        self.f_load = f
+        u_fixed = np.zeros(self.ndofs)
+        for dof, value in fixed.items():
+            u_fixed[dof] = value
+        self.u_prescribed = u_fixed
+        self.timings = {"assemble_s": t1 - t0, "constraints_s": time.perf_counter() - t1}
+        return fixed
+
+    def setup(self, backend: str | None = None, tracked_dofs: np.ndarray | None = None) -> None:
+        """Validate, assemble the stiffness (:meth:`assemble`), factorize it and solve the unit
+        load cases.
+
+        With ``tracked_dofs`` (the dofs contact follows), the factorization also yields the
+        inverse stiffness among them (``tracked_flexibility``, supports kept: zero on fixed dofs).
+        """
+        fixed = self.assemble()
+        t1 = time.perf_counter()
+        platen_dofs = self.platen_dofs
         self.K_ff = self.K[self.free_dofs][:, self.free_dofs].tocsc()
         trailing = None
         if tracked_dofs is not None:
@@ -234,14 +257,8 @@ class Body:
             G[np.ix_(ix, ix)] = self.factor.trailing_inverse
             self.tracked_flexibility = G
 
-        f = np.zeros(self.ndofs)
-        for tr in self.tractions:
-            f += self._traction_vector(tr)
-        u_fixed = np.zeros(self.ndofs)
-        for dof, value in fixed.items():
-            u_fixed[dof] = value
-        self.f_load = f
-        self.u_load = self._solve_with(f, u_fixed)
+        f = self.f_load
+        self.u_load = self._solve_with(f, self.u_prescribed)
         # The platen's reaction (the force it applies to the body, along its component) is
         # linear in the state: load_factor * platen_load_reaction + platen_displacement *
         # platen_stiffness + (reaction per unit contact force) . contact forces.
@@ -255,8 +272,8 @@ class Body:
             self.platen_stiffness = _platen_stiffness(self.K, self.u_platen, platen_dofs)
         if self.large:
             self._setup_large(fixed)
-        self.timings = {"assemble_s": t1 - t0, "constraints_s": t2 - t1, "factorize_s": t3 - t2,
-                        "load_cases_s": time.perf_counter() - t3}
+        self.timings.update(constraints_s=self.timings["constraints_s"] + t2 - t1,
+                            factorize_s=t3 - t2, load_cases_s=time.perf_counter() - t3)
         log.info("body %s: %d points, %d dofs (%d fixed)", self.name, self.ndofs // 2,
                  self.ndofs, len(self.fixed_dofs))
 

@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 
 from . import linalg
+from .contact.settings import ContactSettings
 from .errors import InputError, VfemError
 from .examples import EXAMPLES, load
 
@@ -43,8 +44,12 @@ def _parse_value(text: str, current, key: str, cls):
         raise InputError(f"--set {key}: expected a number, got {text!r}") from None
 
 
+CONTACT_KEYS = {f.name for f in dataclasses.fields(ContactSettings)}
+
+
 def build_parameters(example: str, assignments: list[str]):
-    """The example's parameters with ``key=value`` overrides applied."""
+    """The example's parameters with ``key=value`` overrides applied. ``contact.KEY`` is
+    accepted for the example's parameters that are contact settings (``contact.method``)."""
     cls = load(example).Parameters
     params = cls()
     names = [f.name for f in dataclasses.fields(cls)]
@@ -53,6 +58,9 @@ def build_parameters(example: str, assignments: list[str]):
         if "=" not in item:
             raise InputError(f"--set expects key=value, got {item!r}")
         key, value = (s.strip() for s in item.split("=", 1))
+        if key.startswith("contact.") and key[len("contact."):] in names and \
+                key[len("contact."):] in CONTACT_KEYS:
+            key = key[len("contact."):]  # the example's parameter that is this contact setting
         if key not in names:
             close = difflib.get_close_matches(key, names, n=1)
             hint = f"; did you mean {close[0]!r}?" if close else f"; valid keys: {', '.join(names)}"

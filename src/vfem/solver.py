@@ -90,6 +90,13 @@ class Model:
                 raise InputError(f"model {self.name!r}, body {quadratic[0]!r}: contact with a "
                                  "large-kinematics body needs linear elements (order 1) on every "
                                  "body")
+        if self.contact.method != "vfem":
+            for b in self.bodies:
+                if b.large or b.order != 1:
+                    raise InputError(f"model {self.name!r}, body {b.name!r}: the classical "
+                                     f"contact methods (contact.method = "
+                                     f"{self.contact.method!r}) need linear elements (order 1) "
+                                     "and small kinematics; use contact.method = 'vfem'")
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
         self.contact.validate()
@@ -222,6 +229,13 @@ class Analysis:
         estimated before anything is factorized (:mod:`vfem.memory`): a model that cannot fit
         is refused, and running out of memory anyway is an :class:`AnalysisError` that says so.
         """
+        if self.model.contact.method != "vfem":  # a classical baseline: one global system
+            from .contact.baselines import GlobalContact
+
+            self.contact = GlobalContact(self.model, self.backend)
+            self.surfaces = self.contact.surfaces
+            self.timings.update(self.contact.timings)
+            return
         t0 = time.perf_counter()
         log.info("linear solver: %s", self.backend)
         bodies = self.model.bodies
@@ -294,6 +308,8 @@ class Analysis:
         """
         if not hasattr(self, "contact"):
             self.setup()
+        if self.model.contact.method != "vfem":
+            return self.contact.run(self, on_step, start)
         self.contact.on_iteration = getattr(on_step, "iteration", None)
         t_setup = time.perf_counter()
         settings = self.model.contact

@@ -9,13 +9,25 @@ from ..errors import InputError
 
 CONVERGENCE_CRITERIA = ("stationary", "physical", "thesis")
 VARIANTS = ("thesis", "paired")
+METHODS = ("vfem", "penalty", "lagrange", "augmented")
 
 
 @dataclass(frozen=True)
 class ContactSettings:
-    """Settings of the virtual finite element contact algorithm.
+    """Settings of the contact algorithm: the virtual finite element method, or one of the
+    classical baselines it is measured against (``method``).
 
     Attributes:
+        method: ``"vfem"`` (default) — the virtual finite element method; or a classical
+            baseline it is measured against, one global system of every body with
+            node-to-segment contact (docs/baselines.md): ``"penalty"`` — a penalty on each
+            penetrating node, so the answer depends on ``penalty`` (contact pressure = penalty
+            x penetration); ``"lagrange"`` — Lagrange multipliers, gaps closed exactly;
+            ``"augmented"`` — augmented Lagrangian (Uzawa) with the same penalty, until the
+            gaps are within ``augmented_tolerance``. Of the keys below the baselines use
+            ``search_distance``, ``max_iterations`` (linear solves per step), ``penalty``,
+            ``penalty_factor`` and ``augmented_tolerance``; they need linear elements (order 1)
+            and small kinematics.
         variant: ``"thesis"`` — the plain reading: every node of both bodies checked for both
             compatibility and equilibrium (docs/method.md); ``"paired"`` — per contact pair one
             surface (the softer, or of equals the finer) carries compatibility and the other
@@ -52,8 +64,19 @@ class ContactSettings:
             quadrature order is raised in proportion (thesis §5.6: 3:1 is easily tolerated).
         max_step_cuts: how many times a step is halved after a failure before the analysis stops.
         platen_tolerance: relative mismatch allowed between a platen's reaction and its force.
+        penalty: the baselines' penalty stiffness per unit contact length (``method``
+            ``"penalty"`` or ``"augmented"``): contact pressure per unit penetration (a slave
+            node's force is penalty x penetration x its tributary length). Default (None):
+            ``penalty_factor`` x the larger plane-strain modulus E / (1 - nu^2) of the pair's
+            two bodies / the pair's shortest slave facet. The penalty method's answer
+            (penetration, pressure, contact size) depends on it.
+        penalty_factor: the multiple of E' / h that makes the default ``penalty``.
+        augmented_tolerance: the augmented Lagrangian stops when every active node's gap and
+            every other node's penetration is within this fraction of the shortest slave facet
+            of the model (the same length scale as ``penetration_tolerance``'s default).
     """
 
+    method: str = "vfem"
     variant: str = "paired"
     penetration_tolerance: float | None = None
     equilibrium_tolerance: float = 1e-3
@@ -69,6 +92,9 @@ class ContactSettings:
     size_ratio_limit: float = 3.0
     max_step_cuts: int = 6
     platen_tolerance: float = 1e-5
+    penalty: float | None = None
+    penalty_factor: float = 1000.0
+    augmented_tolerance: float = 1e-9
 
     def validate(self) -> None:
         for f in fields(self):
@@ -76,14 +102,17 @@ class ContactSettings:
             if isinstance(v, float) and not math.isfinite(v):
                 raise InputError(f"contact.{f.name} must be a finite number, got {v!r}")
         positive = ("equilibrium_tolerance", "relaxation", "first_relaxation", "thesis_fraction",
-                    "size_ratio_limit", "platen_tolerance")
+                    "size_ratio_limit", "platen_tolerance", "penalty_factor",
+                    "augmented_tolerance")
         for name in positive:
             if getattr(self, name) <= 0:
                 raise InputError(f"contact.{name} must be > 0, got {getattr(self, name)!r}")
-        for name in ("penetration_tolerance", "search_distance"):
+        for name in ("penetration_tolerance", "search_distance", "penalty"):
             v = getattr(self, name)
             if v is not None and v <= 0:
                 raise InputError(f"contact.{name} must be > 0, got {v!r}")
+        if self.method not in METHODS:
+            raise InputError(f"contact.method must be one of {METHODS}, got {self.method!r}")
         if self.variant not in VARIANTS:
             raise InputError(f"contact.variant must be one of {VARIANTS}, got {self.variant!r}")
         if self.convergence not in CONVERGENCE_CRITERIA:

@@ -51,6 +51,11 @@ class HertzParameters:
     variant: str = "paired"
     swap_bodies: bool = False
     order: int = 1  # 2: quadratic elements (6-node triangles, 9-node quadrilaterals)
+    # the contact method: vfem, or a classical baseline and its parameters (ContactSettings)
+    method: str = "vfem"
+    penalty: float | None = None
+    penalty_factor: float = ContactSettings.penalty_factor
+    augmented_tolerance: float = ContactSettings.augmented_tolerance
 
 
 Parameters = HertzParameters
@@ -106,7 +111,9 @@ def config(p: HertzParameters | None = None) -> ModelConfig:
     )
     bodies = (flat, cylinder) if p.swap_bodies else (cylinder, flat)
     settings = ContactSettings(variant=p.variant, penetration_tolerance=p.penetration_tolerance,
-                               equilibrium_tolerance=p.equilibrium_tolerance)
+                               equilibrium_tolerance=p.equilibrium_tolerance, method=p.method,
+                               penalty=p.penalty, penalty_factor=p.penalty_factor,
+                               augmented_tolerance=p.augmented_tolerance)
     return ModelConfig("hertz", bodies, settings, Steps(count=p.steps))
 
 
@@ -253,7 +260,7 @@ def _figures(out, model: Model, result: AnalysisResult, summary: dict,
         pp[s.body.name] = last.bodies[s.body.name].contact_pressure[nodes[keep]] / p0
     hertz_pressure(out / "pressure.png", xa, pp,
                    f"Hertz, {summary['dofs']} dofs: p_max {th['p_max_error']:+.2%} vs p0, "
-                   f"RMS {th['rms_error_over_p0']:.2%}")
+                   f"RMS {th['rms_error_over_p0']:.2%}", method=p.method)
     cyl_mesh = next(b.mesh for b in model.bodies if b.name == "cylinder")
     tip = int(np.argmin(np.hypot(*cyl_mesh.p)))  # the first point of contact
     y0 = float(last.bodies["cylinder"].displacement[tip, 1])
@@ -268,7 +275,9 @@ def report(s: dict) -> list[str]:
     """The closing lines of a Hertz run."""
     lines = [f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(s['steps'])} "
              f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
-             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"
+             + ("" if s["parameters"].get("method", "vfem") == "vfem"
+                else f", contact method {s['parameters']['method']!r}")]
     if "hertz" in s:
         h = s["hertz"]
         lines.append(f"  p_max {h['p_max']:.1f} (theory {h['p0_theory']:.1f}, "

@@ -42,6 +42,11 @@ class Parameters:
     variant: str = "paired"
     order: int = 1  # 2: quadratic elements (9-node quadrilaterals)
     swap_bodies: bool = False  # list the upper block first
+    # the contact method: vfem, or a classical baseline and its parameters (ContactSettings)
+    method: str = "vfem"
+    penalty: float | None = None
+    penalty_factor: float = ContactSettings.penalty_factor
+    augmented_tolerance: float = ContactSettings.augmented_tolerance
 
 
 def block(y0: float, n: int) -> MeshSpec:
@@ -51,12 +56,15 @@ def block(y0: float, n: int) -> MeshSpec:
 
 
 def settings(p: Parameters) -> ContactSettings:
+    method = dict(method=p.method, penalty=p.penalty, penalty_factor=p.penalty_factor,
+                  augmented_tolerance=p.augmented_tolerance)
     if p.tight:
         # near round-off; the stationary rule still stops (and flags) a fixed point where the
         # corrections cancel, so the residual errors it leaves are reported
         return ContactSettings(variant=p.variant, penetration_tolerance=1e-13,
-                               equilibrium_tolerance=1e-11, max_iterations=2000, max_step_cuts=0)
-    return ContactSettings(variant=p.variant)
+                               equilibrium_tolerance=1e-11, max_iterations=2000, max_step_cuts=0,
+                               **method)
+    return ContactSettings(variant=p.variant, **method)
 
 
 def config(p: Parameters, n_lower: int, n_upper: int, nu: float) -> ModelConfig:
@@ -161,7 +169,9 @@ def run(p: Parameters, out=None, on_step=None) -> dict:
 
 
 def report(summary: dict) -> list[str]:
-    lines = ["vfem: contact patch test — uniform pressure across non-matching meshes",
+    method = summary["parameters"].get("method", "vfem")
+    lines = ["vfem: contact patch test — uniform pressure across non-matching meshes"
+             + ("" if method == "vfem" else f", contact method {method!r}"),
              f"  {'lower/upper':>11} {'nu':>4} {'iters':>5} {'pressure dev':>12} "
              f"{'sigma_y dev':>11} {'penetration':>11} {'eq. error':>9}"]
     for c in summary["cases"]:

@@ -14,15 +14,16 @@ from matplotlib.ticker import MaxNLocator, NullFormatter  # noqa: E402
 
 
 def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[str, np.ndarray],
-                   title: str) -> None:
-    """p/p0 against x/a for each body, with Hertz's ellipse (like thesis Fig. 5.3)."""
+                   title: str, method: str = "vfem") -> None:
+    """p/p0 against x/a for each body, with Hertz's ellipse (like thesis Fig. 5.3);
+    ``method``: the contact method that computed them (the legend's label)."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     s = np.linspace(0, 1, 200)
     ax.plot(s, np.sqrt(1 - s**2), "k-", lw=1.5, label="Hertz")
     for (name, xa), marker in zip(x_over_a.items(), ("o", "s", "^", "v")):
         order = np.argsort(xa)
         ax.plot(xa[order], p_over_p0[name][order], marker, ms=4, mfc="none", ls="",
-                label=f"vfem, {name} (nodal force / undeformed length)")
+                label=f"{method}, {name} (nodal force / undeformed length)")
     ax.set_xlim(0, 1.4)
     ax.set_ylim(-0.1, 1.15)
     ax.axhline(0, color="0.7", lw=0.8)

@@ -1,0 +1,540 @@
+"""The classical contact methods vfem is measured against (``contact.method``): penalty,
+Lagrange multipliers and the augmented Lagrangian, on one global system of every body.
+
+This is contact the way most finite element codes do it, on the same :class:`~vfem.solver.Model`
+as the virtual finite element method (bodies, meshes, supports, loads, platen, load factors):
+
+* **one global system**: the stiffness of every body, block diagonal, reduced to the free dofs
+  by a sparse transformation ``U = T q + load_factor * U_prescribed`` (``K_red = T^T K T``). A
+  force-controlled rigid platen is one more unknown, the platen displacement, to which all its
+  dofs are tied; its equation carries the platen force (scaled by the load factor).
+* **node-to-segment, single pass**: per pair of bodies that may touch, the *slave* surface is the
+  finer one (more candidate nodes per unit length; of equals, the softer, then the first name in
+  alphabetical order; so the choice never depends on the order of the bodies) and its candidate
+  nodes are the constraints; the other surface's candidate facets are the *master segments*.
+  Each slave node is projected on its closest master segment in the undeformed configuration
+  (:func:`~vfem.contact.search.project_points`, a KD-tree), once: small displacements,
+  frictionless. Its gap, linearised,
+
+      g = n . (x_s + u_s - (N1 (x_1 + u_1) + N2 (x_2 + u_2))) = g0 + B U >= 0,
+
+  with ``n`` the master segment's outward normal and ``N1, N2`` its shape functions at the
+  projection. A row of ``B`` puts the slave node's normal force ``Lambda >= 0`` (compressive) on
+  the slave node (``+n``) and, spread by ``N1, N2``, on the master's nodes: the contact forces
+  are ``B^T Lambda``, in balance between the bodies by construction.
+* the **active set** (nodes in contact) is iterated until it no longer changes, and the global
+  matrix refactorized each time it changes (the classical cost):
+
+  - ``penalty``: ``(K + B_A^T E W B_A) q = f - B_A^T E W g0`` over the active (penetrating)
+    nodes, ``E`` the penalty and ``W`` the slave nodes' tributary lengths: contact pressure =
+    penalty x penetration, so the answer depends on the penalty;
+  - ``lagrange``: the saddle point ``[K B_A^T; B_A 0]``, the gaps of the active nodes exactly
+    closed; a node whose multiplier is tensile leaves the set, a node whose gap closes enters;
+  - ``augmented``: augmented Lagrangian (Uzawa): the penalty system with the multipliers
+    ``lambda`` (pressures) as loads, ``lambda <- max(0, lambda - penalty g)`` until every active
+    node's gap and every other node's penetration is within ``augmented_tolerance`` of the
+    shortest slave facet; refactorized only when the active set changes.
+
+* the steps follow ``model.load_factors``, each from the previous step's active set (and
+  multipliers); a step counts its linear solves as its iterations.
+
+A body held only by contact and its platen (the Hertz cylinder) makes the system singular while
+no node touches it: then its closest node is put in the active set, as a seed.
+
+The results are the :class:`~vfem.solver.AnalysisResult` of vfem: nodal contact forces on both
+bodies, the nominal pressure read as vfem reads it (a node's normal contact force over its
+undeformed tributary length on its :class:`~vfem.contact.surface.ContactSurface`; on a master
+node the normal is the master's own node normal), the slave nodes' gaps as ``penetration`` (0 on
+master nodes, where none is measured). See ``docs/baselines.md``.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..bodies import COMPONENTS
+from ..errors import AnalysisError
+from ..linalg import factorize
+from ..memory import memory_guard
+from .algorithm import ContactState, IterationRecord
+from .surface import ContactSurface
+
+log = logging.getLogger(__name__)
+
+#: a Lagrange node enters the active set when its gap is below minus this fraction of the
+#: shortest slave facet (round-off, not physics: the gaps it closes are exact)
+GAP_ROUNDOFF = 1e-10
+#: ... and leaves it when its force is tensile by more than this fraction of the largest force
+FORCE_ROUNDOFF = 1e-10
+
+
+def modulus(surface: ContactSurface) -> float:
+    """The plane-strain modulus E / (1 - nu^2) of the surface's body (E in plane stress)."""
+    return surface.body.material.plane_strain_modulus()
+
+
+def node_density(surface: ContactSurface) -> float:
+    """Candidate nodes per unit length of the candidate surface."""
+    length = float(surface.lengths.sum())
+    return surface.nc / length if length > 0 else 0.0
+
+
+def choose_slave(a: ContactSurface, b: ContactSurface) -> tuple[ContactSurface, ContactSurface]:
+    """(slave, master) of a pair: the slave is the surface with more candidate nodes per unit
+    length (the finer); of equal densities (to 1e-9), the softer (smaller plane-strain modulus);
+    of equals in both, the body whose name sorts first. Independent of the order of the bodies.
+    """
+    da, db = node_density(a), node_density(b)
+    if abs(da - db) > 1e-9 * max(da, db):
+        return (a, b) if da > db else (b, a)
+    ea, eb = modulus(a), modulus(b)
+    if ea != eb:
+        return (a, b) if ea < eb else (b, a)
+    return (a, b) if a.body.name <= b.body.name else (b, a)
+
+
+@dataclass
+class NodeToSegment:
+    """The node-to-segment constraints of every pair, one row per slave node.
+
+    Attributes:
+        slave, master: (m,) the bodies (indices in the model) of each row's slave node and
+            master segment.
+        node: (m,) the slave node's candidate number on its surface.
+        segment, t: (m,) the master segment (candidate facet) and the local coordinate of the
+            projection on it (0 at its first node).
+        normal: (m, 2) the master segment's outward unit normal.
+        g0: (m,) the undeformed gap (> 0 open, < 0 overlapping).
+        weight: (m,) the slave node's tributary length (``ContactSurface.tributary``).
+        penalty: (m,) the pair's penalty (pressure per unit penetration).
+        B_slave, B_master: (m, N) the gap's slave and master parts per global dof (``B`` is
+            their sum): the contact forces are ``B_slave^T Lambda`` on slave nodes and
+            ``B_master^T Lambda`` on master nodes.
+    """
+
+    slave: np.ndarray
+    master: np.ndarray
+    node: np.ndarray
+    segment: np.ndarray
+    t: np.ndarray
+    normal: np.ndarray
+    g0: np.ndarray
+    weight: np.ndarray
+    penalty: np.ndarray
+    B_slave: sp.csr_matrix
+    B_master: sp.csr_matrix
+
+    @property
+    def B(self) -> sp.csr_matrix:
+        return (self.B_slave + self.B_master).tocsr()
+
+    def subset(self, keep: np.ndarray) -> NodeToSegment:
+        return NodeToSegment(self.slave[keep], self.master[keep], self.node[keep],
+                             self.segment[keep], self.t[keep], self.normal[keep], self.g0[keep],
+                             self.weight[keep], self.penalty[keep], self.B_slave[keep],
+                             self.B_master[keep])
+
+
+def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
+                    offsets: np.ndarray, ndofs: int, penalty: float | None,
+                    penalty_factor: float) -> NodeToSegment:
+    """Project every slave node of every pair on its closest master segment (undeformed
+    configuration, vectorised) and assemble the rows of the gaps (COO)."""
+    index = {id(s): i for i, s in enumerate(surfaces)}
+    parts = []
+    for pair in sorted(tuple(sorted(p)) for p in pairs):
+        slave, master = choose_slave(surfaces[pair[0]], surfaces[pair[1]])
+        if slave.nc == 0 or len(master.facets) == 0:
+            continue
+        i, j = index[id(slave)], index[id(master)]
+        xs = slave.X[: slave.nc]
+        seg, t, _, n = master.project(xs)
+        a, b = master.facets[seg, 0], master.facets[seg, 1]
+        xm = (1 - t)[:, None] * master.X[a] + t[:, None] * master.X[b]
+        g0 = np.einsum("ij,ij->i", n, xs - xm)
+        eps = penalty if penalty is not None else (
+            penalty_factor * max(modulus(slave), modulus(master)) / float(slave.lengths.min()))
+        log.info("contact pair %s (slave) / %s (master): %d slave nodes, penalty %.6g",
+                 slave.body.name, master.body.name, slave.nc, eps)
+        parts.append(dict(
+            slave=np.full(slave.nc, i), master=np.full(slave.nc, j),
+            node=np.arange(slave.nc), segment=seg, t=t, normal=n, g0=g0,
+            weight=slave.tributary.copy(), penalty=np.full(slave.nc, eps),
+            slave_points=slave.nodes[: slave.nc] + 0, a_points=master.nodes[a],
+            b_points=master.nodes[b], slave_offset=offsets[i], master_offset=offsets[j]))
+    if not parts:
+        empty = sp.csr_matrix((0, ndofs))
+        return NodeToSegment(*(np.zeros(0, dtype=int),) * 4, np.zeros(0), np.zeros((0, 2)),
+                             np.zeros(0), np.zeros(0), np.zeros(0), empty, empty)
+
+    def cat(key: str) -> np.ndarray:
+        return np.concatenate([p[key] for p in parts])
+
+    m = sum(len(p["node"]) for p in parts)
+    rows = np.arange(m)
+    n = np.concatenate([p["normal"] for p in parts])
+    t = cat("t")
+    dof_s = np.concatenate([p["slave_offset"] + 2 * p["slave_points"] for p in parts])
+    dof_a = np.concatenate([p["master_offset"] + 2 * p["a_points"] for p in parts])
+    dof_b = np.concatenate([p["master_offset"] + 2 * p["b_points"] for p in parts])
+    r2 = np.repeat(rows, 2)
+    comp = np.tile([0, 1], m)
+    B_slave = sp.csr_matrix((n.ravel(), (r2, np.repeat(dof_s, 2) + comp)), shape=(m, ndofs))
+    master_cols = np.concatenate([np.repeat(dof_a, 2) + comp, np.repeat(dof_b, 2) + comp])
+    master_vals = np.concatenate([(-(1 - t)[:, None] * n).ravel(), (-t[:, None] * n).ravel()])
+    B_master = sp.csr_matrix((master_vals, (np.tile(r2, 2), master_cols)), shape=(m, ndofs))
+    return NodeToSegment(cat("slave"), cat("master"), cat("node"), cat("segment"), t, n,
+                         cat("g0"), cat("weight"), cat("penalty"), B_slave, B_master)
+
+
+class _Refined:
+    """A saddle point's factorization whose solves take one step of iterative refinement:
+    general pivoting on a matrix mixing stiffnesses (E ~ 1e9) with unit constraint rows loses
+    digits, and one residual solve brings the gaps of the active nodes back to round-off."""
+
+    def __init__(self, M: sp.spmatrix, factor):
+        self.M, self.factor = M, factor
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        x = self.factor.solve(b)
+        return x + self.factor.solve(b - self.M @ x)
+
+
+class GlobalContact:
+    """A classical baseline (``model.contact.method``: penalty, lagrange or augmented) on the
+    global system of the model's bodies; see the module docstring. ``run`` is what
+    :meth:`vfem.solver.Analysis.run` does for it."""
+
+    def __init__(self, model, backend: str | None = None):
+        self.model = model
+        self.method = model.contact.method
+        self.backend = backend
+        settings = model.contact
+        t0 = time.perf_counter()
+        pairs, self.surfaces = model.contact_surfaces()
+        t1 = time.perf_counter()
+        bodies = model.bodies
+        for b in bodies:
+            b.assemble()
+        sizes = np.array([b.ndofs for b in bodies])
+        self.offsets = np.r_[0, np.cumsum(sizes)[:-1]]
+        N = int(sizes.sum())
+        K = sp.block_diag([b.K for b in bodies], format="csr")
+        free = np.concatenate([o + b.free_dofs for o, b in zip(self.offsets, bodies)])
+        rows, cols = [free], [np.arange(len(free))]
+        self.platen_body = next((i for i, b in enumerate(bodies) if b.platen is not None), None)
+        self.nq = len(free) + (self.platen_body is not None)
+        f1 = np.concatenate([b.f_load for b in bodies])
+        self.U_prescribed = np.concatenate([b.u_prescribed for b in bodies])
+        platen_force = np.zeros(self.nq)
+        if self.platen_body is not None:
+            b = bodies[self.platen_body]
+            rows.append(self.offsets[self.platen_body] + b.platen_dofs)
+            cols.append(np.full(len(b.platen_dofs), self.nq - 1))
+            platen_force[-1] = b.platen.force
+        r, c = np.concatenate(rows), np.concatenate(cols)
+        self.T = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(N, self.nq))
+        self.K = (self.T.T @ K @ self.T).tocsc()
+        # the reduced load at load factor 1: loads, prescribed displacements, platen force
+        self.f1 = self.T.T @ (f1 - K @ self.U_prescribed) + platen_force
+        t2 = time.perf_counter()
+        c = node_to_segment(self.surfaces, pairs, self.offsets, N, settings.penalty,
+                            settings.penalty_factor)
+        Br = (c.B @ self.T).tocsr()
+        # a row without a free dof (slave node and master segment both held) is no constraint
+        live = np.diff(abs(Br).tocsr().indptr) > 0
+        self.c = c.subset(live)
+        self.Br = Br[live]
+        self.g_prescribed = self.c.B @ self.U_prescribed  # per unit load factor
+        t3 = time.perf_counter()
+        slave_lengths = [s.lengths.min() for i, s in enumerate(self.surfaces)
+                         if len(s.lengths) and np.any(self.c.slave == i)]
+        self.h_min = float(min(slave_lengths)) if slave_lengths else 1.0
+        self.gap_tolerance = GAP_ROUNDOFF * self.h_min
+        self.augmented_tolerance = settings.augmented_tolerance * self.h_min
+        self.floating = self._floating_rows()
+        self._factor_key: tuple | None = None
+        self._factor = None
+        self.factorizations = 0
+        self.timings = {"search_s": (t1 - t0) + (t3 - t2), "assemble_s": t2 - t1,
+                        "factorize_s": 0.0, "solve_s": 0.0}
+        log.info("%s: global system of %d unknowns, %d node-to-segment constraints",
+                 self.method, self.nq, len(self.c.node))
+
+    @property
+    def penetration_tolerance(self) -> float:
+        """The gap tolerance the method works to (0 for the penalty method, which has none)."""
+        return {"lagrange": self.gap_tolerance, "augmented": self.augmented_tolerance}.get(
+            self.method, 0.0)
+
+    def _floating_rows(self) -> list[np.ndarray]:
+        """For each body held along its platen's direction only by contact (the platen is its
+        only support that way), the constraint rows that touch it: one of them must stay active
+        or the global matrix is singular."""
+        out = []
+        self.unheld = []  # such bodies without any constraint row: the matrix is singular
+        for i, b in enumerate(self.model.bodies):
+            if b.platen is None:
+                continue
+            held = np.setdiff1d(b.fixed_dofs, b.platen_dofs)
+            if np.any(held % 2 == COMPONENTS[b.platen.component]):
+                continue
+            rows = np.flatnonzero((self.c.slave == i) | (self.c.master == i))
+            if len(rows):
+                out.append(rows)
+            else:
+                self.unheld.append(b)
+        return out
+
+    def _seeded(self, active: np.ndarray, gap: np.ndarray) -> np.ndarray:
+        """``active`` with the closest node of each body that only contact holds, where none
+        of its nodes is active."""
+        out = active.copy()
+        for rows in self.floating:
+            if not out[rows].any():
+                out[rows[np.argmin(gap[rows])]] = True
+        return out
+
+    # -- the linear systems ----------------------------------------------------------------------
+
+    def _factorized(self, active: np.ndarray):
+        """The factorization of the method's matrix for ``active``, refactorized only when the
+        active set changed."""
+        key = (self.method, active.tobytes())
+        if key == self._factor_key:
+            return self._factor
+        A = np.flatnonzero(active)
+        Ba = self.Br[A]
+        t0 = time.perf_counter()
+        try:
+            with memory_guard(f"factorizing the global system ({self.method})"):
+                if self.method == "lagrange":
+                    M = sp.bmat([[self.K, Ba.T], [Ba, None]], format="csc")
+                    self._factor = _Refined(M, factorize(M, self.backend, spd=False,
+                                                         what=f"the {self.method} global system"))
+                else:
+                    ew = self.c.penalty[A] * self.c.weight[A]
+                    M = (self.K + Ba.T @ sp.diags(ew) @ Ba).tocsc()
+                    self._factor = factorize(M, self.backend,
+                                             what=f"the {self.method} global system")
+        except RuntimeError as exc:  # SuperLU: a zero pivot
+            if isinstance(exc, AnalysisError):
+                raise
+            raise AnalysisError(
+                f"the global matrix of the {self.method} method is singular with "
+                f"{len(A)} nodes in contact ({exc}): a body is held by nothing but contact and "
+                "no node of it can touch (no candidate facets near it?)") from None
+        self.timings["factorize_s"] += time.perf_counter() - t0
+        self.factorizations += 1
+        self._factor_key = key
+        return self._factor
+
+    def solve_step(self, load_factor: float, active: np.ndarray, lam: np.ndarray):
+        """Solve at ``load_factor`` from the active set and multipliers (pressures, augmented
+        Lagrangian) of the previous step. Returns (q, Lambda, gap, active, lam, history):
+        the reduced unknowns, each row's normal contact force, its gap, the final active set,
+        the multipliers to start the next step from, and one record per linear solve.
+
+        Raises:
+            AnalysisError: the active set does not settle within ``max_iterations`` solves, or
+                comes back to one it had left.
+        """
+        settings = self.model.contact
+        if self.unheld:
+            b = self.unheld[0]
+            raise AnalysisError(
+                f"body {b.name!r} is held along {b.platen.component} only by its platen and by "
+                "contact, and none of its nodes can touch another body (no contact candidates "
+                "within contact.search_distance), so the global matrix is singular")
+        f = load_factor * self.f1
+        gp = self.c.g0 + load_factor * self.g_prescribed  # gaps with the loads' motion only
+        c, Br = self.c, self.Br
+        ew = c.penalty * c.weight
+        active = self._seeded(active, gp)
+        seen = {active.tobytes()}
+        history: list[IterationRecord] = []
+        for it in range(1, settings.max_iterations + 1):
+            A = np.flatnonzero(active)
+            factor = self._factorized(active)
+            t0 = time.perf_counter()
+            Lam = np.zeros(len(gp))
+            tension = 0
+            if self.method == "lagrange":
+                sol = factor.solve(np.r_[f, -gp[A]])
+                q = sol[: self.nq]
+                Lam[A] = -sol[self.nq:]
+                g = gp + Br @ q
+                scale = float(np.abs(Lam).max(initial=0.0))
+                leave = active & (Lam < -FORCE_ROUNDOFF * scale)
+                tension = int(leave.sum())
+                new = (active & ~leave) | (~active & (g < -self.gap_tolerance))
+            elif self.method == "penalty":
+                q = factor.solve(f - Br[A].T @ (ew[A] * gp[A]))
+                g = gp + Br @ q
+                Lam[A] = -ew[A] * g[A]
+                new = g < 0
+            else:  # augmented Lagrangian
+                q = factor.solve(f + Br[A].T @ (c.weight[A] * lam[A] - ew[A] * gp[A]))
+                g = gp + Br @ q
+                trial = lam - c.penalty * g  # pressures
+                Lam[A] = c.weight[A] * trial[A]
+                new = trial > 0
+            self.timings["solve_s"] += time.perf_counter() - t0
+            if not np.all(np.isfinite(q)):
+                raise AnalysisError(
+                    f"the {self.method} method's linear solve gave non-finite displacements "
+                    f"with {len(A)} nodes in contact: the global matrix is singular (a body "
+                    "held by nothing but contact, with no node of it in contact)")
+            new = self._seeded(new, gp)
+            penetration = float(np.maximum(-g, 0.0).max(initial=0.0))
+            history.append(IterationRecord(it, penetration, 0.0, int((Lam > 0).sum()), tension))
+            if np.array_equal(new, active):
+                if self.method != "augmented":
+                    return q, Lam, g, active, Lam / c.weight, history
+                error = float(np.abs(np.where(active, g, np.minimum(g, 0.0))).max(initial=0.0))
+                if error <= self.augmented_tolerance:
+                    return q, Lam, g, active, np.maximum(trial, 0.0), history
+                lam = np.maximum(trial, 0.0)  # Uzawa's update; the factorization is kept
+                continue
+            key = new.tobytes()
+            if key in seen and self.method != "augmented":
+                changed = np.flatnonzero(new != active)
+                raise AnalysisError(
+                    f"the {self.method} method's active set cycles: it came back to a contact "
+                    f"set it had left after {it} linear solves (nodes switching now: "
+                    f"{self._name_rows(changed)})")
+            seen.add(key)
+            active = new
+        raise AnalysisError(
+            f"the {self.method} method's active set did not settle in {settings.max_iterations} "
+            f"linear solves (contact.max_iterations); largest penetration {penetration:.3g}")
+
+    def _name_rows(self, rows: np.ndarray, limit: int = 8) -> str:
+        """'cylinder 12, 13' for constraint rows (slave body, point number)."""
+        names = [f"{self.model.bodies[self.c.slave[r]].name} "
+                 f"{int(self.surfaces[self.c.slave[r]].nodes[self.c.node[r]])}"
+                 for r in rows[:limit]]
+        return ", ".join(names) + (f" and {len(rows) - limit} more" if len(rows) > limit else "")
+
+    # -- results ----------------------------------------------------------------------------------
+
+    def fields(self, load_factor: float, q: np.ndarray, Lam: np.ndarray, g: np.ndarray):
+        """Per body: the :class:`~vfem.solver.BodyStepResult` and the contact forces on its
+        candidate nodes (nc, 2)."""
+        from ..solver import BodyStepResult
+
+        U = self.T @ q + load_factor * self.U_prescribed
+        f_slave = self.c.B_slave.T @ Lam
+        f_master = self.c.B_master.T @ Lam
+        out, forces = {}, []
+        for i, (s, off) in enumerate(zip(self.surfaces, self.offsets)):
+            b = s.body
+            nv = b.npoints
+            part = slice(off, off + b.ndofs)
+            force = (f_slave[part] + f_master[part]).reshape(-1, 2)
+            cand = s.nodes[: s.nc]
+            mine = self.c.slave == i
+            pressure = np.zeros(nv)
+            # slave nodes: the normal force along the master's normal / tributary length
+            pressure[cand] = (np.bincount(self.c.node[mine], Lam[mine], minlength=s.nc)
+                              / s.tributary)
+            # master nodes: the normal component of the forces spread on them / tributary
+            fm = f_master[part].reshape(-1, 2)[cand]
+            p_master = np.zeros(s.nc)
+            if s.nc and len(s.facets):
+                p_master = -np.einsum("ij,ij->i", fm, s.node_normals()) / s.tributary
+            pressure[cand] += p_master
+            status = np.zeros(nv, dtype=int)
+            carried = np.bincount(self.c.node[mine], Lam[mine] > 0, minlength=s.nc) > 0
+            status[cand] = carried | (np.abs(fm).sum(axis=1) > 0)
+            pen = np.zeros(nv)
+            if mine.any():
+                depth = np.full(s.nc, -np.inf)
+                np.maximum.at(depth, self.c.node[mine], -g[mine])
+                pen[cand] = np.where(np.isfinite(depth), depth, 0.0)
+            out[b.name] = BodyStepResult(U[part].reshape(-1, 2), force, pressure, status, pen)
+            forces.append(force[cand])
+        return out, forces
+
+    # -- the steps --------------------------------------------------------------------------------
+
+    def new_state(self) -> ContactState:
+        m = len(self.c.node)
+        return ContactState(0.0, 0.0, [np.zeros((s.nc, 2)) for s in self.surfaces],
+                            [np.zeros(s.nc, dtype=bool) for s in self.surfaces], 0.0,
+                            {0: np.zeros(m), 1: np.zeros(m)})
+
+    def run(self, analysis, on_step=None, start=None):
+        """The steps of ``model.load_factors`` (what :meth:`vfem.solver.Analysis.run` does for
+        a baseline): each solved from the previous one's active set; ``on_step(step)`` after
+        each. ``analysis`` keeps the steps and state so far (its ``checkpoint``). A step whose
+        active set does not settle stops the analysis (``converged`` False, the message says
+        why); no step is cut, the answer of a linear frictionless problem not depending on the
+        path to it."""
+        from ..solver import AnalysisResult, StepResult
+
+        t_start = time.perf_counter()
+        model = self.model
+        m = len(self.c.node)
+        if start is None:
+            state, steps, target = self.new_state(), [], 1
+        else:
+            state, steps, target = start.state.copy(), list(start.steps), start.target
+            if any(len(state.multipliers.get(k, ())) != m for k in (0, 1)):
+                state.multipliers = self.new_state().multipliers
+        analysis.state, analysis.steps = state, steps
+        analysis.target, analysis.level, analysis.easy = target, 0, 0
+        schedule = [0.0, *model.load_factors]
+        converged, message = True, ""
+        while analysis.target < len(schedule):
+            lf = schedule[analysis.target]
+            active = state.multipliers[1] > 0
+            lam = state.multipliers[0]
+            before = self.factorizations
+            try:
+                q, Lam, g, active, lam, history = self.solve_step(lf, active, lam)
+            except AnalysisError as exc:
+                converged = False
+                remedy = ("bring the bodies within contact.search_distance of each other, or "
+                          "support the body" if "singular" in str(exc) else
+                          f"allow more linear solves (contact.max_iterations = "
+                          f"{model.contact.max_iterations}) or take smaller steps; check that "
+                          "every body is held the way you expect")
+                message = (f"step {len(steps) + 1} (load factor {state.load_factor:.6g} -> "
+                           f"{lf:.6g}) failed: {exc}. What to change: {remedy}")
+                log.info(message)
+                break
+            fields, forces = self.fields(lf, q, Lam, g)
+            platen = float(q[-1]) if self.platen_body is not None else 0.0
+            force = model.bodies[self.platen_body].platen.force if self.platen_body is not None \
+                else 0.0
+            state = ContactState(lf, platen, forces,
+                                 [np.zeros(s.nc, dtype=bool) for s in self.surfaces],
+                                 lf * force, {0: lam, 1: active.astype(float)})
+            step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=len(history),
+                              converged=True, history=history, platen_displacement=platen)
+            step.bodies = fields
+            steps.append(step)
+            analysis.state = state
+            analysis.target += 1
+            log.info("step %d (load factor %.4g): %s converged in %d linear solves "
+                     "(%d factorizations), %d nodes in contact, largest penetration %.3g",
+                     step.step, lf, self.method, len(history), self.factorizations - before,
+                     int(active.sum()), history[-1].max_penetration)
+            if on_step is not None:
+                on_step(step)
+        timings = dict(analysis.timings)
+        timings.update(self.timings)
+        timings["steps_s"] = time.perf_counter() - t_start
+        timings["total_s"] = timings["search_s"] + timings["assemble_s"] + timings["steps_s"]
+        analysis.timings = timings
+        log.info("%s: %d steps, %d linear solves, %d factorizations, %.3g s", self.method,
+                 len(steps), sum(s.iterations for s in steps), self.factorizations,
+                 timings["total_s"])
+        return AnalysisResult(model, converged, steps, timings, message, self.surfaces,
+                              self.penetration_tolerance)
