@@ -135,3 +135,21 @@ def test_ccx_failure_is_reported(level0, tmp_path):
                         deck.reference_node, deck.penalty, deck.tension, deck.approach)
     with pytest.raises(VfemError, match="CalculiX failed"):
         run(broken)
+
+
+def test_bench_rows_without_ccx():
+    from vfem.bench import calculix_rows
+
+    assert calculix_rows([0], ccx="no-such-ccx-here") == []
+
+
+@needs_ccx
+def test_bench_rows():
+    from vfem.bench import calculix_rows
+
+    lines = []
+    (row,) = calculix_rows([0], print_row=lines.append)
+    assert row["dofs"] == 1950 and row["vfem_converged"]
+    assert row["ccx_iterations_total"] > row["ccx_iterations"] > 0
+    assert abs(row["ccx_p_max_error_nodal"]) < 5e-3 and abs(row["vfem_p_max_error"]) < 5e-3
+    assert len(lines) == 2 and lines[1].split()[:2] == ["0", "1950"]

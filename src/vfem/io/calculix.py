@@ -168,9 +168,10 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
             default, 1e11, gives the Hertz problem a penetration of 3e-7 at p0, 1.7e-4 of the
             cylinder's indentation (docs/benchmarks.md has the measured choice).
         tension: the linear law's second constant, sigma_inf (its tension at large
-            clearances). ccx's surface-to-surface contact does not use it: it makes contact
-            elements only where a slave integration point penetrates (the same results with 0,
-            1 and 1e5).
+            clearances), which ccx says is "only relevant for node-to-surface contact" (it
+            replaces 0 by a default of its own): surface-to-surface contact makes contact
+            elements only where a slave integration point penetrates (measured: the same
+            results with 0, 1 and 1.4e5).
         steps: ``"one"``: one ccx step to the last load factor, ccx's automatic increments
             starting with the first load factor (load factors that do not rise steadily get one
             step each); ``"model"``: one ccx step per model step.
