@@ -20,16 +20,19 @@ import dataclasses
 import json
 import math
 import resource
+import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 from skfem import Basis, ElementVector, asm
 from skfem.models.elasticity import linear_elasticity
 
-from .examples.hertz import HertzParameters, build, evaluate
+from .examples.hertz import HertzParameters, build, evaluate, theory
 from .linalg import factorize, resolve
 from .solver import Analysis
 
@@ -225,6 +228,76 @@ def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None =
         rows.append(hertz_case(hertz_parameters(level=level, variant=variant, order=order)))
         if print_row:
             print_row(format_row(rows[-1]))
+    return rows
+
+
+CALCULIX_HEADER = (f"{'level':>5} {'dofs':>8} {'ccx s':>8} {'incs':>5} {'iters':>7} "
+                   f"{'raw err':>9} {'nodal err':>10} {'vfem s':>8} {'vfem err':>9} "
+                   f"{'ccx/vfem':>9}")
+
+
+def calculix_rows(levels: list[int], print_row: Callable[[str], None] | None = None,
+                  ccx: str = "ccx", threads: int = 1, penalty: float = 1e11,
+                  timeout: float = 600.0, keep: str | Path | None = None) -> list[dict]:
+    """vfem and CalculiX on the same Hertz meshes; ``[]`` when ``ccx`` is not installed.
+
+    Per level: vfem's analysis time (as :func:`hertz_benchmark` measures it) and p_max error;
+    the wall time of the ccx process (deck writing and result reading excluded), its
+    increments (load steps) and iterations (``ccx_iterations_total`` counts the contact-making
+    first step's too, as the printed table does), and its p_max error read two ways: ccx's own
+    contact pressure on the slave nodes ("raw", CPRESS) and the cylinder's nodal contact forces
+    ``K u`` per undeformed tributary length (vfem's reading). ``keep``: a folder for ccx's
+    files, one sub-folder per level.
+    """
+    if shutil.which(ccx) is None:
+        return []
+    from .io.calculix import run, write_deck
+
+    rows = []
+    if print_row:
+        print_row(CALCULIX_HEADER)
+    for level in levels:
+        p = HertzParameters(refinement=level)
+        model = build(p)
+        t0 = time.perf_counter()
+        result = Analysis(model).run()
+        vfem_s = time.perf_counter() - t0
+        h = evaluate(result, p) if result.converged else {}
+        with tempfile.TemporaryDirectory(prefix="vfem-bench-ccx-") as tmp:
+            deck = write_deck(model, Path(tmp) / f"hertz{level}.inp", penalty=penalty)
+            c = run(deck, ccx=ccx, threads=threads, timeout=timeout,
+                    p0=theory(p)["p0_theory"],
+                    keep=None if keep is None else Path(keep) / f"level{level}")
+        row = {
+            "level": level,
+            "dofs": c["dofs"],
+            "ccx_s": c["wall_s"],
+            "ccx_threads": c["threads"],
+            "ccx_solver": c["solver"],
+            "ccx_equations": c["equations"],
+            "ccx_increments": c["increments"],
+            "ccx_iterations": c["iterations"],
+            "ccx_cutbacks": c["cutbacks"],
+            "ccx_contact_step_iterations": c["contact_step_iterations"],
+            "ccx_iterations_total": c["iterations"] + c["contact_step_iterations"],
+            "ccx_penalty": penalty,
+            "ccx_p_max_error_raw": c["p_max_error_raw"],
+            "ccx_p_max_error_nodal": c["p_max_error_nodal"],
+            "ccx_flat_p_max_error_nodal": c["p_max_master_error_nodal"],
+            "ccx_total_contact_force": c["contact_normal_force"],
+            "ccx_nodal_residual": c["nodal_residual"],
+            "vfem_s": vfem_s,
+            "vfem_iterations": int(sum(s.iterations for s in result.steps)),
+            "vfem_converged": result.converged,
+            "vfem_p_max_error": h.get("p_max_error", float("nan")),
+            "ratio": c["wall_s"] / vfem_s,
+        }
+        rows.append(row)
+        if print_row:
+            print_row(f"{level:>5} {row['dofs']:>8} {row['ccx_s']:>8.2f} "
+                      f"{row['ccx_increments']:>5} {row['ccx_iterations_total']:>7} "
+                      f"{row['ccx_p_max_error_raw']:>+9.3%} {row['ccx_p_max_error_nodal']:>+10.4%} "
+                      f"{vfem_s:>8.2f} {row['vfem_p_max_error']:>+9.4%} {row['ratio']:>9.1f}")
     return rows
 
 

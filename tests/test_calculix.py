@@ -1,0 +1,155 @@
+"""vfem.io.calculix: the Hertz model as a CalculiX deck (always checked), and run in ccx when it
+is installed (p_max against Hertz, the force balance)."""
+
+import shutil
+
+import numpy as np
+import pytest
+
+from vfem.errors import InputError, VfemError
+from vfem.examples import hertz
+from vfem.io.calculix import run, write_deck
+
+HAVE_CCX = shutil.which("ccx") is not None
+needs_ccx = pytest.mark.skipif(not HAVE_CCX, reason="CalculiX (ccx) is not installed")
+
+
+def blocks(text: str) -> list[tuple[str, list[str]]]:
+    """(keyword line, data lines) of a deck, comments dropped."""
+    out = []
+    for line in text.splitlines():
+        if line.startswith("**"):
+            continue
+        if line.startswith("*"):
+            out.append((line.upper(), []))
+        elif out:
+            out[-1][1].append(line)
+    return out
+
+
+@pytest.fixture(scope="module")
+def level0(tmp_path_factory):
+    p = hertz.HertzParameters(refinement=0)
+    model = hertz.build(p)
+    deck = write_deck(model, tmp_path_factory.mktemp("ccx") / "hertz.inp")
+    return p, model, deck
+
+
+def test_deck_has_the_model(level0):
+    p, model, deck = level0
+    cards = blocks(deck.path.read_text())
+    nodes, elements, materials = {}, {}, []
+    for key, data in cards:
+        if key.startswith("*NODE,"):
+            nodes[key.split("NSET=")[1]] = np.array([[float(v) for v in d.split(",")]
+                                                     for d in data])
+        elif key.startswith("*ELEMENT"):
+            kind = key.split("TYPE=")[1].split(",")[0]
+            elements[key.split("ELSET=")[1]] = (kind, np.array(
+                [[int(v) for v in d.split(",")] for d in data]))
+        elif key == "*ELASTIC":
+            materials.append(tuple(float(v) for v in data[0].split(",")))
+    xy = np.vstack(list(nodes.values()))
+    assert np.array_equal(xy[:, 0], np.arange(1, len(xy) + 1))  # numbered 1..n, no gaps
+    for body in model.bodies:
+        tag = body.name.upper()
+        # the same nodes, in the same order, at the same places
+        assert np.allclose(nodes[f"N_{tag}"][:, 1:].T, body.mesh.p, rtol=1e-13, atol=1e-15)
+        kind, conn = elements[f"E_{tag}"]
+        assert kind == ("CPE3" if body.mesh.t.shape[0] == 3 else "CPE4")
+        assert conn.shape == (body.mesh.t.shape[1], body.mesh.t.shape[0] + 1)
+        # the same elements (as node sets), each counter-clockwise in the x-y plane
+        offset = deck.body(body.name).node_offset
+        local = conn[:, 1:] - offset - 1
+        assert sorted(map(sorted, local.tolist())) == sorted(map(sorted, body.mesh.t.T.tolist()))
+        x = body.mesh.p[:, local.T]
+        area2 = ((x[0, 1] - x[0, 0]) * (x[1, 2] - x[1, 0])
+                 - (x[0, 2] - x[0, 0]) * (x[1, 1] - x[1, 0]))
+        assert np.all(area2 > 0)
+    assert sorted(materials) == sorted((b.material.youngs_modulus, b.material.poissons_ratio)
+                                       for b in model.bodies)
+    keys = [k for k, _ in cards]
+    pair = keys.index("*CONTACT PAIR, INTERACTION=CONTACT, TYPE=SURFACE TO SURFACE")
+    assert cards[pair][1] == ["S_CYLINDER, S_FLAT"]  # the cylinder is the slave
+    assert "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR" in keys
+    assert not any("NLGEOM" in k for k in keys)
+    # the platen: the top face's nodes tied to one node, which carries the force
+    top = np.unique(model.bodies[0].mesh.facets[:, model.bodies[0].mesh.boundaries["top"]])
+    eq = cards[keys.index("*EQUATION")][1]
+    assert len(eq) == 2 * (len(top) - 1)
+    load = cards[keys.index("*CLOAD")][1]
+    assert load == [f"{deck.reference_node}, 2, -1530.0"]
+
+
+def test_contact_surfaces_are_the_faces_on_the_contact_boundaries(level0):
+    p, model, deck = level0
+    cards = dict(blocks(deck.path.read_text()))
+    for body in model.bodies:
+        bd = deck.body(body.name)
+        faces = cards[f"*SURFACE, NAME=S_{body.name.upper()}, TYPE=ELEMENT"]
+        assert len(faces) == len(bd.contact_facets) > 0
+        on_contact = set(np.unique(body.mesh.facets[:, body.mesh.boundaries["contact"]]))
+        conn = {int(d.split(",")[0]): [int(v) - bd.node_offset - 1 for v in d.split(",")[1:]]
+                for d in cards[next(k for k in cards if k.startswith("*ELEMENT")
+                                    and f"E_{body.name.upper()}" in k)]}
+        for line in faces:
+            e, label = (v.strip() for v in line.split(","))
+            nodes = conn[int(e)]
+            k = int(label[1:]) - 1
+            assert {nodes[k], nodes[(k + 1) % len(nodes)]} <= on_contact
+
+
+def test_unsupported_models_are_refused(tmp_path):
+    with pytest.raises(InputError, match="linear elements"):
+        write_deck(hertz.build(hertz.HertzParameters(order=2)), tmp_path / "q.inp")
+    with pytest.raises(InputError, match="no body named"):
+        write_deck(hertz.build(hertz.HertzParameters()), tmp_path / "s.inp", slave="punch")
+
+
+def test_missing_executable(level0):
+    with pytest.raises(VfemError, match="not found"):
+        run(level0[2], ccx="no-such-ccx-here")
+
+
+@needs_ccx
+def test_ccx_reproduces_hertz(level0, tmp_path):
+    p, model, deck = level0
+    r = run(deck, p0=hertz.theory(p)["p0_theory"], keep=tmp_path / "out")
+    # measured (ccx 2.20, penalty 1e11): nodal reading +0.0002 %, raw CPRESS +2.8 %
+    assert abs(r["p_max_error_nodal"]) < 5e-3
+    assert 0.0 < r["p_max_error_raw"] < 0.05
+    assert r["contact_normal_force"] == pytest.approx(1530.0, rel=1e-3)
+    assert r["total_contact_force_nodal"][1] == pytest.approx(1530.0, rel=1e-3)
+    assert r["nodal_residual"] < 1e-3  # K u vanishes off the contact surface: ccx's elements
+    assert r["dofs"] == sum(2 * b.mesh.p.shape[1] for b in model.bodies)
+    assert r["iterations"] > 0 and r["wall_s"] > 0
+    assert (tmp_path / "out" / "job.dat").exists()
+
+
+@needs_ccx
+def test_ccx_failure_is_reported(level0, tmp_path):
+    bad = tmp_path / "bad.inp"
+    bad.write_text(level0[2].path.read_text().replace("*ELASTIC", "*ELASTIK", 1))
+    deck = level0[2]
+    broken = type(deck)(bad, deck.model, deck.bodies, deck.slave, deck.master,
+                        deck.reference_node, deck.penalty, deck.tension, deck.approach)
+    with pytest.raises(VfemError, match="CalculiX failed"):
+        run(broken)
+
+
+def test_bench_rows_without_ccx():
+    from vfem.bench import calculix_rows
+
+    assert calculix_rows([0], ccx="no-such-ccx-here") == []
+
+
+@needs_ccx
+def test_bench_rows():
+    from vfem.bench import calculix_rows
+
+    lines = []
+    (row,) = calculix_rows([0], print_row=lines.append)
+    assert row["dofs"] == 1950 and row["vfem_converged"]
+    assert row["ccx_iterations_total"] > row["ccx_iterations"] > 0
+    assert abs(row["ccx_p_max_error_nodal"]) < 5e-3 and abs(row["vfem_p_max_error"]) < 5e-3
+    assert len(lines) == 2 and lines[1].split()[:2] == ["0", "1950"]
