@@ -1,14 +1,14 @@
-"""Hertz benchmark: vfem against one plain linear solve of the same bodies, by refinement.
+"""Hertz benchmark: vfem against one plain linear solve of the same mesh (docs/benchmarks.md).
 
-    python benchmarks/hertz.py [LEVEL ...]        # same as: vfem bench hertz --levels ...
-    VFEM_VARIANT=thesis python benchmarks/hertz.py  # the thesis's plain reading
+    python benchmarks/hertz.py --dofs 10k 100k 1M --solver all   # same as: vfem bench hertz ...
+    python benchmarks/hertz.py --levels 0 1 2 --methods vfem lagrange --patch
+
+Every option of ``vfem bench hertz`` (``vfem bench --help``).
 """
 
-import os
 import sys
 
-from vfem.bench import hertz_benchmark
+from vfem.cli import main
 
 if __name__ == "__main__":
-    levels = [int(a) for a in sys.argv[1:]] or [0, 1, 2, 3, 4]
-    hertz_benchmark(levels, print_row=print, variant=os.environ.get("VFEM_VARIANT", "paired"))
+    sys.exit(main(["bench", "hertz", *sys.argv[1:]]))

@@ -106,3 +106,21 @@ def test_study_writes_the_table_and_the_convergence_plot(tmp_path):
     # every series reads the Hertz error on the same problem
     assert all(abs(r["p_max_error"]) < 0.01 for rows in study.values() for r in rows)
     assert (tmp_path / "convergence.png").stat().st_size > 10_000
+
+
+def test_bench_compares_contact_methods_and_their_patch_tests(tmp_path, capsys):
+    """vfem bench: each contact method on the same Hertz mesh and the patch test. vfem passes
+    the patch test to round-off; single-pass node-to-segment Lagrange multipliers do not on
+    non-nested meshes (4 against 7 elements), and both get Hertz's p_max."""
+    path = tmp_path / "bench.json"
+    assert main(["bench", "hertz", "--levels", "0", "--methods", "vfem", "lagrange",
+                 "--patch", "--solver", "superlu", "--json", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "patch error" in out
+    table = json.loads(path.read_text())
+    rows = {r["method"]: r for r in table["hertz"]}
+    assert set(rows) == {"vfem", "lagrange"}
+    assert all(r["backend"] == "superlu" and r["peak_mib"] > 0 for r in rows.values())
+    assert abs(rows["vfem"]["p_max_error"]) < 1e-3 and abs(rows["lagrange"]["p_max_error"]) < 1e-3
+    patch = {r["method"]: r["patch_error"] for r in table["patch"]}
+    assert patch["vfem"] < 1e-10 < 1e-3 < patch["lagrange"]

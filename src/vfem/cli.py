@@ -13,6 +13,7 @@ import difflib
 import inspect
 import json
 import logging
+import shutil
 import signal
 import sys
 from pathlib import Path
@@ -339,9 +340,16 @@ def cmd_bench(args) -> int:
             table["patch"].append(row)
             if say:
                 say(f"{method:>10} {row['patch_error']:>12.2e} {row['patch_iterations']:>10}")
+    if args.calculix:
+        if shutil.which("ccx") is None:
+            raise InputError("--calculix: ccx is not installed (Debian: apt install "
+                             "calculix-ccx)")
+        table["calculix"] = bench.calculix_rows(sizes, print_row=say, backend=backends[0])
+    if args.markdown:
+        Path(args.markdown).write_text(bench.markdown(table), encoding="utf-8")
     if args.json:
-        Path(args.json).write_text(json.dumps(table if args.patch else rows, indent=2) + "\n",
-                                   encoding="utf-8")
+        keep = table if (args.patch or args.calculix) else rows
+        Path(args.json).write_text(json.dumps(keep, indent=2) + "\n", encoding="utf-8")
     if args.plot:
         from .io.plots import benchmark_times
 
@@ -421,7 +429,10 @@ def main(argv: list[str] | None = None) -> int:
                        help="contact methods to compare (default vfem)")
     bench.add_argument("--patch", action="store_true",
                        help="also the patch-test error of each method")
+    bench.add_argument("--calculix", action="store_true",
+                       help="also CalculiX (ccx) on the same meshes, one thread")
     bench.add_argument("--plot", help="draw time against dofs to this PNG")
+    bench.add_argument("--markdown", help="also write the tables to this Markdown file")
     bench.add_argument("--in-process", action="store_true",
                        help="run every case in this process (no peak memory per case)")
     bench.add_argument("--json", help="also write the table to this JSON file")

@@ -357,7 +357,11 @@ class PairedContact(VirtualElementContact):
             A[m, :m] = dR
             A[m, m] = b.platen_stiffness
             need = state.platen_force - self.platen_reaction(state)
-            sol = np.linalg.lstsq(A, np.concatenate([rhs, [need]]), rcond=None)[0]
+            b = np.concatenate([rhs, [need]])
+            try:  # an LU solve; least squares (an SVD, ten times dearer) only if singular
+                sol = np.linalg.solve(A, b)
+            except np.linalg.LinAlgError:
+                sol = np.linalg.lstsq(A, b, rcond=None)[0]
             dlam, dplaten = sol[:m], float(sol[m])
         else:
             dlam, dplaten = np.linalg.solve(W, rhs), 0.0
@@ -410,7 +414,8 @@ class PairedContact(VirtualElementContact):
         for k, pair in enumerate(self.contact_pairs):
             rows = slice(offsets[k], offsets[k + 1])
             uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
-            uc = np.einsum("ic,cdm->idm", pair.interp, du[pair.coarse])
+            coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
+            uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
             # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dlam
             W[rows] = np.einsum("id,idm->im", pair.normal, uf - uc)
             dp_dplaten[rows] = pair.platen_rate

@@ -11,6 +11,7 @@ to only about 1e-5); the Schur complement's inverse is the flexibility contact n
 from __future__ import annotations
 
 import ctypes
+import os
 
 import numpy as np
 import scipy.sparse as sp
@@ -33,6 +34,10 @@ def _library():
     """PARDISO's entry point in MKL's runtime library (located by pypardiso)."""
     global _pardiso
     if _pardiso is None:
+        # MKL's OpenMP threads otherwise spin for 200 ms after each call, fighting NumPy's
+        # BLAS threads for the cores in the dense work between calls (measured: the contact
+        # flexibility's Cholesky 7x slower on 2 cores); read when MKL's OpenMP starts
+        os.environ.setdefault("KMP_BLOCKTIME", "0")
         import pypardiso
 
         f = pypardiso.PyPardisoSolver().libmkl.pardiso

@@ -1,0 +1,100 @@
+"""Routes to the flexibility on the contact dofs (the inverse stiffness among them), timed.
+
+    python benchmarks/flexibility.py [DOFS]      # default 300k: the Hertz cylinder at that size
+
+For the Hertz example's cylinder (the body with all the dofs) and its tracked contact dofs, with
+every installed backend:
+
+* ``back-substitution``: factorize, then one solve per contact dof (blocks of 256 columns):
+  what vfem did first;
+* ``contact dofs last``: the route vfem takes, ``factorize(trailing=...)``: SuperLU and CHOLMOD
+  order the contact dofs last and read the Schur complement off the factor's trailing block,
+  PARDISO and MUMPS return it from their Schur-complement feature;
+* ``sparse right-hand sides`` (PARDISO only): factorize, then one solve with the unit vectors of
+  the contact dofs as sparse right-hand sides, only the contact dofs of the solution computed
+  (``iparm[30] = 3``).
+
+Printed: seconds for the factorization and for the flexibility, and the largest difference
+from the first route's flexibility (relative).
+"""
+
+import sys
+import time
+
+import numpy as np
+
+from vfem import linalg
+from vfem.bench import hertz_parameters, parse_size
+from vfem.examples.hertz import build
+from vfem.linalg.pardiso import PardisoFactorization
+
+
+class PartialSolve(PardisoFactorization):
+    """PARDISO with its sparse right-hand-side, partial-solution solve (iparm[30] = 3)."""
+
+    def __init__(self, A, marked):
+        import scipy.sparse as sp
+
+        self.shape = A.shape
+        U = sp.triu(A, format="csr")
+        U.sort_indices()
+        self.n = U.shape[0]
+        self._a = np.ascontiguousarray(U.data, dtype=float)
+        self._ia, self._ja = U.indptr.astype(np.int32), U.indices.astype(np.int32)
+        self._pt = np.zeros(64, dtype=np.int64)
+        self._mtype = 2
+        self._iparm = np.zeros(64, dtype=np.int32)
+        self._iparm[[0, 1, 9, 30, 34]] = [1, 2, 8, 3, 1]
+        self._perm = np.zeros(self.n, dtype=np.int32)
+        self._perm[marked] = 1
+        self._call(12, np.zeros(self.n), np.zeros(self.n), 1)
+
+
+def main(dofs: int) -> None:
+    model = build(hertz_parameters(dofs=dofs))
+    surfaces = model.contact_surfaces()[1]
+    body, surface = model.bodies[0], surfaces[0]
+    body.assemble()
+    K = body.K[body.free_dofs][:, body.free_dofs].tocsc()
+    pos = np.searchsorted(body.free_dofs, surface.tracked_dofs)
+    dofs_ = pos[body.free_dofs[np.minimum(pos, len(body.free_dofs) - 1)]
+                == surface.tracked_dofs]
+    m = len(dofs_)
+    print(f"body {body.name!r}: {K.shape[0]} dofs, {m} contact dofs")
+    print(f"{'backend':>8} {'route':>24} {'factorize s':>12} {'flexibility s':>14} "
+          f"{'difference':>11}")
+    reference = None
+    for name in linalg.available():
+        t0 = time.perf_counter()
+        f = linalg.factorize(K, name)
+        t1 = time.perf_counter()
+        G = np.empty((m, m))
+        for start in range(0, m, 256):
+            cols = dofs_[start:start + 256]
+            E = np.zeros((K.shape[0], len(cols)))
+            E[cols, np.arange(len(cols))] = 1.0
+            G[:, start:start + len(cols)] = f.solve(E)[dofs_]
+        t2 = time.perf_counter()
+        reference = G if reference is None else reference
+        scale = np.abs(reference).max()
+        print(f"{name:>8} {'back-substitution':>24} {t1 - t0:>12.2f} {t2 - t1:>14.2f} "
+              f"{np.abs(G - reference).max() / scale:>11.1e}", flush=True)
+        t0 = time.perf_counter()
+        f = linalg.factorize(K, name, trailing=dofs_, groups=np.arange(K.shape[0]) // 2)
+        t1 = time.perf_counter()
+        print(f"{name:>8} {'contact dofs last':>24} {t1 - t0:>12.2f} {'(included)':>14} "
+              f"{np.abs(f.trailing_inverse - reference).max() / scale:>11.1e}", flush=True)
+        if name == "pardiso":
+            t0 = time.perf_counter()
+            f = PartialSolve(K, dofs_)
+            t1 = time.perf_counter()
+            E = np.zeros((K.shape[0], m), order="F")
+            E[dofs_, np.arange(m)] = 1.0
+            G = f.solve(E)[dofs_]
+            t2 = time.perf_counter()
+            print(f"{name:>8} {'sparse right-hand sides':>24} {t1 - t0:>12.2f} {t2 - t1:>14.2f} "
+                  f"{np.abs(G - reference).max() / scale:>11.1e}", flush=True)
+
+
+if __name__ == "__main__":
+    main(parse_size(sys.argv[1]) if len(sys.argv) > 1 else 300_000)
