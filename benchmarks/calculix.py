@@ -18,7 +18,8 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("levels", type=int, nargs="*", default=[0, 1, 2])
     ap.add_argument("--threads", type=int, default=1, help="ccx's threads (default 1)")
-    ap.add_argument("--penalty", type=float, default=1e11, help="contact stiffness (1e11)")
+    ap.add_argument("--penalty", type=lambda t: None if t.lower() == "hard" else float(t),
+                    default=1e11, help="contact stiffness (1e11), or hard: ccx's own")
     ap.add_argument("--ccx", default="ccx", help="the CalculiX executable")
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per ccx run")
     ap.add_argument("--keep", help="a folder for ccx's files (deck, log, .dat, .frd, .sta)")
@@ -30,7 +31,7 @@ if __name__ == "__main__":
                          penalty=args.penalty, timeout=args.timeout, keep=args.keep)
     if rows:
         print(f"ccx: {rows[0]['ccx_solver']} solver, {rows[0]['ccx_threads']} thread(s), "
-              f"penalty {args.penalty:g}")
+              f"penalty {'hard' if args.penalty is None else f'{args.penalty:g}'}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)

@@ -115,10 +115,13 @@ def hertz_case(p: HertzParameters, backend: str | None = None, method: str = "vf
     vfem_s = plain = peak = None
     for _ in range(repeat):
         t0 = time.perf_counter()
-        run = Analysis(model, backend).run()
+        analysis = Analysis(model, backend)
+        run = analysis.run()
         seconds = time.perf_counter() - t0
         if vfem_s is None or seconds < vfem_s:
             vfem_s, result = seconds, run
+            # the baselines refactorize their global matrix; vfem factorizes each body once
+            factorizations = getattr(analysis.contact, "factorizations", len(model.bodies))
         peak = peak or _peak_mib()  # the first solve's: vfem's own peak, before the plain solve
         again = plain_solve(model, backend)
         if plain is None or again["total_s"] < plain["total_s"]:
@@ -140,6 +143,7 @@ def hertz_case(p: HertzParameters, backend: str | None = None, method: str = "vf
         "search_s": t.get("search_s", 0.0), "assemble_s": assemble,
         "factorize_s": t.get("factorize_s", 0.0), "steps_s": t.get("steps_s", 0.0),
         "iterations": int(sum(s.iterations for s in result.steps)),
+        "factorizations": int(factorizations),
         "converged": result.converged, "message": result.message,
         "peak_mib": peak,
         "p_max_error": h.get("p_max_error", float("nan")),
@@ -214,13 +218,14 @@ def markdown(table: dict) -> str:
     """The tables of ``vfem bench`` (``{"hertz": rows, "patch": rows, "calculix": rows}``) as
     Markdown, for docs/benchmarks.md."""
     out = ["| dofs | contact dofs | method | backend | vfem s | plain s | ratio | ratio w/o "
-           "assembly | iterations | p_max error | peak MiB |",
-           "|---:|---:|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+           "assembly | iterations | factorizations | p_max error | peak MiB |",
+           "|---:|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in table.get("hertz", []):
         out.append(f"| {r['dofs']:,} | {r['contact_dofs']:,} | {r['method']} | {r['backend']} | "
                    f"{r['vfem_s']:.2f} | {r['plain_solve_s']:.2f} | {r['ratio']:.2f} | "
                    f"{r['ratio_without_assembly']:.2f} | {r['iterations']} | "
-                   f"{r['p_max_error']:+.4%} | {r['peak_mib']:,.0f} |".replace(",", " "))
+                   f"{r['factorizations']} | {r['p_max_error']:+.4%} | "
+                   f"{r['peak_mib']:,.0f} |".replace(",", " "))
     if table.get("patch"):
         out += ["", "| method | patch-test error | iterations |", "|---|---:|---:|"]
         out += [f"| {r['method']} | {r['patch_error']:.1e} | {r['patch_iterations']} |"

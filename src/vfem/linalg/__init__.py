@@ -39,7 +39,7 @@ BACKENDS = {
 }
 
 #: what "auto" tries, fastest first (measured: docs/benchmarks.md, "Linear-algebra backends")
-PREFERENCE = ("pardiso", "cholmod", "superlu", "mumps")
+PREFERENCE = ("pardiso", "cholmod", "mumps", "superlu")
 
 _chosen: str | None = None
 _available: dict[str, bool] = {}
