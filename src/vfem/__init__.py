@@ -37,14 +37,16 @@ def load(path: str | Path) -> ModelConfig:
 
 
 def solve(model: Model | ModelConfig | str | Path, out: str | Path | None = None,
-          on_step=None, resume: bool = False) -> AnalysisResult:
+          on_step=None, resume: bool = False, solver: str | None = None) -> AnalysisResult:
     """Solve a model: a :class:`Model`, a :class:`ModelConfig` or the path of an input file.
 
     With ``out``, each converged step is written there as it converges (VTU files for ParaView,
     ``results.pvd``, ``contact.csv``, a checkpoint, ``summary.json`` of the steps so far);
     ``resume=True`` continues from the last checkpoint in ``out`` of an earlier run of the same
     model. ``on_step(step)`` is called after each converged step. An analysis that does not
-    converge returns with ``converged = False`` and the steps done.
+    converge returns with ``converged = False`` and the steps done. ``solver``: the
+    linear-algebra backend (``"superlu"``, ``"pardiso"``, ``"cholmod"``, ``"mumps"``; default:
+    the one chosen with :func:`vfem.linalg.use`, else the fastest installed).
     """
     base = None
     if isinstance(model, (str, Path)):
@@ -53,10 +55,10 @@ def solve(model: Model | ModelConfig | str | Path, out: str | Path | None = None
     if isinstance(model, ModelConfig):
         model = model.build(base)
     if out is None:
-        return Analysis(model).run(on_step)
+        return Analysis(model, solver).run(on_step)
     from .io.results import run_writing
 
-    return run_writing(model, Path(out), on_step, resume)[1]
+    return run_writing(model, Path(out), on_step, resume, backend=solver)[1]
 
 
 __all__ = [

@@ -156,8 +156,8 @@ class ResultsWriter:
                       lambda p: p.write_text("\n".join(lines), encoding="utf-8"))
 
 
-def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = False
-                ) -> tuple[Analysis, AnalysisResult]:
+def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = False,
+                backend: str | None = None) -> tuple[Analysis, AnalysisResult]:
     """Solve ``model``, writing into ``out`` (nothing when None) as each step converges: its
     VTU files, the PVD and contact.csv, its checkpoint (:mod:`vfem.io.checkpoint`) and a
     ``summary.json`` of the steps done so far; then call ``on_step``. A run stopped at any
@@ -165,10 +165,11 @@ def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = Fal
 
     ``resume``: continue from the last checkpoint in ``out`` (written by an earlier run of the
     same model) instead of from the start; the steps already there are kept as they are.
+    ``backend``: the linear-algebra backend (:mod:`vfem.linalg`; None: the chosen one).
     """
     from . import checkpoint
 
-    analysis = Analysis(model)
+    analysis = Analysis(model, backend)
     analysis.setup()
     writer = ResultsWriter(out, model, analysis.surfaces) if out is not None else None
     start = None
