@@ -173,15 +173,17 @@ def patch_case(method: str = "vfem", backend: str | None = None) -> dict:
 def run_isolated(kind: str, **kwargs) -> dict:
     """Run :func:`hertz_case` (``kind="hertz"``, ``kwargs``: ``dofs`` or ``level``,
     ``variant``, ``order``, ``backend``, ``method``) or :func:`patch_case` (``"patch"``) in a
-    fresh Python process; its row."""
-    out = subprocess.run([sys.executable, "-m", "vfem.bench", json.dumps([kind, kwargs])],
-                         capture_output=True, text=True, check=False)
-    if out.returncode != 0:
-        from .errors import AnalysisError
+    fresh Python process; its row (which the process writes to a file)."""
+    with tempfile.TemporaryDirectory(prefix="vfem-bench-") as tmp:
+        row = Path(tmp) / "row.json"
+        out = subprocess.run([sys.executable, "-m", "vfem.bench", json.dumps([kind, kwargs]),
+                              str(row)], capture_output=True, text=True, check=False)
+        if out.returncode != 0 or not row.exists():
+            from .errors import AnalysisError
 
-        tail = (out.stderr or out.stdout).strip().splitlines()[-3:]
-        raise AnalysisError(f"benchmark case {kind} {kwargs} failed: {' | '.join(tail)}")
-    return json.loads(out.stdout.strip().splitlines()[-1])
+            tail = (out.stderr or out.stdout).strip().splitlines()[-3:]
+            raise AnalysisError(f"benchmark case {kind} {kwargs} failed: {' | '.join(tail)}")
+        return json.loads(row.read_text(encoding="utf-8"))
 
 
 def _warm_up(backend: str | None, method: str) -> None:
@@ -198,8 +200,7 @@ def _case(kind: str, kwargs: dict) -> dict:
         return patch_case(kwargs.get("method", "vfem"), kwargs.get("backend"))
     p = hertz_parameters(kwargs.get("dofs"), kwargs.get("level"),
                          kwargs.get("variant", "paired"), kwargs.get("order", 1))
-    return hertz_case(p, kwargs.get("backend"), kwargs.get("method", "vfem"),
-                      kwargs.get("repeat", 2))
+    return hertz_case(p, kwargs.get("backend"), kwargs.get("method", "vfem"), repeat=2)
 
 
 HEADER = (f"{'dofs':>9} {'contact':>7} {'method':>10} {'backend':>8} {'vfem s':>8} "
@@ -242,35 +243,29 @@ def markdown(table: dict) -> str:
     return "\n".join(out) + "\n"
 
 
-def speed_benchmark(sizes: list[dict], backends: list[str], methods: list[str],
-                    variant: str = "paired", isolate: bool = True,
+def speed_benchmark(sizes: list[dict], backends: list[str | None], methods: list[str],
+                    variant: str = "paired", order: int = 1, isolate: bool = True,
                     print_row: Callable[[str], None] | None = None) -> list[dict]:
-    """Every size (``{"dofs": n}`` or ``{"level": L}``) x backend x method; rows."""
+    """Every size (``{"dofs": n}`` or ``{"level": L}``) x backend x method; rows.
+
+    ``isolate``: each case in a fresh process, warmed up, the faster of two solves (the speed
+    tables); otherwise one solve each in this process (the convergence study,
+    ``vfem study hertz``, which wants the errors)."""
     rows = []
     if print_row:
         print_row(HEADER)
     for size in sizes:
         for method in methods:
             for backend in backends:
-                kwargs = dict(size, variant=variant, backend=backend, method=method)
-                row = run_isolated("hertz", **kwargs) if isolate else _case("hertz", kwargs)
+                if isolate:
+                    row = run_isolated("hertz", **size, variant=variant, order=order,
+                                       backend=backend, method=method)
+                else:
+                    p = hertz_parameters(**size, variant=variant, order=order)
+                    row = hertz_case(p, backend, method)
                 rows.append(row)
                 if print_row:
                     print_row(format_row(row))
-    return rows
-
-
-def hertz_benchmark(levels: list[int], print_row: Callable[[str], None] | None = None,
-                    variant: str = "paired", order: int = 1) -> list[dict]:
-    """Refinement levels of the Hertz example, in this process, with the chosen backend (the
-    convergence study, ``vfem study hertz``)."""
-    rows = []
-    if print_row:
-        print_row(HEADER)
-    for level in levels:
-        rows.append(hertz_case(hertz_parameters(level=level, variant=variant, order=order)))
-        if print_row:
-            print_row(format_row(rows[-1]))
     return rows
 
 
@@ -348,9 +343,9 @@ def calculix_rows(levels: list[int | dict], print_row: Callable[[str], None] | N
     return rows
 
 
-if __name__ == "__main__":  # one isolated case: python -m vfem.bench '["hertz", {...}]'
+if __name__ == "__main__":  # one case: python -m vfem.bench '["hertz", {...}]' ROW.json
     import logging
 
     logging.basicConfig(level=logging.WARNING)
     kind, kwargs = json.loads(sys.argv[1])
-    print(json.dumps(_case(kind, kwargs)))
+    Path(sys.argv[2]).write_text(json.dumps(_case(kind, kwargs)), encoding="utf-8")

@@ -358,7 +358,7 @@ def cmd_bench(args) -> int:
 
 
 def cmd_study(args) -> int:
-    from .bench import hertz_benchmark
+    from .bench import speed_benchmark
     from .io.plots import convergence
 
     if args.example != "hertz":
@@ -372,8 +372,9 @@ def cmd_study(args) -> int:
             ("quadratic, paired", "paired", 2, args.quadratic_levels)):
         if not args.quiet:
             print(f"vfem: hertz refinement study, {name}")
-        series[name] = hertz_benchmark(levels, print_row=None if args.quiet else print,
-                                       variant=variant, order=order)
+        series[name] = speed_benchmark([{"level": level} for level in levels], [None], ["vfem"],
+                                       variant=variant, order=order, isolate=False,
+                                       print_row=None if args.quiet else print)
     (out / "study.json").write_text(json.dumps(series, indent=2) + "\n", encoding="utf-8")
     convergence(out / "convergence.png", series,
                 "Hertz (thesis §5.2) under refinement: error against Hertz's theory")

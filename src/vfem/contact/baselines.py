@@ -177,7 +177,7 @@ def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
 
     m = sum(len(p["node"]) for p in parts)
     rows = np.arange(m)
-    n = np.concatenate([p["normal"] for p in parts])
+    n = cat("normal")
     t = cat("t")
     dof_s = np.concatenate([p["slave_offset"] + 2 * p["slave_points"] for p in parts])
     dof_a = np.concatenate([p["master_offset"] + 2 * p["a_points"] for p in parts])
