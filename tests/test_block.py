@@ -1,6 +1,8 @@
 """Thesis §5.4, block: a sharp corner in the contact, same material on both sides."""
 
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -45,16 +47,28 @@ def test_the_pressure_peaks_near_the_corner(solved):
                                                         rel=0.05)  # nearly uniform far away
 
 
-def test_the_check_sees_a_corner_indenting_the_compatibility_side():
-    """With the large block's face the finer one, it carries compatibility and the small block's
-    corner indents it: the both-ways check must report it (it is not part of the iteration)."""
+def test_the_edge_of_the_zone_carries_compatibility_even_where_the_other_face_is_finer():
+    """With the large block's face the finer one, the small block's corner (the edge of the
+    contact zone) still carries compatibility (docs/method.md §6, *The pair*), so no node of
+    either block indents the other. Forcing the large block onto compatibility lets the corner
+    indent it between its nodes: the independent invariant (b) records it, naming the corner's
+    body."""
     p = block.Parameters(large_columns=27)
-    result = Analysis(block.build(p)).run()
+    analysis = Analysis(block.build(p))
+    result = analysis.run()
+    assert result.converged
+    (pair,) = analysis.contact.contact_pairs
+    assert analysis.surfaces[pair.fine].body.name == "small"
     pen = largest_penetrations(result)
-    assert pen["small"]["penetration"] > 1e-4
-    assert pen["small"]["into"] == "large"
-    x = result.model.bodies[0].points[:, pen["small"]["node"]]
-    assert np.hypot(x[0] - p.small_half_width, x[1]) < 0.05  # next to the corner
+    assert max(v["penetration"] for v in pen.values()) <= result.penetration_tolerance
+
+    model = block.build(p)
+    model.contact = dataclasses.replace(model.contact, compatibility_side="large",
+                                        max_step_cuts=3)
+    forced = Analysis(model).run()
+    inv = forced.steps[-1].invariants
+    assert "interpenetration" in inv["failed"]
+    assert inv["where"]["body"] == "small" and inv["max_penetration_any_body"] > 1e-4
 
 
 def test_run_writes_summary_and_figures(tmp_path):

@@ -172,7 +172,20 @@ def cmd_run(args) -> int:
         print(f"vfem: {args.example}, results in {out}/", flush=True)
     progress = Progress(None, not args.quiet)
     return _solve_and_report(lambda: example.run(params, out, on_step=progress, **resume),
-                             progress, example.report, args.quiet, args, out)
+                             progress, lambda summary: _with_invariants(
+                                 example.report(summary), summary), args.quiet, args, out)
+
+
+def _with_invariants(lines: list[str], summary: dict) -> list[str]:
+    """A built-in example's closing lines with the invariants line of its steps
+    (:func:`vfem.io.runner.invariants_line`) before the results line (at the end if none)."""
+    from .io.runner import invariants_line
+
+    line = invariants_line(summary.get("steps") or [])
+    if not line:
+        return lines
+    at = next((k for k, x in enumerate(lines) if x.lstrip().startswith("results")), len(lines))
+    return [*lines[:at], "  " + line, *lines[at:]]
 
 
 def _results_directory(args, default: Path) -> Path:

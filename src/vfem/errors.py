@@ -24,3 +24,12 @@ class RindViolation(AnalysisError):
 
     The step was too large for the contact surface to be found reliably; the solver cuts the step.
     """
+
+
+class InvariantViolation(AnalysisError):
+    """A contact solve converged to a state that breaks an invariant every contact solution must
+    satisfy — force balance, no interpenetration, no tension — checked from the full-mesh
+    results independently of the contact formulation (:mod:`vfem.contact.check`).
+
+    The solver treats it as a failed step: discarded, cut and retried.
+    """

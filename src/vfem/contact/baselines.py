@@ -519,6 +519,9 @@ class GlobalContact:
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=len(history),
                               converged=True, history=history, platen_displacement=platen)
             step.bodies = fields
+            check = getattr(analysis, "invariant_check", None)
+            if check is not None:  # recorded, not enforced: a baseline's answer is its own
+                step.invariants = analysis.check_invariants(fields, history).record()
             steps.append(step)
             analysis.state = state
             analysis.target += 1

@@ -1,28 +1,670 @@
-"""An independent check of a converged state: does any node of any body penetrate another?
+"""Independent checks of a converged state: invariants every contact solution must satisfy.
 
-The paired variant enforces compatibility at one surface of each pair (docs/method.md §6); the
-other surface's nodes are free to indent it where its facets are longer or its geometry sharper.
-This check measures that, for every candidate node of every body against every other body's
-candidate surface, with the same linear kinematics as the analysis: the node's closest point on
-the other undeformed surface, the outward normal there, and the gap
-``g0 + n . (u_node - u_other(closest point))``; where the closest point is a vertex (a corner),
-n is the direction from it to the node. Nodes whose closest point is an end of the other surface
-(beyond its edge) are left out.
+:func:`step_invariants` (and :class:`InvariantCheck`, which keeps each body's boundary between
+steps) takes only the full-mesh results of a step — each body's displacement and contact force
+at every point (:class:`vfem.solver.BodyStepResult`) — and the bodies' meshes and supports;
+nothing of the contact formulation's own state (pairings, virtual nodes, multipliers, which side
+carries compatibility). It checks
 
-When any body is analysed under large displacements the same measure is taken on the deformed
-surfaces: each node's current position against the other surface as it now lies.
+(a) **force balance**: the contact forces of all bodies sum to zero, within ``force_tolerance``
+    (1e-8) of the largest body's total contact force.
+(b) **no interpenetration**: for each pair of bodies that may touch, no boundary node of one, at
+    its deformed position X + u, lies inside the other's deformed boundary deeper (distance to
+    that boundary, symmetry planes left out) than the penetration tolerance plus a *faceting
+    allowance*. Inside is decided by the node's closest point on the other body's deformed
+    boundary polygon (the sign of the distance along the facet's normal there, or along the mean
+    of the two facets' normals at a vertex: exact for any polygon, holes included); for an
+    untangled mesh that is the same as lying in one of its deformed elements, and it costs
+    O(boundary) where locating in the elements costs O(elements) per step.
+    The allowance: a convex part of one piecewise-linear surface (turning through α) can
+    protrude between two nodes of the other surface that lie on it (a facet of length L) by at
+    most (L/2)·tan(α/2) (the isosceles case; (L/2)·sin(α/2) would miss it by 1/cos(α/2)). α is
+    the net turning of the node's own boundary within L of it (the stretch such a facet can
+    span; the node's own angle alone misses a finer surface curving under a coarser facet), at
+    most 90°, and the allowance at most the longer of L/2 and the node's own facets. A node on
+    a symmetry plane (a straight boundary held normal to itself, a roller ``Support``) turns as
+    the mirrored model does.
+    Between two bodies analysed under small kinematics the contact condition is the linearised
+    one (the gap g0 + n·(u_node − u_other) on the undeformed surfaces, as in small-strain
+    contact theory) and the deformed positions differ from it by second-order terms (a facet's
+    rotation times the slip along it; on the wedge examples, driven 0.3 into the plate, the
+    linearised reading is the one that is off). There a node counts as penetrating by the
+    smaller of its depth into the deformed boundary and its linearised depth, so only a
+    penetration both readings see fails.
+(c) **no tension**: no node carries a tensile contact force — the nodal test: F·n > ``1e-8``
+    times the largest nodal contact force of the model is tension, with n the body's own outward
+    nodal normal (the mean of its boundary facets' normals; deformed under large kinematics,
+    undeformed under small, as linear theory reads it: a force tangential to a face that has
+    rotated a little is not tension). With linear facets a compressive traction gives every
+    node a compressive force (φ >= 0), so the test is exact. A quadratic facet's end node gets
+    -L/30 of its far end's traction, so there F·n is summed over each vertex and the midpoints
+    of its facets (weights 1 - φ_far end >= 0 on each facet; a midpoint alone, 4t(1 - t) >= 0);
+    and a quadratic interpolation of non-negative nodal tractions is itself negative near the
+    edge of contact (down to -1/8 of a nodal value), so the other side's nodes there carry
+    small tensile forces: ``quadratic_tension_tolerance`` (5e-2) is the tolerance for bodies
+    with quadratic elements (measured: 1.4e-2 on Hertz with order 2, 1.3e-2 on the gasket).
+    The consistent recovery of a pressure, p = M⁻¹(−F·n) with M the boundary mass matrix over
+    the facets whose nodes all carry force, was measured too and rejected: it recovers the
+    traction exactly where F = M q, but on the other surface of a pair (forces re-integrated
+    from the first) it undershoots at every edge of contact — negative pressures of 3.6 % of
+    the largest on Hertz, 0.4 % on wedge case 1, 29 % next to the block's corner, 23 % on the
+    gasket (``tension_measure="consistent"`` keeps it for comparison).
+
+The solver (:meth:`vfem.solver.Analysis.run`) evaluates them after every converged contact
+step and treats a violation as a failed step (:class:`vfem.errors.InvariantViolation`).
+
+:func:`largest_penetrations` is the older check of the contact candidates' linearised gaps.
 """
 
 from __future__ import annotations
 
-import numpy as np
+import math
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-from ..solver import AnalysisResult, StepResult
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.spatial import cKDTree
+
+from .search import project_points
+
+if TYPE_CHECKING:
+    from ..bodies import Body
+    from ..solver import AnalysisResult, StepResult
+
+#: (a): the resultant of all contact forces, relative to the largest body's total contact force
+FORCE_BALANCE_TOLERANCE = 1e-8
+#: (c): a tensile nodal force F·n, relative to the model's largest nodal contact force
+TENSION_TOLERANCE = 1e-8
+#: (c) on a body with quadratic elements (see the module docstring)
+QUADRATIC_TENSION_TOLERANCE = 5e-2
+TENSION_MEASURES = ("nodal", "consistent")
+
+
+@dataclass
+class _Boundary:
+    """One body's boundary, from its undeformed mesh (computed once). Arrays of nodes are
+    over the boundary nodes (``nodes``: their point numbers), in that local numbering."""
+
+    nodes: np.ndarray  # (nb,) point numbers of every boundary node
+    segments: np.ndarray  # (ns, 2) local numbers, oriented: outward normal (t_y, -t_x)
+    facets: np.ndarray  # (nf, 2 or 3) local numbers of the facets (ends, midpoint), oriented
+    mirror: np.ndarray  # (ns,) bool: the segment lies on a symmetry plane of the model
+    large: bool  # the body is analysed under large kinematics
+
+    @classmethod
+    def of(cls, body: Body) -> _Boundary:
+        mesh = body.mesh
+        X = body.points
+        bf = mesh.boundary_facets()
+        fp = body.facet_points(bf).copy()
+        if len(bf):
+            elem = mesh.f2t[0, bf]
+            centroid = X[:, mesh.t[:, elem]].mean(axis=1).T
+            a, b = X[:, fp[:, 0]].T, X[:, fp[:, 1]].T
+            t = b - a
+            normal = np.column_stack([t[:, 1], -t[:, 0]])
+            flip = np.einsum("ij,ij->i", normal, 0.5 * (a + b) - centroid) < 0
+            fp[flip, :2] = fp[flip][:, 1::-1]
+        mirror = np.isin(bf, _symmetry_facets(body))
+        if fp.shape[1] == 3:  # quadratic: a facet is two chords through its midpoint
+            segments = np.vstack([fp[:, [0, 2]], fp[:, [2, 1]]])
+            mirror = np.concatenate([mirror, mirror])
+        else:
+            segments = fp
+        nodes, local = np.unique(segments, return_inverse=True)
+        lookup = np.full(body.npoints, -1)
+        lookup[nodes] = np.arange(len(nodes))
+        return cls(nodes=nodes, segments=local.reshape(segments.shape), facets=lookup[fp],
+                   mirror=mirror, large=body.large)
+
+
+def _symmetry_facets(body: Body) -> np.ndarray:
+    """Facets on a symmetry plane: on a boundary held in one direction only (a roller
+    ``Support``), straight and normal to that direction. The model continues across them as
+    their mirror image, so they are no surface that contact sees."""
+    mesh = body.mesh
+    out = [np.zeros(0, dtype=np.int64)]
+    for sup in body.supports:
+        if len(sup.components) != 1 or sup.boundary not in (mesh.boundaries or {}):
+            continue
+        facets = np.asarray(mesh.boundaries[sup.boundary])
+        if not len(facets):
+            continue
+        axis = 0 if sup.components[0] == "x" else 1
+        ends = mesh.p[:, mesh.facets[:, facets]]  # (2, 2, nf)
+        along = np.abs(ends[axis, 1] - ends[axis, 0])
+        size = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=0)
+        coord = ends[axis].ravel()
+        if np.all(along <= 1e-9 * size) and np.ptp(coord) <= 1e-9 * max(size.max(), 1e-300):
+            out.append(facets)
+    return np.concatenate(out)
+
+
+class _Polygon:
+    """A body's boundary at positions ``x`` ((nb, 2), local numbering); what is asked is
+    computed on first use."""
+
+    def __init__(self, boundary: _Boundary, x: np.ndarray):
+        self.b, self.x = boundary, x
+        self._cache: dict = {}
+
+    def _get(self, key, make):
+        if key not in self._cache:
+            self._cache[key] = make()
+        return self._cache[key]
+
+    @property
+    def ends(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._get("ends", lambda: (self.x[self.b.segments[:, 0]],
+                                          self.x[self.b.segments[:, 1]]))
+
+    @property
+    def lengths(self) -> np.ndarray:
+        return self._get("lengths", lambda: np.linalg.norm(self.ends[1] - self.ends[0], axis=1))
+
+    @property
+    def unit_normals(self) -> np.ndarray:
+        def make():
+            a, b = self.ends
+            d = b - a
+            return np.column_stack([d[:, 1], -d[:, 0]]) / np.maximum(self.lengths,
+                                                                     1e-300)[:, None]
+        return self._get("unit_normals", make)
+
+    @property
+    def surface(self) -> np.ndarray:
+        """The segments that are surface (not on a symmetry plane)."""
+        return self._get("surface", lambda: np.flatnonzero(~self.b.mirror)
+                         if (~self.b.mirror).any() else np.arange(len(self.b.mirror)))
+
+    @property
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._get("box", lambda: (self.x.min(axis=0), self.x.max(axis=0)))
+
+    def inside(self, pts: np.ndarray) -> np.ndarray:
+        """Which of ``pts`` (m, 2) lie inside the polygon (on it counts as inside): the sign
+        of the distance to the closest point along the facet's normal, or at a vertex along
+        the sum of its facets' unit normals."""
+        a, b = self.ends
+        seg, t, dist = project_points(pts, a, b)[:3]
+        n = self.unit_normals
+        vertex_normal = self._get("vertex_normals", lambda: _scatter_add(
+            len(self.x), self.b.segments, n))
+        at = np.where(t <= 0, self.b.segments[seg, 0], self.b.segments[seg, 1])
+        end = (t <= 0) | (t >= 1)
+        c = a[seg] + t[:, None] * (b[seg] - a[seg])
+        direction = np.where(end[:, None], vertex_normal[at], n[seg])
+        return np.einsum("ij,ij->i", pts - c, direction) <= 1e-12 * np.maximum(
+            self.lengths[seg], 1e-300)
+
+    def depth(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Distance of ``pts`` to the surface segments, and the length of the closest one."""
+        a, b = self.ends
+        keep = self.surface
+        seg, _, dist = project_points(pts, a[keep], b[keep])[:3]
+        return dist, self.lengths[keep][seg]
+
+    @property
+    def turning(self) -> np.ndarray:
+        """(nb,) the signed exterior angle at each node (> 0 convex, < 0 concave). Where one
+        of a node's segments lies on a symmetry plane, the other's mirror image takes its
+        place (the node on the plane is no corner of the whole model)."""
+        def make():
+            a, b = self.ends
+            d = b - a
+            seg, mirror = self.b.segments, self.b.mirror
+            d_in = np.zeros_like(self.x)
+            d_out = np.zeros_like(self.x)
+            d_in[seg[~mirror, 1]] = d[~mirror]
+            d_out[seg[~mirror, 0]] = d[~mirror]
+            plane = np.zeros_like(self.x)  # the symmetry plane's direction at its nodes
+            plane[seg[mirror, 0]] = d[mirror]
+            plane[seg[mirror, 1]] = d[mirror]
+            on = np.linalg.norm(plane, axis=1) > 0
+            t = plane / np.maximum(np.linalg.norm(plane, axis=1), 1e-300)[:, None]
+            # the mirror image of a segment arriving along w leaves along w - 2 (w.t) t
+            miss_out = on & ~d_out.any(axis=1)
+            miss_in = on & ~d_in.any(axis=1)
+            d_out[miss_out] = (d_in - 2 * np.einsum("ij,ij->i", d_in, t)[:, None] * t)[miss_out]
+            d_in[miss_in] = (d_out - 2 * np.einsum("ij,ij->i", d_out, t)[:, None] * t)[miss_in]
+            cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+            return np.arctan2(cross, np.einsum("ij,ij->i", d_in, d_out))
+        return self._get("turning", make)
+
+    def turning_within(self, nodes: np.ndarray, radius: np.ndarray) -> np.ndarray:
+        """The net turning of the boundary near each of ``nodes`` (local numbers): the sum of
+        the signed turning angles of the boundary nodes within ``radius`` (per node) of it, at
+        least 0. A facet of another surface whose ends lie on this one spans that much of it."""
+        tree = self._get("tree", lambda: cKDTree(self.x))
+        turn = self.turning
+        out = np.zeros(len(nodes))
+        for k, near in enumerate(tree.query_ball_point(self.x[nodes], radius)):
+            out[k] = turn[near].sum()
+        return np.maximum(out, 0.0)
+
+    @property
+    def adjacent(self) -> np.ndarray:
+        """(nb,) the longer of the surface segments at each node."""
+        def make():
+            out = np.zeros(len(self.x))
+            keep = ~self.b.mirror
+            for col in (0, 1):
+                np.maximum.at(out, self.b.segments[keep, col], self.lengths[keep])
+            return out
+        return self._get("adjacent", make)
+
+    @property
+    def normals(self) -> np.ndarray:
+        """(nb, 2) the outward unit normal at each node (the mean of its surface segments'
+        normals, weighted by their lengths; on a symmetry plane, its component along the
+        plane)."""
+        def make():
+            a, b = self.ends
+            d = b - a
+            n = np.column_stack([d[:, 1], -d[:, 0]])
+            seg, mirror = self.b.segments, self.b.mirror
+            out = _scatter_add(len(self.x), seg[~mirror], n[~mirror])
+            plane = np.zeros_like(self.x)
+            for col in (0, 1):
+                plane[seg[mirror, col]] = d[mirror]
+            on = np.flatnonzero(plane.any(axis=1) & out.any(axis=1))
+            t = plane[on] / np.linalg.norm(plane[on], axis=1)[:, None]
+            out[on] = np.einsum("ij,ij->i", out[on], t)[:, None] * t
+            norm = np.linalg.norm(out, axis=1)
+            return out / np.where(norm > 0, norm, 1.0)[:, None]
+        return self._get("normals", make)
+
+
+def _scatter_add(n: int, segments: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """(n, 2): each segment's value added at both its ends."""
+    out = np.zeros((n, 2))
+    for col in (0, 1):
+        np.add.at(out, segments[:, col], values)
+    return out
+
+
+@dataclass
+class Invariants:
+    """The three invariants of one state (see the module docstring) and where they are worst.
+
+    ``force_balance``: |sum of every body's contact forces| / the largest body's |total|
+    (0 when no body carries force); ``resultant``: that sum (x, y); ``totals``: each body's.
+    ``max_penetration``: the deepest boundary node inside another body (0 when none);
+    ``penetration``, ``allowed`` and ``where``: the decisive node — the one that exceeds its
+    allowed depth by most, or else the deepest — its depth, its allowed depth and
+    ``{"body", "node", "into", "x", "y", "deformed_depth", "linearised_depth"}`` (None when no
+    node is inside another body; ``linearised_depth`` None under large kinematics).
+    ``tension``: the largest tensile measure relative to the model's largest (0 when none),
+    ``tension_where``: ``{"body", "node", "value"}`` of it (value: F·n, or the recovered
+    pressure for the consistent measure), against ``tension_tolerance`` (that body's).
+    """
+
+    force_balance: float = 0.0
+    force_tolerance: float = FORCE_BALANCE_TOLERANCE
+    resultant: tuple[float, float] = (0.0, 0.0)
+    totals: dict[str, tuple[float, float]] = field(default_factory=dict)
+    max_penetration: float = 0.0
+    penetration: float = 0.0
+    allowed: float = 0.0
+    where: dict | None = None
+    tension: float = 0.0
+    tension_tolerance: float = TENSION_TOLERANCE
+    tension_where: dict | None = None
+    tension_measure: str = "nodal"
+    seconds: float = 0.0
+    #: the invariants whose violation makes the state fail (``ok``); the others are recorded
+    enforced: tuple[str, ...] = ("force balance", "interpenetration", "tension")
+
+    @property
+    def balanced(self) -> bool:
+        return self.force_balance <= self.force_tolerance
+
+    @property
+    def separated(self) -> bool:
+        return self.where is None or self.penetration <= self.allowed
+
+    @property
+    def compressive(self) -> bool:
+        return self.tension <= self.tension_tolerance
+
+    @property
+    def ok(self) -> bool:
+        """No enforced invariant is violated."""
+        return not any(name in self.enforced for name in self.failed())
+
+    def failed(self) -> list[str]:
+        """The names of the invariants violated (enforced or not): "force balance",
+        "interpenetration", "tension"."""
+        return [name for name, good in (("force balance", self.balanced),
+                                        ("interpenetration", self.separated),
+                                        ("tension", self.compressive)) if not good]
+
+    def message(self) -> str:
+        """What is violated of the enforced invariants, between which bodies and at which
+        nodes ("" when nothing)."""
+        parts = []
+        if not self.balanced and "force balance" in self.enforced:
+            body = max(self.totals, key=lambda k: math.hypot(*self.totals[k]), default="")
+            fx, fy = self.resultant
+            parts.append(
+                f"invariant (a) force balance violated: the contact forces of all bodies sum "
+                f"to ({fx:.6g}, {fy:.6g}), {self.force_balance:.3g} of the largest body's total "
+                f"contact force (body {body!r}; tolerance {self.force_tolerance:.3g})")
+        if not self.separated and "interpenetration" in self.enforced:
+            w = self.where
+            parts.append(
+                f"invariant (b) no interpenetration violated: node {w['node']} of body "
+                f"{w['body']!r}, at ({w['x']:.6g}, {w['y']:.6g}) deformed, lies "
+                f"{self.penetration:.3g} inside body {w['into']!r} (allowed {self.allowed:.3g}: "
+                "penetration tolerance and faceting allowance)")
+        if not self.compressive and "tension" in self.enforced:
+            w = self.tension_where
+            what = ("a tensile contact force (F.n = " if self.tension_measure == "nodal"
+                    else "a tensile recovered contact pressure (")
+            parts.append(
+                f"invariant (c) no tension violated: node {w['node']} of body {w['body']!r} "
+                f"carries {what}{w['value']:.6g}, {self.tension:.3g} of the model's largest; "
+                f"tolerance {self.tension_tolerance:.3g})")
+        return "; ".join(parts)
+
+    def record(self) -> dict:
+        """The measures as plain JSON values (``StepResult.invariants``, summary.json)."""
+        return {"force_balance": float(self.force_balance),
+                "force_balance_tolerance": float(self.force_tolerance),
+                "max_penetration_any_body": float(self.max_penetration),
+                "penetration": float(self.penetration),
+                "allowed": float(self.allowed),
+                "where": dict(self.where) if self.where else None,
+                "tension": float(self.tension),
+                "tension_tolerance": float(self.tension_tolerance),
+                "tension_where": dict(self.tension_where) if self.tension_where else None,
+                "tension_measure": self.tension_measure,
+                "passed": bool(self.ok),
+                "failed": self.failed(),
+                "enforced": list(self.enforced),
+                "seconds": float(self.seconds)}
+
+
+class InvariantCheck:
+    """The invariants of the states of one model (:func:`step_invariants` for one state).
+
+    Args:
+        bodies: the bodies, or a model (its ``bodies`` and ``contact_pairs``).
+        pairs: the pairs of bodies that may touch: names ``(a, b)``, or sets of two body
+            indices; None means the model's ``contact_pairs``, and then every pair.
+        penetration_tolerance: the analysis' penetration tolerance (length).
+        force_tolerance: (a)'s relative tolerance.
+        tension_tolerance: (c)'s relative tolerance (bodies with linear elements).
+        quadratic_tension_tolerance: (c)'s relative tolerance on bodies with quadratic ones.
+        tension_measure: ``"nodal"`` (default) or ``"consistent"`` (module docstring).
+
+    Each body's boundary polygon, oriented, is taken from its undeformed mesh once. A call
+    costs O(boundary nodes): the bodies' interiors are never visited, apart from summing
+    their contact forces.
+    """
+
+    def __init__(self, bodies, pairs=None, penetration_tolerance: float = 0.0,
+                 force_tolerance: float = FORCE_BALANCE_TOLERANCE,
+                 tension_tolerance: float = TENSION_TOLERANCE,
+                 quadratic_tension_tolerance: float = QUADRATIC_TENSION_TOLERANCE,
+                 tension_measure: str = "nodal"):
+        if hasattr(bodies, "bodies"):  # a model
+            if pairs is None:
+                pairs = bodies.contact_pairs
+            bodies = bodies.bodies
+        self.bodies = list(bodies)
+        names = [b.name for b in self.bodies]
+        if pairs is None:
+            pairs = [(i, j) for i in range(len(names)) for j in range(i)]
+        ordered = []
+        for pair in pairs:
+            i, j = (names.index(k) if isinstance(k, str) else int(k) for k in pair)
+            if i != j:
+                ordered += [(i, j), (j, i)]
+        self.pairs = sorted(set(ordered))
+        if tension_measure not in TENSION_MEASURES:
+            raise ValueError(f"tension_measure must be one of {TENSION_MEASURES}, got "
+                             f"{tension_measure!r}")
+        self.penetration_tolerance = float(penetration_tolerance)
+        self.force_tolerance = float(force_tolerance)
+        self.tension_tolerance = float(tension_tolerance)
+        self.quadratic_tension_tolerance = float(quadratic_tension_tolerance)
+        self.tension_measure = tension_measure
+        self._boundaries: list[_Boundary] | None = None
+        self._reference: list[_Polygon] | None = None
+
+    @property
+    def boundaries(self) -> list[_Boundary]:
+        if self._boundaries is None:
+            self._boundaries = [_Boundary.of(b) for b in self.bodies]
+        return self._boundaries
+
+    @property
+    def reference(self) -> list[_Polygon]:
+        """Each body's boundary undeformed."""
+        if self._reference is None:
+            self._reference = [_Polygon(g, b.points[:, g.nodes].T)
+                               for b, g in zip(self.bodies, self.boundaries)]
+        return self._reference
+
+    def __call__(self, fields: dict, extra_allowance: float = 0.0,
+                 force_tolerance: float | None = None,
+                 enforced: tuple[str, ...] | None = None) -> Invariants:
+        """The invariants of a state: ``fields[body name]`` has ``displacement`` and
+        ``contact_force`` ((npoints, 2) each, at ``Body.points``). ``extra_allowance`` is added
+        to every allowed depth, ``force_tolerance`` replaces (a)'s and ``enforced`` names the
+        invariants that decide ``ok`` (default all three; the thesis variant's residual
+        errors)."""
+        t0 = time.perf_counter()
+        out = Invariants(force_tolerance=self.force_tolerance if force_tolerance is None
+                         else float(force_tolerance),
+                         tension_measure=self.tension_measure)
+        if enforced is not None:
+            out.enforced = tuple(enforced)
+        ref = self.reference
+        u = [np.asarray(fields[b.name].displacement)[g.nodes]
+             for b, g in zip(self.bodies, self.boundaries)]
+        cur = [r if not np.any(ui) else _Polygon(r.b, r.x + ui) for r, ui in zip(ref, u)]
+        F = [np.asarray(fields[b.name].contact_force, dtype=float) for b in self.bodies]
+        self._force_balance(F, out)
+        self._interpenetration(cur, out, extra_allowance)
+        # (c)'s normals: the deformed ones under large kinematics, the undeformed ones (linear
+        # theory's) under small
+        own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
+        Fb = [f[g.nodes] for f, g in zip(F, self.boundaries)]
+        if self.tension_measure == "nodal":
+            self._tension_nodal(Fb, own, out)
+        else:
+            self._tension_consistent(Fb, own, out)
+        out.seconds = time.perf_counter() - t0
+        return out
+
+    # -- (a) ------------------------------------------------------------------------------------
+
+    def _force_balance(self, F: list[np.ndarray], out: Invariants) -> None:
+        # per component: a column sum is several times faster than sum(axis=0) on (n, 2)
+        totals = np.array([[f[:, 0].sum(), f[:, 1].sum()] for f in F]).reshape(-1, 2)
+        out.totals = {b.name: (float(t[0]), float(t[1])) for b, t in zip(self.bodies, totals)}
+        resultant = totals.sum(axis=0)
+        out.resultant = (float(resultant[0]), float(resultant[1]))
+        scale = float(np.linalg.norm(totals, axis=1).max(initial=0.0))
+        out.force_balance = float(np.linalg.norm(resultant)) / scale if scale > 0 else 0.0
+
+    # -- (b) ------------------------------------------------------------------------------------
+
+    def _interpenetration(self, cur: list[_Polygon], out: Invariants, extra: float) -> None:
+        tol = self.penetration_tolerance + extra
+        best = None  # (excess, depth, allowed, i, local node, j, deformed, linearised)
+        deepest = 0.0
+        for i, j in self.pairs:
+            gi, gj = cur[i], cur[j]
+            if len(gi.x) == 0 or len(gj.b.segments) == 0:
+                continue
+            lo, hi = gj.box
+            pad = 1e-9 * max(float(np.linalg.norm(hi - lo)), 1e-300)
+            near = np.flatnonzero(np.all((gi.x >= lo - pad) & (gi.x <= hi + pad), axis=1))
+            if not near.size:
+                continue
+            node = near[gj.inside(gi.x[near])]
+            if not node.size:
+                continue
+            depth, L = gj.depth(gi.x[node])
+            deformed, linearised = depth, None
+            if not (gi.b.large or gj.b.large):
+                linearised = self._linearised_depth(i, j, node, cur)
+                depth = np.minimum(depth, linearised)
+            alpha = np.minimum(gi.turning_within(node, L), 0.5 * np.pi)
+            allowed = tol + np.minimum(0.5 * L * np.tan(0.5 * alpha),
+                                       np.maximum(gi.adjacent[node], 0.5 * L))
+            deepest = max(deepest, float(depth.max()))
+            k = int(np.argmax(depth - allowed))
+            cand = (float(depth[k] - allowed[k]), float(depth[k]), float(allowed[k]), i,
+                    int(node[k]), j, float(deformed[k]),
+                    None if linearised is None else float(linearised[k]))
+            if best is None or (cand[0] > 0 and cand[0] > best[0]) or (
+                    best[0] <= 0 and cand[0] <= 0 and cand[1] > best[1]):
+                best = cand
+        out.max_penetration = max(deepest, 0.0)
+        if best is None:
+            out.allowed = tol
+            return
+        _, out.penetration, out.allowed, i, k, j, deformed, linearised = best
+        pos = cur[i].x[k]
+        out.where = {"body": self.bodies[i].name, "node": int(cur[i].b.nodes[k]),
+                     "into": self.bodies[j].name, "x": float(pos[0]), "y": float(pos[1]),
+                     "deformed_depth": deformed, "linearised_depth": linearised}
+
+    def _linearised_depth(self, i: int, j: int, node: np.ndarray, cur: list[_Polygon]
+                          ) -> np.ndarray:
+        """Small kinematics: the depth of body i's boundary ``node`` (local numbers) into body
+        j as linear theory reads it, -n . (X + u - X_c - u_c), with X_c the closest point on
+        j's undeformed surface, n the outward normal of that segment (from its vertex to the
+        node where the closest point is a vertex the node is outside of) and u_c the
+        displacement there (linear along the segment)."""
+        ri, rj = self.reference[i], self.reference[j]
+        keep = rj.surface
+        A, B = (e[keep] for e in rj.ends)
+        P = ri.x[node]
+        seg, t, dist = project_points(P, A, B)[:3]
+        d = B[seg] - A[seg]
+        c = A[seg] + t[:, None] * d
+        n = rj.unit_normals[keep][seg]
+        at_vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * np.maximum(
+            np.linalg.norm(d, axis=1), 1e-300))
+        toward = (P - c) / np.maximum(dist, 1e-300)[:, None]
+        n = np.where((at_vertex & (np.einsum("ij,ij->i", toward, n) > 0))[:, None], toward, n)
+        uj = cur[j].x - rj.x
+        ends = rj.b.segments[keep][seg]
+        uc = (1 - t)[:, None] * uj[ends[:, 0]] + t[:, None] * uj[ends[:, 1]]
+        return -np.einsum("ij,ij->i", cur[i].x[node] - (c + uc), n)
+
+    # -- (c) ------------------------------------------------------------------------------------
+
+    def _tolerance(self, body: Body) -> float:
+        return self.quadratic_tension_tolerance if body.order != 1 else self.tension_tolerance
+
+    def _tension_nodal(self, F: list[np.ndarray], own: list[_Polygon], out: Invariants) -> None:
+        scale = max((float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in F),
+                    default=0.0)
+        out.tension_tolerance = min((self._tolerance(b) for b in self.bodies),
+                                    default=self.tension_tolerance)
+        if scale == 0:
+            return
+        worst = None  # (value / scale / tolerance, value, body, local node)
+        for b, f, g in zip(self.bodies, F, own):
+            fn = np.einsum("ij,ij->i", f, g.normals)
+            if g.b.facets.shape[1] == 3:
+                # quadratic facets: a vertex with the midpoints of its facets (weights
+                # 1 - phi_far_end >= 0 on each facet), a midpoint alone (4 t (1 - t) >= 0)
+                mid = g.b.facets[:, 2]
+                patch = fn.copy()
+                for col in (0, 1):
+                    np.add.at(patch, g.b.facets[:, col], fn[mid])
+                patch[mid] = fn[mid]
+                fn = patch
+            if not len(fn):
+                continue
+            k = int(np.argmax(fn))
+            ratio = fn[k] / scale / self._tolerance(b)
+            if fn[k] > 0 and (worst is None or ratio > worst[0]):
+                worst = (ratio, float(fn[k]), b, k)
+        if worst is not None:
+            _, value, b, k = worst
+            out.tension = value / scale
+            out.tension_tolerance = self._tolerance(b)
+            out.tension_where = {"body": b.name, "node": int(own[self.bodies.index(b)].b.nodes[k]),
+                                 "value": value}
+
+    def _tension_consistent(self, F: list[np.ndarray], own: list[_Polygon],
+                            out: Invariants) -> None:
+        recovered = []
+        for b, f, g in zip(self.bodies, F, own):
+            fn = np.einsum("ij,ij->i", f, g.normals)
+            carries = np.linalg.norm(f, axis=1) > 0
+            # the facets whose every node carries force: where the traction is not zero
+            fac = g.b.facets[carries[g.b.facets].all(axis=1)]
+            if not len(fac):
+                continue
+            used = np.unique(fac)
+            local = np.full(len(f), -1)
+            local[used] = np.arange(len(used))
+            M = _boundary_mass(g.x, fac, local, len(used))
+            p = spla.spsolve(M.tocsc(), -fn[used])
+            recovered.append((b, g.b.nodes[used], np.atleast_1d(p)))
+        out.tension_tolerance = self.tension_tolerance
+        scale = max((float(np.abs(p).max(initial=0.0)) for _, _, p in recovered), default=0.0)
+        if scale == 0:
+            return
+        worst = None
+        for b, nodes, p in recovered:
+            k = int(np.argmin(p))
+            if p[k] < 0 and (worst is None or -p[k] > worst[0]):
+                worst = (float(-p[k]), b.name, int(nodes[k]), float(p[k]))
+        if worst is not None:
+            out.tension = worst[0] / scale
+            out.tension_where = {"body": worst[1], "node": worst[2], "value": worst[3]}
+
+
+def _boundary_mass(x: np.ndarray, facets: np.ndarray, local: np.ndarray, n: int
+                   ) -> sp.csr_matrix:
+    """The mass matrix ∫φφᵀ over straight boundary facets (2 or 3 nodes: ends, midpoint)."""
+    L = np.linalg.norm(x[facets[:, 1]] - x[facets[:, 0]], axis=1)
+    if facets.shape[1] == 2:
+        ref = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
+    else:
+        ref = np.array([[4.0, -1.0, 2.0], [-1.0, 4.0, 2.0], [2.0, 2.0, 16.0]]) / 30.0
+    k = facets.shape[1]
+    rows = np.repeat(local[facets], k, axis=1).ravel()
+    cols = np.tile(local[facets], (1, k)).ravel()
+    vals = (L[:, None, None] * ref[None]).ravel()
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+def step_invariants(model_or_bodies, pairs, fields: dict, penetration_tolerance: float,
+                    **options) -> Invariants:
+    """The three invariants of one state (see :class:`InvariantCheck` for the arguments;
+    ``fields``: body name -> its :class:`~vfem.solver.BodyStepResult`, or anything with
+    ``displacement`` and ``contact_force``)."""
+    return InvariantCheck(model_or_bodies, pairs, penetration_tolerance, **options)(fields)
 
 
 def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
                          ) -> dict[str, dict]:
     """Per body: the largest penetration of its candidate nodes into another body.
+
+    The paired variant enforces compatibility at one surface of each pair (docs/method.md §6);
+    the other surface's nodes are free to indent it where its facets are longer or its geometry
+    sharper. This measures that, for every candidate node of every body against every other
+    body's candidate surface, with the same linear kinematics as the analysis: the node's
+    closest point on the other undeformed surface, the outward normal there, and the gap
+    ``g0 + n . (u_node - u_other(closest point))``; where the closest point is a vertex (a
+    corner), n is the direction from it to the node. Nodes whose closest point is an end of the
+    other surface (beyond its edge) are left out. When any body is analysed under large
+    displacements the same measure is taken on the deformed surfaces: each node's current
+    position against the other surface as it now lies.
 
     Returns ``{body: {"penetration": value (> 0 overlap, <= 0 none), "node": point number,
     "into": other body}}`` for the given step (default: the last).

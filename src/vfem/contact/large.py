@@ -7,7 +7,7 @@ sliding of the touching surfaces without requiring rediscretization"), so every 
 
 1. **re-pairs** the surfaces on the current geometry: every compatibility-side node finds its
    virtual node on the opposing surface as it now lies, with that surface's current normal
-   (continuous along it, :meth:`LargeDeformationContact._smooth_normals`); the transfer of the
+   (continuous along it, :func:`~vfem.contact.paired.virtual_nodes`); the transfer of the
    traction to the opposing nodes is re-integrated over the current overlap of the two surfaces.
    Tractions stay nominal (per undeformed length of the compatibility side), so the two sides'
    forces remain equal and opposite in total, and act along the current normals;
@@ -77,7 +77,7 @@ from .algorithm import (
     SolveResult,
     closing_motion,
 )
-from .paired import PairedContact
+from .paired import PairedContact, virtual_nodes
 from .search import project_points
 from .surface import ContactSurface
 
@@ -159,6 +159,8 @@ def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: fl
 class LargeDeformationContact(PairedContact):
     """Frictionless contact with large displacements and sliding (see the module docstring)."""
 
+    keep_all_nodes = True  # which nodes are over the other surface changes as bodies slide
+
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
                  backend: str | None = None):
         for s in surfaces:
@@ -189,38 +191,31 @@ class LargeDeformationContact(PairedContact):
 
     # -- pairing in the current configuration ---------------------------------------------------
 
-    @staticmethod
-    def _smooth_normals(sc: ContactSurface, x: np.ndarray, seg: np.ndarray, t: np.ndarray
-                        ) -> np.ndarray:
-        """The opposing surface's normal at the virtual nodes, continuous along the surface.
-
-        Facet normals jump at every vertex of a faceted curved surface, so a node sliding past
-        a vertex would turn its force abruptly (by the angle between the facets) and a node
-        right under a vertex would take one facet's normal or the other's. The normal here is
-        interpolated between the nodal normals (the mean of the adjacent facets' normals, at the
-        surface's tracked positions ``x``) with the facet's shape functions: continuous, and the
-        facet normal itself on a flat surface.
-        """
-        n = sc.interpolation(seg, t) @ sc.node_normals(x)
-        return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-
     def penetrations(self, state: ContactState) -> list[np.ndarray]:
         """Re-pair every contact pair on the current geometry and return the penetrations (> 0
-        overlap) of the pairs' compatibility-side nodes."""
+        overlap) of the pairs' compatibility-side nodes (:meth:`PairedContact._overlap`: a node
+        that is not over the other surface measures its distance from its end)."""
         x = self.positions(state)
         out = []
-        for pair in self.contact_pairs:
+        for k, pair in enumerate(self.contact_pairs):
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            pts = x[pair.fine][pair.nodes]
-            A, B = sc.segments(x[pair.coarse])
-            seg, t, _ = project_points(pts, A, B)
-            normal = self._smooth_normals(sc, x[pair.coarse], seg, t)
-            closest = A[seg] + t[:, None] * (B[seg] - A[seg])
-            gap = np.einsum("ij,ij->i", pts - closest, normal)
-            interp = sc.interpolation(seg, t)
-            pair.normal, pair.interp, pair.rind_depth = normal, interp, sc.rind_depth[seg]
-            pair.transfer = self._transfer(sf, sc, 0.0, x[pair.fine], x[pair.coarse])
-            out.append(-gap)
+            geo = self._overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes)
+            if geo is None:  # the surfaces no longer face each other anywhere
+                pair.carries = np.zeros(len(pair.nodes), dtype=bool)
+                pair.mass = np.zeros_like(pair.mass)
+                pair.transfer = np.zeros_like(pair.transfer)
+                pair.patches = None
+                self._q(state, k)[:] = 0.0
+                out.append(np.full(len(pair.nodes), -np.inf))
+                continue
+            pair.normal, pair.interp, pair.rind_depth = geo.normal, geo.interp, geo.rind_depth
+            # a node that is not over the other surface, or whose facets do not overlap it,
+            # carries nothing
+            pair.mass, pair.transfer = geo.mass, geo.transfer
+            pair.carries = geo.carries & ~geo.beyond
+            pair.patches = geo.fpatch, geo.cpatch
+            self._q(state, k)[~pair.carries] = 0.0
+            out.append(-geo.gap)
         return out
 
     # -- the iteration ----------------------------------------------------------------------------
@@ -318,10 +313,10 @@ class LargeDeformationContact(PairedContact):
             on = np.flatnonzero(q != 0)
             if not len(on):
                 continue
-            sc = self.surfaces[pair.coarse]
-            A, B = sc.segments(x[pair.coarse])
-            seg, t, _ = project_points(x[pair.fine][pair.nodes[on]], A, B)
-            qn = q[on, None] * self._smooth_normals(sc, x[pair.coarse], seg, t)
+            sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
+            normal = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes[on],
+                                   *pair.patches)[0]
+            qn = q[on, None] * normal
             out[pair.fine] += pair.mass[:, pair.nodes[on]] @ qn
             out[pair.coarse] -= pair.transfer[:, pair.nodes[on]] @ qn
         return np.concatenate([F.ravel() for F in out])
@@ -404,7 +399,7 @@ class LargeDeformationContact(PairedContact):
             p = p - self._normal_motion(pair, a, np.arange(len(pair.nodes)))
             reach = max(tol, float(np.max(p, initial=0.0)))
             lin_pens.append(p)
-            sets.append(np.flatnonzero((self._q(state, k) != 0) | (p > -reach)))
+            sets.append(np.flatnonzero(pair.carries & ((self._q(state, k) != 0) | (p > -reach))))
         m = sum(len(s_) for s_ in sets)
         # force patterns per unit traction value, stacked candidate dofs x m
         A = np.zeros((nt, m))

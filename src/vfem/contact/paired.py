@@ -73,9 +73,94 @@ class ContactPair:
     gap0: np.ndarray  # (m,) undeformed gap (> 0 open)
     interp: np.ndarray  # (m, nc_coarse) virtual node = interp @ coarse candidate nodes
     transfer: np.ndarray  # (nc_coarse, nc_fine) coarse nodal force per unit fine traction value
-    mass: np.ndarray  # (nc_fine, nc_fine) the fine surface's N (all candidate facets)
+    mass: np.ndarray  # (nc_fine, nc_fine) the fine surface's N over the overlap
     rind_depth: np.ndarray  # (m,) thickness of the coarse element under each virtual node
+    carries: np.ndarray  # (m,) whose traction reaches the other surface
+    patches: tuple[np.ndarray, np.ndarray] | None  # each side's facets facing the other
     platen_rate: np.ndarray | None = None  # (m,) penetration change per unit platen motion
+
+
+#: A facet faces the other body when its outward normal and the other surface's normal where
+#: it is closest make an angle of at least 120 degrees (cosine <= -0.5). A flat punch's sides
+#: (90 degrees to the block it presses) so do not face the block, and its corners end its
+#: contact surface; the facets of a smooth or mildly angled surface (a faceted cylinder, a
+#: shallow wedge, a chamfer up to 60 degrees) all do.
+FACING = 0.5
+
+#: A surface with an edge inside the contact zone (an end of its patch over the other surface)
+#: carries compatibility unless it gives way this many times less per unit length than the
+#: other: a node-free corner of the equilibrium side would otherwise indent the compatibility
+#: side between its nodes (measured on the thesis's block example, equal materials: 2.7e-4, a
+#: thousand times the penetration tolerance). A much stiffer surface with the edge (a rigid
+#: punch) stays on the equilibrium side: as compatibility side it would hold a traction the
+#: soft surface cannot control.
+EDGE_RATIO = 4.0
+
+
+def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray) -> np.ndarray:
+    """The candidate facets of ``s`` (at tracked positions ``x``) that face the body of ``so``
+    (at ``xo``): its patch in their pair (:data:`FACING`)."""
+    if len(s.facets) == 0 or len(so.facets) == 0:
+        return np.zeros(0, dtype=int)
+    a, b = s.segments(x)
+    n = outward_normals(a, b)
+    mid, _ = s.curve(np.arange(len(s.facets)), np.full(len(s.facets), 0.5), x)
+    seg, t, _, m, _ = so.closest(mid, xo, None, n)
+    return np.flatnonzero(np.einsum("ij,ij->i", n, m) <= -FACING)
+
+
+def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:
+    """(nc,) True at the ends of a patch of facets (vertices on one facet of it)."""
+    return np.bincount(s.facets[patch, :2].ravel(), minlength=s.nc)[: s.nc] == 1
+
+
+def beyond(s: ContactSurface, seg: np.ndarray, t_free: np.ndarray, ends: np.ndarray
+           ) -> np.ndarray:
+    """Points whose closest point on a patch is one of its ends (``ends``), outside the end
+    facet's normal strip (``t_free`` off [0, 1]): they are not over the patch."""
+    e = s.facets[seg]
+    return (((t_free < -1e-9) & ends[e[:, 0]]) | ((t_free > 1 + 1e-9) & ends[e[:, 1]]))
+
+
+def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np.ndarray,
+                  nodes: np.ndarray, fpatch: np.ndarray, cpatch: np.ndarray):
+    """The virtual nodes of ``nodes`` of ``sf`` on the patch ``cpatch`` of ``sc`` (positions
+    ``xf``, ``xc``): (normal, gap, interp, facet, beyond) — see :meth:`PairedContact._overlap`.
+    """
+    pts = xf[nodes]
+    seg, t, _, _, tf = sc.closest(pts, xc, cpatch, sf.node_normals(xf, fpatch)[nodes])
+    closest, _ = sc.curve(seg, t, xc)
+    past = beyond(sc, seg, tf, patch_ends(sc, cpatch))
+    interp = sc.interpolation(seg, t)
+    normal = interp @ sc.node_normals(xc, cpatch)
+    d = pts - closest
+    dn = np.linalg.norm(d, axis=1)
+    normal = np.where((past & (dn > 0))[:, None], d / np.maximum(dn, 1e-300)[:, None], normal)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    return normal, np.einsum("ij,ij->i", d, normal), interp, seg, past
+
+
+@dataclass
+class Overlap:
+    """The pairing of a compatibility surface's nodes with the other surface (one
+    configuration; :meth:`PairedContact._overlap`). Arrays over ``nodes``."""
+
+    nodes: np.ndarray  # candidate nodes of the compatibility side
+    normal: np.ndarray  # (m, 2) the normal along which the gap is measured
+    gap: np.ndarray  # (m,) > 0 open
+    interp: np.ndarray  # (m, nc_other) virtual node = interp @ the other surface's nodes
+    rind_depth: np.ndarray  # (m,) thickness of the other body's element there
+    beyond: np.ndarray  # (m,) not over the other surface (no virtual node)
+    carries: np.ndarray  # (m,) whose traction reaches the other surface (overlap under it)
+    mass: np.ndarray  # (nc_fine, nc_fine) N over the overlap
+    transfer: np.ndarray  # (nc_other, nc_fine) T over the overlap
+    fpatch: np.ndarray  # the facets of each side that face the other (:func:`facing`)
+    cpatch: np.ndarray
+
+    def subset(self, keep: np.ndarray) -> Overlap:
+        return Overlap(self.nodes[keep], self.normal[keep], self.gap[keep], self.interp[keep],
+                       self.rind_depth[keep], self.beyond[keep], self.carries[keep], self.mass,
+                       self.transfer, self.fpatch, self.cpatch)
 
 
 class PairedContact(VirtualElementContact):
@@ -93,47 +178,85 @@ class PairedContact(VirtualElementContact):
 
     # -- geometry of the pairs (once) -------------------------------------------------------------
 
+    #: nodes that keep every candidate node of the compatibility side (large kinematics, where
+    #: which nodes overlap the other surface changes as the bodies slide)
+    keep_all_nodes = False
+
     def _make_pair(self, i: int, j: int) -> ContactPair | None:
         si, sj = self.surfaces[i], self.surfaces[j]
         if len(si.facets) == 0 or len(sj.facets) == 0:
             return None
-        ci, cj = self._compliance_density(i, j), self._compliance_density(j, i)
-        if abs(ci - cj) > 1e-9 * max(ci, cj):
+        (ci, ei), (cj, ej) = self._compliance_density(i, j), self._compliance_density(j, i)
+        if ci == 0.0 and cj == 0.0:
+            return None  # no facet of either faces the other
+        if ei != ej and (ci if ei else cj) * EDGE_RATIO >= max(ci, cj):
+            # the contact zone ends at an edge of one surface (a corner over the other): that
+            # surface carries compatibility, unless it is much stiffer
+            fine, coarse = (i, j) if ei else (j, i)
+        elif abs(ci - cj) > 1e-9 * max(ci, cj):
             fine, coarse = (i, j) if ci > cj else (j, i)
         else:  # equal: a rule that does not depend on the order of the bodies
             fine, coarse = (i, j) if si.body.name < sj.body.name else (j, i)
+        if self.settings.compatibility_side is not None:  # forced (for testing)
+            names = (si.body.name, sj.body.name)
+            if self.settings.compatibility_side in names:
+                fine, coarse = (i, j) if si.body.name == self.settings.compatibility_side \
+                    else (j, i)
         sf, sc = self.surfaces[fine], self.surfaces[coarse]
-        nodes = self._facing_nodes(fine, coarse)
-        seg, t, _, n = sc.project(sf.X[nodes])
-        closest, _ = sc.curve(seg, t)
-        gap0 = np.einsum("ij,ij->i", sf.X[nodes] - closest, n)
-        interp = sc.interpolation(seg, t)
-        mass = sf.mass_matrix(np.ones(len(sf.facets))).toarray()
+        nodes = (self._facing_nodes(fine, coarse) if self.keep_all_nodes else None)
+        geo = self._overlap(sf, sc, nodes=nodes)
+        if geo is None:
+            return None
+        if not self.keep_all_nodes:  # only the nodes over the other surface take part
+            keep = geo.carries & ~geo.beyond
+            geo = geo.subset(keep)
         log.info("contact pair: %s (compatibility, %d nodes) against %s (equilibrium)",
-                 sf.body.name, len(nodes), sc.body.name)
-        # the transfer must reach across every gap the pair may close (bodies that start apart)
-        gap = float(np.abs(gap0).max()) if len(gap0) else 0.0
-        return ContactPair(fine, coarse, nodes, n, gap0, interp, self._transfer(sf, sc, gap), mass,
-                           sc.rind_depth[seg])
+                 sf.body.name, len(geo.nodes), sc.body.name)
+        if not len(geo.nodes):
+            return None
+        return ContactPair(fine, coarse, geo.nodes, geo.normal, geo.gap, geo.interp,
+                           geo.transfer, geo.mass, geo.rind_depth, geo.carries,
+                           (geo.fpatch, geo.cpatch))
 
-    def _compliance_density(self, i: int, j: int) -> float:
-        """How much body i's surface facing j gives way, per unit length: the median nodal
-        flexibility along the normal (1 / Castigliano stiffness) over the median facet length.
+    def _compliance_density(self, i: int, j: int) -> tuple[float, bool]:
+        """How much body i's surface facing j gives way, per unit length, where the two meet:
+        the median nodal flexibility along the normal (1 / Castigliano stiffness) over the median
+        facet length, over i's facets that face j and lie over j's surface facing i; and whether
+        an end of i's surface facing j lies over j's (an edge of i inside the contact zone).
 
         The compatibility side must be the one whose own flexibility carries the pair: the
         softer surface, and of two equally stiff ones the finer. A much stiffer surface with a
         finer mesh would hold a traction that the other surface cannot control, and the
         pressures would oscillate (measured on Hertz with the flat as compatibility side:
-        nodal pressures up to 56 % off).
+        nodal pressures up to 56 % off). Only the facets where the surfaces overlap count, so
+        the mesh far from the contact (a coarse far field, a long exterior facet) does not
+        decide it.
         """
-        s = self.surfaces[i]
-        mid = 0.5 * (s.X[s.facets[:, 0]] + s.X[s.facets[:, 1]])
-        facing = self._nearest_body(i, mid) == j
-        lengths = s.lengths[facing] if facing.any() else s.lengths
-        nodes = np.unique(s.facets[facing]) if facing.any() else np.arange(s.nc)
-        stiffness = s.normal_stiffness(nodes, s.node_normals()[nodes])
+        s, so = self.surfaces[i], self.surfaces[j]
+        patch, opatch = facing(s, s.X, so, so.X), facing(so, so.X, s, s.X)
+        if not len(patch) or not len(opatch):
+            return 0.0, False
+        oends = patch_ends(so, opatch)
+        mid, _ = s.curve(patch, np.full(len(patch), 0.5))
+        seg, _, _, _, tf = so.closest(mid, None, opatch, outward_normals(*s.segments(s.X))[patch])
+        over = patch[~beyond(so, seg, tf, oends)]
+        if not len(over):
+            return 0.0, False
+        # ends of the patch at a corner of the body (another candidate facet, not facing j,
+        # meets it there), not where the candidates or the boundary stop
+        valence = np.bincount(s.facets[:, :2].ravel(), minlength=s.nc)[: s.nc]
+        ends = np.flatnonzero(patch_ends(s, patch) & (valence >= 2))
+        normals = s.node_normals(None, patch)
+        seg, _, _, _, tf = so.closest(s.X[ends], None, opatch, normals[ends])
+        e = so.facets[seg]
+        shared = ((tf <= 1e-9) & oends[e[:, 0]]) | ((tf >= 1 - 1e-9) & oends[e[:, 1]])
+        # (where both surfaces end together, at a symmetry plane, there is no edge)
+        edge = bool((~beyond(so, seg, tf, oends) & ~shared).any())
+        nodes = np.unique(s.facets[over])
+        stiffness = s.normal_stiffness(nodes, s.node_normals(None, over)[nodes])
         flexibility = 1.0 / stiffness[np.isfinite(stiffness) & (stiffness > 0)]
-        return float(np.median(flexibility) / np.median(lengths)) if len(flexibility) else 0.0
+        return (float(np.median(flexibility) / np.median(s.lengths[over]))
+                if len(flexibility) else 0.0), edge
 
     def _facing_nodes(self, i: int, j: int) -> np.ndarray:
         s = self.surfaces[i]
@@ -149,35 +272,69 @@ class PairedContact(VirtualElementContact):
         return best
 
     @staticmethod
-    def _transfer(sf: ContactSurface, sc: ContactSurface, gap: float = 0.0,
-                  xf: np.ndarray | None = None, xc: np.ndarray | None = None) -> np.ndarray:
-        """Coarse nodal forces from a fine traction: T[c, f] = int phi_c(proj(y)) phi_f(y) dy.
+    def _overlap(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray | None = None,
+                 xc: np.ndarray | None = None, nodes: np.ndarray | None = None
+                 ) -> Overlap | None:
+        """Where the compatibility surface ``sf`` meets ``sc`` (undeformed, or at tracked
+        positions ``xf`` and ``xc``): each node's virtual node, normal and gap, and the
+        transfer of the traction (thesis §4.4-4.5).
 
-        Integrated over the fine facets, split where the projection onto the coarse surface
-        passes a coarse facet's end, with a Gauss rule exact to degree 5 on each piece: exact for
-        the piecewise polynomial integrand (degree 4 at most, with quadratic elements) on
-        straight facets, so a uniform traction crosses exactly and the total force is conserved.
-        On curved (quadratic) facets the points and weights follow the curve; the splits are
-        found on the chords.
+        Each surface takes part with its **patch**: the facets that face the other body
+        (:func:`facing`). A sharp corner of the other body (the edge of a flat punch) so ends
+        the patch, and a point of ``sf`` whose closest point on the patch is its end, beyond
+        which it lies (outside the end facet's normal strip), is not over the other surface:
+        it has no virtual node and its gap is its distance from that end, along the line to it.
+        Elsewhere the normal is the patch's, interpolated between its nodal normals
+        (continuous along a faceted curve; the facet normal on a flat) at the virtual node.
 
-        With ``xf`` and ``xc`` (tracked positions of the two surfaces in a deformed
-        configuration) the overlap is found on the deformed surfaces, while the measure stays
-        the fine side's undeformed length: the traction is nominal.
+        ``nodes``: the ``sf`` nodes to pair (default: the nodes of its patch).
         """
         xf = sf.X if xf is None else xf
         xc = sc.X if xc is None else xc
+        fpatch, cpatch = facing(sf, xf, sc, xc), facing(sc, xc, sf, xf)
+        if not len(fpatch) or not len(cpatch):
+            return None
+        if nodes is None:
+            nodes = np.unique(sf.facets[fpatch])
+        normal, gap, interp, seg, past = virtual_nodes(sf, sc, xf, xc, nodes, fpatch, cpatch)
+        reach = float(np.abs(gap[~past]).max()) if (~past).any() else 0.0
+        mass, transfer = PairedContact._transfer(sf, sc, fpatch, cpatch,
+                                                 sc.node_normals(xc, cpatch),
+                                                 patch_ends(sc, cpatch), reach, xf, xc)
+        carries = mass[:, nodes].any(axis=0)
+        return Overlap(nodes, normal, gap, interp, sc.rind_depth[seg], past, carries, mass,
+                       transfer, fpatch, cpatch)
+
+    @staticmethod
+    def _transfer(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray,
+                  cpatch: np.ndarray, cnormals: np.ndarray, ends: np.ndarray, gap: float,
+                  xf: np.ndarray, xc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Both sides' nodal forces per unit traction value, from one integral over the overlap.
+
+        ``N[i, k] = int phi_i(y) phi_k(y) dy`` (the compatibility side, eq. 4.4.11) and
+        ``T[c, k] = int phi_c(proj(y)) phi_k(y) dy`` (the equilibrium side: the same traction
+        re-integrated with its shape functions), both over the part of the patch ``fpatch`` of
+        ``sf`` that lies over the patch ``cpatch`` of ``sc`` (points beyond its ends count
+        nothing). Since the shape functions of each side sum to one, the two sides' forces are
+        equal and opposite for any traction, to round-off, and force reaches only nodes whose
+        facets overlap the other surface.
+
+        Integrated over the fine facets, split where the projection onto the coarse patch passes
+        one of its vertices (seen along its nodal normal), with a Gauss rule exact to degree 5
+        on each piece: exact for the piecewise polynomial integrand (degree 4 at most, with
+        quadratic elements) on straight facets, so a uniform traction crosses exactly. On
+        curved (quadratic) facets the points and weights follow the curve; the splits are found
+        on the chords. Positions ``xf``, ``xc`` may be deformed; the measure stays the fine
+        side's undeformed length (the traction is nominal).
+        """
         fa, fb = sf.segments(xf)
-        ca, cb = sc.segments(xc)
+        fa, fb = fa[fpatch], fb[fpatch]
         d = fb - fa
-        # coarse facet ends seen along their (vertex) normal: where they split the fine facets
-        ends = np.unique(sc.facets[:, :2])
-        vn = np.zeros((sc.nc, 2))
-        cn = outward_normals(ca, cb)
-        np.add.at(vn, sc.facets[:, 0], cn)
-        np.add.at(vn, sc.facets[:, 1], cn)
-        vn = vn[ends] / np.maximum(np.linalg.norm(vn[ends], axis=1), 1e-300)[:, None]
-        P = xc[ends]
-        # solve fa + s d = P + tau vn for every (facet, coarse node)
+        # the coarse patch's vertices seen along their normals: where they split the fine facets
+        verts = np.unique(sc.facets[cpatch, :2])
+        vn = cnormals[verts]
+        P = xc[verts]
+        # solve fa + s d = P + tau vn for every (facet, coarse vertex)
         det = d[:, None, 0] * (-vn[None, :, 1]) - d[:, None, 1] * (-vn[None, :, 0])
         rx = P[None, :, 0] - fa[:, None, 0]
         ry = P[None, :, 1] - fa[:, None, 1]
@@ -185,14 +342,14 @@ class PairedContact(VirtualElementContact):
             s = (rx * (-vn[None, :, 1]) - ry * (-vn[None, :, 0])) / det
             tau = (d[:, None, 0] * ry - d[:, None, 1] * rx) / det
         # points farther than this from the coarse surface face something else (``gap``: the
-        # largest undeformed gap of the pair's nodes)
+        # largest gap of the pair's nodes)
         reach = gap + 2.0 * (sf.lengths.max() + sc.lengths.max())
         ok = np.isfinite(s) & (s > 1e-12) & (s < 1 - 1e-12) & (np.abs(tau) < reach)
         X, W = get_quadrature(RefLine, 5)
         xi, w = X[0], W
         wts, fac, sloc = [], [], []
-        for f in range(len(sf.facets)):
-            cuts = np.unique(np.concatenate([[0.0, 1.0], s[f, ok[f]]]))
+        for k, f in enumerate(fpatch):
+            cuts = np.unique(np.concatenate([[0.0, 1.0], s[k, ok[k]]]))
             lo, hi = cuts[:-1], cuts[1:]
             sq = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
             wts.append(((hi - lo)[:, None] * w[None, :]).ravel())
@@ -202,18 +359,21 @@ class PairedContact(VirtualElementContact):
         fac, sloc = np.concatenate(fac), np.concatenate(sloc)
         _, tangent = sf.curve(fac, sloc)
         wts = wts * np.linalg.norm(tangent, axis=1)
-        pts, _ = sf.curve(fac, sloc, xf)
-        seg, tt, dist, _ = sc.project(pts, xc)
-        cend = sc.facets[seg]
-        beyond = (((tt <= 0) & sc.surface_ends[cend[:, 0]])
-                  | ((tt >= 1) & sc.surface_ends[cend[:, 1]]))
-        wts = np.where(beyond | (dist > reach), 0.0, wts)
+        pts, tangent = sf.curve(fac, sloc, xf)
+        own = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+        own /= np.maximum(np.linalg.norm(own, axis=1), 1e-300)[:, None]
+        seg, tt, dist, _, tf = sc.closest(pts, xc, cpatch, own)
+        wts = np.where(beyond(sc, seg, tf, ends) | (dist > reach), 0.0, wts)
+        N = np.zeros((sf.nc, sf.nc))
         T = np.zeros((sc.nc, sf.nc))
-        fend = sf.facets[fac]
-        for ci, cw in zip(cend.T, sc.shape(tt).T):
-            for fi, fw in zip(fend.T, sf.shape(sloc).T):
+        fend, cend = sf.facets[fac], sc.facets[seg]
+        fshape = sf.shape(sloc).T
+        for fi, fw in zip(fend.T, fshape):
+            for ci, cw in zip(cend.T, sc.shape(tt).T):
                 np.add.at(T, (ci, fi), wts * cw * fw)
-        return T
+            for gi, gw in zip(fend.T, fshape):
+                np.add.at(N, (gi, fi), wts * gw * fw)
+        return N, T
 
     # -- state of the pairs -----------------------------------------------------------------------
 

@@ -6,25 +6,36 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 
-def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray,
+                   point_normals: np.ndarray | None = None, free: bool = False):
     """Closest point on a set of segments for each point.
 
     A KD-tree on the segment midpoints limits the candidates: the closest segment's midpoint is
     no farther than the nearest midpoint plus half the longest segment. The exact projection onto
     the candidates is vectorised.
 
+    **Ties** (a point equally far from two segments, e.g. closest to the vertex they share, to
+    1e-9 of the longest segment): with ``point_normals`` (the outward normal of the surface the
+    point lies on) the segment whose outward normal (``(t_y, -t_x)``) is most opposed to it wins,
+    so the point pairs with the facet that faces it; then the one whose segment the point lies
+    over (unclamped t inside [0, 1]); then the lowest segment number. The two nodes of a
+    symmetric model that lie over mirrored vertices so choose mirrored facets.
+
     Args:
         points: (m, 2) query points.
         a, b: (s, 2) segment ends.
+        point_normals: (m, 2) unit normals at the points, for ties (optional).
+        free: also return the unclamped local coordinate (where the point lies along the
+            segment's line: outside [0, 1] beyond its ends).
 
     Returns:
-        (segment, t, distance): the nearest segment of each point, the local coordinate of the
-        closest point on it (0 at ``a``, 1 at ``b``) and the distance.
+        (segment, t, distance[, t_free]): the nearest segment of each point, the local coordinate
+        of the closest point on it (0 at ``a``, 1 at ``b``) and the distance.
     """
     m, s = len(points), len(a)
     if s == 0 or m == 0:
-        return np.zeros(m, dtype=int), np.zeros(m), np.full(m, np.inf)
+        empty = (np.zeros(m, dtype=int), np.zeros(m), np.full(m, np.inf))
+        return empty + (np.zeros(m),) if free else empty
     d = b - a
     L2 = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
     mid = 0.5 * (a + b)
@@ -35,13 +46,22 @@ def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray
     counts = np.fromiter((len(c) for c in lists), dtype=int, count=m)
     pt = np.repeat(np.arange(m), counts)
     sg = np.fromiter((j for c in lists for j in c), dtype=int, count=int(counts.sum()))
-    t = np.clip(np.einsum("ij,ij->i", points[pt] - a[sg], d[sg]) / L2[sg], 0.0, 1.0)
+    tf = np.einsum("ij,ij->i", points[pt] - a[sg], d[sg]) / L2[sg]
+    t = np.clip(tf, 0.0, 1.0)
     diff = points[pt] - (a[sg] + t[:, None] * d[sg])
-    d2 = np.einsum("ij,ij->i", diff, diff)
-    # per point, the candidate with the smallest distance (ties: the lowest segment number)
-    order = np.lexsort((sg, d2, pt))
+    dist = np.sqrt(np.einsum("ij,ij->i", diff, diff))
+    # distances equal to 1e-9 of the longest segment are ties
+    level = np.floor(dist / (1e-9 * np.sqrt(L2.max()))) if len(dist) else dist
+    facing = np.zeros(len(sg))
+    if point_normals is not None:
+        n = np.column_stack([d[sg, 1], -d[sg, 0]]) / np.sqrt(L2[sg])[:, None]
+        facing = np.round(np.einsum("ij,ij->i", point_normals[pt], n), 9)
+    outside = (tf < -1e-9) | (tf > 1 + 1e-9)
+    # per point, the candidate with the smallest distance, then the tie rules
+    order = np.lexsort((sg, outside, facing, level, pt))
     first = order[np.r_[0, np.flatnonzero(np.diff(pt[order])) + 1]]
-    return sg[first], t[first], np.sqrt(d2[first])
+    out = (sg[first], t[first], dist[first])
+    return out + (tf[first],) if free else out
 
 
 def outward_normals(a: np.ndarray, b: np.ndarray) -> np.ndarray:

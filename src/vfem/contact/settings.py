@@ -74,6 +74,10 @@ class ContactSettings:
         augmented_tolerance: the augmented Lagrangian stops when every active node's gap and
             every other node's penetration is within this fraction of the shortest slave facet
             of the model (the same length scale as ``penetration_tolerance``'s default).
+        compatibility_side: the paired variant: the name of a body that carries compatibility
+            in every contact pair it belongs to, instead of the surface chosen by stiffness and
+            facet size (for testing that the answer does not depend on the choice beyond
+            discretisation error). Default (None): the softer surface, of equals the finer.
     """
 
     method: str = "vfem"
@@ -95,6 +99,7 @@ class ContactSettings:
     penalty: float | None = None
     penalty_factor: float = 1000.0
     augmented_tolerance: float = 1e-9
+    compatibility_side: str | None = None
 
     def validate(self) -> None:
         for f in fields(self):

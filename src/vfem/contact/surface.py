@@ -27,7 +27,7 @@ from skfem import BilinearForm, ElementLineP1, FacetBasis, MeshTri
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
-from ..bodies import Body
+from ..bodies import COMPONENTS, Body
 from ..errors import InputError
 from .search import outward_normals, project_points
 
@@ -167,12 +167,16 @@ class ContactSurface:
             self.G = cols[self.tracked_dofs]
         self.platen_row = -body.u_platen[self.candidate_dofs]
 
-    def node_normals(self, x: np.ndarray | None = None) -> np.ndarray:
-        """(nc, 2) outward unit normals at the candidate nodes (mean of the adjacent facets'),
-        undeformed or at tracked positions ``x``."""
-        n = outward_normals(*self.segments(self.X if x is None else x))
+    def node_normals(self, x: np.ndarray | None = None, facets: np.ndarray | None = None
+                     ) -> np.ndarray:
+        """(nc, 2) outward unit normals at the candidate nodes (mean of the adjacent facets',
+        of the subset ``facets`` if given; zero at nodes on none), undeformed or at tracked
+        positions ``x``."""
+        ids = np.arange(len(self.facets)) if facets is None else np.asarray(facets)
+        x = self.X if x is None else x
+        n = outward_normals(x[self.facets[ids, 0]], x[self.facets[ids, 1]])
         out = np.zeros((self.nc, 2))
-        for col in self.facets.T:
+        for col in self.facets[ids].T:
             np.add.at(out, col, n)
         return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
 
@@ -239,16 +243,28 @@ class ContactSurface:
     def project(self, points: np.ndarray, x: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Closest point on the candidate surface (undeformed, or at tracked positions ``x``)
-        for each point.
+        for each point: (facet, t, distance, outward normal there); :meth:`closest`."""
+        return self.closest(points, x)[:4]
 
-        Returns (facet, t, distance, outward normal there). The chords give the facet and a
-        first t; on curved facets a few Newton steps then find the closest point on the curve.
+    def closest(self, points: np.ndarray, x: np.ndarray | None = None,
+                facets: np.ndarray | None = None, point_normals: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Closest point on the candidate facets (or on the subset ``facets``), undeformed or at
+        tracked positions ``x``, for each point.
+
+        Returns (facet, t, distance, outward facet normal there, t_free). The chords give the
+        facet, a first t and ``t_free``, the unclamped coordinate along the chord (outside
+        [0, 1]: the point lies beyond that end of the facet); on curved facets a few Newton
+        steps then find the closest point on the curve. Ties between facets are broken by
+        ``point_normals`` (:func:`~vfem.contact.search.project_points`).
         """
         x = self.X if x is None else x
-        a, b = self.segments(x)
-        seg, t, dist = project_points(points, a, b)
+        ids = np.arange(len(self.facets)) if facets is None else np.asarray(facets)
+        a, b = x[self.facets[ids, 0]], x[self.facets[ids, 1]]
+        local, t, dist, t_free = project_points(points, a, b, point_normals, free=True)
+        seg = ids[local] if len(ids) else local
         pos, tangent = self.curve(seg, t, x)
-        if self.order == 2:
+        if self.order == 2 and len(seg):
             for _ in range(4):
                 second = np.einsum("k,nkd->nd", _SECOND[:, 0],
                                    x[self.facets[seg]])  # d2x/dt2, constant on a facet
@@ -260,7 +276,7 @@ class ContactSurface:
             dist = np.linalg.norm(points - pos, axis=1)
         normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
         normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
-        return seg, t, dist, normal
+        return seg, t, dist, normal, t_free
 
     def locate(self, x_tracked: np.ndarray, points: np.ndarray) -> np.ndarray:
         """Rind triangle containing each point (current configuration), or -1
@@ -433,13 +449,40 @@ def facet_shape_derivative(t: np.ndarray, order: int) -> np.ndarray:
 _SECOND = np.array([[4.0], [4.0], [-8.0]])  # second derivatives of the 3-node shape functions
 
 
+def predicted_translation(body: Body, load_factor: float) -> np.ndarray:
+    """(2,) the body's motion at ``load_factor`` as its prescribed displacements predict it, a
+    rigid translation (the mean prescribed value of each component; zero for a component that
+    nothing prescribes). What candidate selection needs to see bodies that start apart."""
+    out = np.zeros(2)
+    for c in range(2):
+        values = [pd.at(load_factor) for pd in body.prescribed
+                  if COMPONENTS[pd.component] == c]
+        if values:
+            out[c] = float(np.mean(values))
+    return out
+
+
 def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
-                            search_distance: float) -> list[np.ndarray]:
-    """Per body, the exterior facets within ``search_distance`` of a body it may touch."""
+                            search_distance: float,
+                            load_factors: tuple[float, ...] = ()) -> list[np.ndarray]:
+    """Per body, the exterior facets within ``search_distance`` of a body it may touch, at any
+    load factor of the schedule.
+
+    Bodies that start apart and are driven together must find each other: each body's facets
+    are moved by the body's :func:`predicted_translation` at load factors sampled over the
+    schedule (its values and 16 between its smallest and largest), and a facet is a candidate
+    when, at one of them, its midpoint is within ``search_distance`` plus its half length of
+    another body's surface (the exact distance to that body's facets, so that one long facet
+    elsewhere does not widen the search) or inside that body (bodies that start overlapping).
+    """
     ext = [exterior_facets(b) for b in bodies]
-    mids, half = [], []
+    lf = np.concatenate([[0.0], np.asarray(load_factors, dtype=float)])
+    samples = np.unique(np.concatenate([lf, np.linspace(lf.min(), lf.max(), 17)]))
+    moves = [np.array([predicted_translation(b, x) for x in samples]) for b in bodies]
+    ends, mids, half = [], [], []
     for b, f in zip(bodies, ext):
         a, c = b.mesh.p[:, b.mesh.facets[0, f]].T, b.mesh.p[:, b.mesh.facets[1, f]].T
+        ends.append((a, c))
         mids.append(0.5 * (a + c))
         half.append(0.5 * np.linalg.norm(c - a, axis=1))
     out = []
@@ -448,7 +491,21 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
         for j in range(len(bodies)):
             if i == j or frozenset((i, j)) not in pairs or len(ext[j]) == 0 or len(ext[i]) == 0:
                 continue
-            d, _ = cKDTree(mids[j]).query(mids[i])
-            keep |= d <= search_distance + half[i] + half[j].max()
+            relative = moves[i] - moves[j]
+            mesh = bodies[j].mesh
+            lo, hi = mesh.p.min(axis=1), mesh.p.max(axis=1)
+            scale = float(np.ptp(np.vstack([mids[i], mids[j]]), axis=0).max())
+            for r in np.unique(relative, axis=0):
+                if not np.all(np.abs(r) <= 1e6 * max(scale, 1e-300)):
+                    continue  # a motion no step of a contact analysis can follow
+                x = mids[i] + r
+                _, _, d = project_points(x, *ends[j])
+                keep |= d <= search_distance + half[i]
+                # facets that start inside the other body (an initial overlap)
+                box = np.flatnonzero(~keep & np.all((x >= lo) & (x <= hi), axis=1))
+                if len(box):
+                    inside = locate_in_triangles(mesh.p[:, : mesh.nvertices].T,
+                                                 triangles(mesh.t), x[box]) >= 0
+                    keep[box[inside]] = True
         out.append(ext[i][keep])
     return out

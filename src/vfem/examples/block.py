@@ -34,6 +34,7 @@ from ..bodies import PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.check import largest_penetrations
 from ..contact.settings import ContactSettings
+from ..io.runner import run_status
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -184,7 +185,7 @@ def _figures(out: Path, model: Model, result: AnalysisResult, p: Parameters) -> 
 
 def report(s: dict) -> list[str]:
     steps = s["steps"]
-    lines = [f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(steps)} "
+    lines = [f"vfem: {run_status(s)} in {len(steps)} "
              f"step(s), {sum(x['iterations'] for x in steps)} contact iterations, "
              f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
     if "block" in s:

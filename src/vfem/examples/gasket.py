@@ -40,6 +40,7 @@ from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_paramet
 from ..contact.search import project_points
 from ..contact.settings import ContactSettings
 from ..errors import InputError
+from ..io.runner import run_status
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model, StepResult
 
@@ -456,7 +457,7 @@ def _contact_window(model: Model, step: StepResult) -> tuple[float, float, float
 def report(s: dict) -> list[str]:
     """The closing lines of a gasket run."""
     rows = s["steps"]
-    lines = [f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(rows)} steps, "
+    lines = [f"vfem: {run_status(s)} in {len(rows)} steps, "
              f"{sum(r['iterations'] for r in rows)} contact iterations, {s['dofs']} dofs, "
              f"{s['timings']['total_s']:.1f} s"]
     lines.append(f"  first overlap at step {s['first_overlap_step']}, largest contact force "

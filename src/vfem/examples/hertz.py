@@ -23,6 +23,7 @@ import numpy as np
 from ..bodies import Platen, Support
 from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
+from ..io.runner import run_status
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -273,7 +274,7 @@ def _figures(out, model: Model, result: AnalysisResult, summary: dict,
 
 def report(s: dict) -> list[str]:
     """The closing lines of a Hertz run."""
-    lines = [f"vfem: {'converged' if s['converged'] else 'NOT converged'} in {len(s['steps'])} "
+    lines = [f"vfem: {run_status(s)} in {len(s['steps'])} "
              f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
              f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"
              + ("" if s["parameters"].get("method", "vfem") == "vfem"

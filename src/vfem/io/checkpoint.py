@@ -67,7 +67,7 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
         "step": {"step": step.step, "load_factor": step.load_factor,
                  "iterations": step.iterations, "converged": step.converged,
                  "platen_displacement": step.platen_displacement, "cuts": step.cuts,
-                 "fixed_point": step.fixed_point,
+                 "fixed_point": step.fixed_point, "invariants": step.invariants,
                  "history": [dataclasses.asdict(h) for h in step.history]},
         "state": {"load_factor": state.load_factor,
                   "platen_displacement": state.platen_displacement,

@@ -229,13 +229,16 @@ def progress_summary(model: Model, steps: list[StepResult], status: str, message
 
 
 def step_record(step: StepResult) -> dict:
-    """The fields every example's ``summary.json`` gives per step."""
+    """The fields every example's ``summary.json`` gives per step; ``invariants``: the
+    independent checks of the converged state (:meth:`vfem.contact.check.Invariants.record`;
+    empty when the step was not checked)."""
     last = step.history[-1] if step.history else None
     return {"step": step.step, "load_factor": step.load_factor, "iterations": step.iterations,
             "converged": step.converged, "cuts": step.cuts,
             "stopped_at_fixed_point": step.fixed_point,
             "max_penetration": last.max_penetration if last else 0.0,
-            "max_equilibrium_error": last.max_equilibrium_error if last else 0.0}
+            "max_equilibrium_error": last.max_equilibrium_error if last else 0.0,
+            "invariants": step.invariants}
 
 
 def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
