@@ -267,6 +267,31 @@ def test_a_cut_step_that_then_satisfies_the_invariants_goes_on(monkeypatch):
     assert result.timings["invariants_s"] > 0
 
 
+def test_an_invariant_not_enforced_is_recorded_and_logged(monkeypatch, caplog):
+    """Interpenetration injected (the punch's displacement pushed 1e-3 into the flat): a stop
+    if the solver enforces it (``vfem.solver.ENFORCED``), else recorded in the step."""
+    from vfem import solver
+
+    real = Analysis._fields
+
+    def fields(self, state, pairings):
+        out = real(self, state, pairings)
+        out["punch"].displacement[:, 1] -= 1e-3
+        return out
+
+    monkeypatch.setattr(Analysis, "_fields", fields)
+    with caplog.at_level(logging.WARNING, logger="vfem.solver"):
+        result = Analysis(punch_model()).run()
+    if "interpenetration" in solver.ENFORCED:
+        assert not result.converged and "invariant (b) no interpenetration" in result.message
+        return
+    assert result.converged
+    inv = result.steps[-1].invariants
+    assert inv["failed"] == ["interpenetration"] and inv["passed"]
+    assert inv["penetration"] > 9e-4 and inv["where"]["body"] in ("punch", "flat")
+    assert any("recorded, not enforced: interpenetration" in r.message for r in caplog.records)
+
+
 def test_invariant_violation_is_an_analysis_error():
     assert issubclass(InvariantViolation, Exception)
     from vfem.errors import AnalysisError

@@ -19,8 +19,9 @@ carries compatibility). It checks
     The allowance: a convex part of one piecewise-linear surface (turning through α) can
     protrude between two nodes of the other surface that lie on it (a facet of length L) by at
     most (L/2)·tan(α/2) (the isosceles case; (L/2)·sin(α/2) would miss it by 1/cos(α/2)). α is
-    the net turning of the node's own boundary within L of it (the stretch such a facet can
-    span; the node's own angle alone misses a finer surface curving under a coarser facet), at
+    the convex turning of the node's own boundary within L of it (the stretch such a facet can
+    span; the node's own angle alone misses a finer surface curving under a coarser facet, and
+    the concave bottom of an indentation does not lower what its convex shoulder protrudes), at
     most 90°, and the allowance at most the longer of L/2 and the node's own facets. A node on
     a symmetry plane (a straight boundary held normal to itself, a roller ``Support``) turns as
     the mirrored model does.
@@ -235,15 +236,17 @@ class _Polygon:
         return self._get("turning", make)
 
     def turning_within(self, nodes: np.ndarray, radius: np.ndarray) -> np.ndarray:
-        """The net turning of the boundary near each of ``nodes`` (local numbers): the sum of
-        the signed turning angles of the boundary nodes within ``radius`` (per node) of it, at
-        least 0. A facet of another surface whose ends lie on this one spans that much of it."""
+        """The convex turning of the boundary near each of ``nodes`` (local numbers): the sum
+        of the convex turning angles of the boundary nodes within ``radius`` (per node) of it.
+        A facet of another surface whose ends lie on this one spans that much of it; concave
+        turns there (the bottom of an indentation next to its convex shoulder) do not lower
+        what the convex ones can protrude."""
         tree = self._get("tree", lambda: cKDTree(self.x))
-        turn = self.turning
+        turn = np.maximum(self.turning, 0.0)
         out = np.zeros(len(nodes))
         for k, near in enumerate(tree.query_ball_point(self.x[nodes], radius)):
             out[k] = turn[near].sum()
-        return np.maximum(out, 0.0)
+        return out
 
     @property
     def adjacent(self) -> np.ndarray:
@@ -540,26 +543,32 @@ class InvariantCheck:
     def _linearised_depth(self, i: int, j: int, node: np.ndarray, cur: list[_Polygon]
                           ) -> np.ndarray:
         """Small kinematics: the depth of body i's boundary ``node`` (local numbers) into body
-        j as linear theory reads it, -n . (X + u - X_c - u_c), with X_c the closest point on
-        j's undeformed surface, n the outward normal of that segment (from its vertex to the
-        node where the closest point is a vertex the node is outside of) and u_c the
-        displacement there (linear along the segment)."""
+        j as linear theory reads it. With X_c the closest point on j's undeformed surface and
+        u_c the displacement there (linear along the segment), r = X + u - (X_c + u_c) is the
+        node's offset from it; the depth is -n . r with n the outward normal of the segment,
+        and where X_c is a vertex, |r| with the sign of -r . (the sum of the vertex's two
+        normals): a node beside a corner is not read along the extension of one of its
+        facets."""
         ri, rj = self.reference[i], self.reference[j]
         keep = rj.surface
+        seg_nodes = rj.b.segments[keep]
         A, B = (e[keep] for e in rj.ends)
-        P = ri.x[node]
-        seg, t, dist = project_points(P, A, B)[:3]
-        d = B[seg] - A[seg]
-        c = A[seg] + t[:, None] * d
-        n = rj.unit_normals[keep][seg]
-        at_vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * np.maximum(
-            np.linalg.norm(d, axis=1), 1e-300))
-        toward = (P - c) / np.maximum(dist, 1e-300)[:, None]
-        n = np.where((at_vertex & (np.einsum("ij,ij->i", toward, n) > 0))[:, None], toward, n)
+        normals = rj.unit_normals[keep]
+        vertex_normal = rj._get("surface_vertex_normals", lambda: _scatter_add(
+            len(rj.x), seg_nodes, normals))
+        seg, t, dist = project_points(ri.x[node], A, B)[:3]
+        c = A[seg] + t[:, None] * (B[seg] - A[seg])
         uj = cur[j].x - rj.x
-        ends = rj.b.segments[keep][seg]
+        ends = seg_nodes[seg]
         uc = (1 - t)[:, None] * uj[ends[:, 0]] + t[:, None] * uj[ends[:, 1]]
-        return -np.einsum("ij,ij->i", cur[i].x[node] - (c + uc), n)
+        r = cur[i].x[node] - (c + uc)
+        depth = -np.einsum("ij,ij->i", r, normals[seg])
+        at = np.where(t <= 0, ends[:, 0], ends[:, 1])
+        vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * np.maximum(
+            np.linalg.norm(B[seg] - A[seg], axis=1), 1e-300))
+        outside = np.einsum("ij,ij->i", r, vertex_normal[at]) > 0
+        depth[vertex] = np.where(outside, -1.0, 1.0)[vertex] * np.linalg.norm(r, axis=1)[vertex]
+        return depth
 
     # -- (c) ------------------------------------------------------------------------------------
 

@@ -116,6 +116,9 @@ def invariants_line(steps: list[dict]) -> str:
     if tension["tension"] > tension["tension_tolerance"]:
         w = tension["tension_where"]
         text += f"tension {tension['tension']:.1e} at node {w['node']} of {w['body']!r}"
+    elif tension["tension"] > 0:
+        text += (f"no tension (largest tensile nodal force {tension['tension']:.1e}, within "
+                 f"{tension['tension_tolerance']:.0e})")
     else:
         text += "no tension"
     failed = sorted({name for c in checked for name in c.get("failed", [])})
