@@ -9,12 +9,13 @@ For each step (an increment of the load factor):
    (:class:`~vfem.contact.paired.PairedContact` by default, or the thesis's
    :class:`~vfem.contact.algorithm.VirtualElementContact`) iterates check -> correct until
    converged, moving a force-controlled platen as it goes;
-3. **check** — the converged state's full-mesh results must satisfy three invariants, checked
+3. **check** — three invariants of the converged state's full-mesh results, checked
    independently of the contact formulation (:mod:`vfem.contact.check`): the contact forces of
-   all bodies balance, no boundary node lies inside another body, no node carries tension;
+   all bodies balance, no boundary node lies inside another body, no node carries tension. All
+   three are recorded per step; those in :data:`ENFORCED` (force balance) fail the step;
 4. a step that fails (no convergence, a cycling contact set, a node pushed past the rind of
-   another body, a broken invariant) is cut in half and retried from exactly the last converged
-   state, and the increment grows back after easy steps (vfem-method §3.2, *Reading*;
+   another body, a broken enforced invariant) is cut in half and retried from exactly the last
+   converged state, and the increment grows back after easy steps (vfem-method §3.2, *Reading*;
    docs/method.md §7).
 
 Results of converged steps are kept in :class:`AnalysisResult` and handed to a callback as soon
@@ -365,7 +366,7 @@ class Analysis:
 
         Step control: a step that fails (no convergence within ``max_iterations``, a contact
         set that cycles, a node pushed past a rind, an element turned inside out, a converged state
-        that breaks one of the invariants of :mod:`vfem.contact.check`) is discarded
+        that breaks an enforced invariant of :mod:`vfem.contact.check`) is discarded
         — every body goes back to the last converged state exactly — and retried with half the
         increment, down to 1 / 2**``max_step_cuts`` of the scheduled one; after
         :data:`EASY_STEPS` steps in a row that converge in at most :func:`easy_iterations`

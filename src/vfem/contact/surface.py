@@ -494,6 +494,7 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
             relative = moves[i] - moves[j]
             mesh = bodies[j].mesh
             lo, hi = mesh.p.min(axis=1), mesh.p.max(axis=1)
+            tri = None  # body j's triangles, made only if a facet may start inside it
             scale = float(np.ptp(np.vstack([mids[i], mids[j]]), axis=0).max())
             for r in np.unique(relative, axis=0):
                 if not np.all(np.abs(r) <= 1e6 * max(scale, 1e-300)):
@@ -504,8 +505,9 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
                 # facets that start inside the other body (an initial overlap)
                 box = np.flatnonzero(~keep & np.all((x >= lo) & (x <= hi), axis=1))
                 if len(box):
-                    inside = locate_in_triangles(mesh.p[:, : mesh.nvertices].T,
-                                                 triangles(mesh.t), x[box]) >= 0
+                    tri = triangles(mesh.t) if tri is None else tri
+                    inside = locate_in_triangles(mesh.p[:, : mesh.nvertices].T, tri,
+                                                 x[box]) >= 0
                     keep[box[inside]] = True
         out.append(ext[i][keep])
     return out
