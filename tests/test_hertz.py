@@ -133,3 +133,38 @@ def test_step_cutting_is_bounded_and_reported():
     assert "(load factor 0 -> 0.025)" in result.message
     assert " of body 'cylinder'" in result.message
     assert "What to change: allow more iterations (contact.max_iterations = 3)" in result.message
+
+
+def _pressure_reading():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parent.parent / "benchmarks" / "pressure_reading.py"
+    spec = importlib.util.spec_from_file_location("pressure_reading", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_pointwise_pressure_at_48_facets_and_no_symmetry_plane_effect():
+    """Issue 16, item 5: at 48 facets across a the pressure is within 1 % of Hertz's at every
+    node over |x| < 0.8 a, read either way (measured: nodal reading 0.45 %, traction q 0.82 %).
+    The node at x = 0 reads low on these meshes (1.9 % at 12 facets, halving with each
+    refinement), and a full model, the half mirrored about x = 0, reads the same there
+    (measured 1.86 %): it is the cylinder mesh's centre of rings, not the symmetry plane.
+    ``benchmarks/pressure_reading.py`` prints the table docs/method.md §6 quotes."""
+    import vfem
+
+    bench = _pressure_reading()
+    p = HertzParameters(facets_per_half_width=48)
+    th = theory(p)
+    e = bench.errors(vfem.solve(build(p)), th["a_theory"], th["p0_theory"])
+    for name, values in e.items():
+        assert values[1] < 1.0, (name, values)
+    p = HertzParameters()
+    th = theory(p)
+    half = bench.errors(vfem.solve(build(p)), th["a_theory"], th["p0_theory"])
+    full = bench.errors(vfem.solve(bench.mirrored(p)), th["a_theory"], th["p0_theory"])
+    for name in half:
+        assert half[name][3] == pytest.approx(full[name][3], abs=0.1)  # % of p0
+        assert half[name][3] < -1.0  # the low reading is there in both

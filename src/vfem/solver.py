@@ -140,9 +140,19 @@ class BodyStepResult:
 
     displacement: np.ndarray  # (npoints, 2), at the body's points (Body.points)
     contact_force: np.ndarray  # (npoints, 2) nodal force applied by the other bodies
-    contact_pressure: np.ndarray  # (npoints,) nominal normal pressure (force / undeformed length)
+    #: (npoints,) nominal normal pressure: normal nodal contact force / undeformed tributary
+    #: length, i.e. the traction averaged with the node's shape function (int phi q / int phi)
+    contact_pressure: np.ndarray
     contact_status: np.ndarray  # (npoints,) 0 free, 1 in contact
     penetration: np.ndarray  # (npoints,) signed penetration at candidate nodes (0 elsewhere)
+    #: (npoints,) the formulation's nominal normal traction at the node (paired variant: the
+    #: unknowns q on the compatibility side, that field read at the other side's nodes); where a
+    #: formulation has none, the nodal reading ``contact_pressure``
+    contact_traction: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.contact_traction is None:
+            self.contact_traction = self.contact_pressure
 
 
 @dataclass
@@ -479,9 +489,14 @@ class Analysis:
             force[cand] = F
             pressure = np.zeros(nv)
             pressure[cand] = np.where(p.other >= 0, p.force, 0.0) / s.tributary
+            traction = None
+            if p.pressure is not None:  # the formulation's traction field (paired)
+                traction = np.zeros(nv)
+                traction[cand] = p.pressure
             status = np.zeros(nv, dtype=int)
             status[cand] = p.participating & (p.force > 0)
             pen = np.zeros(nv)
             pen[cand] = np.where(np.isfinite(p.penetration), p.penetration, 0.0)
-            out[b.name] = BodyStepResult(u.reshape(-1, 2), force, pressure, status, pen)
+            out[b.name] = BodyStepResult(u.reshape(-1, 2), force, pressure, status, pen,
+                                         traction)
         return out

@@ -57,6 +57,9 @@ class Pairing:
     force: np.ndarray  # (nc,) own compressive normal force
     virtual_force: np.ndarray  # (nc,) opposing compressive force re-integrated on own elements
     participating: np.ndarray  # (nc,) bool: embedded or carrying compressive force
+    #: (nc,) the formulation's normal traction at the node (nominal), where it has one; None:
+    #: the results read nodal force over tributary length
+    pressure: np.ndarray | None = None
 
     @property
     def equilibrium_error(self) -> np.ndarray:

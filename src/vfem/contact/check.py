@@ -548,7 +548,11 @@ class InvariantCheck:
         node's offset from it; the depth is -n . r with n the outward normal of the segment,
         and where X_c is a vertex, |r| with the sign of -r . (the sum of the vertex's two
         normals): a node beside a corner is not read along the extension of one of its
-        facets."""
+        facets. A node that lies on a vertex of j (distance 0: a tie) is read against the
+        facet that faces its own surface (the face of a punch, not its side). Off the
+        vertices the depth is the smaller of the readings along j's facet normal and along
+        i's own outward normal (the formulation may measure along either, or between them;
+        after a slip they differ by the slip times the angle between the surfaces)."""
         ri, rj = self.reference[i], self.reference[j]
         keep = rj.surface
         seg_nodes = rj.b.segments[keep]
@@ -556,13 +560,21 @@ class InvariantCheck:
         normals = rj.unit_normals[keep]
         vertex_normal = rj._get("surface_vertex_normals", lambda: _scatter_add(
             len(rj.x), seg_nodes, normals))
-        seg, t, dist = project_points(ri.x[node], A, B)[:3]
+        # a node on a vertex of j's surface (the block's node under a punch's corner) is read
+        # against the facet that faces its own surface, not the other one through the vertex
+        seg, t, dist = project_points(ri.x[node], A, B, point_normals=ri.normals[node])[:3]
         c = A[seg] + t[:, None] * (B[seg] - A[seg])
         uj = cur[j].x - rj.x
         ends = seg_nodes[seg]
         uc = (1 - t)[:, None] * uj[ends[:, 0]] + t[:, None] * uj[ends[:, 1]]
         r = cur[i].x[node] - (c + uc)
-        depth = -np.einsum("ij,ij->i", r, normals[seg])
+        # linear theory measures the gap along one normal per pair; which one (j's facet's,
+        # i's own, or a blend of the two, as the paired formulation's common normal) is a
+        # choice of the formulation, and after a slip s along surfaces that meet at an angle
+        # the readings differ by s times that angle: a penetration counts only if both
+        # surfaces' normals see it
+        depth = np.minimum(-np.einsum("ij,ij->i", r, normals[seg]),
+                           np.einsum("ij,ij->i", r, ri.normals[node]))
         at = np.where(t <= 0, ends[:, 0], ends[:, 1])
         vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * np.maximum(
             np.linalg.norm(B[seg] - A[seg], axis=1), 1e-300))

@@ -189,6 +189,10 @@ class LargeDeformationContact(PairedContact):
                 x[i] = s.X + u[s.tracked_dofs].reshape(-1, 2)
         return x
 
+    def pairing_positions(self, state: ContactState) -> list[np.ndarray]:
+        """The pairs follow the current configuration."""
+        return self.positions(state)
+
     # -- pairing in the current configuration ---------------------------------------------------
 
     def penetrations(self, state: ContactState) -> list[np.ndarray]:

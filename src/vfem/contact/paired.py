@@ -140,6 +140,34 @@ def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np
     return normal, np.einsum("ij,ij->i", d, normal), interp, seg, past
 
 
+def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: float,
+                  c_coarse: float) -> None:
+    """Small-strain contact: measure the gaps along one normal that does not depend on which
+    surface carries compatibility (in place on ``geo``, undeformed geometry).
+
+    The normal is the two surfaces' outward normals (the other surface's at the virtual node,
+    minus the node's own), each weighted by its body's stiffness per unit length (the inverse
+    of :meth:`PairedContact._compliance_density`): where the bodies are pressed together the
+    stiffer surface keeps its shape and the interface takes its normal, and two equally stiff
+    ones meet on the mean plane. Swapping the roles gives the same line. **Why**: with the
+    other surface's normal alone, a stiff flat made the compatibility side of the Hertz
+    problem took the cylinder's normals, tilted by up to a/R, and a horizontal contact force
+    of 2.6 % of the load appeared on the half model, where the cylinder as compatibility side
+    has none. Nodes beyond the other surface keep the direction to its end.
+    """
+    if not len(geo.nodes):
+        return
+    total = c_fine + c_coarse
+    w_coarse = c_fine / total if total > 0 else 0.5  # the stiffer surface weighs more
+    own = sf.node_normals(None, geo.fpatch)[geo.nodes]
+    n = w_coarse * geo.normal - (1.0 - w_coarse) * own
+    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+    n = np.where(geo.beyond[:, None], geo.normal, n)
+    d = sf.X[geo.nodes] - geo.interp @ sc.X[: sc.nc]  # from the virtual node to the node
+    geo.normal = n
+    geo.gap = np.einsum("ij,ij->i", d, n)
+
+
 @dataclass
 class Overlap:
     """The pairing of a compatibility surface's nodes with the other surface (one
@@ -210,6 +238,8 @@ class PairedContact(VirtualElementContact):
         if not self.keep_all_nodes:  # only the nodes over the other surface take part
             keep = geo.carries & ~geo.beyond
             geo = geo.subset(keep)
+            c_fine, c_coarse = (ci, cj) if fine == i else (cj, ci)
+            common_normal(sf, sc, geo, c_fine, c_coarse)
         log.info("contact pair: %s (compatibility, %d nodes) against %s (equilibrium)",
                  sf.body.name, len(geo.nodes), sc.body.name)
         if not len(geo.nodes):
@@ -632,5 +662,43 @@ class PairedContact(VirtualElementContact):
             out.append(Pairing(other=other, facet=np.zeros(nc, int), t=zeros, normal=normal,
                                penetration=pen, embedded=pen > 0, stiffness=zeros,
                                virtual_stiffness=zeros, force=force, virtual_force=force.copy(),
-                               participating=np.where(compat, touching, force > 0)))
+                               participating=np.where(compat, touching, force > 0),
+                               pressure=np.zeros(nc)))
+        x = self.pairing_positions(state)
+        for k, pair in enumerate(self.contact_pairs):
+            q = self._q(state, k)
+            out[pair.fine].pressure[pair.nodes] += q
+            out[pair.coarse].pressure += self._traction_on_other_side(k, q, x)
+        return out
+
+    def pairing_positions(self, state: ContactState) -> list[np.ndarray]:
+        """The tracked positions the pairs are built on: undeformed (linear kinematics)."""
+        return [s.X for s in self.surfaces]
+
+    def _traction_on_other_side(self, k: int, q: np.ndarray, x: list[np.ndarray]
+                                ) -> np.ndarray:
+        """(nc,) pair k's traction read at the equilibrium side's nodes: the compatibility
+        side's traction field ``q`` (its nodal values, interpolated by its shape functions)
+        at each node's closest point on the compatibility patch, zero beyond its ends.
+
+        This is the traction the forces ``F = -T q`` integrate (the same field, eq. 4.4.11),
+        read pointwise: a nodal force over a tributary length would instead average it with
+        the neighbours' (and halve the tributary on a symmetry plane, where the reading then
+        dips by a few percent under a peak).
+        """
+        pair = self.contact_pairs[k]
+        sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
+        out = np.zeros(sc.nc)
+        if pair.patches is None or not np.any(q):
+            return out
+        fpatch, cpatch = pair.patches
+        xf, xc = x[pair.fine], x[pair.coarse]
+        nodes = np.unique(sc.facets[cpatch])
+        seg, t, _, _, tf = sf.closest(xc[nodes], xf, fpatch,
+                                      sc.node_normals(xc, cpatch)[nodes])
+        qf = np.zeros(sf.nc)
+        qf[pair.nodes] = q
+        p = sf.interpolation(seg, t) @ qf
+        p[beyond(sf, seg, tf, patch_ends(sf, fpatch))] = 0.0
+        out[nodes] = p
         return out

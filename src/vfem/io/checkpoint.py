@@ -126,7 +126,8 @@ def read(out: Path, model: Model) -> Checkpoint | None:
 
 def _step(meta: dict, arrays: dict[str, np.ndarray], model: Model) -> StepResult:
     step = StepResult(**{**meta, "history": [IterationRecord(**h) for h in meta["history"]]})
-    step.bodies = {b.name: BodyStepResult(**{f: arrays[f"field_{i}_{f}"] for f in _FIELDS})
+    step.bodies = {b.name: BodyStepResult(**{f: arrays[f"field_{i}_{f}"] for f in _FIELDS
+                                                if f"field_{i}_{f}" in arrays})
                    for i, b in enumerate(model.bodies)}
     return step
 

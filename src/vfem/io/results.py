@@ -4,8 +4,11 @@ ParaView opens ``results.pvd`` as a time series (time = load factor) holding eve
 gives the load factor (``timestep``), the body's index in the model (``part``), its name (``name``)
 and the VTU file (``file``). Point fields: ``displacement`` (3 components, z = 0, so ParaView's
 *Warp By Vector* works), ``contact_force`` (nodal force applied by the other bodies),
-``contact_pressure`` (nominal: normal contact force per undeformed tributary length),
-``contact_status`` (1 in contact, 0 free), ``penetration`` (> 0 overlapping). Cell fields:
+``contact_pressure`` (nominal: normal contact force per undeformed tributary length, the
+traction averaged with the node's shape function), ``contact_traction`` (the formulation's
+nominal traction at the node: in the paired variant its unknowns q on the compatibility side,
+read at the other side's nodes; elsewhere as ``contact_pressure``), ``contact_status``
+(1 in contact, 0 free), ``penetration`` (> 0 overlapping). Cell fields:
 ``stress_xx``, ``stress_yy``, ``stress_xy``, ``stress_zz``, ``von_mises`` (element averages).
 Quadratic elements are written as VTK's 6-node triangles and 9-node quadrilaterals, with the
 fields at every node.
@@ -107,6 +110,7 @@ class ResultsWriter:
                             "contact_force": np.column_stack([r.contact_force,
                                                               np.zeros(npts)]),
                             "contact_pressure": r.contact_pressure,
+                            "contact_traction": r.contact_traction,
                             "contact_status": r.contact_status.astype(np.int32),
                             "penetration": r.penetration},
                 cell_data={_CELL_FIELD.get(k, k): [v] for k, v in stress.items()},
