@@ -45,6 +45,7 @@ SHAPES = {
     "wedge_plate_grid": shapes.wedge_plate_grid,
     "gasket": shapes.gasket,
     "rounded_punch": shapes.rounded_punch,
+    "filleted_punch": shapes.filleted_punch,
 }
 
 

@@ -441,6 +441,176 @@ def rounded_punch(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: 
     return replace(mesh, _boundaries={**mesh.boundaries, "face": face})
 
 
+def filleted_punch(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: float = 0.5,
+                   radius: float = 0.1, n_flat: int = 16, n_arc: int = 4, rows: int = 8,
+                   grading: float = 1.25, h_tangent: float | None = None) -> MeshQuad:
+    """A flat punch with rounded corners: the rectangle ``|x - x0| <= width / 2``,
+    ``y0 <= y <= y0 + height`` whose two bottom corners are circular arcs of radius ``radius``
+    tangent to the face and to the sides, in quadrilaterals. The flat part of the face has
+    ``n_flat`` facets between the tangent points ``x0 -+ (width / 2 - radius)`` (nodes exactly
+    there) and each arc ``n_arc`` facets (nodes on the arc): equal ones, or, given
+    ``h_tangent``, facets that long at the tangent points growing geometrically away from them
+    (where a contact zone ends on a slightly indented arc). Below the arcs' centres ``n_arc``
+    rows follow the face around the corners, graded towards it in ratio ``grading``; above them
+    ``rows - n_arc`` rows continue the grading geometrically to the top. Each corner holds one
+    interior node of three elements (a grid of quadrilaterals cannot turn a smooth corner
+    without one). The mesh is symmetric about x = x0.
+
+    Named boundaries: ``face`` (the flat part and the two arcs: what may touch), ``left`` and
+    ``right`` (the vertical sides above the arcs) and ``top``.
+    """
+    a, r, h, g = 0.5 * width, radius, height, grading
+    if not all(np.isfinite(v) for v in (x0, y0, width, height, radius, grading)):
+        raise ValueError(f"need finite x0, y0, width, height, radius and grading, got {x0}, "
+                         f"{y0}, {width}, {height}, {radius} and {grading}")
+    if not (width > 0 and 0 < r < a and h > r):
+        raise ValueError("need width > 0, 0 < radius < width / 2 and height > radius, got "
+                         f"{width}, {radius} and {height}")
+    if not (n_flat >= 1 and n_arc >= 2 and rows > n_arc and g > 0):
+        raise ValueError(f"need n_flat >= 1, n_arc >= 2, rows > n_arc and grading > 0, got "
+                         f"{n_flat}, {n_arc}, {rows} and {grading}")
+    check_count((n_flat + 2.0 * n_arc + 1.0) * (rows + 1.0), "filleted_punch")
+    n_flat, n_arc, rows = int(n_flat), int(n_arc), int(rows)
+    longest = min(2 * (a - r) / n_flat, 0.5 * np.pi * r / n_arc)
+    if h_tangent is not None and not 0 < h_tangent <= longest:
+        raise ValueError(f"h_tangent must lie in (0, {longest:.6g}] (the equal facets' length), "
+                         f"got {h_tangent}")
+    with np.errstate(all="ignore"):  # sizes beyond round-off: refused when the nodes are made
+        return _filleted_punch(x0, y0, a, r, h, g, n_flat, n_arc, rows, h_tangent)
+
+
+def _filleted_punch(x0: float, y0: float, a: float, r: float, h: float, g: float, n_flat: int,
+                    n_arc: int, rows: int, h_tangent: float | None) -> MeshQuad:
+    """:func:`filleted_punch` of checked parameters (a: the half-width)."""
+    if h_tangent is None:
+        u = np.linspace(-(a - r), a - r, n_flat + 1)
+        phi = 0.5 * np.pi * np.arange(n_arc + 1) / n_arc  # from the flat's tangent point
+    else:  # facets h_tangent q^(distance in facets from the nearest tangent point), q >= 1
+        i = np.arange(n_flat)
+        u = -(a - r) + _fitted(lambda q: h_tangent * q ** np.minimum(i, n_flat - 1 - i),
+                               2 * (a - r))
+        phi = _fitted(lambda q: h_tangent / r * q ** np.arange(n_arc), 0.5 * np.pi)
+    u = 0.5 * (u - u[::-1])  # symmetric about 0
+    phi = 1.5 * np.pi - phi
+    m1 = min(max(int(np.argmin(np.abs(phi - 1.25 * np.pi))), 1), n_arc - 1)
+    k, m2 = m1, n_arc - m1  # the arc's facets on the flat's side and on the side's; k: rows of
+    # the layer that follows the face around a corner
+    w = _geometric(n_arc, r, g)  # offsets from the face of the rows below the arcs' centres
+    t = w[: k + 1]
+    lower_v = np.concatenate([t, t[-1] + _geometric(m2, r - t[-1], g)[1:]])
+    lower_u = np.concatenate([t, t[-1] + _geometric(m1, r - t[-1], g)[1:]])
+    upper_v = r + _continued(lower_v[-1] - lower_v[-2], rows - n_arc, h - r)
+    # the middle: columns on the flat's nodes, all the rows
+    v = np.concatenate([lower_v, upper_v[1:]])
+    middle = np.array(np.meshgrid(u, v, indexing="ij"))
+    # the left corner: the layer along the arc (i from the flat's tangent point to the side's,
+    # j into the body), its inner edge the lines Q1-P-Q2 about the centre c, then the block
+    # c, Q1, P, Q2 inside it (P: the node of three elements, its angles near 120 degrees)
+    c = np.array([-a + r, r])
+    rho = r - t[-1]
+    e = np.array([np.cos(phi), np.sin(phi)])
+    e[:, 0], e[:, -1] = (0.0, -1.0), (-1.0, 0.0)
+    q1, q2 = c + rho * e[:, 0], c + rho * e[:, -1]
+    p_mid = c + min(np.sqrt(2.0) * (3 + np.sqrt(3)) / 6 * rho, rho + 0.5 * t[-1]) * e[:, m1]
+    inner = np.empty(n_arc + 1)  # distance from c to the lines Q1-P-Q2 along e
+    for i in range(n_arc + 1):
+        A, B = (q1, p_mid) if i <= m1 else (p_mid, q2)
+        d = B - A
+        inner[i] = ((A[0] - c[0]) * d[1] - (A[1] - c[1]) * d[0]) / (e[0, i] * d[1]
+                                                                   - e[1, i] * d[0])
+    inner[0], inner[-1] = rho, rho
+    radius_ij = r - np.outer(r - inner, t / t[-1])  # (i, j)
+    layer = c[:, None, None] + radius_ij[None] * e[:, :, None]
+    layer[:, :, 0] = c[:, None] + r * e  # the arc itself
+    bottom = np.array([-a + lower_u[k:], np.full(m1 + 1, r)])  # Q2 -> c
+    top = layer[:, m1::-1, k]  # P -> Q1
+    left = layer[:, n_arc:m1 - 1:-1, k]  # Q2 -> P (m1 >= 1)
+    right = np.array([np.full(m2 + 1, -a + r), lower_v[n_arc:k - 1:-1]])  # c -> Q1 (k >= 1)
+    corner = _transfinite(bottom, top, left, right)
+    side = np.array(np.meshgrid(-a + lower_u, upper_v, indexing="ij"))
+    mirror = np.array([-1.0, 1.0])[:, None, None]
+    blocks = [middle, layer, corner, side, mirror * layer, mirror * corner, mirror * side]
+    face_blocks = (0, 1, 4)  # the face: row 0 of these blocks
+    points, quads, face, n = [], [], [], 0
+    for b, X in enumerate(blocks):
+        idx = n + np.arange(X.shape[1] * X.shape[2]).reshape(X.shape[1:])
+        quads.append(np.vstack([idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(),
+                                idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()]))
+        points.append(X.reshape(2, -1))
+        if b in face_blocks:
+            face.append(idx[:, 0])
+        n += idx.size
+    p = np.hstack(points)
+    if not np.isfinite(p).all():
+        raise ValueError("the parameters make coordinates that are not finite numbers; check "
+                         "the sizes and the grading")
+    tol = 1e-9 * max(2 * a, h)
+    rep = np.arange(p.shape[1])  # the first of the nodes at one position stands for them all
+    pairs = cKDTree(p.T).query_pairs(tol, output_type="ndarray")
+    np.minimum.at(rep, pairs[:, 1], pairs[:, 0])
+    keep, new = np.unique(rep, return_inverse=True)
+    p = p[:, keep] + np.array([[x0], [y0]])
+    t4 = new[np.hstack(quads)]
+    on_face = np.zeros(p.shape[1], dtype=bool)
+    on_face[new[np.concatenate(face)]] = True
+    mesh = MeshQuad(p, _counter_clockwise(p, t4)).with_boundaries({
+        "top": lambda q: q[1] > y0 + h - tol,
+        "left": lambda q: q[0] < x0 - a + tol,
+        "right": lambda q: q[0] > x0 + a - tol,
+    })
+    bnd = mesh.boundary_facets()
+    face_facets = bnd[on_face[mesh.facets[0, bnd]] & on_face[mesh.facets[1, bnd]]]
+    return replace(mesh, _boundaries={**mesh.boundaries, "face": face_facets})
+
+
+def _geometric(n: int, length: float, ratio: float) -> np.ndarray:
+    """n + 1 positions from 0 to ``length``, each interval ``ratio`` times the one before."""
+    s = ratio ** (np.arange(n, dtype=float) - (n - 1 if ratio > 1 else 0))  # at most 1
+    x = length * np.concatenate([[0.0], np.cumsum(s) / s.sum()])
+    x[-1] = length
+    return x
+
+
+def _continued(first: float, n: int, length: float) -> np.ndarray:
+    """n + 1 positions from 0 to ``length`` whose intervals are ``first * q**(i + 1)``: a
+    geometric grading continuing from an interval ``first``, its ratio q chosen to fit."""
+    return _fitted(lambda q: first * q ** np.arange(1, n + 1, dtype=float), length)
+
+
+def _fitted(sizes: Callable[[float], np.ndarray], length: float) -> np.ndarray:
+    """Positions 0, ..., ``length`` whose intervals are ``sizes(q)`` (increasing in q, and
+    from q = 0 on) with q found by bisection to fit; the last one exactly ``length``."""
+    lo, hi = 0.0, 1.0
+    with np.errstate(over="ignore", invalid="ignore"):
+        while np.sum(sizes(hi)) < length and hi < 1e300:
+            hi *= 2.0
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if np.sum(sizes(mid)) < length else (lo, mid)
+    s = np.asarray(sizes(hi), dtype=float)
+    x = np.concatenate([[0.0], np.cumsum(s * (length / s.sum()))])
+    x[-1] = length
+    return x
+
+
+def _transfinite(bottom: np.ndarray, top: np.ndarray, left: np.ndarray, right: np.ndarray
+                 ) -> np.ndarray:
+    """(2, m + 1, n + 1) grid points between four sides given as nodes (2, m + 1) bottom and
+    top, (2, n + 1) left and right, running with the grid's indices (Coons patch; parameters:
+    the two opposite sides' relative arc lengths, averaged)."""
+    def fraction(x):
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x, axis=1), axis=0))])
+        return s / s[-1]
+
+    xi = 0.5 * (fraction(bottom) + fraction(top))[:, None]
+    eta = 0.5 * (fraction(left) + fraction(right))[None, :]
+    B, T = bottom[:, :, None], top[:, :, None]
+    L, R = left[:, None, :], right[:, None, :]
+    return ((1 - eta) * B + eta * T + (1 - xi) * L + xi * R
+            - (1 - xi) * (1 - eta) * bottom[:, :1, None] - xi * (1 - eta) * bottom[:, -1:, None]
+            - (1 - xi) * eta * top[:, :1, None] - xi * eta * top[:, -1:, None])
+
+
 def _grid_line(a: float, b: float, h: float, h_fine: float | None, growth: float,
                fine: Sequence[float]) -> np.ndarray:
     """Grid positions on [a, b]: uniform (spacing <= h), or graded towards ``fine``."""
