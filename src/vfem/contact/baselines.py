@@ -14,7 +14,12 @@ as the virtual finite element method (bodies, meshes, supports, loads, platen, l
   nodes are the constraints; the other surface's candidate facets are the *master segments*.
   Each slave node is projected on its closest master segment in the undeformed configuration
   (:func:`~vfem.contact.search.project_points`, a KD-tree), once: small displacements,
-  frictionless. Its gap, linearised,
+  frictionless; a node over a vertex takes the facet it lies over, then the one facing it
+  (:func:`master_projection`: mirrored nodes, mirrored facets). A node whose projection falls
+  beyond the end of the master's candidate surface is not over it and has no row
+  (:func:`beyond_the_end`), and a node that is the slave of several bodies (a block under two
+  punches) keeps only its row on the closest (:func:`closest_master`): one node constrained
+  against two bodies made dependent rows and a singular Lagrange system. Its gap, linearised,
 
       g = n . (x_s + u_s - (N1 (x_1 + u_1) + N2 (x_2 + u_2))) = g0 + B U >= 0,
 
@@ -66,8 +71,9 @@ from .surface import ContactSurface
 
 log = logging.getLogger(__name__)
 
-#: a Lagrange node enters the active set when its gap is below minus this fraction of the
-#: shortest slave facet (round-off, not physics: the gaps it closes are exact)
+#: a node enters the active set when its gap is below minus this fraction of the shortest
+#: slave facet (round-off, not physics: the gaps Lagrange closes are exact; penalty and
+#: augmented nodes stay in while they penetrate at all)
 GAP_ROUNDOFF = 1e-10
 #: ... and leaves it when its force is tensile by more than this fraction of the largest force
 FORCE_ROUNDOFF = 1e-10
@@ -153,7 +159,7 @@ def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
             continue
         i, j = index[id(slave)], index[id(master)]
         xs = slave.X[: slave.nc]
-        seg, t, _, n = master.project(xs)
+        seg, t, dist, n, t_free = master_projection(slave, master, xs)
         a, b = master.facets[seg, 0], master.facets[seg, 1]
         xm = (1 - t)[:, None] * master.X[a] + t[:, None] * master.X[b]
         g0 = np.einsum("ij,ij->i", n, xs - xm)
@@ -164,7 +170,8 @@ def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
         parts.append(dict(
             slave=np.full(slave.nc, i), master=np.full(slave.nc, j),
             node=np.arange(slave.nc), segment=seg, t=t, normal=n, g0=g0,
-            weight=slave.tributary.copy(), penalty=np.full(slave.nc, eps),
+            weight=slave.tributary.copy(), penalty=np.full(slave.nc, eps), distance=dist,
+            outside=(t_free < -1e-9) | (t_free > 1 + 1e-9), off=beyond_the_end(master, seg, t_free),
             slave_points=slave.nodes[: slave.nc] + 0, a_points=master.nodes[a],
             b_points=master.nodes[b], slave_offset=offsets[i], master_offset=offsets[j]))
     if not parts:
@@ -188,8 +195,69 @@ def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
     master_cols = np.concatenate([np.repeat(dof_a, 2) + comp, np.repeat(dof_b, 2) + comp])
     master_vals = np.concatenate([(-(1 - t)[:, None] * n).ravel(), (-t[:, None] * n).ravel()])
     B_master = sp.csr_matrix((master_vals, (np.tile(r2, 2), master_cols)), shape=(m, ndofs))
-    return NodeToSegment(cat("slave"), cat("master"), cat("node"), cat("segment"), t, n,
-                         cat("g0"), cat("weight"), cat("penalty"), B_slave, B_master)
+    B_slave.eliminate_zeros()  # t = 0 or 1: no entry on the far node (a row of held dofs
+    B_master.eliminate_zeros()  # only is then recognised as no constraint)
+    c = NodeToSegment(cat("slave"), cat("master"), cat("node"), cat("segment"), t, n,
+                      cat("g0"), cat("weight"), cat("penalty"), B_slave, B_master)
+    longest = max(float(s.lengths.max()) for s in surfaces if len(s.lengths))
+    on = ~cat("off")
+    keep = np.zeros(m, dtype=bool)
+    keep[on] = closest_master(c.slave[on], c.node[on], cat("distance")[on], cat("outside")[on],
+                              1e-9 * longest)
+    if not keep.all():
+        log.info("node-to-segment: %d slave nodes beyond the end of a master surface and %d "
+                 "rows on a farther master left out", int((~on).sum()), int((on & ~keep).sum()))
+    return c if keep.all() else c.subset(keep)
+
+
+def master_projection(slave: ContactSurface, master: ContactSurface, xs: np.ndarray):
+    """Each slave node's closest point on the master's candidate facets: (facet, t, distance,
+    normal, unclamped t), as :meth:`ContactSurface.closest`, with ties (a node over a vertex)
+    broken by the facet that lies under the node, then by the one facing it (the slave's node
+    normal), so that mirrored nodes pick mirrored facets: a node under a punch's corner takes
+    the punch's face, not its side, and a node beside the corner on the face's line takes the
+    side it lies beside, not the face's extension beyond the corner."""
+    plain = master.closest(xs)  # ties: the facet the node lies over, then the lowest number
+    facing = master.closest(xs, point_normals=slave.node_normals())  # the facing one first
+    over = (facing[4] >= -1e-9) & (facing[4] <= 1 + 1e-9)
+    return tuple(np.where(over[:, None] if a.ndim == 2 else over, a, b)
+                 for a, b in zip(facing, plain))
+
+
+def beyond_the_end(master: ContactSurface, seg: np.ndarray, t_free: np.ndarray) -> np.ndarray:
+    """Whether each projection falls beyond an end of the master's candidate surface (past the
+    last facet of a chain, whose end node has no other candidate facet): such a node is not
+    over that surface and no contact of it (its gap would be measured to the last facet's
+    line extended, which passes through every node of a surface collinear with it: another
+    punch's face, the block beside a punch whose sides are no candidates)."""
+    count = np.bincount(master.facets.ravel(), minlength=master.nc)
+    return (((t_free < -1e-9) & (count[master.facets[seg, 0]] == 1))
+            | ((t_free > 1 + 1e-9) & (count[master.facets[seg, 1]] == 1)))
+
+
+def closest_master(slave: np.ndarray, node: np.ndarray, distance: np.ndarray,
+                   outside: np.ndarray, tie: float) -> np.ndarray:
+    """Which rows to keep where a slave node has one row per body it is the slave of (a block
+    under two punches): only its row on the closest master surface (distances equal to ``tie``
+    are ties; of tied rows, those whose projection lies over the master facet, not beyond its
+    end; rows still tied are all kept, so mirrored nodes keep mirrored rows).
+
+    One node constrained against several bodies at once is no contact of a single pass: the
+    constraints of two such nodes against the same two master points are linearly dependent
+    (a block's nodes under one punch also held level with the other punch's corner, beyond
+    its end, where the extended face passes through them), and the saddle point of the
+    Lagrange method is singular ("Factor is exactly singular"); penalty and augmented
+    methods answer, but with the far body's corner pulling on nodes it does not touch.
+    """
+    key = slave.astype(np.int64) * (int(node.max(initial=0)) + 1) + node
+    level = np.floor(distance / tie) if tie > 0 else distance
+    order = np.lexsort((outside, level, key))
+    first = np.r_[True, key[order][1:] != key[order][:-1]]
+    best = np.maximum.accumulate(np.where(first, np.arange(len(order)), 0))
+    keep = np.zeros(len(key), dtype=bool)
+    keep[order] = ((level[order] == level[order][best])
+                   & (outside[order] == outside[order][best]))
+    return keep
 
 
 class _Refined:
@@ -246,6 +314,7 @@ class GlobalContact:
         c = node_to_segment(self.surfaces, pairs, self.offsets, N, settings.penalty,
                             settings.penalty_factor)
         Br = (c.B @ self.T).tocsr()
+        Br.eliminate_zeros()
         # a row without a free dof (slave node and master segment both held) is no constraint
         live = np.diff(abs(Br).tocsr().indptr) > 0
         self.c = c.subset(live)
@@ -377,13 +446,15 @@ class GlobalContact:
                 q = factor.solve(f - Br[A].T @ (ew[A] * gp[A]))
                 g = gp + Br @ q
                 Lam[A] = -ew[A] * g[A]
-                new = g < 0
+                # a node enters past round-off (two bodies' coincident nodes moving together
+                # have gaps of +-1e-18 that would cycle), stays while it penetrates at all
+                new = (active & (g < 0)) | (g < -self.gap_tolerance)
             else:  # augmented Lagrangian
                 q = factor.solve(f + Br[A].T @ (c.weight[A] * lam[A] - ew[A] * gp[A]))
                 g = gp + Br @ q
                 trial = lam - c.penalty * g  # pressures
                 Lam[A] = c.weight[A] * trial[A]
-                new = trial > 0
+                new = (active & (trial > 0)) | (trial > c.penalty * self.gap_tolerance)
             self.timings["solve_s"] += time.perf_counter() - t0
             if not np.all(np.isfinite(q)):
                 raise AnalysisError(
@@ -519,6 +590,8 @@ class GlobalContact:
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=len(history),
                               converged=True, history=history, platen_displacement=platen)
             step.bodies = fields
+            if hasattr(analysis, "warn_large_strain"):
+                analysis.warn_large_strain(step)  # every baseline body has small kinematics
             check = getattr(analysis, "invariant_check", None)
             if check is not None:  # recorded, not enforced: a baseline's answer is its own
                 step.invariants = analysis.check_invariants(fields, history).record()
