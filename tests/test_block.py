@@ -51,8 +51,9 @@ def test_the_edge_of_the_zone_carries_compatibility_even_where_the_other_face_is
     """With the large block's face the finer one, the small block's corner (the edge of the
     contact zone) still carries compatibility (docs/method.md §6, *The pair*), so no node of
     either block indents the other. Forcing the large block onto compatibility lets the corner
-    indent it between its nodes: the independent invariant (b) records it, naming the corner's
-    body."""
+    indent it between its nodes (measured 2.2e-3 at the last step): the independent invariant
+    (b) sees it, and lets it pass as faceting (a corner between two nodes of a facet of length
+    L may stand L/2 proud of it; docs/method.md §7)."""
     p = block.Parameters(large_columns=27)
     analysis = Analysis(block.build(p))
     result = analysis.run()
@@ -66,9 +67,11 @@ def test_the_edge_of_the_zone_carries_compatibility_even_where_the_other_face_is
     model.contact = dataclasses.replace(model.contact, compatibility_side="large",
                                         max_step_cuts=3)
     forced = Analysis(model).run()
+    assert forced.converged
     inv = forced.steps[-1].invariants
-    assert "interpenetration" in inv["failed"]
-    assert inv["where"]["body"] == "small" and inv["max_penetration_any_body"] > 1e-4
+    assert not inv["failed"]
+    assert inv["max_penetration_any_body"] > 1e-3
+    assert result.steps[-1].invariants["max_penetration_any_body"] <= result.penetration_tolerance
 
 
 def test_run_writes_summary_and_figures(tmp_path):

@@ -1,0 +1,99 @@
+"""Small strain pushed too far (issue 16, item 6): a small-kinematics body whose strain
+exceeds 5 % after a step is warned about, once, by name, with kinematics = "total" suggested;
+the analysis goes on."""
+
+import dataclasses
+import logging
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vfem
+from vfem.solver import SMALL_STRAIN_LIMIT
+
+PUNCH = Path(__file__).parent.parent / "examples" / "punch" / "flat_punch.toml"
+
+
+def punch(depth=None, method=None):
+    """examples/punch/flat_punch.toml (0.01 deep: 2.5 % at the corners' elements), or pressed
+    ``depth`` deep."""
+    m = vfem.load(PUNCH).build()
+    if depth is not None:
+        p = m.bodies[1]
+        m.bodies[1] = dataclasses.replace(p, prescribed=tuple(
+            dataclasses.replace(pd, value=-depth) for pd in p.prescribed))
+    if method is not None:
+        m.contact = dataclasses.replace(m.contact, method=method)
+    return m
+
+
+def strain_warnings(caplog):
+    return [r for r in caplog.records
+            if r.levelno == logging.WARNING and "small kinematics is meant for" in r.message]
+
+
+def test_max_strain_is_the_largest_absolute_principal_strain():
+    m = punch()
+    block = m.bodies[0]
+    block.assemble()
+    x, y = block.points
+    for exx, eyy, exy in ((0.1, -0.03, 0.0), (-0.02, 0.01, 0.0), (0.0, 0.0, 0.04),
+                          (0.03, 0.01, 0.02)):
+        u = np.column_stack([exx * x + exy * y, eyy * y + exy * x]).ravel()
+        expected = abs(exx + eyy) / 2 + np.hypot((exx - eyy) / 2, exy)
+        strain, element = block.max_strain(u)
+        assert strain == pytest.approx(expected, rel=1e-12)
+        assert 0 <= element < block.mesh.t.shape[1]
+
+
+@pytest.mark.parametrize("method", ["vfem", "lagrange"])
+def test_a_body_pressed_past_five_percent_is_warned_about_once(method, caplog):
+    m = punch(depth=0.15, method=method)
+    with caplog.at_level(logging.WARNING):
+        result = vfem.solve(m)
+    assert result.converged, result.message  # a warning, not a failure
+    warned = strain_warnings(caplog)
+    assert len(warned) == 1  # once per body per run, though every step is beyond 5 %
+    text = warned[0].message
+    assert warned[0].name == "vfem.solver"
+    # 9.32 % (vfem), 9.39 % (lagrange) under the punch's corner after the first quarter
+    assert re.match(r"body 'block': strain 9\.[34]\d % at step 1 \(load factor 0\.25\), "
+                    r"element \d+ at \(0\.525, -0\.025\)", text), text
+    assert 'kinematics = "total"' in text
+    strain, _ = m.bodies[0].max_strain(result.steps[0].bodies["block"].displacement.ravel())
+    assert strain > SMALL_STRAIN_LIMIT
+    punch_strain, _ = m.bodies[1].max_strain(result.steps[-1].bodies["punch"].displacement.ravel())
+    assert punch_strain < SMALL_STRAIN_LIMIT  # the punch is not named
+
+
+def test_an_ordinary_run_is_not_warned_about(caplog):
+    with caplog.at_level(logging.WARNING):
+        result = vfem.solve(punch())
+    assert result.converged
+    assert not strain_warnings(caplog)
+    strain, _ = result.model.bodies[0].max_strain(
+        result.steps[-1].bodies["block"].displacement.ravel())
+    assert 0.02 < strain < SMALL_STRAIN_LIMIT  # 2.5 %: the corners' elements
+
+
+def test_large_kinematics_bodies_are_not_checked(caplog, monkeypatch):
+    """Only small-kinematics bodies are read (a large-kinematics body's strain is its own)."""
+    from vfem.solver import Analysis, StepResult
+
+    m = punch()
+    m.bodies[0] = dataclasses.replace(m.bodies[0], kinematics="total")
+    analysis = Analysis(m)
+    read = []
+    monkeypatch.setattr(type(m.bodies[1]), "max_strain",
+                        lambda self, u: (read.append(self.name), (1.0, 0))[1])
+    step = StepResult(1, 1.0, 1, True, [])
+    step.bodies = {b.name: None for b in m.bodies}
+    step.bodies["punch"] = type("R", (), {"displacement": np.zeros((3, 2))})()
+    with caplog.at_level(logging.WARNING):
+        analysis.warn_large_strain(step)
+        analysis.warn_large_strain(step)
+    assert read == ["punch"]  # the block is large, and the punch is named once
+    assert len(strain_warnings(caplog)) == 1
+    assert strain_warnings(caplog)[0].message.startswith("body 'punch': strain 100 %")
