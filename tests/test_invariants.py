@@ -200,15 +200,22 @@ def test_turning_angles_faceting_allowance_and_symmetry_planes():
     p += np.array([[0.5625], [0.05]])
     diamond = MeshTri(p, diamond.t)
     bodies = [blocks()[0], Body("diamond", diamond, MAT)]
-    for shift, ok in ((0.01, True), (0.08, False)):
+    under = np.flatnonzero(np.isclose(bodies[0].points[1], 0)
+                           & np.isin(np.round(bodies[0].points[0], 9), (0.5, 0.625)))
+    tip = int(np.argmin(diamond.p[1]))
+    for shift, touching, ok in ((0.01, True, True), (0.08, True, False), (0.01, False, False)):
         fields = {b.name: SimpleNamespace(displacement=np.zeros((b.npoints, 2)),
                                           contact_force=np.zeros((b.npoints, 2)))
                   for b in bodies}
         fields["diamond"].displacement[:, 1] = -shift
+        if touching:  # the facet's nodes carry the corner's force
+            fields[bodies[0].name].contact_force[under, 1] = -1.0
+            fields["diamond"].contact_force[tip, 1] = 2.0
         inv = step_invariants(bodies, None, fields, TOL)
         assert inv.separated == ok
         assert inv.where["body"] == "diamond" and inv.penetration == pytest.approx(shift)
-        assert inv.allowed == pytest.approx(TOL + 0.0625)
+        # where nothing touches the facet, a corner inside it is contact missed, not faceting
+        assert inv.allowed == pytest.approx(TOL + (0.0625 if touching else 0.0))
 
 
 # -- the solver ---------------------------------------------------------------------------------

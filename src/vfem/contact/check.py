@@ -201,12 +201,13 @@ class _Polygon:
         return np.einsum("ij,ij->i", pts - c, direction) <= 1e-12 * np.maximum(
             self.lengths[seg], 1e-300)
 
-    def depth(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Distance of ``pts`` to the surface segments, and the length of the closest one."""
+    def depth(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Distance of ``pts`` to the surface segments, the length of the closest one and
+        its two nodes (local numbers)."""
         a, b = self.ends
         keep = self.surface
         seg, _, dist = project_points(pts, a[keep], b[keep])[:3]
-        return dist, self.lengths[keep][seg]
+        return dist, self.lengths[keep][seg], self.b.segments[keep][seg]
 
     @property
     def turning(self) -> np.ndarray:
@@ -472,12 +473,12 @@ class InvariantCheck:
              for b, g in zip(self.bodies, self.boundaries)]
         cur = [r if not np.any(ui) else _Polygon(r.b, r.x + ui) for r, ui in zip(ref, u)]
         F = [np.asarray(fields[b.name].contact_force, dtype=float) for b in self.bodies]
+        Fb = [f[g.nodes] for f, g in zip(F, self.boundaries)]
         self._force_balance(F, out)
-        self._interpenetration(cur, out, extra_allowance)
+        self._interpenetration(cur, out, extra_allowance, Fb)
         # (c)'s normals: the deformed ones under large kinematics, the undeformed ones (linear
         # theory's) under small
         own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
-        Fb = [f[g.nodes] for f, g in zip(F, self.boundaries)]
         if self.tension_measure == "nodal":
             self._tension_nodal(Fb, own, out)
         else:
@@ -498,7 +499,8 @@ class InvariantCheck:
 
     # -- (b) ------------------------------------------------------------------------------------
 
-    def _interpenetration(self, cur: list[_Polygon], out: Invariants, extra: float) -> None:
+    def _interpenetration(self, cur: list[_Polygon], out: Invariants, extra: float,
+                          forces: list[np.ndarray] | None = None) -> None:
         tol = self.penetration_tolerance + extra
         best = None  # (excess, depth, allowed, i, local node, j, deformed, linearised)
         deepest = 0.0
@@ -514,7 +516,18 @@ class InvariantCheck:
             node = near[gj.inside(gi.x[near])]
             if not node.size:
                 continue
-            depth, L = gj.depth(gi.x[node])
+            depth, L, ends = gj.depth(gi.x[node])
+            if forces is not None:
+                # the faceting allowance is for a node between two nodes of the other surface
+                # that lie on this one: where the facet is not in or next to a contact zone
+                # (no node of it or of its neighbours carries force), a node inside it is
+                # contact missed (a curved body's first touch between the other's nodes), not
+                # faceting
+                loaded = np.abs(forces[j]).sum(axis=1) > 0
+                near = loaded.copy()
+                for a, b in ((0, 1), (1, 0)):
+                    np.logical_or.at(near, gj.b.segments[:, a], loaded[gj.b.segments[:, b]])
+                L = np.where(near[ends].any(axis=1), L, 0.0)
             deformed, linearised, second = depth, None, 0.0
             if not (gi.b.large or gj.b.large):
                 linearised, second = self._linearised_depth(i, j, node, cur)

@@ -92,6 +92,11 @@ BODY_TOLERANCE = 1e-8
 MAX_DAMPING = 6
 
 
+def _concatenate(parts: list[np.ndarray]) -> np.ndarray:
+    """The parts one after the other; empty where there are none (no contact pair)."""
+    return np.concatenate(parts) if parts else np.zeros(0)
+
+
 def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: float,
                            dp_dplaten: np.ndarray | None = None, dR: np.ndarray | None = None,
                            stiffness: float = 0.0, need: float = 0.0,
@@ -440,13 +445,12 @@ class LargeDeformationContact(PairedContact):
             p[rows] = lin_pens[k][s_]
             q0[rows] = self._q(state, k)[s_]
             row += len(s_)
-        rate = np.concatenate([r[s_] for r, s_ in zip(rates, sets)])
+        rate = _concatenate([r[s_] for r, s_ in zip(rates, sets)])
         dR = -motion @ A[off[self.platen_body]:off[self.platen_body + 1]] if platen else None
         if platen and m == 0 and stiffness == 0.0:
             # nothing may touch yet and nothing else holds the platen's body: move the platen
             # just far enough to close the smallest gap
-            q, dplaten = q0, closing_motion(np.concatenate(lin_pens), np.concatenate(rates),
-                                            need)
+            q, dplaten = q0, closing_motion(_concatenate(lin_pens), _concatenate(rates), need)
         else:
             q, dplaten = linear_complementarity(W, q0, p, tol, rate if platen else None, dR,
                                                 stiffness, need)

@@ -104,9 +104,17 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray)
         return np.zeros(0, dtype=int)
     a, b = s.segments(x)
     n = outward_normals(a, b)
-    mid, _ = s.curve(np.arange(len(s.facets)), np.full(len(s.facets), 0.5), x)
-    seg, t, _, m, _ = so.closest(mid, xo, None, n)
-    return np.flatnonzero(np.einsum("ij,ij->i", n, m) <= -FACING)
+    nf = len(s.facets)
+    ids = np.arange(nf)
+    # each facet is read at its midpoint and near its ends: a facet partly under the other body
+    # whose midpoint lies beyond the other's corner faces its side there, not elsewhere (read
+    # at the midpoint alone, such a facet was dropped and the contact missed altogether)
+    faces = np.zeros(nf, dtype=bool)
+    for t in (0.5, 0.05, 0.95):
+        pts, _ = s.curve(ids, np.full(nf, t), x)
+        seg, _, _, m, _ = so.closest(pts, xo, None, n)
+        faces |= np.einsum("ij,ij->i", n, m) <= -FACING
+    return np.flatnonzero(faces)
 
 
 def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:
@@ -267,9 +275,13 @@ class PairedContact(VirtualElementContact):
         if not len(patch) or not len(opatch):
             return 0.0, False
         oends = patch_ends(so, opatch)
-        mid, _ = s.curve(patch, np.full(len(patch), 0.5))
-        seg, _, _, _, tf = so.closest(mid, None, opatch, outward_normals(*s.segments(s.X))[patch])
-        over = patch[~beyond(so, seg, tf, oends)]
+        normals = outward_normals(*s.segments(s.X))[patch]
+        inside = np.zeros(len(patch), dtype=bool)
+        for t in (0.5, 0.05, 0.95):  # as in facing(): a facet partly over the other surface
+            pts, _ = s.curve(patch, np.full(len(patch), t))
+            seg, _, _, _, tf = so.closest(pts, None, opatch, normals)
+            inside |= ~beyond(so, seg, tf, oends)
+        over = patch[inside]
         if not len(over):
             return 0.0, False
         # ends of the patch at a corner of the body (another candidate facet, not facing j,
