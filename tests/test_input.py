@@ -10,7 +10,7 @@ import pytest
 
 import vfem
 from vfem.cli import main
-from vfem.examples import block, gasket, hertz, patch, sliding, wedge
+from vfem.examples import block, gasket, hertz, patch, punch, sliding, wedge
 from vfem.io.input import dumps, load, loads, reference
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -24,6 +24,7 @@ def example_files():
     yield EXAMPLES / "block.toml", block.config(block.Parameters())
     yield EXAMPLES / "gasket.toml", gasket.config(gasket.GasketParameters())
     yield EXAMPLES / "sliding.toml", sliding.config(sliding.Parameters())
+    yield EXAMPLES / "punch" / "flat_punch.toml", punch.config(punch.Parameters())
     for key, config in patch.configs(patch.Parameters()).items():
         yield EXAMPLES / "patch" / f"{key}.toml", config
     for key, config in wedge.configs(wedge.WedgeParameters()).items():
@@ -38,7 +39,7 @@ def test_example_files_describe_the_built_in_models(path, config):
 
 
 def test_every_example_with_bodies_has_its_files():
-    assert len(list(example_files())) == 4 + 12 + 5
+    assert len(list(example_files())) == 5 + 12 + 5
     assert sorted(p.name for p in (EXAMPLES / "patch").glob("*.toml")) == sorted(
         f"{k}.toml" for k in patch.configs(patch.Parameters()))
 
@@ -132,7 +133,7 @@ def test_the_bad_input_deck_is_large_enough():
 def test_check_accepts_every_example_file(capsys):
     for path, _ in example_files():
         assert main(["check", str(path)]) == 0
-    assert capsys.readouterr().out.count("is valid") == 21
+    assert capsys.readouterr().out.count("is valid") == 22
 
 
 def test_missing_input_file(capsys):

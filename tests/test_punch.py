@@ -9,31 +9,24 @@ with the largest pressure of the model and a sideways force of 3.8 % of the load
 """
 
 import dataclasses
+import json
 from pathlib import Path
 
 import numpy as np
 import pytest
-from skfem import Basis, ElementQuad1, ElementVector, MeshQuad, asm, condense, solve
-from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 import vfem
+from vfem.cli import build_parameters, main
+from vfem.examples import punch
 
 EXAMPLES = Path(__file__).parent.parent / "examples" / "punch"
 
 
 @pytest.fixture(scope="module")
 def reference():
-    """The block alone, its top nodes with |x| <= 0.5 moved down 0.01, free sideways."""
-    m = MeshQuad.init_tensor(np.linspace(-2, 2, 81), np.linspace(-2, 0, 41))
-    basis = Basis(m, ElementVector(ElementQuad1()))
-    K = asm(linear_elasticity(*lame_parameters(1e9, 0.3)), basis)
-    bottom = basis.get_dofs(lambda x: np.isclose(x[1], -2)).all()
-    top = basis.get_dofs(lambda x: np.isclose(x[1], 0) & (np.abs(x[0]) <= 0.5 + 1e-12))
-    ty = top.nodal["u^2"]
-    u = np.zeros(K.shape[0])
-    u[ty] = -0.01
-    u = solve(*condense(K, np.zeros(K.shape[0]), u, D=np.concatenate([bottom, ty])))
-    return float(-(K @ u)[ty].sum())
+    """The block alone, its top nodes with |x| <= 0.5 moved down 0.01, free sideways
+    (:func:`vfem.examples.punch.reference_force`, what ``vfem run punch`` compares with)."""
+    return punch.reference_force()
 
 
 def model(name="flat_punch", **contact):
@@ -222,3 +215,44 @@ def test_sadowsky_punch_under_refinement():
                 assert error < 0.03 or graded is None
             errors.append(error)
         assert errors[0] > errors[1] > errors[2]
+
+
+def test_the_built_in_example_writes_its_numbers_and_figures(tmp_path, reference):
+    """``vfem run punch`` (examples/punch/flat_punch.toml as a built-in): summary.json's
+    numbers, the figures, the VTU series; the CLI exits 0 and prints the comparison."""
+    assert punch.config() == vfem.load(EXAMPLES / "flat_punch.toml")
+    assert reference == pytest.approx(1.06696e7, rel=1e-5)
+    s = punch.run(punch.Parameters(), tmp_path / "api")
+    assert s["converged"] and len(s["steps"]) == 4
+    c = s["punch"]
+    assert c["force_balance"] <= 1e-8
+    assert c["reference_force"] == reference
+    assert abs(c["difference_from_reference"]) < 0.01
+    assert c["difference_from_reference"] < 0  # the punch's own compression (measured -0.26 %)
+    assert c["force"] == pytest.approx(-c["block_contact_force"][1], rel=1e-15)
+    assert c["sideways_over_force"] <= 1e-8
+    assert c["block_nodes_outside_punch_loaded"] == 0
+    assert -0.5 - 1e-12 <= c["contact_zone"][0] and c["contact_zone"][1] <= 0.5 + 1e-12
+    assert all(step["invariants"]["force_balance"] <= 1e-8 for step in s["steps"])
+    assert json.loads((tmp_path / "api" / "summary.json").read_text())["punch"] == c
+    for name in ("pressure.png", "deformed.png"):
+        assert (tmp_path / "api" / name).stat().st_size > 10_000
+    assert (tmp_path / "api" / "results.pvd").read_text().count("<DataSet") == 8
+    report = "\n".join(punch.report(s))
+    assert "0 outside it" in report and "rigid punch" in report
+
+
+def test_the_built_in_example_from_the_command_line(tmp_path, capsys):
+    assert main(["run", "punch", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "invariants: forces balance to" in out and "0 outside it" in out
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert abs(s["punch"]["difference_from_reference"]) < 0.01
+    p = build_parameters("punch", ["refinement=1", "stiffness_ratio=1000", "steps=2",
+                                   "kinematics=total", "swap_bodies=true"])
+    bodies = punch.config(p).bodies
+    assert [b.name for b in bodies] == ["punch", "block"]
+    assert dict(bodies[1].mesh.parameters)["nx"] == 160 and bodies[0].kinematics == "total"
+    assert bodies[0].material.youngs_modulus == 1e12
+    assert main(["export", "punch", "--out", str(tmp_path / "flat_punch.toml")]) == 0
+    assert vfem.load(tmp_path / "flat_punch.toml") == vfem.load(EXAMPLES / "flat_punch.toml")

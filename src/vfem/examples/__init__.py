@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import importlib
 
-EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding")
+EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch")
 
 
 def load(name: str):

@@ -37,6 +37,32 @@ def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[
     plt.close(fig)
 
 
+def punch_pressure(path: Path, x: np.ndarray, p: np.ndarray, force: float, a: float,
+                   title: str) -> None:
+    """Nodal contact pressure against x under a flat punch of half-width ``a``, with Sadowsky's
+    rigid punch on a half-plane carrying the same ``force``: P / (pi sqrt(a^2 - x^2))."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    s = np.linspace(-a, a, 801)[1:-1]
+    ax.plot(s, force / (np.pi * np.sqrt(a**2 - s**2)), "k-", lw=1.2,
+            label=f"Sadowsky, rigid punch on a half-plane: $P/(\\pi\\sqrt{{a^2-x^2}})$, "
+                  f"a = {a:g}, P = {force:.4g}")
+    ax.plot(x, p, "o", ms=4, mfc="none", color="tab:blue",
+            label="vfem, block (nodal force / undeformed length)")
+    for edge in (-a, a):
+        ax.axvline(edge, color="0.6", lw=0.8, ls="--")
+    ax.axhline(0, color="0.7", lw=0.8)
+    top = max(float(np.max(p)) if len(p) else 0.0, 3 * force / (np.pi * a))
+    ax.set_ylim(-0.05 * top, 1.4 * top)  # room for the legend above the corners
+    ax.set_xlabel("x (undeformed) [length]")
+    ax.set_ylabel("contact pressure p [force / length^2]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper center")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
     """p_max error and RMS profile error against contact facets across a, per series.
 
@@ -70,14 +96,15 @@ def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
 def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np.ndarray,
                                                                    np.ndarray]]]],
                    title: str, window: tuple[float, float, float, float] | None = None,
-                   mesh_lines: bool | None = None) -> None:
+                   mesh_lines: bool | None = None, legend_loc: str = "best") -> None:
     """One or more configurations of a model drawn over each other (thesis Figs. 5.4-5.23).
 
     ``frames``: (label, bodies) with bodies a list of (points (n, 2), cells (m, k) of vertex
     numbers, displacement (n, 2)), optionally preceded by the body's name (for the legend).
     Each frame gets its own colour; with one frame each body gets its own. Mesh lines are drawn
     when there is a single frame (default), outlines only when several are overlaid.
-    ``window`` = (xmin, xmax, ymin, ymax), default: everything.
+    ``window`` = (xmin, xmax, ymin, ymax), default: everything. ``legend_loc``: matplotlib's
+    legend position ("best" searches every position, slow on large meshes).
     """
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     mesh_lines = len(frames) == 1 if mesh_lines is None else mesh_lines
@@ -112,7 +139,7 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     ax.set_ylim(window[2], window[3])
     ax.set_aspect("equal")
     ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=8, loc="best")
+    ax.legend(fontsize=8, loc=legend_loc)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
