@@ -423,9 +423,13 @@ def test_found(name):
     check(FOUND[name][0])
 
 
-#: Placements of UNSOLVED that converge with the invariants since the fixes above.
+#: Placements of UNSOLVED that converge with the invariants since the fixes above (the last two:
+#: a facet over which a vertex of the other surface lies, facing it, joins the patch).
 SOLVED = ("large kinematics: a node of the upper body 0.03 inside the block's corner",
-          "large kinematics: a one-element punch between two block nodes, one under its middle")
+          "large kinematics: a one-element punch between two block nodes, one under its middle",
+          # a facet over which a vertex of the other surface lies, facing it, is in the patch
+          "overlap inside the rind, soft one-element body",
+          "large kinematics, flat punch on matching nodes, E ratio 1")
 
 
 @pytest.mark.parametrize("name", SOLVED)

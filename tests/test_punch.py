@@ -114,11 +114,12 @@ def test_two_punches_on_one_block():
 
 
 def test_large_kinematics_punch_and_drop(reference):
-    """Under large kinematics the same: balance, nothing beyond the corners; the force is
-    1.45 % below the small-strain reference (geometric and material nonlinearity at 1 %
-    strain under the corners)."""
+    """Under large kinematics the same: balance, nothing beyond the block facets next to the
+    corners (the punch's corners slide outwards over them); the force is 1.45 % below the
+    small-strain reference (geometric and material nonlinearity at 1 % strain under the
+    corners)."""
     for name in ("flat_punch", "drop"):
-        load, _ = check_punch(vfem.solve(large(model(name))))
+        load, _ = check_punch(vfem.solve(large(model(name))), reach=0.051)  # block facet 0.05
         assert load == pytest.approx(reference, rel=0.02)
 
 
