@@ -115,7 +115,7 @@ def test_two_punches_on_one_block():
 
 def test_large_kinematics_punch_and_drop(reference):
     """Under large kinematics the same: balance, nothing beyond the block facets next to the
-    corners (the punch's corners slide outwards over them); the force is 1.45 % below the
+    corners (the punch's corners slide outwards over them); the force is 1.49 % below the
     small-strain reference (geometric and material nonlinearity at 1 % strain under the
     corners)."""
     for name in ("flat_punch", "drop"):
