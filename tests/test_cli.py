@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import meshio
 import pytest
@@ -124,3 +125,40 @@ def test_bench_compares_contact_methods_and_their_patch_tests(tmp_path, capsys):
     assert abs(rows["vfem"]["p_max_error"]) < 1e-3 and abs(rows["lagrange"]["p_max_error"]) < 1e-3
     patch = {r["method"]: r["patch_error"] for r in table["patch"]}
     assert patch["vfem"] < 1e-10 < 1e-3 < patch["lagrange"]
+
+
+def test_output_locations_and_self_contact_are_one_message(tmp_path, capsys):
+    """Issue 17, item 1: no traceback for an --out that names a file, a self-contact pair, a
+    file-system error or a bug; one message, exit 2 (input) or 1 (internal error)."""
+    afile = tmp_path / "afile"
+    afile.write_text("not a folder")
+    assert main(["-q", "run", "springs", "--out", str(afile)]) == 2
+    assert "a file, not a folder" in capsys.readouterr().err
+    assert afile.read_text() == "not a folder"  # nothing written over it
+
+    model = tmp_path / "self.toml"
+    text = (Path(__file__).parent.parent / "examples" / "punch" / "flat_punch.toml").read_text()
+    model.write_text(text.replace('name = "flat_punch"',
+                                  'name = "flat_punch"\ncontact_pairs = [["block", "block"]]'))
+    for command in (["check", str(model)], ["-q", "run", str(model), "--out",
+                                            str(tmp_path / "out")]):
+        assert main(command) == 2
+        err = capsys.readouterr().err
+        assert "names one body twice" in err and "Traceback" not in err
+
+
+def test_file_system_errors_and_bugs_end_without_a_traceback(monkeypatch, tmp_path, capsys):
+    import vfem.cli as cli
+
+    def disk_full(args):
+        raise OSError(28, "No space left on device", str(tmp_path / "x.vtu"))
+
+    def bug(args):
+        raise ValueError("something vfem did not foresee")
+
+    for fake, status, words in ((disk_full, 2, "x.vtu: No space left on device"),
+                                (bug, 1, "internal error: ValueError")):
+        monkeypatch.setattr(cli, "cmd_check", fake)
+        assert main(["check", "hertz"]) == status
+        err = capsys.readouterr().err
+        assert words in err and "Traceback" not in err and len(err.strip().splitlines()) == 1

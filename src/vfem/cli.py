@@ -188,11 +188,27 @@ def _with_invariants(lines: list[str], summary: dict) -> list[str]:
     return [*lines[:at], "  " + line, *lines[at:]]
 
 
+def _writable_folder(out: Path, what: str) -> None:
+    """Refuse, before anything is solved, an output folder that is a file or cannot be made or
+    written (one message naming the path; the run would otherwise fail after its first step)."""
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{what} {out}: a file, not a folder; name a folder for the results")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".vfem-write-test"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise InputError(f"{what} {out}: cannot write there ({exc.strerror or exc})") from None
+
+
 def _results_directory(args, default: Path) -> Path:
     """Where a run writes: ``--resume DIR`` (which must hold an earlier run), else ``--out``,
     else ``default``."""
     if not args.resume:
-        return Path(args.out or default)
+        out = Path(args.out or default)
+        _writable_folder(out, "--out" if args.out else "the results folder")
+        return out
     if args.out and Path(args.out) != Path(args.resume):
         raise InputError("--resume continues in its own results directory; leave out --out")
     if not any(Path(args.resume).glob("**/checkpoint")):
@@ -486,6 +502,16 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("vfem: interrupted", file=sys.stderr)
         return 130
+    except OSError as exc:  # the file system: a path that cannot be read or written
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"vfem: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except Exception as exc:  # a bug: one line, no traceback unless asked for (-vv)
+        if args.verbose >= 2:
+            raise
+        print(f"vfem: internal error: {type(exc).__name__}: {exc} (a bug in vfem: please "
+              "report it with the input; -vv shows the traceback)", file=sys.stderr)
+        return 1
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

@@ -79,6 +79,9 @@ class Model:
                              f"different from the one before (and the first not 0), got "
                              f"{list(self.load_factors)}")
         for a, b in self.contact_pairs or ():
+            if a == b:
+                raise InputError(f"model {self.name!r}: contact pair [{a!r}, {b!r}] names one "
+                                 "body twice: contact of a body with itself is not supported")
             for n in (a, b):
                 if n not in names:
                     raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
