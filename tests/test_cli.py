@@ -162,3 +162,19 @@ def test_file_system_errors_and_bugs_end_without_a_traceback(monkeypatch, tmp_pa
         assert main(["check", "hertz"]) == status
         err = capsys.readouterr().err
         assert words in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_folder_friction_and_one_body_are_told_plainly(tmp_path, capsys):
+    """Issue 17, item 8: `vfem run DIR`, a `friction` key, a one-body model."""
+    assert main(["run", str(tmp_path)]) == 2
+    assert "is a folder" in capsys.readouterr().err
+    text = (Path(__file__).parent.parent / "examples" / "punch" / "flat_punch.toml").read_text()
+    model = tmp_path / "friction.toml"
+    model.write_text(text.replace("[steps]", "[contact]\nfriction = 0.3\n\n[steps]"))
+    assert main(["check", str(model)]) == 2
+    err = capsys.readouterr().err
+    assert "friction is not available yet" in err and "did you mean" not in err
+    one = tmp_path / "one.toml"
+    one.write_text(text[: text.index('[[bodies]]\nname = "punch"')])
+    assert main(["check", str(one)]) == 0
+    assert "1 body (" in capsys.readouterr().out

@@ -140,6 +140,10 @@ def _load_input(path: str):
 
 def _example(name: str, alternatives: str = ""):
     """The module of a built-in example; an unknown name is refused with the closest one."""
+    if name not in EXAMPLES and Path(name).is_dir():
+        raise InputError(f"{name} is a folder: give an input file (.toml) or a built-in example "
+                         f"({', '.join(EXAMPLES)}); to redraw a results folder's figures: "
+                         f"vfem plot {name}")
     if name not in EXAMPLES:
         close = difflib.get_close_matches(name, EXAMPLES, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
@@ -275,10 +279,12 @@ def run_input_file(args) -> int:
 def cmd_check(args) -> int:
     config, model = _checked_model(args.file)
     if not args.quiet:
+        n, steps = len(model.bodies), len(model.load_factors)
         print(f"vfem: {args.file}: model {config.name!r} is valid — "
-              f"{len(model.bodies)} bodies ("
+              f"{n} {'body' if n == 1 else 'bodies'} ("
               + ", ".join(f"{b.name}: {b.npoints} nodes" for b in model.bodies)
-              + f"), {len(model.load_factors)} steps")
+              + f"), {steps} {'step' if steps == 1 else 'steps'}"
+              + ("; with one body there is no contact to solve" if n == 1 else ""))
     return 0
 
 
