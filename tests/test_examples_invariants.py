@@ -45,6 +45,7 @@ from pathlib import Path
 import pytest
 
 import vfem
+from invariant_record import violations
 from vfem.examples import EXAMPLES
 from vfem.examples import load as load_example
 
@@ -137,30 +138,6 @@ def _model(case, tmp_path: Path):
 
 
 # -- the invariants of a step, read from its record ----------------------------------------------
-
-
-def violations(inv: dict) -> list[str]:
-    """Each invariant the recorded measures (``Invariants.record()``) break, in words — all
-    three, enforced or not (``Invariants.message()`` names only the enforced ones)."""
-    out = []
-    if inv["force_balance"] > inv["force_balance_tolerance"]:
-        out.append(f"(a) force balance: the contact forces sum to {inv['force_balance']:.3g} of "
-                   f"the largest body's total (tolerance {inv['force_balance_tolerance']:.3g})")
-    w = inv["where"]
-    if w is not None and inv["penetration"] > inv["allowed"]:
-        out.append(f"(b) interpenetration: node {w['node']} of {w['body']!r} at "
-                   f"({w['x']:.6g}, {w['y']:.6g}) lies {inv['penetration']:.3g} inside "
-                   f"{w['into']!r} (allowed {inv['allowed']:.3g}; deformed depth "
-                   f"{w['deformed_depth']:.3g}, linearised depth {w['linearised_depth']})")
-    if inv["tension"] > inv["tension_tolerance"]:
-        t = inv["tension_where"]
-        out.append(f"(c) tension: node {t['node']} of {t['body']!r} carries {t['value']:.6g}, "
-                   f"{inv['tension']:.3g} of the largest (tolerance "
-                   f"{inv['tension_tolerance']:.3g})")
-    # the record's own verdict says the same
-    named = {"force balance": "(a)", "interpenetration": "(b)", "tension": "(c)"}
-    assert sorted(named[f] for f in inv["failed"]) == sorted(v[:3] for v in out), (inv, out)
-    return out
 
 
 def step_violations(result) -> list[str]:

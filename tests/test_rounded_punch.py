@@ -182,17 +182,24 @@ def check_finite_and_smooth(result):
     return pr[k], xr[k]
 
 
+def against_lagrange(mesh: dict):
+    """vfem and the Lagrange baseline on the same fine meshes: each symmetric and balanced,
+    total force and peak pressure within 1 % of each other. Returns both results."""
+    vfem_result = vfem.solve(fine_model("vfem", **mesh))
+    lagrange = vfem.solve(fine_model("lagrange", **mesh))
+    load, peak, _ = check_symmetric(vfem_result)
+    load_l, peak_l, _ = check_symmetric(lagrange)
+    assert load == pytest.approx(load_l, rel=0.01)
+    assert peak == pytest.approx(peak_l, rel=0.01)
+    return vfem_result, lagrange
+
+
 def test_fine_mesh_against_the_lagrange_baseline():
     """Acceptance: total force and peak pressure within 1 % of the Lagrange baseline on a fine
     mesh (17k dofs; 0.001 at the tangent points). Measured: 9.4726e6 against 9.4684e6 (+0.045 %),
     p_max 5.230e7 against 5.205e7 (+0.47 %), both at |x| = 0.4049; balanced and symmetric to
     round-off both ways."""
-    vfem_result = vfem.solve(fine_model("vfem", **FINE))
-    lagrange = vfem.solve(fine_model("lagrange", **FINE))
-    load, peak, _ = check_symmetric(vfem_result)
-    load_l, peak_l, _ = check_symmetric(lagrange)
-    assert load == pytest.approx(load_l, rel=0.01)
-    assert peak == pytest.approx(peak_l, rel=0.01)
+    vfem_result, lagrange = against_lagrange(FINE)
     p, x = check_finite_and_smooth(vfem_result)
     p_l, x_l = check_finite_and_smooth(lagrange)
     assert x == x_l
@@ -204,12 +211,8 @@ def test_finer_mesh_the_peak_is_finite():
     (5.230e7 to 5.248e7; the nodal pressure at a sharp corner grows like h^-1/2, 41 % per halving)
     and keeps the baseline within 1 %: force +0.027 %, p_max +0.34 %."""
     fine_peak = check_finite_and_smooth(vfem.solve(fine_model("vfem", **FINE)))[0]
-    result = vfem.solve(fine_model("vfem", **FINER))
-    lagrange = vfem.solve(fine_model("lagrange", **FINER))
-    load, peak, _ = check_symmetric(result)
-    load_l, peak_l, _ = check_symmetric(lagrange)
-    assert load == pytest.approx(load_l, rel=0.01)
-    assert peak == pytest.approx(peak_l, rel=0.01)
+    result, lagrange = against_lagrange(FINER)
+    _, peak, _ = check_symmetric(result)
     check_finite_and_smooth(result)
     check_finite_and_smooth(lagrange)
     assert peak == pytest.approx(fine_peak, rel=0.01)

@@ -256,6 +256,7 @@ class Analysis:
         self.model = model
         self.backend = resolve_backend(backend)  # None: the one chosen (--solver), else auto
         self.timings: dict[str, float] = {}
+        self.strain_warned: set[str] = set()  # bodies already warned about (warn_large_strain)
 
     def setup(self) -> None:
         """Find each body's contact candidates, then assemble and factorize every body.
@@ -358,13 +359,12 @@ class Analysis:
         largest principal strain (:meth:`Body.max_strain`) exceeds :data:`SMALL_STRAIN_LIMIT`,
         naming the body, the strain, the step and where, once per body per run. One
         interpolation per small body and step, none once every such body has been named."""
-        warned = self.__dict__.setdefault("_strain_warned", set())
         for b in self.model.bodies:
-            if b.large or b.name in warned or b.name not in step.bodies:
+            if b.large or b.name in self.strain_warned or b.name not in step.bodies:
                 continue
             strain, element = b.max_strain(step.bodies[b.name].displacement.ravel())
             if strain > SMALL_STRAIN_LIMIT:
-                warned.add(b.name)
+                self.strain_warned.add(b.name)
                 x, y = b.mesh.p[:, b.mesh.t[:, element]].mean(axis=1)
                 log.warning("body %r: strain %.3g %% at step %d (load factor %.6g), element %d "
                             "at (%.4g, %.4g), beyond the %g %% small kinematics is meant for: "

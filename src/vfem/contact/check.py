@@ -502,6 +502,9 @@ class InvariantCheck:
     def _interpenetration(self, cur: list[_Polygon], out: Invariants, extra: float,
                           forces: list[np.ndarray] | None = None) -> None:
         tol = self.penetration_tolerance + extra
+        # per body: its boundary nodes that carry contact force or neighbour one that does
+        touched = None if forces is None else [_loaded_or_next(g.b.segments, f)
+                                               for g, f in zip(cur, forces)]
         best = None  # (excess, depth, allowed, i, local node, j, deformed, linearised)
         deepest = 0.0
         for i, j in self.pairs:
@@ -517,17 +520,12 @@ class InvariantCheck:
             if not node.size:
                 continue
             depth, L, ends = gj.depth(gi.x[node])
-            if forces is not None:
+            if touched is not None:
                 # the faceting allowance is for a node between two nodes of the other surface
-                # that lie on this one: where the facet is not in or next to a contact zone
-                # (no node of it or of its neighbours carries force), a node inside it is
-                # contact missed (a curved body's first touch between the other's nodes), not
-                # faceting
-                loaded = np.abs(forces[j]).sum(axis=1) > 0
-                near = loaded.copy()
-                for a, b in ((0, 1), (1, 0)):
-                    np.logical_or.at(near, gj.b.segments[:, a], loaded[gj.b.segments[:, b]])
-                L = np.where(near[ends].any(axis=1), L, 0.0)
+                # that lie on this one: where the facet is not in or next to a contact zone,
+                # a node inside it is contact missed (a curved body's first touch between the
+                # other's nodes), not faceting
+                L = np.where(touched[j][ends].any(axis=1), L, 0.0)
             deformed, linearised, second = depth, None, 0.0
             if not (gi.b.large or gj.b.large):
                 linearised, second = self._linearised_depth(i, j, node, cur)
@@ -700,6 +698,16 @@ def _boundary_mass(x: np.ndarray, facets: np.ndarray, local: np.ndarray, n: int
     cols = np.tile(local[facets], (1, k)).ravel()
     vals = (L[:, None, None] * ref[None]).ravel()
     return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+def _loaded_or_next(segments: np.ndarray, forces: np.ndarray) -> np.ndarray:
+    """(nb,) the boundary nodes that carry a contact force (``forces``, (nb, 2)) or share a
+    boundary segment with one that does."""
+    loaded = np.abs(forces).sum(axis=1) > 0
+    out = loaded.copy()
+    for a, b in ((0, 1), (1, 0)):
+        np.logical_or.at(out, segments[:, a], loaded[segments[:, b]])
+    return out
 
 
 def step_invariants(model_or_bodies, pairs, fields: dict, penetration_tolerance: float,

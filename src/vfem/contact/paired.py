@@ -104,15 +104,8 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray)
         return np.zeros(0, dtype=int)
     a, b = s.segments(x)
     n = outward_normals(a, b)
-    nf = len(s.facets)
-    ids = np.arange(nf)
-    # each facet is read at its midpoint and near its ends: a facet partly under the other body
-    # whose midpoint lies beyond the other's corner faces its side there, not elsewhere (read
-    # at the midpoint alone, such a facet was dropped and the contact missed altogether)
-    faces = np.zeros(nf, dtype=bool)
-    for t in (0.5, 0.05, 0.95):
-        pts, _ = s.curve(ids, np.full(nf, t), x)
-        seg, _, _, m, _ = so.closest(pts, xo, None, n)
+    faces = np.zeros(len(s.facets), dtype=bool)
+    for _, m, _ in _read_facets(s, np.arange(len(s.facets)), x, so, xo, None, n):
         faces |= np.einsum("ij,ij->i", n, m) <= -FACING
     # and a facet over which a vertex of the other surface lies, facing it: a punch's corner
     # that has slid past the end of the face it pressed presses the block's facet beyond (left
@@ -125,6 +118,25 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray)
             & (np.einsum("ij,ij->i", vn, n[seg]) <= -FACING))
     faces[seg[over]] = True
     return np.flatnonzero(faces)
+
+
+#: Where a facet is read against the other surface: its midpoint and near its ends. A facet
+#: partly under the other body, its midpoint just past the other's corner, faces that corner's
+#: side at its midpoint only (read there alone, such a facet was dropped and the contact missed
+#: altogether: a punch overhanging a block's edge, tests/test_fuzz_placement.py).
+FACET_READINGS = (0.5, 0.05, 0.95)
+
+
+def _read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
+                 so: ContactSurface, xo: np.ndarray | None, ofacets: np.ndarray | None,
+                 normals: np.ndarray):
+    """For each of :data:`FACET_READINGS`: the closest point on ``so`` (its facets
+    ``ofacets``, all if None) of that point of each of ``facets`` of ``s`` (positions ``x``,
+    ``xo``; ties by ``normals``), as (facet of so, its normal there, unclamped t)."""
+    for t in FACET_READINGS:
+        pts, _ = s.curve(facets, np.full(len(facets), t), x)
+        seg, _, _, m, tf = so.closest(pts, xo, ofacets, normals)
+        yield seg, m, tf
 
 
 def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:
@@ -286,10 +298,8 @@ class PairedContact(VirtualElementContact):
             return 0.0, False
         oends = patch_ends(so, opatch)
         normals = outward_normals(*s.segments(s.X))[patch]
-        inside = np.zeros(len(patch), dtype=bool)
-        for t in (0.5, 0.05, 0.95):  # as in facing(): a facet partly over the other surface
-            pts, _ = s.curve(patch, np.full(len(patch), t))
-            seg, _, _, _, tf = so.closest(pts, None, opatch, normals)
+        inside = np.zeros(len(patch), dtype=bool)  # a facet over the other surface, even partly
+        for seg, _, tf in _read_facets(s, patch, None, so, None, opatch, normals):
             inside |= ~beyond(so, seg, tf, oends)
         over = patch[inside]
         if not len(over):
