@@ -187,12 +187,22 @@ def test_cli_runs_hertz_with_a_baseline(tmp_path, capsys):
 
 
 def test_a_body_only_contact_could_hold_but_none_can_touch_is_refused():
-    """The cylinder 0.2 above the flat: no candidates, so nothing holds it (singular)."""
+    """A puck pulled away from a block by its platen: no candidates, so nothing holds it
+    (singular). Pushed towards the block from the same gap, it finds it (the candidates are
+    looked for where the platen brings it, vfem.contact.surface.platen_approach)."""
+    from test_no_contact import puck
+
+    away = puck(+1e6)
+    away.contact = dataclasses.replace(away.contact, method="penalty")
+    result = Analysis(away).run()
+    assert not result.converged
+    assert "body 'puck' is held along y only by its platen and by contact" in result.message
+    assert "within contact.search_distance of each other" in result.message
     result = Analysis(hertz.build(hertz.HertzParameters(method="penalty",
                                                         initial_gap=0.2))).run()
-    assert not result.converged
-    assert "body 'cylinder' is held along y only by its platen and by contact" in result.message
-    assert "within contact.search_distance of each other" in result.message
+    assert result.converged
+    force = result.steps[-1].bodies["flat"].contact_force.sum(axis=0)
+    assert force[1] == pytest.approx(-1530.0, rel=1e-6)  # the platen tolerance
 
 
 # -- several bodies: two punches on one block (issue 16) ------------------------------------------

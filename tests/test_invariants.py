@@ -250,7 +250,7 @@ def unbalanced(monkeypatch, attempts):
 
 def test_a_state_that_breaks_an_invariant_is_cut_then_stops_the_analysis(monkeypatch, caplog):
     calls = unbalanced(monkeypatch, attempts=100)
-    with caplog.at_level(logging.WARNING, logger="vfem.solver"):
+    with caplog.at_level(logging.INFO, logger="vfem.solver"):
         result = Analysis(punch_model(max_step_cuts=2)).run()
     assert not result.converged and result.steps == []
     assert calls == [1.0, 0.5, 0.25]  # the step, then cut twice

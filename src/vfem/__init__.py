@@ -37,16 +37,19 @@ def load(path: str | Path) -> ModelConfig:
 
 
 def solve(model: Model | ModelConfig | str | Path, out: str | Path | None = None,
-          on_step=None, resume: bool = False, solver: str | None = None) -> AnalysisResult:
+          on_step=None, resume: bool = False, solver: str | None = None,
+          overwrite: bool = False) -> AnalysisResult:
     """Solve a model: a :class:`Model`, a :class:`ModelConfig` or the path of an input file.
 
     With ``out``, each converged step is written there as it converges (VTU files for ParaView,
-    ``results.pvd``, ``contact.csv``, a checkpoint, ``summary.json`` of the steps so far);
-    ``resume=True`` continues from the last checkpoint in ``out`` of an earlier run of the same
-    model. ``on_step(step)`` is called after each converged step. An analysis that does not
-    converge returns with ``converged = False`` and the steps done. ``solver``: the
+    ``results.pvd``, ``contact.csv``, ``reactions.csv``, a checkpoint, ``summary.json`` of the
+    steps so far); ``resume=True`` continues from the last checkpoint in ``out`` of an earlier
+    run of the same model. ``on_step(step)`` is called after each converged step. An analysis
+    that does not converge returns with ``converged = False`` and the steps done. ``solver``: the
     linear-algebra backend (``"superlu"``, ``"pardiso"``, ``"cholmod"``, ``"mumps"``; default:
-    the one chosen with :func:`vfem.linalg.use`, else the fastest installed).
+    the one chosen with :func:`vfem.linalg.use`, else the fastest installed). ``out`` is kept
+    as the command line keeps it (:mod:`vfem.io.folders`): an earlier run's files there are
+    cleared, another model's are refused (:class:`InputError`) unless ``overwrite``.
     """
     base = None
     if isinstance(model, (str, Path)):
@@ -56,9 +59,17 @@ def solve(model: Model | ModelConfig | str | Path, out: str | Path | None = None
         model = model.build(base)
     if out is None:
         return Analysis(model, solver).run(on_step)
+    from .io.folders import ResultsFolder, run_description
     from .io.results import run_writing
 
-    return run_writing(model, Path(out), on_step, resume, backend=solver)[1]
+    folder = ResultsFolder(Path(out), run_description(f"vfem.solve({model.name!r})",
+                                                      f"python: {model.name}", []))
+    folder.prepare(overwrite=overwrite, resume=resume)
+    try:
+        return run_writing(model, Path(out), on_step, resume, backend=solver)[1]
+    finally:
+        folder.update()
+        folder.stamp_summary()
 
 
 __all__ = [

@@ -8,6 +8,12 @@ so for a linear body the whole response the contact algorithm needs is
 where ``u_load`` is the solution under the body's loads and prescribed displacements at load factor
 1, ``u_platen`` the solution for a unit motion of its force-controlled platen (if any), and
 ``K^-1`` is applied with the body's own factorization, supports kept.
+
+Loads that follow a load curve (an ``amplitude``, :func:`multiplier`) are not proportional to the
+load factor: the loads are grouped by curve into :class:`LoadCase` s, one solve each, and the
+first term becomes ``sum_k m_k(load_factor) u_k`` (:func:`superpose`; the loads without a curve
+share the proportional case, ``m = load_factor``). Frictionless small-strain contact is path
+independent, so this superposition stays exact.
 """
 
 from __future__ import annotations
@@ -46,6 +52,80 @@ log = logging.getLogger(__name__)
 
 COMPONENTS = {"x": 0, "y": 1}
 
+#: A load curve: ``((load_factor, multiplier), ...)`` points, load factors strictly increasing.
+Amplitude = tuple[tuple[float, float], ...]
+
+
+def check_amplitude(amplitude, where: str) -> None:
+    """Raise :class:`InputError` (``where`` names the body, the load and its boundary) unless
+    ``amplitude`` is a load curve: [load factor, multiplier] pairs, finite numbers, load factors
+    strictly increasing. The one check of every load's ``amplitude`` (:meth:`Body.validate`)."""
+    try:
+        pts = np.asarray(amplitude, dtype=float)
+    except (TypeError, ValueError):
+        pts = None
+    if pts is None or pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 1:
+        raise InputError(f"{where}: the amplitude must be [load factor, multiplier] pairs, "
+                         f"e.g. [[0.0, 0.0], [1.0, 1.0]]; got {amplitude!r}")
+    if not np.all(np.isfinite(pts)):
+        raise InputError(f"{where}: the amplitude must hold finite numbers, got {amplitude!r}")
+    bad = np.flatnonzero(np.diff(pts[:, 0]) <= 0)
+    if len(bad):
+        k = int(bad[0])
+        raise InputError(f"{where}: the amplitude must have strictly increasing load factors; "
+                         f"{pts[k, 0]:g} is followed by {pts[k + 1, 0]:g}")
+
+
+def multiplier(amplitude: Amplitude | None, load_factor: float) -> float:
+    """What a load's value is multiplied by at ``load_factor``: the load factor itself without an
+    ``amplitude`` (proportional loading), else the curve interpolated linearly (constant beyond
+    its ends). The one interpolation of every load curve."""
+    if amplitude is None:
+        return load_factor
+    lf, mult = np.asarray(amplitude, dtype=float).T
+    return float(np.interp(load_factor, lf, mult))
+
+
+def curve_key(amplitude) -> Amplitude | None:
+    """``amplitude`` as a hashable tuple of float pairs (None stays None): loads with equal
+    curves share one :class:`LoadCase`."""
+    if amplitude is None:
+        return None
+    return tuple((float(t), float(m)) for t, m in amplitude)
+
+
+def superpose(load_factor: float, terms):
+    """``sum m(load_factor) * value`` over ``terms``, pairs (amplitude, value) with a value an
+    array or a number (:func:`multiplier`). With the one proportional term of a body without
+    load curves it is ``load_factor * value`` exactly, as before load curves existed."""
+    out = None
+    for amplitude, value in terms:
+        term = multiplier(amplitude, load_factor) * value
+        out = term if out is None else out + term
+    return out
+
+
+@dataclass
+class LoadCase:
+    """The loads of a small-kinematics body that follow one load curve.
+
+    Attributes:
+        amplitude: the curve (:func:`curve_key`), None for the loads proportional to the load
+            factor.
+        force: (ndofs) the nodal load vector of its tractions at multiplier 1.
+        prescribed: (ndofs) its prescribed displacements' values at multiplier 1 on their dofs,
+            zero on every other dof.
+        displacement: (ndofs) the body's response to them, supports kept (after
+            :meth:`Body.setup`).
+        platen_reaction: the platen's reaction to them (after :meth:`Body.setup`).
+    """
+
+    amplitude: Amplitude | None
+    force: np.ndarray
+    prescribed: np.ndarray
+    displacement: np.ndarray | None = None
+    platen_reaction: float = 0.0
+
 
 @dataclass(frozen=True)
 class Support:
@@ -68,10 +148,11 @@ class PrescribedDisplacement:
         boundary: the boundary's name.
         component: ``"x"`` or ``"y"``.
         value: the displacement at load factor 1.
-        amplitude: ``[[load_factor, multiplier], ...]`` points (load factors increasing): the
-            displacement is ``value`` times the multiplier interpolated linearly at the load
-            factor (constant beyond the ends), instead of ``value`` times the load factor. For
-            loads that are not proportional, e.g. press then slide; large kinematics only.
+        amplitude: a load curve, ``[[load_factor, multiplier], ...]`` points (load factors
+            strictly increasing): the displacement is ``value`` times the multiplier
+            interpolated linearly at the load factor (constant beyond the ends), instead of
+            ``value`` times the load factor. For loads that are not proportional, e.g. press
+            then slide, or load, hold and unload; small or large kinematics.
     """
 
     boundary: str
@@ -81,10 +162,7 @@ class PrescribedDisplacement:
 
     def at(self, load_factor: float) -> float:
         """The prescribed displacement at ``load_factor``."""
-        if self.amplitude is None:
-            return load_factor * self.value
-        lf, mult = np.asarray(self.amplitude, dtype=float).T
-        return self.value * float(np.interp(load_factor, lf, mult))
+        return self.value * multiplier(self.amplitude, load_factor)
 
 
 @dataclass(frozen=True)
@@ -94,10 +172,15 @@ class Traction:
     Attributes:
         boundary: the boundary's name.
         value: the traction (tx, ty), force per unit undeformed length, at load factor 1.
+        amplitude: a load curve, ``[[load_factor, multiplier], ...]`` points (load factors
+            strictly increasing): the traction is ``value`` times the multiplier interpolated
+            linearly at the load factor (constant beyond the ends), instead of ``value`` times
+            the load factor.
     """
 
     boundary: str
     value: tuple[float, float]
+    amplitude: tuple[tuple[float, float], ...] | None = None
 
 
 @dataclass
@@ -136,19 +219,29 @@ class Platen:
     """A rigid, force-controlled platen on a named boundary.
 
     Every node of the boundary moves by the same (unknown) displacement along ``component``; the
-    solver finds it so that the platen's reaction equals ``force`` times the load factor. This is
-    how a body held only by the load (the Hertz cylinder) is loaded without a singular stiffness.
-    ``force`` is the total force on the platen along ``component`` (negative: towards -x or -y).
+    solver finds it so that the platen's reaction equals ``force`` times the load factor (or
+    times its load curve's multiplier). This is how a body held only by the load (the Hertz
+    cylinder) is loaded without a singular stiffness. ``force`` is the total force on the platen
+    along ``component`` (negative: towards -x or -y).
 
     Attributes:
         boundary: the boundary the platen holds.
         component: the direction it moves in, ``"x"`` or ``"y"``.
         force: its total force at load factor 1 (negative: towards -x or -y).
+        amplitude: a load curve, ``[[load_factor, multiplier], ...]`` points (load factors
+            strictly increasing): the force is ``force`` times the multiplier interpolated
+            linearly at the load factor (constant beyond the ends), instead of ``force`` times
+            the load factor.
     """
 
     boundary: str
     component: str
     force: float
+    amplitude: tuple[tuple[float, float], ...] | None = None
+
+    def force_at(self, load_factor: float) -> float:
+        """The force the platen must apply at ``load_factor``."""
+        return self.force * multiplier(self.amplitude, load_factor)
 
 
 @dataclass
@@ -202,8 +295,10 @@ class Body:
         """Validate and assemble, without factorizing anything: the basis, the stiffness ``K``
         (all dofs), the constrained dofs (``fixed_dofs``, ``platen_dofs``, ``free_dofs``), the
         load vector ``f_load`` and ``u_prescribed`` (the constrained dofs' values, 0 on supports
-        and the platen's dofs), both at load factor 1. Refuses a body free to move as a rigid
-        body. Returns the prescribed value of every supported or prescribed dof.
+        and the platen's dofs), both with every load at its full value (load factor 1, or
+        multiplier 1 on a load curve), and the same split by load curve (``load_cases``, the
+        proportional case first). Refuses a body free to move as a rigid body. Returns the
+        prescribed value of every supported or prescribed dof.
 
         :meth:`setup` starts with it; the classical baselines (:mod:`vfem.contact.baselines`),
         which solve every body in one global system, need only this part.
@@ -218,14 +313,13 @@ class Body:
         fixed = self._constraints()
         self._check_supported()
         self.free_dofs = np.setdiff1d(np.arange(self.ndofs), self.fixed_dofs)
-        f = np.zeros(self.ndofs)
-        for tr in self.tractions:
-            f += self._traction_vector(tr)
-        self.f_load = f
-        u_fixed = np.zeros(self.ndofs)
-        for dof, value in fixed.items():
-            u_fixed[dof] = value
-        self.u_prescribed = u_fixed
+        self.load_cases = self._load_cases(fixed)
+        if len(self.load_cases) == 1:  # proportional loading: as before load curves existed
+            self.f_load = self.load_cases[0].force
+            self.u_prescribed = self.load_cases[0].prescribed
+        else:
+            self.f_load = sum(c.force for c in self.load_cases)
+            self.u_prescribed = sum(c.prescribed for c in self.load_cases)
         self.timings = {"assemble_s": t1 - t0, "constraints_s": time.perf_counter() - t1}
         return fixed
 
@@ -257,18 +351,23 @@ class Body:
             G[np.ix_(ix, ix)] = self.factor.trailing_inverse
             self.tracked_flexibility = G
 
-        f = self.f_load
-        self.u_load = self._solve_with(f, self.u_prescribed)
+        for case in self.load_cases:
+            case.displacement = self._solve_with(case.force, case.prescribed)
+        self.u_load = (self.load_cases[0].displacement if len(self.load_cases) == 1
+                       else sum(c.displacement for c in self.load_cases))
         # The platen's reaction (the force it applies to the body, along its component) is
-        # linear in the state: load_factor * platen_load_reaction + platen_displacement *
-        # platen_stiffness + (reaction per unit contact force) . contact forces.
+        # linear in the state: sum_k m_k(load_factor) * (case k's reaction) + platen_displacement
+        # * platen_stiffness + (reaction per unit contact force) . contact forces.
         self.u_platen = np.zeros(self.ndofs)
         self.platen_load_reaction = self.platen_stiffness = 0.0
         if self.platen is not None:
             u_unit = np.zeros(self.ndofs)
             u_unit[platen_dofs] = 1.0
             self.u_platen = self._solve_with(np.zeros(self.ndofs), u_unit)
-            self.platen_load_reaction = float((self.K @ self.u_load - f)[platen_dofs].sum())
+            for case in self.load_cases:
+                case.platen_reaction = float((self.K @ case.displacement
+                                              - case.force)[platen_dofs].sum())
+            self.platen_load_reaction = sum(c.platen_reaction for c in self.load_cases)
             self.platen_stiffness = _platen_stiffness(self.K, self.u_platen, platen_dofs)
         if self.large:
             self._setup_large(fixed)
@@ -306,6 +405,8 @@ class Body:
             nl.prescribe(self.platen_dofs,
                          lambda lf: np.full(len(self.platen_dofs), self._platen_value))
         nl.add_nodal_forces(np.arange(self.ndofs), self.f_load)
+        if any(tr.amplitude is not None for tr in self.tractions):  # not proportional
+            nl.set_load_history(self.applied_load)
         self.nonlinear = nl
         self._equilibrated: tuple | None = None
 
@@ -427,6 +528,50 @@ class Body:
                                    dtype=int)
         return fixed
 
+    def _load_cases(self, fixed: dict[int, float]) -> list[LoadCase]:
+        """The body's loads grouped by load curve: the proportional case (also holding the
+        supports' zeros) first, then one per distinct ``amplitude`` of its tractions and
+        prescribed displacements, in order of first mention. A dof that several conditions
+        prescribe belongs to the last prescribed displacement on it, as in :meth:`_constraints`.
+        ``fixed``: the prescribed value of every constrained dof (from :meth:`_constraints`)."""
+        keys = [None]
+        for load in (*self.tractions, *self.prescribed):
+            key = curve_key(load.amplitude)
+            if key not in keys:
+                keys.append(key)
+        cases = [LoadCase(k, np.zeros(self.ndofs), np.zeros(self.ndofs)) for k in keys]
+        for tr in self.tractions:
+            cases[keys.index(curve_key(tr.amplitude))].force += self._traction_vector(tr)
+        owner = dict.fromkeys(fixed, 0)
+        for pd in self.prescribed:  # later ones win, as in _constraints
+            owner.update(dict.fromkeys(self._boundary_dofs(pd.boundary, pd.component).tolist(),
+                                       keys.index(curve_key(pd.amplitude))))
+        for dof, value in fixed.items():
+            cases[owner[dof]].prescribed[dof] = value
+        return cases
+
+    def load_displacement(self, load_factor: float, dofs: np.ndarray | None = None
+                          ) -> np.ndarray:
+        """Small kinematics: the displacement (ndofs, or of ``dofs``) due to the loads and
+        prescribed displacements at ``load_factor``, each case at its curve's multiplier
+        (``load_factor * u_load`` without load curves); after :meth:`setup`."""
+        if dofs is None:
+            return superpose(load_factor, ((c.amplitude, c.displacement)
+                                           for c in self.load_cases))
+        return superpose(load_factor, ((c.amplitude, c.displacement[dofs])
+                                       for c in self.load_cases))
+
+    def platen_load_reaction_at(self, load_factor: float) -> float:
+        """Small kinematics: the platen's reaction to the loads and prescribed displacements at
+        ``load_factor`` (``load_factor * platen_load_reaction`` without load curves)."""
+        return superpose(load_factor, ((c.amplitude, c.platen_reaction)
+                                       for c in self.load_cases))
+
+    def prescribed_at(self, load_factor: float) -> np.ndarray:
+        """(ndofs) the constrained dofs' prescribed values at ``load_factor`` (zero on supports,
+        the platen's dofs and the free dofs; after :meth:`assemble`)."""
+        return superpose(load_factor, ((c.amplitude, c.prescribed) for c in self.load_cases))
+
     def element(self):
         """The scalar scikit-fem element of each displacement component."""
         tri = isinstance(self.mesh, MeshTri)
@@ -515,19 +660,12 @@ class Body:
         for c in comps:
             if c not in COMPONENTS:
                 raise InputError(f"{where}: component must be 'x' or 'y', got {c!r}")
-        for pd in self.prescribed:
-            if pd.amplitude is None:
-                continue
-            if not self.large:
-                raise InputError(f"{where}: prescribed displacement on {pd.boundary!r} has an "
-                                 "amplitude, which needs large kinematics (small kinematics "
-                                 "superposes loads proportional to the load factor)")
-            pts = np.asarray(pd.amplitude, dtype=float)
-            if (pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 1
-                    or not np.all(np.isfinite(pts)) or np.any(np.diff(pts[:, 0]) <= 0)):
-                raise InputError(f"{where}: amplitude of the prescribed displacement on "
-                                 f"{pd.boundary!r} must be [load factor, multiplier] pairs with "
-                                 "finite numbers and increasing load factors")
+        for kind, loads in (("prescribed displacement", self.prescribed),
+                            ("traction", self.tractions),
+                            ("platen", (self.platen,) if self.platen else ())):
+            for load in loads:
+                if load.amplitude is not None:
+                    check_amplitude(load.amplitude, f"{where}: {kind} on {load.boundary!r}")
         values = [pd.value for pd in self.prescribed] + [v for t in self.tractions for v in t.value]
         values += [self.platen.force] if self.platen else []
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
@@ -606,18 +744,67 @@ class Body:
         """Full displacement vector (ndofs) for the given state."""
         if self.large:
             return self.equilibrate(load_factor, platen_displacement, contact_force).copy()
-        return (load_factor * self.u_load + platen_displacement * self.u_platen
+        return (self.load_displacement(load_factor) + platen_displacement * self.u_platen
                 + self.response(contact_force))
+
+    def applied_load(self, load_factor: float) -> np.ndarray:
+        """The body's applied nodal loads (ndofs: its tractions' load vector) at
+        ``load_factor``, each traction at its load curve's multiplier; the one place reactions,
+        force balances and the large-kinematics loads read the loads from."""
+        return superpose(load_factor, ((c.amplitude, c.force) for c in self.load_cases))
+
+    def nodal_reaction(self, u: np.ndarray, load_factor: float = 1.0,
+                       contact_force: np.ndarray | None = None) -> np.ndarray:
+        """The nodal forces (ndofs) the constraints (supports, prescribed displacements, the
+        platen) apply to the body, for displacement ``u`` (ndofs) under the loads at
+        ``load_factor`` and the nodal ``contact_force`` (ndofs): the out-of-balance force
+        ``K u - applied_load(load_factor) - f_contact`` (the internal force in place of ``K u``
+        under large kinematics) on the constrained dofs (``fixed_dofs``), zero on the free
+        ones, where it is only the solver's residual. Adding it to the loads and contact
+        forces balances the body, so its sum is the body's total support reaction, each
+        constrained dof counted once."""
+        Ku = self.nonlinear.internal_force_at(u) if self.large else self.K @ u
+        r = Ku - self.applied_load(load_factor)
+        if contact_force is not None:
+            r = r - contact_force
+        out = np.zeros(self.ndofs)
+        out[self.fixed_dofs] = r[self.fixed_dofs]
+        return out
+
+    def reaction_dofs(self) -> dict[str, np.ndarray]:
+        """Per boundary that carries a support, a prescribed displacement or the platen (in
+        that order of first mention), the dofs its own conditions constrain: a support's
+        components, a prescribed component, the platen's component. A node shared by two such
+        boundaries (a corner) is in both where both constrain the same component."""
+        parts: dict[str, list[np.ndarray]] = {}
+        for s in self.supports:
+            for c in s.components:
+                parts.setdefault(s.boundary, []).append(self._boundary_dofs(s.boundary, c))
+        for pd in self.prescribed:
+            parts.setdefault(pd.boundary, []).append(self._boundary_dofs(pd.boundary,
+                                                                         pd.component))
+        if self.platen is not None:
+            parts.setdefault(self.platen.boundary, []).append(self.platen_dofs)
+        return {name: np.unique(np.concatenate(d)) for name, d in parts.items()}
+
+    def boundary_reactions(self, nodal_reaction: np.ndarray) -> dict[str, tuple[float, float]]:
+        """Per constrained boundary (:meth:`reaction_dofs`), the total (x, y) of
+        ``nodal_reaction`` (ndofs, from :meth:`nodal_reaction`) over the dofs it constrains.
+        A shared corner dof counts in each boundary that constrains it, so the boundaries'
+        totals add up to the body's total only where no dof is shared."""
+        r = np.asarray(nodal_reaction, dtype=float).ravel()
+        out = {}
+        for name, dofs in self.reaction_dofs().items():
+            out[name] = (float(r[dofs[dofs % 2 == 0]].sum()), float(r[dofs[dofs % 2 == 1]].sum()))
+        return out
 
     def reaction(self, u: np.ndarray, boundary: str, component: str, load_factor: float = 1.0,
                  contact_force: np.ndarray | None = None) -> float:
         """Total force the supports (or prescribed displacements) on ``boundary`` apply to the
         body along ``component``, for displacement ``u`` (ndofs) under the body's loads at
-        ``load_factor`` and the nodal ``contact_force`` (ndofs)."""
-        Ku = self.nonlinear.internal_force_at(u) if self.large else self.K @ u
-        r = Ku - load_factor * self.f_load
-        if contact_force is not None:
-            r -= contact_force
+        ``load_factor`` and the nodal ``contact_force`` (ndofs): :meth:`nodal_reaction` summed
+        over the boundary's dofs of that component (zero where none of them is constrained)."""
+        r = self.nodal_reaction(u, load_factor, contact_force)
         return float(r[self._boundary_dofs(boundary, component)].sum())
 
     def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
@@ -690,4 +877,5 @@ def _with_von_mises(avg: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return avg
 
 
-__all__ = ["Body", "Support", "PrescribedDisplacement", "Traction", "Platen", "Linearization"]
+__all__ = ["Body", "Support", "PrescribedDisplacement", "Traction", "Platen", "Linearization",
+           "LoadCase", "check_amplitude", "multiplier", "superpose"]

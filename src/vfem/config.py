@@ -194,7 +194,8 @@ MAX_STEPS = 1_000_000
 @dataclass(frozen=True)
 class Steps:
     """The load history. Every load, prescribed displacement and platen force is scaled by the
-    load factor (proportional loading); each step ends at the next load factor.
+    load factor (proportional loading), or by its load curve's multiplier where it has an
+    ``amplitude``; each step ends at the next load factor.
 
     Attributes:
         count: that many equal steps from 0 to 1 (used when ``load_factors`` is not given; at
@@ -222,9 +223,11 @@ class Output:
 
     Attributes:
         directory: the results folder, a relative path inside the folder where vfem runs
-            (no absolute path, drive or ``..`` that climbs out). Default: ``results/<name>``.
-            The command line's ``--out`` overrides it and may be any folder.
-        figures: draw the figures (deformed shape, contact pressure, history) at the end.
+            (no absolute path, drive or ``..`` that climbs out). Default: ``results/<name>``
+            (with the command line's ``--set`` changes in the name). The command line's
+            ``--out`` overrides it and may be any folder.
+        figures: draw the figures at the end (deformed shape, contact pressure, history, von
+            Mises stress; ``vfem plot`` redraws them from the files).
     """
 
     directory: str | None = None

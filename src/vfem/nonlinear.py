@@ -224,6 +224,7 @@ class NonlinearBody:
         p = self.mesh.doflocs
         self.length = float(np.hypot(*(p.max(axis=1) - p.min(axis=1))))
         self.nodal_forces = np.zeros(self.ndofs)
+        self._load_history: Callable[[float], np.ndarray] | None = None
         self._prescribed: list[tuple[np.ndarray, Values]] = []
         self.displacement = np.zeros(self.ndofs)
         self.load_factor = 0.0
@@ -304,6 +305,18 @@ class NonlinearBody:
         dofs = np.asarray(dofs, dtype=int).ravel()
         np.add.at(self.nodal_forces, dofs,
                   np.broadcast_to(np.asarray(forces, dtype=float), dofs.shape))
+
+    def set_load_history(self, loads: Callable[[float], np.ndarray]) -> None:
+        """Dead nodal forces that are not proportional to the load factor: ``loads(load_factor)``
+        (ndofs) replaces ``load_factor * nodal_forces`` (load curves, :class:`vfem.bodies.Body`
+        passes its :meth:`~vfem.bodies.Body.applied_load`)."""
+        self._load_history = loads
+
+    def dead_loads(self, load_factor: float) -> np.ndarray:
+        """The dead nodal forces (ndofs) at ``load_factor``."""
+        if self._load_history is None:
+            return load_factor * self.nodal_forces
+        return np.asarray(self._load_history(load_factor), dtype=float)
 
     def _dirichlet(self, load_factor: float) -> tuple[np.ndarray, np.ndarray]:
         """Prescribed dofs and their total displacement at ``load_factor``."""
@@ -408,7 +421,7 @@ class NonlinearBody:
         """``f_int - load_factor f_ext`` (ndofs): on the prescribed dofs the forces the supports
         apply to the body (equilibrium: ``f_int = f_ext + reactions``); round-off elsewhere after
         a converged step."""
-        return self.internal_force() - self.load_factor * self.nodal_forces
+        return self.internal_force() - self.dead_loads(self.load_factor)
 
     # -- Newton ---------------------------------------------------------------------------------
 
@@ -603,7 +616,7 @@ class NonlinearBody:
 
     def _loads(self, load_factor: float, extra_force: np.ndarray | None) -> np.ndarray:
         """External nodal forces: the dead loads at ``load_factor`` plus ``extra_force``."""
-        f_ext = load_factor * self.nodal_forces
+        f_ext = self.dead_loads(load_factor)
         return f_ext if extra_force is None else f_ext + extra_force
 
     def _reference_force(self, f_ext: np.ndarray, f_int: np.ndarray) -> float:

@@ -4,7 +4,8 @@ For each step (an increment of the load factor):
 
 1. **predict** — every body is solved on its own with the new loads and the contact forces it
    already carries (for linear bodies this is a change of the load factor in the superposition
-   ``u = load_factor * u_load + platen * u_platen + K^-1 f_contact``);
+   ``u = load_factor * u_load + platen * u_platen + K^-1 f_contact``, the first term summed
+   over the body's load curves, :meth:`~vfem.bodies.Body.load_displacement`);
 2. **resolve contact** — the variant chosen by ``ContactSettings.variant``
    (:class:`~vfem.contact.paired.PairedContact` by default, or the thesis's
    :class:`~vfem.contact.algorithm.VirtualElementContact`) iterates check -> correct until
@@ -42,8 +43,14 @@ from .contact.algorithm import (
     VirtualElementContact,
 )
 from .contact.check import InvariantCheck, Invariants
+from .contact.search import project_points
 from .contact.settings import ContactSettings
-from .contact.surface import ContactSurface, check_initial_overlap, select_candidate_facets
+from .contact.surface import (
+    ContactSurface,
+    check_initial_overlap,
+    exterior_facets,
+    select_candidate_facets,
+)
 from .errors import AnalysisError, InputError, InvariantViolation, RindViolation
 from .linalg import resolve as resolve_backend
 from .memory import check_memory, memory_guard
@@ -56,7 +63,8 @@ class Model:
     """Bodies, the contact settings and the load schedule.
 
     ``load_factors``: the load factor at the end of each step, starting from 0. They may go down
-    as well as up (unloading, thesis §5.5); loads and prescribed displacements scale with them.
+    as well as up (unloading, thesis §5.5); loads and prescribed displacements scale with them,
+    or follow their load curves (``amplitude``).
     """
 
     name: str
@@ -153,10 +161,40 @@ class BodyStepResult:
     #: unknowns q on the compatibility side, that field read at the other side's nodes); where a
     #: formulation has none, the nodal reading ``contact_pressure``
     contact_traction: np.ndarray | None = None
+    #: (npoints, 2) nodal force the supports, prescribed displacements and platen apply to the
+    #: body (:meth:`Body.nodal_reaction`): zero on unconstrained dofs. With the contact force and
+    #: the applied loads it balances the body (:func:`add_reactions`)
+    reaction: np.ndarray | None = None
+    #: per boundary carrying a support, a prescribed displacement or the platen, the total (x, y)
+    #: of ``reaction`` over the dofs that boundary's own conditions constrain
+    #: (:meth:`Body.boundary_reactions`: a shared corner dof counts in each boundary constraining
+    #: it; the body's total, ``reaction.sum(axis=0)``, counts it once)
+    reactions: dict[str, tuple[float, float]] = field(default_factory=dict)
+    #: (2,) resultant (x, y) of the body's applied loads (its tractions) at the step's load factor
+    applied_load: np.ndarray | None = None
 
     def __post_init__(self):
         if self.contact_traction is None:
             self.contact_traction = self.contact_pressure
+
+    @property
+    def reaction_total(self) -> np.ndarray:
+        """(2,) the body's total support reaction (x, y): ``reaction`` summed over the nodes,
+        each constrained dof once; zeros where reactions were not computed."""
+        return np.zeros(2) if self.reaction is None else self.reaction.sum(axis=0)
+
+
+def add_reactions(body: Body, r: BodyStepResult, load_factor: float) -> BodyStepResult:
+    """Fill ``r``'s support reactions (``reaction``, ``reactions``, ``applied_load``) from its
+    displacement and contact force at ``load_factor``: one evaluation of the body's stiffness
+    (internal force under large kinematics) per converged step, so every output reads the same
+    numbers. Returns ``r``."""
+    nodal = body.nodal_reaction(np.asarray(r.displacement).ravel(), load_factor,
+                                np.asarray(r.contact_force).ravel())
+    r.reaction = nodal.reshape(-1, 2)
+    r.reactions = body.boundary_reactions(nodal)
+    r.applied_load = body.applied_load(load_factor).reshape(-1, 2).sum(axis=0)
+    return r
 
 
 @dataclass
@@ -205,11 +243,44 @@ def easy_iterations(settings: ContactSettings) -> int:
     return max(3, settings.max_iterations // 10)
 
 
+def unreachable_pairs(model: Model, pairs: set[frozenset[int]],
+                      surfaces: list) -> list[str]:
+    """A note for every pair of bodies that may touch but has no contact candidate on either
+    body: how far apart they are, against the search distance (``contact.search_distance``).
+    Such bodies cannot touch in the analysis; a body that only contact would hold (pushed by
+    a platen) then has nothing to push against, and the stop diagnosis says so."""
+    notes = []
+    for pair in sorted(tuple(sorted(p)) for p in pairs):
+        i, j = pair
+        if surfaces[i].nc or surfaces[j].nc:
+            continue
+        ends = []
+        for b in (model.bodies[i], model.bodies[j]):
+            f = b.mesh.facets[:, exterior_facets(b)]
+            ends.append((b.mesh.p[:, f[0]].T, b.mesh.p[:, f[1]].T))
+        gap = float(project_points(np.vstack(ends[0]), *ends[1])[2].min()) if len(
+            ends[0][0]) and len(ends[1][0]) else np.inf
+        distance = model.contact.search_distance
+        said = (f"{distance:.3g}" if distance is not None else
+                "2 % of the smaller body's size, the default")
+        notes.append(f"bodies {model.bodies[i].name!r} and {model.bodies[j].name!r} are "
+                     f"{gap:.3g} apart and no load is predicted to bring them within the contact "
+                     f"search distance ({said}; contact.search_distance): no facet of theirs is "
+                     "a contact candidate, so they cannot touch in this analysis")
+    return notes
+
+
 def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
-              settings: ContactSettings) -> str:
+              settings: ContactSettings, unreachable: list[str] = ()) -> str:
     """The message of an analysis that stops: which step, what failed (the error names the
-    bodies and nodes), and what the user can change."""
+    bodies and nodes), and what the user can change. ``unreachable``: notes of
+    :func:`unreachable_pairs`, the likely cause when there are any."""
     text = str(exc)
+    if unreachable:
+        return (f"step {step} (load factor {start:.6g} -> {target:.6g}) failed: no contact was "
+                f"found: {'; '.join(unreachable)}. What to change: set contact.search_distance "
+                "above the gap, or start the bodies closer; a body held only by contact (a "
+                "platen) has nothing to push against until it touches")
     if isinstance(exc, InvariantViolation):
         remedy = ("the contact iteration met its own stopping rule but the state it reached "
                   "breaks an invariant checked from the full-mesh results; take smaller steps "
@@ -257,6 +328,7 @@ class Analysis:
         self.backend = resolve_backend(backend)  # None: the one chosen (--solver), else auto
         self.timings: dict[str, float] = {}
         self.strain_warned: set[str] = set()  # bodies already warned about (warn_large_strain)
+        self.unreachable: list[str] = []  # pairs that cannot touch (unreachable_pairs)
 
     def setup(self) -> None:
         """Find each body's contact candidates, then assemble and factorize every body.
@@ -280,6 +352,9 @@ class Analysis:
         log.info("linear solver: %s", self.backend)
         bodies = self.model.bodies
         pairs, self.surfaces = self.model.contact_surfaces()
+        self.unreachable = unreachable_pairs(self.model, pairs, self.surfaces)
+        for note in self.unreachable:
+            log.warning("%s", note)
         t1 = time.perf_counter()
         check_memory(self.surfaces, pairs)
         with memory_guard("factorizing the bodies and computing their flexibility"):
@@ -383,7 +458,7 @@ class Analysis:
         state = start.copy()
         state.load_factor = load_factor
         platen = next((b.platen for b in self.model.bodies if b.platen is not None), None)
-        state.platen_force = load_factor * platen.force if platen is not None else 0.0
+        state.platen_force = platen.force_at(load_factor) if platen is not None else 0.0
         res = self.contact.solve(state)
         history_out.extend(res.history)
         if not res.converged:
@@ -460,12 +535,13 @@ class Analysis:
                 if self.level >= settings.max_step_cuts:
                     converged = False
                     message = diagnosis(len(steps) + 1, state.load_factor, lf, self.level, exc,
-                                        settings)
+                                        settings, self.unreachable)
                     log.info(message)  # the caller reports it (AnalysisResult.message)
                     break
                 self.level += 1
-                log.warning("step to load factor %.6g failed (%s); cutting the increment to "
-                            "%.6g", lf, exc, full / 2**self.level)
+                # step control at work, not a failure: the progress line counts the cuts
+                log.info("step to load factor %.6g not reached (%s); cutting the increment to "
+                         "%.6g", lf, exc, full / 2**self.level)
                 continue
             for b in self.model.bodies:
                 b.commit_step()
@@ -525,6 +601,7 @@ class Analysis:
             status[cand] = p.participating & (p.force > 0)
             pen = np.zeros(nv)
             pen[cand] = np.where(np.isfinite(p.penetration), p.penetration, 0.0)
-            out[b.name] = BodyStepResult(u.reshape(-1, 2), force, pressure, status, pen,
-                                         traction)
+            out[b.name] = add_reactions(
+                b, BodyStepResult(u.reshape(-1, 2), force, pressure, status, pen, traction),
+                state.load_factor)
         return out

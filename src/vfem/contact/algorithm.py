@@ -74,7 +74,7 @@ class ContactState:
     platen_displacement: float
     forces: list[np.ndarray]  # per body (nc, 2), the force the other bodies apply on it
     released: list[np.ndarray] = field(default_factory=list)  # nodes released last iteration
-    platen_force: float = 0.0  # the force the platen must apply (scheduled force x load factor)
+    platen_force: float = 0.0  # the force the platen must apply (Platen.force_at)
     multipliers: dict = field(default_factory=dict)  # per-pair traction values (paired)
 
     def copy(self) -> ContactState:
@@ -196,7 +196,7 @@ class VirtualElementContact:
         for s, F in zip(self.surfaces, state.forces):
             b = s.body
             dofs = s.tracked_dofs
-            u = (state.load_factor * b.u_load[dofs] + state.platen_displacement
+            u = (b.load_displacement(state.load_factor, dofs) + state.platen_displacement
                  * b.u_platen[dofs] + s.G @ F.ravel())
             out.append(s.X + u.reshape(-1, 2))
         return out
@@ -207,7 +207,7 @@ class VirtualElementContact:
             return 0.0
         s = self.surfaces[self.platen_body]
         b = s.body
-        return (state.load_factor * b.platen_load_reaction
+        return (b.platen_load_reaction_at(state.load_factor)
                 + state.platen_displacement * b.platen_stiffness
                 + float(s.platen_row @ state.forces[self.platen_body].ravel()))
 

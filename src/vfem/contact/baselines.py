@@ -7,7 +7,9 @@ as the virtual finite element method (bodies, meshes, supports, loads, platen, l
 * **one global system**: the stiffness of every body, block diagonal, reduced to the free dofs
   by a sparse transformation ``U = T q + load_factor * U_prescribed`` (``K_red = T^T K T``). A
   force-controlled rigid platen is one more unknown, the platen displacement, to which all its
-  dofs are tied; its equation carries the platen force (scaled by the load factor).
+  dofs are tied; its equation carries the platen force (scaled by the load factor). Loads on
+  load curves (``amplitude``) are kept apart, one load vector per curve, each scaled by its
+  curve's multiplier.
 * **node-to-segment, single pass**: per pair of bodies that may touch, the *slave* surface is the
   finer one (more candidate nodes per unit length; of equals, the softer, then the first name in
   alphabetical order; so the choice never depends on the order of the bodies) and its candidate
@@ -62,7 +64,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..bodies import COMPONENTS
+from ..bodies import COMPONENTS, curve_key, superpose
 from ..errors import AnalysisError
 from ..linalg import factorize
 from ..memory import memory_guard
@@ -297,19 +299,35 @@ class GlobalContact:
         rows, cols = [free], [np.arange(len(free))]
         self.platen_body = next((i for i, b in enumerate(bodies) if b.platen is not None), None)
         self.nq = len(free) + (self.platen_body is not None)
-        f1 = np.concatenate([b.f_load for b in bodies])
-        self.U_prescribed = np.concatenate([b.u_prescribed for b in bodies])
-        platen_force = np.zeros(self.nq)
+        # the loads by load curve (the proportional case first): every body's load cases and
+        # the platen force, each at multiplier 1
+        keys = [None]
+        for b in bodies:
+            keys += [cs.amplitude for cs in b.load_cases if cs.amplitude not in keys]
+        if self.platen_body is not None:
+            amplitude = curve_key(bodies[self.platen_body].platen.amplitude)
+            keys += [amplitude] if amplitude not in keys else []
+        f1 = [np.zeros(N) for _ in keys]
+        U1 = [np.zeros(N) for _ in keys]
+        for b, off in zip(bodies, self.offsets):
+            for cs in b.load_cases:
+                k = keys.index(cs.amplitude)
+                f1[k][off:off + b.ndofs] = cs.force
+                U1[k][off:off + b.ndofs] = cs.prescribed
+        platen_force = [np.zeros(self.nq) for _ in keys]
         if self.platen_body is not None:
             b = bodies[self.platen_body]
             rows.append(self.offsets[self.platen_body] + b.platen_dofs)
             cols.append(np.full(len(b.platen_dofs), self.nq - 1))
-            platen_force[-1] = b.platen.force
+            platen_force[keys.index(curve_key(b.platen.amplitude))][-1] = b.platen.force
         r, c = np.concatenate(rows), np.concatenate(cols)
         self.T = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(N, self.nq))
         self.K = (self.T.T @ K @ self.T).tocsc()
-        # the reduced load at load factor 1: loads, prescribed displacements, platen force
-        self.f1 = self.T.T @ (f1 - K @ self.U_prescribed) + platen_force
+        self.curves = keys
+        #: per load curve: the prescribed displacements (all dofs) and the reduced load (loads,
+        #: prescribed displacements, platen force), at multiplier 1
+        self.U_prescribed = U1
+        self.f1 = [self.T.T @ (f - K @ U) + pf for f, U, pf in zip(f1, U1, platen_force)]
         t2 = time.perf_counter()
         c = node_to_segment(self.surfaces, pairs, self.offsets, N, settings.penalty,
                             settings.penalty_factor)
@@ -319,7 +337,7 @@ class GlobalContact:
         live = np.diff(abs(Br).tocsr().indptr) > 0
         self.c = c.subset(live)
         self.Br = Br[live]
-        self.g_prescribed = self.c.B @ self.U_prescribed  # per unit load factor
+        self.g_prescribed = [self.c.B @ U for U in self.U_prescribed]  # per unit multiplier
         t3 = time.perf_counter()
         slave_lengths = [s.lengths.min() for i, s in enumerate(self.surfaces)
                          if len(s.lengths) and np.any(self.c.slave == i)]
@@ -403,6 +421,11 @@ class GlobalContact:
         self._factor_key = key
         return self._factor
 
+    def at(self, load_factor: float, per_curve: list) -> np.ndarray:
+        """``per_curve`` (one vector per load curve, :attr:`curves`, at multiplier 1) at
+        ``load_factor``: ``load_factor`` times the one vector of a model without load curves."""
+        return superpose(load_factor, zip(self.curves, per_curve))
+
     def solve_step(self, load_factor: float, active: np.ndarray, lam: np.ndarray):
         """Solve at ``load_factor`` from the active set and multipliers (pressures, augmented
         Lagrangian) of the previous step. Returns (q, Lambda, gap, active, lam, history):
@@ -420,8 +443,8 @@ class GlobalContact:
                 f"body {b.name!r} is held along {b.platen.component} only by its platen and by "
                 "contact, and none of its nodes can touch another body (no contact candidates "
                 "within contact.search_distance), so the global matrix is singular")
-        f = load_factor * self.f1
-        gp = self.c.g0 + load_factor * self.g_prescribed  # gaps with the loads' motion only
+        f = self.at(load_factor, self.f1)
+        gp = self.c.g0 + self.at(load_factor, self.g_prescribed)  # with the loads' motion only
         c, Br = self.c, self.Br
         ew = c.penalty * c.weight
         active = self._seeded(active, gp)
@@ -497,9 +520,9 @@ class GlobalContact:
     def fields(self, load_factor: float, q: np.ndarray, Lam: np.ndarray, g: np.ndarray):
         """Per body: the :class:`~vfem.solver.BodyStepResult` and the contact forces on its
         candidate nodes (nc, 2)."""
-        from ..solver import BodyStepResult
+        from ..solver import BodyStepResult, add_reactions
 
-        U = self.T @ q + load_factor * self.U_prescribed
+        U = self.T @ q + self.at(load_factor, self.U_prescribed)
         f_slave = self.c.B_slave.T @ Lam
         f_master = self.c.B_master.T @ Lam
         out, forces = {}, []
@@ -528,7 +551,9 @@ class GlobalContact:
                 depth = np.full(s.nc, -np.inf)
                 np.maximum.at(depth, self.c.node[mine], -g[mine])
                 pen[cand] = np.where(np.isfinite(depth), depth, 0.0)
-            out[b.name] = BodyStepResult(U[part].reshape(-1, 2), force, pressure, status, pen)
+            out[b.name] = add_reactions(
+                b, BodyStepResult(U[part].reshape(-1, 2), force, pressure, status, pen),
+                load_factor)
             forces.append(force[cand])
         return out, forces
 
@@ -582,11 +607,11 @@ class GlobalContact:
                 break
             fields, forces = self.fields(lf, q, Lam, g)
             platen = float(q[-1]) if self.platen_body is not None else 0.0
-            force = model.bodies[self.platen_body].platen.force if self.platen_body is not None \
-                else 0.0
+            force = (model.bodies[self.platen_body].platen.force_at(lf)
+                     if self.platen_body is not None else 0.0)
             state = ContactState(lf, platen, forces,
                                  [np.zeros(s.nc, dtype=bool) for s in self.surfaces],
-                                 lf * force, {0: lam, 1: active.astype(float)})
+                                 force, {0: lam, 1: active.astype(float)})
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=len(history),
                               converged=True, history=history, platen_displacement=platen)
             step.bodies = fields

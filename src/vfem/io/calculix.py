@@ -96,6 +96,9 @@ def _check_supported(model) -> None:
         if any(pd.amplitude is not None for pd in b.prescribed):
             raise InputError(f"CalculiX deck: body {b.name!r} has a prescribed displacement "
                              "with an amplitude, which the writer does not translate")
+        if b.platen is not None and b.platen.amplitude is not None:
+            raise InputError(f"CalculiX deck: body {b.name!r} has a platen force with an "
+                             "amplitude, which the writer does not translate")
 
 
 def _counter_clockwise(mesh) -> tuple[np.ndarray, int]:
@@ -159,7 +162,8 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
 
     Args:
         model: a two-body :class:`~vfem.solver.Model` with linear elements, small kinematics,
-            supports, prescribed displacements (no amplitude) and at most one platen.
+            supports, prescribed displacements (no amplitude) and at most one platen (no
+            amplitude).
         path: the ``.inp`` file to write.
         slave: the slave body's name; default the one with the smaller Young's modulus.
         penalty: the contact stiffness (pressure per unit overclosure) of ccx's linear

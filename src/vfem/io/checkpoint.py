@@ -28,7 +28,9 @@ from ..errors import InputError
 from ..solver import BodyStepResult, Checkpoint, Model, StepResult
 
 FOLDER = "checkpoint"
-_FIELDS = [f.name for f in dataclasses.fields(BodyStepResult)]
+#: the array fields of a body's step results (the per-boundary reaction totals, a dict, go into
+#: the JSON text)
+_FIELDS = [f.name for f in dataclasses.fields(BodyStepResult) if f.name != "reactions"]
 
 
 def fingerprint(model: Model) -> str:
@@ -55,7 +57,8 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
     for i, b in enumerate(model.bodies):
         r = step.bodies[b.name]
         for f in _FIELDS:
-            arrays[f"field_{i}_{f}"] = getattr(r, f)
+            if getattr(r, f) is not None:
+                arrays[f"field_{i}_{f}"] = getattr(r, f)
         for key, value in checkpoint.bodies.get(b.name, {}).items():
             arrays[f"body_{i}_{key}"] = np.asarray(value)
     for i, (F, rel) in enumerate(zip(state.forces, state.released)):
@@ -69,6 +72,8 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
                  "platen_displacement": step.platen_displacement, "cuts": step.cuts,
                  "fixed_point": step.fixed_point, "invariants": step.invariants,
                  "history": [dataclasses.asdict(h) for h in step.history]},
+        "reactions": {b.name: {k: list(v) for k, v in step.bodies[b.name].reactions.items()}
+                      for b in model.bodies},
         "state": {"load_factor": state.load_factor,
                   "platen_displacement": state.platen_displacement,
                   "platen_force": state.platen_force,
@@ -112,7 +117,7 @@ def read(out: Path, model: Model) -> Checkpoint | None:
                              "materials, loads or settings differ); give the same model and "
                              "options as the run that wrote them, or run afresh without "
                              "--resume")
-        steps.append(_step(meta["step"], arrays, model))
+        steps.append(_step(meta["step"], arrays, model, meta.get("reactions", {})))
     state = ContactState(
         meta["state"]["load_factor"], meta["state"]["platen_displacement"],
         [arrays[f"force_{i}"] for i in range(len(model.bodies))],
@@ -124,10 +129,13 @@ def read(out: Path, model: Model) -> Checkpoint | None:
     return Checkpoint(steps, state, bodies, **meta["control"])
 
 
-def _step(meta: dict, arrays: dict[str, np.ndarray], model: Model) -> StepResult:
+def _step(meta: dict, arrays: dict[str, np.ndarray], model: Model,
+          reactions: dict[str, dict[str, list[float]]]) -> StepResult:
     step = StepResult(**{**meta, "history": [IterationRecord(**h) for h in meta["history"]]})
     step.bodies = {b.name: BodyStepResult(**{f: arrays[f"field_{i}_{f}"] for f in _FIELDS
-                                                if f"field_{i}_{f}" in arrays})
+                                                if f"field_{i}_{f}" in arrays},
+                                          reactions={k: tuple(v) for k, v in
+                                                     reactions.get(b.name, {}).items()})
                    for i, b in enumerate(model.bodies)}
     return step
 

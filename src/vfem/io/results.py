@@ -1,4 +1,5 @@
-"""Results on disk: a VTU file per body and converged step, a PVD index, contact.csv, summary.json.
+"""Results on disk: a VTU file per body and converged step, a PVD index, contact.csv,
+reactions.csv, summary.json.
 
 ParaView opens ``results.pvd`` as a time series (time = load factor) holding every body; each entry
 gives the load factor (``timestep``), the body's index in the model (``part``), its name (``name``)
@@ -8,7 +9,9 @@ and the VTU file (``file``). Point fields: ``displacement`` (3 components, z = 0
 traction averaged with the node's shape function), ``contact_traction`` (the formulation's
 nominal traction at the node: in the paired variant its unknowns q on the compatibility side,
 read at the other side's nodes; elsewhere as ``contact_pressure``), ``contact_status``
-(1 in contact, 0 free), ``penetration`` (> 0 overlapping). Cell fields:
+(1 in contact, 0 free), ``penetration`` (> 0 overlapping), ``reaction`` (3 components, z = 0:
+the nodal force the supports, prescribed displacements and platen apply to the body, zero on
+unconstrained dofs; :attr:`vfem.solver.BodyStepResult.reaction`). Cell fields:
 ``stress_xx``, ``stress_yy``, ``stress_xy``, ``stress_zz``, ``von_mises`` (element averages).
 Quadratic elements are written as VTK's 6-node triangles and 9-node quadrilaterals, with the
 fields at every node.
@@ -21,6 +24,14 @@ nominal contact pressure (as ``contact_pressure``), ``gap`` = -``penetration`` (
 overlapping; 0 where the contact algorithm measured none, e.g. the coarse side of a paired
 contact), ``status`` ``contact`` or ``free``. Numbers are written with 17 significant digits
 (round-trip exact).
+
+``reactions.csv``: one row per converged step, body and boundary carrying a support, a prescribed
+displacement or a platen, columns ``step, load_factor, body, boundary, Rx, Ry``: the total force
+that boundary's conditions apply to the body, summed over the dofs they constrain (a corner dof
+two boundaries constrain counts in both rows; the body's total in ``summary.json`` counts it
+once). Sign: the force *on the body*, so with the contact force and the applied loads it sums
+to zero; a platen pushing a body down gives a negative ``Ry``, equal to the platen's force at
+the step (``Platen.force_at``). Same 17 digits as ``contact.csv``.
 
 Files are written as each step converges, into a temporary name first and then renamed, so an
 analysis that fails or is killed later never damages what was already written; with them come
@@ -53,6 +64,7 @@ log = logging.getLogger(__name__)
 _CELL_FIELD = {"sxx": "stress_xx", "syy": "stress_yy", "sxy": "stress_xy", "szz": "stress_zz"}
 CONTACT_COLUMNS = ("step", "load_factor", "body", "node", "x", "y", "ux", "uy", "pressure",
                    "gap", "status")
+REACTION_COLUMNS = ("step", "load_factor", "body", "boundary", "Rx", "Ry")
 
 
 def _atomic_write(path: Path, write) -> None:
@@ -65,7 +77,8 @@ class ResultsWriter:
     """Writes the VTU/PVD series step by step into ``out`` (created if needed).
 
     ``surfaces``: the analysis's contact surfaces (``Analysis.surfaces``, one per body); when
-    given, every step also rewrites ``contact.csv`` with the rows of all steps so far.
+    given, every step also rewrites ``contact.csv`` with the rows of all steps so far. Every
+    step rewrites ``reactions.csv`` with the rows of all steps so far.
     """
 
     def __init__(self, out: Path, model: Model, surfaces: list[ContactSurface] | None = None):
@@ -81,15 +94,17 @@ class ResultsWriter:
                 raise InputError(f"model {model.name!r}: no contact surface given for body "
                                  f"{', '.join(map(repr, missing))}")
         self.contact_rows: list[list[str]] = []
+        self.reaction_rows: list[list[str]] = []
 
     def restore(self, steps: list[StepResult]) -> None:
         """Take up the series of an earlier run whose ``steps`` are already on disk (their
-        VTU files are kept; the PVD and contact.csv are rebuilt from them)."""
+        VTU files are kept; the PVD, contact.csv and reactions.csv are rebuilt from them)."""
         for step in steps:
             for body in self.model.bodies:
                 self.entries.append((step.load_factor, body.name, self._vtu_name(body, step)))
             if self.surfaces is not None:
                 self.add_contact_rows(step)
+            self.add_reaction_rows(step)
 
     @staticmethod
     def _vtu_name(body, step: StepResult) -> str:
@@ -98,6 +113,7 @@ class ResultsWriter:
     def write_step(self, step: StepResult) -> None:
         for body in self.model.bodies:
             r = step.bodies[body.name]
+            reaction = r.reaction if r.reaction is not None else np.zeros_like(r.contact_force)
             cell_type, conn = body.cells()
             npts = body.npoints
             u = np.column_stack([r.displacement, np.zeros(len(r.displacement))])
@@ -112,7 +128,8 @@ class ResultsWriter:
                             "contact_pressure": r.contact_pressure,
                             "contact_traction": r.contact_traction,
                             "contact_status": r.contact_status.astype(np.int32),
-                            "penetration": r.penetration},
+                            "penetration": r.penetration,
+                            "reaction": np.column_stack([reaction, np.zeros(npts)])},
                 cell_data={_CELL_FIELD.get(k, k): [v] for k, v in stress.items()},
             )
             _atomic_write(self.out / name,
@@ -122,6 +139,8 @@ class ResultsWriter:
         if self.surfaces is not None:
             self.add_contact_rows(step)
             self.write_contact_csv()
+        self.add_reaction_rows(step)
+        self.write_reactions_csv()
 
     def add_contact_rows(self, step: StepResult) -> None:
         """Keep the rows of ``step``'s contact candidate nodes for ``contact.csv``."""
@@ -139,13 +158,18 @@ class ResultsWriter:
                      _num(r.contact_pressure[n]), _num(gap[k]),
                      "contact" if r.contact_status[n] > 0 else "free"])
 
+    def add_reaction_rows(self, step: StepResult) -> None:
+        """Keep the rows of ``step``'s per-boundary support reactions for ``reactions.csv``."""
+        for body in self.model.bodies:
+            for boundary, (rx, ry) in step.bodies[body.name].reactions.items():
+                self.reaction_rows.append([str(step.step), _num(step.load_factor), body.name,
+                                           boundary, _num(rx), _num(ry)])
+
     def write_contact_csv(self) -> None:
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(CONTACT_COLUMNS)
-        w.writerows(self.contact_rows)
-        _atomic_write(self.out / "contact.csv",
-                      lambda p: p.write_text(buf.getvalue(), encoding="utf-8"))
+        _write_csv(self.out / "contact.csv", CONTACT_COLUMNS, self.contact_rows)
+
+    def write_reactions_csv(self) -> None:
+        _write_csv(self.out / "reactions.csv", REACTION_COLUMNS, self.reaction_rows)
 
     def write_pvd(self) -> None:
         lines = ['<?xml version="1.0"?>',
@@ -160,12 +184,21 @@ class ResultsWriter:
                       lambda p: p.write_text("\n".join(lines), encoding="utf-8"))
 
 
+def _write_csv(path: Path, columns: tuple[str, ...], rows: list[list[str]]) -> None:
+    """``columns`` then ``rows``, written atomically (a reader never sees half a file)."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(columns)
+    w.writerows(rows)
+    _atomic_write(path, lambda p: p.write_text(buf.getvalue(), encoding="utf-8"))
+
+
 def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = False,
                 backend: str | None = None) -> tuple[Analysis, AnalysisResult]:
     """Solve ``model``, writing into ``out`` (nothing when None) as each step converges: its
-    VTU files, the PVD and contact.csv, its checkpoint (:mod:`vfem.io.checkpoint`) and a
-    ``summary.json`` of the steps done so far; then call ``on_step``. A run stopped at any
-    moment leaves every completed step readable.
+    VTU files, the PVD, contact.csv and reactions.csv, its checkpoint
+    (:mod:`vfem.io.checkpoint`) and a ``summary.json`` of the steps done so far; then call
+    ``on_step``. A run stopped at any moment leaves every completed step readable.
 
     ``resume``: continue from the last checkpoint in ``out`` (written by an earlier run of the
     same model) instead of from the start; the steps already there are kept as they are.
@@ -208,17 +241,22 @@ def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = Fal
 def run_example(model: Model, out: Path, summarize, draw=None, on_step=None,
                 resume: bool = False) -> dict:
     """What a built-in example's ``run`` does: solve ``model`` writing each step into ``out``
-    (:func:`run_writing`), ``summarize(result)`` into its summary, ``draw(model, result,
-    summary)`` its figures (if ``draw`` is given; a list of the files' names, if it returns one,
-    goes into the summary as ``figures``), and write ``summary.json``."""
+    (:func:`run_writing`), ``summarize(result)`` into its summary and write ``summary.json``;
+    then, if ``draw`` is given, its figures: ``draw(model, result, summary)`` adds to the
+    summary (and to ``out``) what the example's figures need beyond the results files (True:
+    nothing), and
+    :func:`vfem.io.replot.draw_run` draws them from the folder, as ``vfem plot`` redraws them
+    (figure set: the summary's ``example``)."""
     out = Path(out)
     _, result = run_writing(model, out, on_step, resume)
     summary = summarize(result)
-    if draw is not None:
-        names = draw(model, result, summary)
-        if names is not None:
-            summary["figures"] = names
     write_summary(out, summary)
+    if draw:  # a function, or True: the figures need nothing beyond the files
+        from .replot import draw_run
+
+        if callable(draw):
+            draw(model, result, summary)
+        draw_run(out, summary, summary["example"], model)
     return summary
 
 
@@ -235,14 +273,57 @@ def progress_summary(model: Model, steps: list[StepResult], status: str, message
 def step_record(step: StepResult) -> dict:
     """The fields every example's ``summary.json`` gives per step; ``invariants``: the
     independent checks of the converged state (:meth:`vfem.contact.check.Invariants.record`;
-    empty when the step was not checked)."""
+    empty when the step was not checked); the forces on each body (:func:`force_record`)."""
     last = step.history[-1] if step.history else None
     return {"step": step.step, "load_factor": step.load_factor, "iterations": step.iterations,
             "converged": step.converged, "cuts": step.cuts,
             "stopped_at_fixed_point": step.fixed_point,
             "max_penetration": last.max_penetration if last else 0.0,
             "max_equilibrium_error": last.max_equilibrium_error if last else 0.0,
-            "invariants": step.invariants}
+            "invariants": step.invariants, **force_record(step)}
+
+
+def total(force: np.ndarray) -> list[float]:
+    """The resultant (x, y) of nodal forces (n, 2), summed per component (the same digits
+    wherever a total is reported)."""
+    force = np.asarray(force, dtype=float)
+    return [float(force[:, 0].sum()), float(force[:, 1].sum())]
+
+
+def imbalance(contact: list[float], reaction: list[float], applied: list[float]) -> float:
+    """``|contact + reaction + applied| / |contact|`` for a body's resultant forces (x, y): 0
+    when the body is in equilibrium. Without contact force, relative to the larger of the
+    other two (0 when all three are zero)."""
+    c, r, a = (np.asarray(v, dtype=float) for v in (contact, reaction, applied))
+    scale = float(np.linalg.norm(c)) or max(float(np.linalg.norm(r)), float(np.linalg.norm(a)))
+    return float(np.linalg.norm(c + r + a)) / scale if scale > 0 else 0.0
+
+
+def force_record(step: StepResult) -> dict:
+    """Per body of a converged step: ``contact_force`` (x, y) the resultant of the nodal
+    contact forces; ``reactions``: ``{"total": [Rx, Ry], "boundaries": {name: [Rx, Ry]}}``,
+    the force the supports,
+    prescribed displacements and platen apply to the body (the total counts each constrained
+    dof once, each boundary sums the dofs its own conditions constrain, see
+    :attr:`vfem.solver.BodyStepResult.reactions`); ``applied_load`` the resultant of its
+    tractions at the step's load factor; ``reaction_imbalance``: :func:`imbalance` of the three,
+    which balance (0 up to the solver's residual). The last three leave out a body whose
+    reactions were not computed (a step read back from an older checkpoint)."""
+    out: dict = {"contact_force": {name: total(r.contact_force)
+                                   for name, r in step.bodies.items()},
+                 "reactions": {}, "applied_load": {}, "reaction_imbalance": {}}
+    for name, r in step.bodies.items():
+        if r.reaction is None:
+            continue
+        contact, reaction = out["contact_force"][name], total(r.reaction)
+        applied = [float(v) for v in (r.applied_load if r.applied_load is not None
+                                      else np.zeros(2))]
+        out["reactions"][name] = {"total": reaction,
+                                  "boundaries": {k: [float(v) for v in xy]
+                                                 for k, xy in r.reactions.items()}}
+        out["applied_load"][name] = applied
+        out["reaction_imbalance"][name] = imbalance(contact, reaction, applied)
+    return out
 
 
 def example_summary(name: str, result: AnalysisResult, parameters) -> dict:

@@ -2,8 +2,9 @@
 
 The built-in examples have their own post-processing (Hertz's theory, the wedge's shares); a
 model from an input file gets the generic one here: per step the iterations and the physical
-errors, per body the contact force, the largest contact pressure and displacement, and the figures
-of :mod:`vfem.io.replot` drawn from the files written (so ``vfem plot`` redraws them identically).
+errors, per body the contact force and support reactions, the largest contact pressure and
+displacement, and the figures of :mod:`vfem.io.replot` drawn from the files written (so
+``vfem plot`` redraws them identically).
 """
 
 from __future__ import annotations
@@ -16,31 +17,33 @@ import numpy as np
 from ..config import ModelConfig
 from ..solver import AnalysisResult, Model
 from .input import to_data
-from .results import run_writing, step_record, write_summary
+from .results import force_record, run_writing, step_record, total, write_summary
 
 log = logging.getLogger(__name__)
 
 
-def _total(force: np.ndarray) -> list[float]:
-    """The resultant (x, y) of nodal forces (n, 2), summed per component as the examples do,
-    so the same model gives the same digits."""
-    return [float(force[:, 0].sum()), float(force[:, 1].sum())]
-
-
 def body_summary(result: AnalysisResult) -> dict:
-    """Per body at the last converged step: contact force (sum of nodal forces), largest
-    nominal contact pressure, nodes in contact, largest displacement."""
+    """Per body at the last converged step: contact force (sum of nodal forces), support
+    reactions (``reactions``: the body's total, ``reactions_by_boundary``, ``applied_load``:
+    :func:`vfem.io.results.force_record`), largest nominal contact pressure, nodes in contact,
+    largest displacement."""
     out = {}
     if not result.steps:
         return out
     last = result.steps[-1]
+    forces = force_record(last)
     for s in result.surfaces:
         r = last.bodies[s.body.name]
-        out[s.body.name] = {
+        name = s.body.name
+        reactions = forces["reactions"].get(name)
+        out[name] = {
             "nodes": int(s.body.npoints),
             "dofs": int(s.body.ndofs),
             "contact_candidate_nodes": int(s.nc),
-            "contact_force": _total(r.contact_force),
+            "contact_force": total(r.contact_force),
+            **({"reactions": reactions["total"],
+                "reactions_by_boundary": reactions["boundaries"],
+                "applied_load": forces["applied_load"][name]} if reactions else {}),
             "max_contact_pressure": float(r.contact_pressure.max()),
             "contact_nodes": int((r.contact_status > 0).sum()),
             "max_displacement": float(np.linalg.norm(r.displacement, axis=1).max()),
@@ -52,9 +55,7 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
     """The ``summary.json`` of a model run from an input file."""
     steps = []
     for s in result.steps:
-        steps.append({**step_record(s), "platen_displacement": s.platen_displacement,
-                      "contact_force": {name: _total(b.contact_force)
-                                        for name, b in s.bodies.items()}})
+        steps.append({**step_record(s), "platen_displacement": s.platen_displacement})
     return {
         "model": config.name,
         "input": source,
@@ -76,18 +77,17 @@ def run(config: ModelConfig, out: Path, base: Path | None = None, on_step=None,
         source: str | None = None, figures: bool | None = None, model: Model | None = None,
         resume: bool = False) -> dict:
     """Solve ``config`` (mesh files relative to ``base``; or its ``model`` already built),
-    writing VTU/PVD and contact.csv per converged step, then ``summary.json`` and the figures
-    into ``out``."""
+    writing VTU/PVD, contact.csv and reactions.csv per converged step, then ``summary.json``
+    and the figures into ``out``."""
     out = Path(out)
     model = model or config.build(base)
     _, result = run_writing(model, out, on_step, resume)
     summary = summarize(result, config, source)
     write_summary(out, summary)
     if (config.output.figures if figures is None else figures) and result.steps:
-        from .replot import plot_results
+        from .replot import draw_run
 
-        summary["figures"] = [p.name for p in plot_results(out)]
-        write_summary(out, summary)
+        draw_run(out, summary, "input", model)
     return summary
 
 
@@ -130,6 +130,35 @@ def invariants_line(steps: list[dict]) -> str:
     return text
 
 
+def _xy(v) -> str:
+    return f"({v[0]:.6g}, {v[1]:.6g})"
+
+
+def balance_line(steps: list[dict]) -> str:
+    """One line on how the forces on each body balance over the steps (summary.json's
+    ``steps[*].reaction_imbalance``, :func:`vfem.io.results.imbalance`): the largest
+    ``|contact + reactions + applied loads| / |contact|``, its body and step; "" when no step
+    has reactions."""
+    worst = max(((v, name, x["step"]) for x in steps
+                 for name, v in (x.get("reaction_imbalance") or {}).items()), default=None)
+    if worst is None:
+        return ""
+    v, name, step = worst
+    return (f"forces on each body (contact + reactions + applied loads) balance to {v:.1e} "
+            f"of its contact force (largest: {name!r}, step {step})")
+
+
+def reaction_lines(steps: list[dict]) -> list[str]:
+    """A built-in example's closing lines on forces: per body at the last step its contact
+    force and support reactions, then :func:`balance_line`; [] when no step has reactions."""
+    if not steps or not steps[-1].get("reactions"):
+        return []
+    last = steps[-1]
+    lines = [f"{name}: contact force {_xy(last['contact_force'][name])}, reactions "
+             f"{_xy(r['total'])}" for name, r in last["reactions"].items()]
+    return [*lines, balance_line(steps)]
+
+
 def run_status(s: dict) -> str:
     """"converged", "NOT converged", or, where the thesis variant ended steps at its fixed point
     with residuals above its tolerance (docs/method.md §5), not "converged" but what it did."""
@@ -148,11 +177,12 @@ def report(s: dict, out: Path) -> list[str]:
     """The one-screen summary the CLI prints at the end of a run."""
     n_iter = sum(x["iterations"] for x in s["steps"])
     lines = [f"vfem: {s['model']}: {run_status(s)} — "
-             f"{len(s['steps'])} steps, {n_iter} contact iterations, {s['dofs']} dofs, "
+             f"{len(s['steps'])} step{'' if len(s['steps']) == 1 else 's'}, {n_iter} contact "
+             f"iteration{'' if n_iter == 1 else 's'}, {s['dofs']} dofs, "
              f"{s['timings'].get('total_s', 0.0):.1f} s"]
     for name, b in s["bodies"].items():
-        fx, fy = b["contact_force"]
-        lines.append(f"  {name:>12}: contact force ({fx:.6g}, {fy:.6g}), p_max "
+        reactions = f", reactions {_xy(b['reactions'])}" if "reactions" in b else ""
+        lines.append(f"  {name:>12}: contact force {_xy(b['contact_force'])}{reactions}, p_max "
                      f"{b['max_contact_pressure']:.6g}, {b['contact_nodes']} nodes in contact, "
                      f"largest displacement {b['max_displacement']:.4g}")
     if s["steps"]:
@@ -160,10 +190,11 @@ def report(s: dict, out: Path) -> list[str]:
         lines.append(f"  largest residual penetration {worst['max_penetration']:.2e} "
                      f"(tolerance {s['penetration_tolerance']:.2e}), equilibrium error "
                      f"{max(x['max_equilibrium_error'] for x in s['steps']):.2e}")
-    line = invariants_line(s["steps"])
-    if line:
-        lines.append("  " + line)
-    lines.append(f"  results: {out}/ (summary.json, results.pvd for ParaView, contact.csv"
+    for line in (balance_line(s["steps"]), invariants_line(s["steps"])):
+        if line:
+            lines.append("  " + line)
+    lines.append(f"  results: {out}/ (summary.json, results.pvd for ParaView, contact.csv, "
+                 "reactions.csv"
                  + (", " + ", ".join(s["figures"]) if s.get("figures") else "") + ")")
     return lines
 
