@@ -65,7 +65,8 @@ def test_contact_forces_balance_the_support_and_the_drive(default):
 def test_files_and_summary(default):
     out, s = default
     names = ["mesh.png", "prediction.png"] + [f"case{k}.png" for k in range(1, 6)] + [
-        "cases_1_3_5.png", "cases_1_2_3.png", "cases_3_4_5.png"]
+        "cases_1_3_5.png", "cases_1_2_3.png", "cases_3_4_5.png"] + [
+        f"von_mises_case{k}.png" for k in range(1, 6)]
     assert s["figures"] == names
     for name in names:
         assert (out / name).stat().st_size > 10_000, name

@@ -91,6 +91,8 @@ def validate(p: Parameters) -> None:
                          "small block's corner must lie under the large block)")
     if p.steps < 1:
         raise InputError(f"block: steps must be at least 1, got {p.steps}")
+    if p.large_columns < 1:
+        raise InputError(f"block: large_columns must be at least 1, got {p.large_columns}")
     build(p).validate()
 
 
@@ -144,43 +146,71 @@ def run(p: Parameters, out, on_step=None, figures: bool = True,
     from ..io.results import run_example
 
     def draw(model, result, summary):
-        if result.steps:
-            _figures(Path(out), model, result, p)
+        """What the figures need beyond the results files: the linear prediction (contact
+        ignored, as extra VTU files) and the windows (``summary.json``'s ``figure_data``)."""
+        from ..io.replot import write_frames
+
+        if not result.steps:
+            return
+        lf = result.steps[-1].load_factor
+        w = p.small_half_width
+        summary["figure_data"] = {
+            "frames": {"prediction": write_frames(
+                Path(out), "prediction", model,
+                {b.name: (lf * b.u_load).reshape(-1, 2) for b in model.bodies})},
+            "window": [0.0, p.large_half_width, -p.small_height, p.large_height],
+            "corner_window": [w - 0.15, w + 0.15, -0.15, 0.1]}
 
     return run_example(build(p), out, lambda r: summarize(r, p), draw if figures else None,
                        on_step, resume)
 
 
-def _figures(out: Path, model: Model, result: AnalysisResult, p: Parameters) -> None:
-    """Thesis Figs. 5.14-5.16 (initial, linear prediction, final) and the contact pressure."""
-    from ..io.plots import configurations, history
+def figures(folder) -> list[Path]:
+    """The figures of a block results folder (:class:`vfem.io.replot.Folder`), which the run
+    draws and ``vfem plot`` redraws: thesis Figs. 5.14-5.16 (``initial.png``,
+    ``prediction.png``, ``final.png``), ``corner.png``, ``pressure.png`` (the small block's
+    top, the last step's VTU) and ``von_mises.png``."""
+    from ..io import plots, replot
 
-    def frame(displacement):
-        return [(b.name, b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
-                 displacement(b)[: b.mesh.nvertices]) for b in model.bodies]
+    s = folder.summary
+    if not folder.has_steps or "figure_data" not in s:
+        return []
+    data = s["figure_data"]
+    method = replot.contact_label(s)
+    last = folder.steps[-1]
 
-    last = result.steps[-1]
-    zero = frame(lambda b: np.zeros((b.npoints, 2)))
-    predicted = frame(lambda b: (last.load_factor * b.u_load).reshape(-1, 2))
-    final = frame(lambda b: last.bodies[b.name].displacement)
-    window = (0.0, p.large_half_width, -p.small_height, p.large_height)
-    configurations(out / "initial.png", [("initial", zero)], "Block: initial configuration "
-                   "(thesis Fig. 5.14)", window)
-    configurations(out / "prediction.png", [("linear prediction", predicted)],
-                   "Block: linear prediction, contact ignored (Fig. 5.15)", window)
-    configurations(out / "final.png", [("final", final)],
-                   "Block: final configuration, true scale (Fig. 5.16)", window)
-    w = p.small_half_width
-    zoom = (w - 0.15, w + 0.15, -0.15, 0.1)
-    configurations(out / "corner.png", [("final", final)],
-                   "Block: the small block's corner, final configuration", zoom)
-    b = next(b for b in model.bodies if b.name == "small")
-    pts = b.points
-    top = np.flatnonzero(np.abs(pts[1]) < 1e-12)
-    order = top[np.argsort(pts[0, top])]
-    series = {"small block (top face)": last.bodies["small"].contact_pressure[order]}
-    history(out / "pressure.png", pts[0, order], series, "x",
-            "nominal contact pressure", "Block: contact pressure on the small block")
+    def frame(bodies, zero=False):
+        return [(b.name, b.points, b.polygons, 0.0 * b.displacement if zero else b.displacement)
+                for b in bodies]
+
+    out = folder.directory
+    window, zoom = tuple(data["window"]), tuple(data["corner_window"])
+    names = ["initial.png", "prediction.png", "final.png", "corner.png"]
+    plots.configurations(out / names[0], [("initial", frame(last.bodies, zero=True))],
+                         "Block: initial configuration (thesis Fig. 5.14)", window)
+    plots.configurations(out / names[1], [("linear prediction",
+                                           frame(folder.frames("prediction")))],
+                         "Block: linear prediction, contact ignored (Fig. 5.15)", window,
+                         magnification=1.0)
+    final = frame(last.bodies)
+    plots.configurations(out / names[2], [("final", final)],
+                         f"Block: final configuration (Fig. 5.16)\n{method}", window,
+                         magnification=1.0)
+    plots.configurations(out / names[3], [("final", final)],
+                         f"Block: the small block's corner, final configuration\n{method}",
+                         zoom, magnification=1.0)
+    small = next(b for b in last.bodies if b.name == "small")
+    x, y = small.points.T
+    top = np.flatnonzero(np.abs(y) < 1e-12)
+    order = top[np.argsort(x[top], kind="stable")]
+    pressure = np.asarray(small.point_data["contact_pressure"], dtype=float).ravel()
+    plots.history(out / "pressure.png", x[order], {"small block (top face)": pressure[order]},
+                  f"x, undeformed ({plots.LENGTH})",
+                  f"nominal contact pressure ({plots.LENGTH})",
+                  f"Block: contact pressure on the small block\n{method}")
+    vm = replot.von_mises(folder, last, "von_mises.png",
+                          f"Block: von Mises stress, final configuration\n{method}", window)
+    return [out / n for n in names] + [out / "pressure.png", vm]
 
 
 def report(s: dict) -> list[str]:
@@ -196,6 +226,6 @@ def report(s: dict) -> list[str]:
         lines.append(f"  largest residual penetration {b['max_penetration']:.2e} (tolerance "
                      f"{b['penetration_tolerance']:.1e}); any node of either block, checked "
                      f"both ways: {b['largest_penetration_any_node']:.2e}")
-    lines.append("  results: summary.json, results.pvd (ParaView), initial.png, prediction.png, "
-                 "final.png, corner.png, pressure.png")
+    lines.append("  results: summary.json, results.pvd (ParaView), contact.csv"
+                 + "".join(f", {f}" for f in s.get("figures", [])))
     return lines

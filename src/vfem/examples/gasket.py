@@ -375,76 +375,116 @@ def run(p: GasketParameters, out, on_step=None, figures: bool = True,
     from ..io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p),
-                       (lambda model, r, summary: draw(r, p, out)) if figures else None,
-                       on_step, resume)
+                       (lambda model, r, summary: figure_data(r, summary, out)) if figures
+                       else None, on_step, resume)
 
 
-def draw(result: AnalysisResult, p: GasketParameters, out) -> list[str]:
-    """The figures of thesis Figs. 5.17 to 5.23 and the force history; returns their names.
-
-    Configurations at true scale (the meshes' vertices; quadratic elements drawn straight).
-    """
+def figure_data(result: AnalysisResult, summary: dict, out) -> None:
+    """What the figures need beyond the results files, into ``summary.json``'s
+    ``figure_data``: the VTU step of each scheduled step (``scheduled``; a cut step adds solver
+    steps) and, as extra VTU files, the configuration with contact ignored and the linear
+    predictions of the steps drawn (:data:`SHOWN_STEPS`)."""
     from pathlib import Path
 
-    from ..io.plots import configurations, history
+    from ..io.replot import write_frames
 
-    out = Path(out)
     model = result.model
     steps = scheduled_steps(result)
-    bodies = sorted(model.bodies, key=lambda b: b.name)  # soft, stiff: the same colours always
-    zero = {b.name: np.zeros((b.npoints, 2)) for b in bodies}
-    names: list[str] = []
-
-    def frame(label, disp):
-        return (label, [(b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
-                         disp[b.name][: b.mesh.nvertices]) for b in bodies])
-
-    def save(name, frames, title, **kw):
-        configurations(out / name, frames, title, **kw)
-        names.append(name)
-
-    n = p.steps
-    save("initial.png", [frame("initial (soft left, stiff right)", zero)],
-         "Gasket: initial configuration")
-    ignored = {b.name: b.u_load.reshape(-1, 2) for b in bodies}
-    save("ignoring_contact.png", [frame("initial", zero),
-                                  frame(f"step {n}, contact ignored", ignored)],
-         f"Gasket: initial and step {n} positions, contact ignored")
+    frames = {"ignoring_contact": write_frames(
+        Path(out), "ignoring_contact", model,
+        {b.name: b.u_load.reshape(-1, 2) for b in model.bodies})}
     for k in SHOWN_STEPS:
         if k > len(steps) or steps[k - 1] is None:
             continue
-        res = steps[k - 1]
-        pred = prediction(model, steps[k - 2] if k >= 2 else None, res.load_factor)
-        disp = {name: r.displacement for name, r in res.bodies.items()}
+        label = f"prediction{k:02d}"
+        frames[label] = write_frames(Path(out), label, model, prediction(
+            model, steps[k - 2] if k >= 2 else None, steps[k - 1].load_factor))
+    summary["figure_data"] = {"frames": frames,
+                              "scheduled": [s.step if s is not None else None for s in steps]}
+
+
+def figures(folder) -> list:
+    """The figures of a gasket results folder (:class:`vfem.io.replot.Folder`), which the run
+    draws and ``vfem plot`` redraws: thesis Figs. 5.17 to 5.23, the force history (from
+    ``summary.json``'s steps) and ``von_mises.png`` at the step of the largest force.
+
+    Configurations at true scale, every element's boundary through its nodes (quadratic faces
+    drawn through their midpoints); the soft gasket first, so each keeps its colour or line
+    style in every figure.
+    """
+    from ..io import plots, replot
+
+    s = folder.summary
+    data = s.get("figure_data")
+    if not folder.has_steps or not data:
+        return []
+    out = folder.directory
+    method = replot.contact_label(s)
+    n = s["parameters"]["steps"]
+    scheduled = data["scheduled"]
+    names: list[str] = []
+
+    def frame(label, bodies, zero=False):
+        bodies = sorted(bodies, key=lambda b: b.name)  # soft, stiff
+        return (label, [(b.name, b.points, b.polygons,
+                         0.0 * b.displacement if zero else b.displacement) for b in bodies])
+
+    def save(name, frames, title, magnification=1.0, **kw):
+        plots.configurations(out / name, frames, title, magnification=magnification, **kw)
+        names.append(name)
+
+    first = folder.steps[0].bodies
+    save("initial.png", [frame("initial", first, zero=True)],
+         "Gasket: initial configuration (soft left, stiff right)", magnification=None)
+    save("ignoring_contact.png", [frame("initial", first, zero=True),
+                                  frame(f"step {n}, contact ignored",
+                                        folder.frames("ignoring_contact"))],
+         f"Gasket: initial and step {n} positions, contact ignored")
+    for k in SHOWN_STEPS:
+        label = f"prediction{k:02d}"
+        if label not in data["frames"]:
+            continue
+        res = folder.step(scheduled[k - 1]).bodies
+        pred = folder.frames(label)
         save(f"step{k:02d}_prediction.png", [frame(f"step {k}, linear prediction", pred)],
              f"Gasket: linear prediction for step {k} (step {k - 1}'s contact forces held)")
-        save(f"step{k:02d}_resolved.png", [frame(f"step {k}, resolved", disp)],
-             f"Gasket: resolved position after iterations, step {k}")
-        window = _contact_window(model, res)
+        save(f"step{k:02d}_resolved.png", [frame(f"step {k}, resolved", res)],
+             f"Gasket: resolved position after iterations, step {k}\n{method}")
+        window = _contact_window(res)
         if window is not None:
             save(f"step{k:02d}_contact.png",
-                 [frame(f"step {k}, linear prediction", pred), frame(f"step {k}, resolved", disp)],
-                 f"Gasket: contact region, step {k}, true scale", window=window,
+                 [frame(f"step {k}, linear prediction", pred), frame(f"step {k}, resolved", res)],
+                 f"Gasket: contact region, step {k}\n{method}", window=window,
                  mesh_lines=False)
-    if steps and steps[-1] is not None:
-        disp = {name: r.displacement for name, r in steps[-1].bodies.items()}
-        save("initial_final.png", [frame("initial", zero), frame(f"final (step {2 * n})", disp)],
-             "Gasket: initial and final configurations")
-    F = np.r_[0.0, [float(np.linalg.norm(total_force(s))) for s in steps if s is not None]]
+    if scheduled and scheduled[-1] is not None:
+        save("initial_final.png", [frame("initial", first, zero=True),
+                                   frame(f"final (step {2 * n})",
+                                         folder.step(scheduled[-1]).bodies)],
+             f"Gasket: initial and final configurations\n{method}")
+    F = force_history(s)
     k = np.arange(n + 1)
     series = {"loading: after step k": F[: n + 1]}
     if len(F) == 2 * n + 1:
         series[f"unloading: after step {2 * n} - k"] = F[::-1][: n + 1]
-    history(out / "contact_force.png", k, series, "step k", "total contact force on a gasket",
-            "Gasket: contact force, loading and unloading (mirrored)")
+    plots.history(out / "contact_force.png", k[: len(series["loading: after step k"])], series,
+                  "step k", "total contact force on a gasket (model units)",
+                  f"Gasket: contact force, loading and unloading (mirrored)\n{method}")
     names.append("contact_force.png")
-    return names
+    at = s.get("largest_force_step")
+    step = folder.step(scheduled[at - 1]) if at else folder.steps[-1]
+    vm = replot.von_mises(folder, step, "von_mises.png",
+                          f"Gasket: von Mises stress at step {at or step.step} (largest contact "
+                          f"force)\n{method}")
+    return [out / name for name in names] + [vm]
 
 
-def _contact_window(model: Model, step: StepResult) -> tuple[float, float, float, float] | None:
-    """A square window around the nodes carrying contact force (current configuration)."""
-    pts = [(b.points.T + step.bodies[b.name].displacement)[
-        np.linalg.norm(step.bodies[b.name].contact_force, axis=1) > 0] for b in model.bodies]
+def _contact_window(bodies) -> tuple[float, float, float, float] | None:
+    """A square window around the nodes carrying contact force (current configuration) of a
+    step's bodies (:class:`vfem.io.replot.BodyFrame`)."""
+    pts = []
+    for b in bodies:
+        f = np.asarray(b.point_data["contact_force"], dtype=float)[:, :2]
+        pts.append((b.points + b.displacement)[np.linalg.norm(f, axis=1) > 0])
     pts = np.vstack(pts)
     if len(pts) == 0:
         return None

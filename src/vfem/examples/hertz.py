@@ -23,6 +23,7 @@ import numpy as np
 from ..bodies import Platen, Support
 from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
+from ..errors import InputError
 from ..io.runner import run_status
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
@@ -74,13 +75,24 @@ def theory(p: HertzParameters) -> dict[str, float]:
 
 def validate(p: HertzParameters) -> None:
     """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    for name in ("force", "radius"):
+        value = getattr(p, name)
+        if not (isinstance(value, (int, float)) and 0 < value < math.inf):
+            raise InputError(f"{name} must be a finite number > 0 (the cylinder is pressed onto "
+                             f"the flat), got {value!r}")
+    if p.facets_per_half_width < 1 or p.refinement < 0:
+        raise InputError("facets_per_half_width must be at least 1 and refinement not negative, "
+                         f"got {p.facets_per_half_width} and {p.refinement}")
     build(p).validate()
 
 
 def config(p: HertzParameters | None = None) -> ModelConfig:
     """The model as data (what ``examples/hertz.toml`` holds for the defaults)."""
     p = p or HertzParameters()
-    th = theory(p) if p.cylinder_youngs_modulus > 0 and p.flat_youngs_modulus > 0 else None
+    try:  # parameters that make no theory (a Poisson's ratio of 3) are refused by validate()
+        th = theory(p) if p.cylinder_youngs_modulus > 0 and p.flat_youngs_modulus > 0 else None
+    except (ValueError, ArithmeticError):
+        th = None
     a = th["a_theory"] if th else 0.06
     n = p.facets_per_half_width * 2**p.refinement
     h = a / n
@@ -236,40 +248,46 @@ def run(p: HertzParameters, out, on_step=None, figures: bool = True,
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
     from ..io.results import run_example
 
-    def draw(model, result, summary):
-        if "hertz" in summary:
-            _figures(Path(out), model, result, summary, p)
-
-    return run_example(build(p), out, lambda r: summarize(r, p), draw if figures else None,
-                       on_step, resume)
+    return run_example(build(p), out, lambda r: summarize(r, p), figures, on_step, resume)
 
 
-def _figures(out, model: Model, result: AnalysisResult, summary: dict,
-             p: HertzParameters) -> None:
-    """The pressure against Hertz's ellipse on both bodies, and the deformed contact region."""
-    from ..io.plots import configurations, hertz_pressure
+def figures(folder) -> list[Path]:
+    """The figures of a Hertz results folder (:class:`vfem.io.replot.Folder`), which the run
+    draws and ``vfem plot`` redraws: ``pressure.png``, p/p0 against x/a at the last step's
+    contact candidate nodes (``contact.csv``) with Hertz's ellipse (a and p0 from
+    ``summary.json``'s ``hertz``); ``deformed.png``, the contact region; ``von_mises.png``."""
+    from ..io import plots, replot
 
-    th = summary["hertz"]
+    s = folder.summary
+    if not folder.has_steps or "hertz" not in s:  # the full load was not reached
+        return []
+    th = s["hertz"]
     a, p0 = th["a_theory"], th["p0_theory"]
-    last = result.steps[-1]
+    method = replot.contact_label(s)
+    last = folder.steps[-1]
     xa, pp = {}, {}
-    for s in result.surfaces:
-        nodes = s.nodes[: s.nc]
-        x = s.body.points[0, nodes]
-        keep = x < 1.4 * a
-        xa[s.body.name] = x[keep] / a
-        pp[s.body.name] = last.bodies[s.body.name].contact_pressure[nodes[keep]] / p0
-    hertz_pressure(out / "pressure.png", xa, pp,
-                   f"Hertz, {summary['dofs']} dofs: p_max {th['p_max_error']:+.2%} vs p0, "
-                   f"RMS {th['rms_error_over_p0']:.2%}", method=p.method)
-    cyl_mesh = next(b.mesh for b in model.bodies if b.name == "cylinder")
-    tip = int(np.argmin(np.hypot(*cyl_mesh.p)))  # the first point of contact
-    y0 = float(last.bodies["cylinder"].displacement[tip, 1])
-    meshes = [(b.name, b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
-               last.bodies[b.name].displacement[: b.mesh.nvertices]) for b in model.bodies]
-    configurations(out / "deformed.png", [("deformed", meshes)],
-                   f"Hertz: contact region at load {p.force:g}, true scale (a = {a:.4f})",
-                   window=(0.0, 2.0 * a, y0 - 0.5 * a, y0 + 0.7 * a))
+    for b in last.bodies:
+        c = folder.contact(last, b)
+        keep = c.x[:, 0] < 1.4 * a
+        xa[b.name] = c.x[keep, 0] / a
+        pp[b.name] = c.pressure[keep] / p0
+    out = folder.directory
+    plots.hertz_pressure(out / "pressure.png", xa, pp,
+                         f"Hertz, {s['dofs']} dofs: p_max {th['p_max_error']:+.2%} vs p0, "
+                         f"RMS {th['rms_error_over_p0']:.2%}\n{method}",
+                         method=s["parameters"].get("method", "vfem"))
+    cyl = next(b for b in last.bodies if b.name == "cylinder")
+    tip = int(np.argmin(np.hypot(*cyl.points.T)))  # the first point of contact
+    y0 = float(cyl.displacement[tip, 1])
+    meshes = [(b.name, b.points, b.polygons, b.displacement) for b in last.bodies]
+    plots.configurations(out / "deformed.png", [("deformed", meshes)],
+                         f"Hertz: contact region at load {th['applied_force']:g} "
+                         f"(a = {a:.4f})\n{method}",
+                         window=(0.0, 2.0 * a, y0 - 0.5 * a, y0 + 0.7 * a), magnification=1.0)
+    vm = replot.von_mises(folder, last, "von_mises.png",
+                          f"Hertz: von Mises stress near the contact (a = {a:.4f})\n{method}",
+                          window=(0.0, 3.0 * a, y0 - 2.0 * a, y0 + 1.0 * a))
+    return [out / "pressure.png", out / "deformed.png", vm]
 
 
 def report(s: dict) -> list[str]:
@@ -295,5 +313,6 @@ def report(s: dict) -> list[str]:
         lines.append(f"  note: {len(fixed)} of {len(s['steps'])} steps stopped where the "
                      f"compatibility and equilibrium corrections cancel (largest residual "
                      f"penetration {worst['max_penetration']:.2e}); see docs/method.md §5")
-    lines.append("  results: summary.json, results.pvd (ParaView), pressure.png, deformed.png")
+    lines.append("  results: summary.json, results.pvd (ParaView), contact.csv"
+                 + "".join(f", {f}" for f in s.get("figures", [])))
     return lines

@@ -211,41 +211,57 @@ def run(p: Parameters, out, on_step=None, figures: bool = True,
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
     from ..io.results import run_example
 
-    def draw(model, result, summary):
-        if "punch" in summary:
-            return _figures(Path(out), model, result, summary, p)
-        return None
-
-    return run_example(build(p), out, lambda r: summarize(r, p), draw if figures else None,
-                       on_step, resume)
+    return run_example(build(p), out, lambda r: summarize(r, p),
+                       (lambda model, result, summary: _figure_data(summary, p)) if figures
+                       else None, on_step, resume)
 
 
-def _figures(out: Path, model: Model, result: AnalysisResult, summary: dict,
-             p: Parameters) -> list[str]:
-    """``pressure.png``: the block's nodal pressure against Sadowsky's shape; ``deformed.png``:
-    the right corner, deformed, displacements magnified."""
-    from ..io.plots import configurations, punch_pressure
-
-    s = summary["punch"]
+def _figure_data(summary: dict, p: Parameters) -> None:
+    """What the figures need beyond the results files: the corner's window and the
+    magnification of ``deformed.png`` (into ``summary.json``'s ``figure_data``)."""
     a = p.punch_half_width
-    last = result.steps[-1]
-    block, top = _block_top(result)
-    x = block.points[0, top]
-    keep = np.abs(x) <= 2 * a
-    punch_pressure(out / "pressure.png", x[keep],
-                   last.bodies["block"].contact_pressure[top[keep]], s["force"], a,
-                   f"Flat punch: block's contact pressure, force {s['force']:.4g} "
-                   f"({s['difference_from_reference']:+.2%} from the rigid punch)")
-    meshes = [(b.name, b.mesh.p[:, : b.mesh.nvertices].T, b.mesh.t.T,
-               MAGNIFICATION * last.bodies[b.name].displacement[: b.mesh.nvertices])
-              for b in model.bodies]
     h = 2 * a / _divisions(p)[2]  # the punch's facet length
     depth = MAGNIFICATION * p.indentation
-    configurations(out / "deformed.png", [("deformed", meshes)],
-                   f"Flat punch: the right corner, displacements x{MAGNIFICATION:g}",
-                   window=(a - 0.5 * a, a + 0.5 * a, -depth - 0.4 * a, -depth + 0.3 * a + h),
-                   legend_loc="upper right")
-    return ["pressure.png", "deformed.png"]
+    summary["figure_data"] = {
+        "magnification": MAGNIFICATION,
+        "corner_window": [a - 0.5 * a, a + 0.5 * a, -depth - 0.4 * a, -depth + 0.3 * a + h]}
+
+
+def figures(folder) -> list[Path]:
+    """The figures of a punch results folder (:class:`vfem.io.replot.Folder`), which the run
+    draws and ``vfem plot`` redraws: ``pressure.png``, the block's nodal pressure along its top
+    (the last step's VTU) against Sadowsky's shape for the computed force (``summary.json``'s
+    ``punch``); ``deformed.png``, the right corner, displacements magnified; ``von_mises.png``,
+    the same corner filled by the von Mises stress."""
+    from ..io import plots, replot
+
+    s = folder.summary
+    if not folder.has_steps or "punch" not in s:  # the full indentation was not reached
+        return []
+    c, data = s["punch"], s["figure_data"]
+    a = c["punch_half_width"]
+    method = replot.contact_label(s)
+    last = folder.steps[-1]
+    block = next(b for b in last.bodies if b.name == "block")
+    x, y = block.points.T
+    top = np.flatnonzero(np.abs(y) <= 1e-12 * max(1.0, float(np.abs(x).max())))
+    top = top[np.argsort(x[top], kind="stable")]
+    keep = np.abs(x[top]) <= 2 * a
+    pressure = np.asarray(block.point_data["contact_pressure"], dtype=float).ravel()
+    out = folder.directory
+    plots.punch_pressure(out / "pressure.png", x[top[keep]], pressure[top[keep]], c["force"], a,
+                         f"Flat punch: block's contact pressure, force {c['force']:.4g} "
+                         f"({c['difference_from_reference']:+.2%} from the rigid punch)\n"
+                         f"{method}")
+    meshes = [(b.name, b.points, b.polygons, b.displacement) for b in last.bodies]
+    m, window = data["magnification"], tuple(data["corner_window"])
+    plots.configurations(out / "deformed.png", [("deformed", meshes)],
+                         f"Flat punch: the right corner\n{method}", window=window,
+                         legend_loc="upper right", magnification=m)
+    vm = replot.von_mises(folder, last, "von_mises.png",
+                          f"Flat punch: von Mises stress at the right corner\n{method}",
+                          window=window, magnification=m)
+    return [out / "pressure.png", out / "deformed.png", vm]
 
 
 def report(s: dict) -> list[str]:
@@ -270,5 +286,6 @@ def report(s: dict) -> list[str]:
         lines.append(f"  p at the centre {c['p_centre_block']:.4g} (Sadowsky's half-plane "
                      f"{c['p_centre_sadowsky']:.4g}), p_max {c['p_max_block']:.4g} at "
                      f"|x| = {abs(c['p_max_block_at_x']):.4g}")
-    lines.append("  results: summary.json, results.pvd (ParaView), pressure.png, deformed.png")
+    lines.append("  results: summary.json, results.pvd (ParaView), contact.csv"
+                 + "".join(f", {f}" for f in s.get("figures", [])))
     return lines

@@ -176,44 +176,71 @@ def run(p: Parameters, out, on_step=None, figures: bool = True,
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
     from ..io.results import run_example
 
-    def draw(model, result, summary):
-        return _figures(Path(out), model, result, p) if result.steps else None
-
-    return run_example(build(p), out, lambda r: summarize(r, p), draw if figures else None,
-                       on_step, resume)
+    return run_example(build(p), out, lambda r: summarize(r, p),
+                       (lambda model, result, summary: _figure_data(model, result, summary, p))
+                       if figures else None, on_step, resume)
 
 
-def _figures(out: Path, model: Model, result: AnalysisResult, p: Parameters) -> list[str]:
-    """The reactions against the slide, and the deformed bodies at three moments."""
-    from ..io.plots import configurations, history_panels
-
-    rows = reactions(result)
-    slide = np.asarray(rows["slide"])
-    sliding = np.asarray(rows["load_factor"]) >= 1.0
-    panels = [("normal reaction (pressing down)",
-               {"punch": (slide[sliding], -np.asarray(rows["normal"])[sliding])}, False),
-              ("tangential reaction",
-               {"punch": (slide[sliding], np.asarray(rows["tangential"])[sliding])}, False)]
-    history_panels(out / "reactions.png", panels, "slide (punch top displacement along x)",
-                   "Sliding: the punch's reactions at constant depth")
-    names = ["reactions.png"]
+def _figure_data(model: Model, result: AnalysisResult, summary: dict, p: Parameters) -> None:
+    """What the figures need beyond the results files (``summary.json``'s ``figure_data``):
+    the three moments drawn (pressed in, half way, slid: their VTU step) and a window that
+    follows the punch."""
+    if not result.steps:
+        return
     picks = {"pressed in": next((s for s in result.steps if s.load_factor >= 1.0), None),
              "half way": next((s for s in result.steps if s.load_factor >= 1.5), None),
              "slid": result.steps[-1]}
     half = 0.5 * p.punch_width
     top = next(b for b in model.bodies if b.name == "punch").boundary_points("top")
+    shown = []
     for (label, step), name in zip(picks.items(), ("pressed.png", "halfway.png", "slid.png")):
         if step is None:
             continue
-        frame = [(b.name, b.mesh.p.T, b.mesh.t.T, step.bodies[b.name].displacement)
-                 for b in model.bodies]
         x = p.start + float(np.mean(step.bodies["punch"].displacement[top, 0]))
-        window = (x - 2.5 * half, x + 2.5 * half, p.block_height - 0.6, p.block_height + 0.4)
-        configurations(out / name, [(label, frame)],
-                       f"Sliding: {label} (load factor {step.load_factor:g}), true scale",
-                       window)
-        names.append(name)
-    return names
+        shown.append({"label": label, "file": name, "step": step.step,
+                      "window": [x - 2.5 * half, x + 2.5 * half, p.block_height - 0.6,
+                                 p.block_height + 0.4]})
+    summary["figure_data"] = {"moments": shown}
+
+
+def figures(folder) -> list[Path]:
+    """The figures of a sliding results folder (:class:`vfem.io.replot.Folder`), which the run
+    draws and ``vfem plot`` redraws: ``reactions.png``, the punch's reactions against the
+    slide (``summary.json``'s ``sliding.reactions``); the deformed bodies at three moments
+    (``pressed.png``, ``halfway.png``, ``slid.png``); ``von_mises.png``, slid."""
+    from ..io import plots, replot
+
+    s = folder.summary
+    if not folder.has_steps or "sliding" not in s or "figure_data" not in s:
+        return []
+    method = replot.contact_label(s)
+    out = folder.directory
+    rows = s["sliding"]["reactions"]
+    slide = np.asarray(rows["slide"], dtype=float)
+    sliding = np.asarray(rows["load_factor"]) >= 1.0
+    panels = [(f"normal reaction, pressing down ({plots.LENGTH})",
+               {"punch": (slide[sliding], -np.asarray(rows["normal"])[sliding])}, False),
+              (f"tangential reaction ({plots.LENGTH})",
+               {"punch": (slide[sliding], np.asarray(rows["tangential"])[sliding])}, False)]
+    plots.history_panels(out / "reactions.png", panels,
+                         f"slide: punch top displacement along x ({plots.LENGTH})",
+                         f"Sliding: the punch's reactions at constant depth\n{method}")
+    written = [out / "reactions.png"]
+    moments = s["figure_data"]["moments"]
+    for m in moments:
+        step = folder.step(m["step"])
+        frame = [(b.name, b.points, b.polygons, b.displacement) for b in step.bodies]
+        plots.configurations(out / m["file"], [(m["label"], frame)],
+                             f"Sliding: {m['label']} (load factor {step.load_factor:g})\n"
+                             f"{method}", tuple(m["window"]), magnification=1.0)
+        written.append(out / m["file"])
+    if moments:
+        last = moments[-1]
+        step = folder.step(last["step"])
+        written.append(replot.von_mises(
+            folder, step, "von_mises.png", f"Sliding: von Mises stress, {last['label']} (load "
+            f"factor {step.load_factor:g})\n{method}", tuple(last["window"])))
+    return written
 
 
 def report(s: dict) -> list[str]:
@@ -230,9 +257,12 @@ def report(s: dict) -> list[str]:
                          f"over {e['steady_steps']} steady steps "
                          f"{100 * e['normal_reaction_max_deviation']:.3f} %; tangential "
                          f"reaction at most {e['tangential_reaction_max']:.3g}")
-        lines.append(f"  largest penetration of any node into the other body (deformed "
-                     f"surfaces): {e['largest_penetration_any_node']:.2e} (tolerance "
-                     f"{e['penetration_tolerance']:.1e})")
-    lines.append("  results: summary.json, results.pvd (ParaView), reactions.png, pressed.png, "
-                 "halfway.png, slid.png")
+        residual = max((x["max_penetration"] for x in steps), default=0.0)
+        lines.append(f"  residual penetration {residual:.2e} (tolerance "
+                     f"{e['penetration_tolerance']:.1e}); any node of either body into the "
+                     f"other's deformed facets: {e['largest_penetration_any_node']:.2e}, punch "
+                     "vertices below the block's straight facets that cut across the curved "
+                     "contact (faceting, not an iteration error: docs/examples.md, Sliding)")
+    lines.append("  results: summary.json, results.pvd (ParaView), contact.csv"
+                 + "".join(f", {f}" for f in s.get("figures", [])))
     return lines

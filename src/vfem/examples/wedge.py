@@ -358,6 +358,9 @@ def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False) -> dic
     for case in cases(p):
         t0 = time.perf_counter()
         model = build(p, case)
+        start_case = getattr(on_step, "start_case", None)  # the CLI's progress: label the case
+        if start_case is not None:
+            start_case(f"case {case}")
         result, compatibility = solve_case(model, out / f"case{case}" if out else None,
                                            on_step, resume)
         steps, message = result.steps, result.message
@@ -388,62 +391,87 @@ def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False) -> dic
         "parameters": dataclasses.asdict(p),
         "timings": {},
     }
-    if out is not None and p.figures:
-        summary["figures"] = draw(out, first, finals, models, p)
     summary["timings"] = {"total_s": time.perf_counter() - start,
                           "cases_s": float(sum(c["seconds"] for c in entries))}
     if out is not None:
         write_summary(out, summary)
+        if p.figures:
+            from ..io.replot import draw_run, write_frames
+
+            summary["figure_data"] = {
+                "first_case": cases(p)[0],
+                "final_steps": {str(c): step.step for c, step in finals.items()},
+                "frames": {"prediction": write_frames(
+                    out, "prediction", first,
+                    {b.name: b.u_load.reshape(-1, 2) for b in first.bodies})}}
+            draw_run(out, summary, "wedge", first)
     return summary
 
 
-def draw(out: Path, first: Model, finals: dict[int, StepResult], models: dict[int, Model],
-         p: WedgeParameters) -> list[str]:
-    """The thesis's figures 5.4 to 5.13 (those whose cases ran); returns the file names."""
-    from ..io.plots import configurations
+def figures(folder) -> list[Path]:
+    """The figures of a wedge results folder (:class:`vfem.io.replot.Folder`), which the run
+    draws and ``vfem plot`` redraws: the thesis's figures 5.4 to 5.13 (those whose cases
+    reached the full motion; each case's results in ``caseN/``) and ``von_mises_caseN.png``,
+    each such case's final state filled by the von Mises stress."""
+    from ..io import plots, replot
 
-    def frames(model: Model, disp: dict[str, np.ndarray], label: str = "") -> list:
+    s = folder.summary
+    data = s.get("figure_data")
+    if not data:
+        return []
+    method = replot.contact_label(s)
+    mesh = s["parameters"]["mesh"]
+    motion = s["parameters"]["motion"]
+    out = folder.directory
+
+    def frames(bodies, label: str = "", zero: bool = False) -> list:
         """One frame per body (wedge first), so each body gets its colour and legend entry."""
-        order = sorted(model.bodies, key=lambda b: b.name != "wedge")
-        return [(f"{label}{b.name}", [(b.points.T, b.mesh.t.T, disp[b.name])]) for b in order]
+        order = sorted(bodies, key=lambda b: b.name != "wedge")
+        return [(f"{label}{b.name}", [(b.points, b.polygons,
+                                       0.0 * b.displacement if zero else b.displacement)])
+                for b in order]
 
-    def outline(model: Model, disp: dict[str, np.ndarray], label: str) -> tuple:
+    def outline(bodies, label: str) -> tuple:
         """One frame for a whole configuration: both bodies in one colour."""
-        order = sorted(model.bodies, key=lambda b: b.name != "wedge")
-        return (label, [(b.points.T, b.mesh.t.T, disp[b.name]) for b in order])
+        order = sorted(bodies, key=lambda b: b.name != "wedge")
+        return (label, [(b.name, b.points, b.polygons, b.displacement) for b in order])
 
-    names = []
-    zero = {b.name: np.zeros((b.npoints, 2)) for b in first.bodies}
-    configurations(out / "mesh.png", frames(first, zero),
-                   f"Wedge (thesis Fig. 5.4): the meshes in the original configuration "
-                   f"({p.mesh})", mesh_lines=True)
-    names.append("mesh.png")
-    prediction = {b.name: b.u_load.reshape(-1, 2) for b in first.bodies}
-    configurations(out / "prediction.png", frames(first, prediction),
-                   f"Wedge (Fig. 5.5): the linear prediction, contact ignored: the wedge "
-                   f"moves down {p.motion:g}", mesh_lines=True)
-    names.append("prediction.png")
-    final = {case: {name: r.displacement for name, r in step.bodies.items()}
-             for case, step in finals.items()}
-    for case in sorted(finals):
-        name = f"case{case}.png"
-        configurations(out / name, frames(models[case], final[case]),
-                       f"Wedge case {case} (Fig. {THESIS_FIGURES[case]}): E_wedge / E_plate = "
-                       f"{RATIOS[case - 1]:g}, final configuration, true scale",
-                       mesh_lines=True)
-        names.append(name)
+    written = []
+    first = folder.sub(f"case{data['first_case']}")
+    if first.has_steps:
+        plots.configurations(out / "mesh.png", frames(first.steps[0].bodies, zero=True),
+                             f"Wedge (thesis Fig. 5.4): the meshes in the original "
+                             f"configuration ({mesh})", mesh_lines=True)
+        written.append(out / "mesh.png")
+    plots.configurations(out / "prediction.png", frames(folder.frames("prediction")),
+                         f"Wedge (Fig. 5.5): the linear prediction, contact ignored: the wedge "
+                         f"moves down {motion:g}", mesh_lines=True, magnification=1.0)
+    written.append(out / "prediction.png")
+    final = {int(c): folder.sub(f"case{c}").step(n).bodies
+             for c, n in data["final_steps"].items()}
+    for case in sorted(final):
+        plots.configurations(out / f"case{case}.png", frames(final[case]),
+                             f"Wedge case {case} (Fig. {THESIS_FIGURES[case]}): E_wedge / "
+                             f"E_plate = {RATIOS[case - 1]:g}, final configuration\n{method}",
+                             mesh_lines=True, magnification=1.0)
+        written.append(out / f"case{case}.png")
     for group, figure in OVERLAYS:
-        if not all(c in finals for c in group):
+        if not all(c in final for c in group):
             continue
         name = "cases_" + "_".join(str(c) for c in group) + ".png"
-        configurations(out / name,
-                       [outline(models[c], final[c],
-                                f"case {c}: E_wedge / E_plate = {RATIOS[c - 1]:g}")
-                        for c in group],
-                       f"Wedge (Fig. {figure}): final configurations of cases "
-                       f"{', '.join(str(c) for c in group)}, true scale", mesh_lines=False)
-        names.append(name)
-    return names
+        plots.configurations(out / name,
+                             [outline(final[c], f"case {c}: E_wedge / E_plate = "
+                                                f"{RATIOS[c - 1]:g}") for c in group],
+                             f"Wedge (Fig. {figure}): final configurations of cases "
+                             f"{', '.join(str(c) for c in group)}\n{method}",
+                             mesh_lines=False, magnification=1.0)
+        written.append(out / name)
+    for case in sorted(final):
+        step = folder.sub(f"case{case}").step(data["final_steps"][str(case)])
+        written.append(replot.von_mises(
+            folder, step, f"von_mises_case{case}.png",
+            f"Wedge case {case}: von Mises stress, final configuration\n{method}"))
+    return written
 
 
 def report(s: dict) -> list[str]:

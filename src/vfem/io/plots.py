@@ -10,7 +10,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
+from matplotlib.colors import Normalize  # noqa: E402
 from matplotlib.ticker import MaxNLocator, NullFormatter  # noqa: E402
+
+#: the axis label of a model coordinate (vfem has no unit system: lengths are the model's own)
+LENGTH = "model units"
+#: a fixed legend place beside the axes: never over the drawing, and fast (matplotlib's "best"
+#: tests every position against every drawn vertex, minutes on a large mesh)
+OUTSIDE = {"loc": "upper left", "bbox_to_anchor": (1.02, 1.0), "borderaxespad": 0.0}
+_LINESTYLES = ("-", "--", ":", "-.")
 
 
 def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[str, np.ndarray],
@@ -27,8 +35,8 @@ def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[
     ax.set_xlim(0, 1.4)
     ax.set_ylim(-0.1, 1.15)
     ax.axhline(0, color="0.7", lw=0.8)
-    ax.set_xlabel("x / a")
-    ax.set_ylabel("p / p0")
+    ax.set_xlabel("x / a (undeformed x over Hertz's half-width; dimensionless)")
+    ax.set_ylabel("p / p0 (pressure over Hertz's peak; dimensionless)")
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
@@ -53,8 +61,8 @@ def punch_pressure(path: Path, x: np.ndarray, p: np.ndarray, force: float, a: fl
     ax.axhline(0, color="0.7", lw=0.8)
     top = max(float(np.max(p)) if len(p) else 0.0, 3 * force / (np.pi * a))
     ax.set_ylim(-0.05 * top, 1.4 * top)  # room for the legend above the corners
-    ax.set_xlabel("x (undeformed) [length]")
-    ax.set_ylabel("contact pressure p [force / length^2]")
+    ax.set_xlabel(f"x, undeformed ({LENGTH})")
+    ax.set_ylabel(f"contact pressure p ({LENGTH})")
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper center")
@@ -93,28 +101,47 @@ def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
     plt.close(fig)
 
 
+
+
+def magnified(title: str, magnification: float) -> str:
+    """``title`` with the displacements' magnification stated, e.g. "... — displacements × 10"
+    (× 1: true scale), so a reader never takes a magnified shape for the real one."""
+    text = f"displacements × {magnification:g}" + (" (true scale)" if magnification == 1 else "")
+    last = title.rsplit("\n", 1)[-1]
+    return f"{title}{chr(10) if len(last) + len(text) > 70 else ' — '}{text}"
+
+
 def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np.ndarray,
                                                                    np.ndarray]]]],
                    title: str, window: tuple[float, float, float, float] | None = None,
-                   mesh_lines: bool | None = None, legend_loc: str = "best") -> None:
+                   mesh_lines: bool | None = None, legend_loc: str | None = None,
+                   magnification: float | None = None) -> None:
     """One or more configurations of a model drawn over each other (thesis Figs. 5.4-5.23).
 
     ``frames``: (label, bodies) with bodies a list of (points (n, 2), cells (m, k) of vertex
     numbers, displacement (n, 2)), optionally preceded by the body's name (for the legend).
-    Each frame gets its own colour; with one frame each body gets its own. Mesh lines are drawn
-    when there is a single frame (default), outlines only when several are overlaid.
-    ``window`` = (xmin, xmax, ymin, ymax), default: everything. ``legend_loc``: matplotlib's
-    legend position ("best" searches every position, slow on large meshes).
+    With one frame each body gets its own colour and legend entry; with several, each frame
+    gets its own colour and each named body its own line style (also in the legend), so every
+    body can be told apart. Mesh lines are drawn when there is a single frame (default),
+    outlines only when several are overlaid. ``window`` = (xmin, xmax, ymin, ymax), default:
+    everything. ``legend_loc``: a matplotlib legend position inside the axes; default beside
+    them. ``magnification``: the displacements are multiplied by it and the title says so
+    (None: the title says nothing, for configurations that are not deformed shapes).
     """
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     mesh_lines = len(frames) == 1 if mesh_lines is None else mesh_lines
-    fig, ax = plt.subplots(figsize=(7.5, 4.6))
+    scale = 1.0 if magnification is None else float(magnification)
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+    styles: dict[str, str] = {}  # body name -> line style (several frames)
     for k, (label, bodies) in enumerate(frames):
         for j, entry in enumerate(bodies):
             body_name, (p, t, u) = (entry[0], entry[1:]) if len(entry) == 4 else (None, entry)
             c = colors[(j if len(frames) == 1 else k) % len(colors)]
-            x = np.asarray(p)[:, :2] + np.asarray(u)[:, :2]
+            ls = "-"
+            if len(frames) > 1 and body_name is not None:
+                ls = styles.setdefault(body_name, _LINESTYLES[len(styles) % len(_LINESTYLES)])
+            x = np.asarray(p)[:, :2] + scale * np.asarray(u)[:, :2]
             lo, hi = np.minimum(lo, x.min(axis=0)), np.maximum(hi, x.max(axis=0))
             if len(frames) == 1:
                 name = f"{label}: {body_name}" if body_name else (label if j == 0 else None)
@@ -128,18 +155,74 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
                     poly = poly[(cx > window[0] - pad) & (cx < window[1] + pad)
                                 & (cy > window[2] - pad) & (cy < window[3] + pad)]
                 ax.add_collection(PolyCollection(poly, facecolors="none", edgecolors=c,
-                                                 linewidths=0.4, label=name))
+                                                 linewidths=0.4, linestyles=ls, label=name))
             else:
                 ax.add_collection(LineCollection(x[_outline(np.asarray(t))], colors=c,
-                                                 linewidths=0.9, label=name))
+                                                 linewidths=0.9, linestyles=ls, label=name))
+    if len(styles) > 1:  # which line style is which body
+        for body_name, ls in styles.items():
+            ax.plot([], [], color="0.3", ls=ls, lw=0.9, label=body_name)
     if window is None:
         pad = 0.03 * (hi - lo).max()
         window = (lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad)
     ax.set_xlim(window[0], window[1])
     ax.set_ylim(window[2], window[3])
     ax.set_aspect("equal")
-    ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=8, loc=legend_loc)
+    ratio = (window[1] - window[0]) / max(window[3] - window[2], 1e-300)
+    fig.set_size_inches(min(12.0, max(7.0, 3.6 * ratio + (2.9 if legend_loc is None else 1.2))),
+                        4.6)
+    ax.set_xlabel(f"x ({LENGTH})")
+    ax.set_ylabel(f"y ({LENGTH})")
+    ax.set_title(title if magnification is None else magnified(title, scale), fontsize=10)
+    ax.legend(fontsize=8, **({"loc": legend_loc} if legend_loc else OUTSIDE))
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.ndarray,
+                                             np.ndarray]],
+              title: str, magnification: float = 1.0,
+              window: tuple[float, float, float, float] | None = None) -> None:
+    """The deformed bodies filled by their elements' von Mises stress, one colour scale for all.
+
+    ``bodies``: (name, points (n, 2), cells (m, k) point numbers around each cell,
+    displacement (n, 2), von Mises stress per cell (m,)). Each body's outline is drawn in its
+    own colour and named in the legend. One PolyCollection per body (fast on large meshes).
+    """
+    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
+    values = [np.asarray(b[4], dtype=float).ravel() for b in bodies]
+    finite = np.concatenate([v[np.isfinite(v)] for v in values] + [np.zeros(1)])
+    norm = Normalize(vmin=float(finite.min()), vmax=float(finite.max()) or 1.0)
+    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+    mappable = None
+    for j, ((name, p, t, u, _), v) in enumerate(zip(bodies, values)):
+        x = np.asarray(p)[:, :2] + magnification * np.asarray(u)[:, :2]
+        lo, hi = np.minimum(lo, x.min(axis=0)), np.maximum(hi, x.max(axis=0))
+        mappable = PolyCollection(x[np.asarray(t)], array=v, cmap="viridis", norm=norm,
+                                  edgecolors="face", linewidths=0.2)
+        ax.add_collection(mappable)
+        ax.add_collection(LineCollection(x[_outline(np.asarray(t))],
+                                         colors=colors[j % len(colors)], linewidths=1.0,
+                                         label=name))
+    if window is None:
+        pad = 0.03 * (hi - lo).max()
+        window = (lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad)
+    ax.set_xlim(window[0], window[1])
+    ax.set_ylim(window[2], window[3])
+    ax.set_aspect("equal")
+    # a figure shaped like the window (equal axes leave the rest blank)
+    ratio = (window[1] - window[0]) / max(window[3] - window[2], 1e-300)
+    fig.set_size_inches(min(12.0, max(5.5, 3.4 * ratio + 2.4)), 4.6)
+    ax.set_xlabel(f"x ({LENGTH})")
+    ax.set_ylabel(f"y ({LENGTH})")
+    ax.set_title(magnified(title, magnification), fontsize=10)
+    if mappable is not None:
+        fig.colorbar(mappable, ax=ax, label=f"von Mises stress ({LENGTH})", shrink=0.8,
+                     pad=0.02)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(0.0, -0.15), ncol=4,
+              borderaxespad=0.0, title="outlines")
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
@@ -163,7 +246,7 @@ def history(path: Path, x: np.ndarray, series: dict[str, np.ndarray], xlabel: st
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
@@ -171,8 +254,8 @@ def history(path: Path, x: np.ndarray, series: dict[str, np.ndarray], xlabel: st
 
 def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.ndarray,
                                                                     np.ndarray]]],
-                              title: str, xlabel: str = "x (undeformed)",
-                              ylabel: str = "nominal contact pressure") -> None:
+                              title: str, xlabel: str = f"x, undeformed ({LENGTH})",
+                              ylabel: str = f"nominal contact pressure ({LENGTH})") -> None:
     """Contact pressure against x, per body: the last profile of each body bold, the ones
     before it as lighter lines of the same colour.
 
@@ -180,7 +263,7 @@ def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.n
     A body without nodes in contact is listed in the legend as such.
     """
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    fig, ax = plt.subplots(figsize=(8.5, 4.2))
     markers = ("o", "s", "^", "v", "D", "x")
     for j, (name, profiles) in enumerate(bodies.items()):
         c = colors[j % len(colors)]
@@ -191,10 +274,12 @@ def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.n
         if len(x) == 0:
             label += ": no node in contact"
         for k, (lab, xb, pb) in enumerate(before):
+            # with a marker: a step with a single node in contact is a point, which a line
+            # alone does not draw (the legend would name a step the plot does not show)
             order = np.argsort(xb, kind="stable")
             ax.plot(np.asarray(xb)[order], np.asarray(pb)[order], "-", color=c, lw=0.8,
-                    alpha=0.2 + 0.4 * (k + 1) / (len(before) + 1),
-                    label=f"{name}: {lab}")
+                    marker=".", ms=3, alpha=0.25 + 0.45 * (k + 1) / (len(before) + 1),
+                    label=f"{name}: {lab}" + ("" if len(xb) else ": no node in contact"))
         order = np.argsort(x, kind="stable")
         ax.plot(np.asarray(x)[order], np.asarray(p)[order], "-", color=c, lw=1.4,
                 marker=markers[j % len(markers)], ms=4, mfc="none", label=f"{name}: {label}")
@@ -203,7 +288,7 @@ def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.n
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, **OUTSIDE)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
@@ -237,7 +322,7 @@ def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarra
         ax.set_ylabel(ylabel, fontsize=8)
         ax.grid(alpha=0.3, which="both")
         if series:
-            ax.legend(fontsize=7, loc="best")
+            ax.legend(fontsize=7, loc="upper right")
     axes[-1, 0].set_xlabel(xlabel)
     axes[-1, 0].xaxis.set_major_locator(MaxNLocator(integer=True))
     fig.suptitle(title, fontsize=10)

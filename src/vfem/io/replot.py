@@ -1,7 +1,13 @@
 """Figures from a results directory, without solving: only the files on disk are read.
 
-:func:`plot_results` reads ``results.pvd`` (and the VTU files it lists), ``contact.csv`` and,
-if present, ``summary.json`` (see :mod:`vfem.io.results` for their content) and writes:
+Every figure vfem draws is drawn here, from a results folder (:class:`Folder`): a run writes
+its files, then calls :func:`plot_results` on its folder, and ``vfem plot`` calls the same, so
+both draw the same figures from the same data. ``summary.json``'s ``figure_set`` says which
+figures: a built-in example's (its module's ``figures(folder)``; what they need beyond the
+results files, e.g. Hertz's half-width or a linear prediction, the example writes into
+``summary.json``'s ``figure_data`` or as extra VTU files, :func:`write_frames`), or ``"input"``
+for an input file's run, whose generic figures are these (also drawn for a folder that
+records no figure set, e.g. one written before figure sets were recorded):
 
 * ``deformed.png`` — the last step's deformed configuration of every body, true scale, mesh lines,
   windowed on the contact zone (the bounding box of the deformed nodes in contact, padded); when
@@ -11,7 +17,8 @@ if present, ``summary.json`` (see :mod:`vfem.io.results` for their content) and 
   up to three earlier steps as lighter lines;
 * ``history.png`` — per step: iterations, final largest penetration and equilibrium error (from
   ``summary.json``'s ``steps``, when there), and the magnitude of the resultant contact force
-  on each body (the sum of the VTU's nodal ``contact_force``; per unit thickness).
+  on each body (the sum of the VTU's nodal ``contact_force``; per unit thickness);
+* ``von_mises.png`` — the last step's deformed bodies filled by the VTU's element ``von_mises``.
 
 Without ``contact.csv`` (results written by an older version), the nodes in contact and their
 pressure are taken from the VTU's ``contact_status`` and ``contact_pressure`` point fields.
@@ -32,7 +39,7 @@ import numpy as np
 
 from ..errors import InputError
 from . import plots
-from .results import _safe
+from .results import _safe, write_summary
 
 log = logging.getLogger(__name__)
 
@@ -53,6 +60,7 @@ class BodyFrame:
     polygons: np.ndarray  # (m, k) point numbers around each cell
     displacement: np.ndarray  # (n, 2)
     point_data: dict[str, np.ndarray]
+    cell_data: dict[str, np.ndarray] = field(default_factory=dict)  # one value per cell
 
 
 @dataclass
@@ -130,7 +138,8 @@ def read_vtu(path: Path, part: int, name: str) -> BodyFrame:
     u = np.asarray(m.point_data["displacement"], dtype=float)
     return BodyFrame(part=part, name=name, path=path, points=np.asarray(m.points)[:, :2],
                      polygons=np.asarray(block.data)[:, _POLYGONS[block.type]],
-                     displacement=u[:, :2], point_data=dict(m.point_data))
+                     displacement=u[:, :2], point_data=dict(m.point_data),
+                     cell_data={k: np.asarray(v[0]).ravel() for k, v in m.cell_data.items()})
 
 
 def read_steps(directory: Path) -> list[Step]:
@@ -183,33 +192,50 @@ def _contact_nodes(frame: BodyFrame) -> ContactNodes:
                         np.ones(len(node), dtype=bool))
 
 
-def plot_results(directory: Path | str) -> list[Path]:
-    """Write ``deformed.png`` (and maybe ``deformed_overall.png``), ``contact_pressure.png`` and
-    ``history.png`` into ``directory`` from its results files; return the paths written.
+class Folder:
+    """A results folder as its files give it: ``summary.json`` (``{}`` when absent), the steps of
+    ``results.pvd`` (read on first use) and the nodes of ``contact.csv`` (or, for results
+    without it, the VTU's contact fields). Every figure is drawn from one of these, never from
+    a solver's objects, so ``vfem plot`` redraws what the run drew."""
 
-    Raises :class:`~vfem.errors.InputError` naming the path when the directory, its
-    ``results.pvd`` or a VTU file it lists is missing or unreadable.
-    """
-    directory = Path(directory)
-    if not directory.is_dir():
-        raise InputError(f"results directory {directory} does not exist")
-    steps = read_steps(directory)
-    csv_path = directory / "contact.csv"
-    table = read_contact_csv(csv_path) if csv_path.is_file() else None
-    summary = None
-    summary_path = directory / "summary.json"
-    if summary_path.is_file():
-        try:
-            summary = json.loads(summary_path.read_text(encoding="utf-8"))
-        except (ValueError, UnicodeDecodeError) as exc:
-            raise InputError(f"{summary_path}: not valid JSON: {exc}") from None
+    def __init__(self, directory: Path | str, summary: dict | None = None):
+        self.directory = Path(directory)
+        if not self.directory.is_dir():
+            raise InputError(f"results directory {self.directory} does not exist")
+        self.summary = read_summary(self.directory) if summary is None else summary
+        self._steps: list[Step] | None = None
+        self._table: dict | None = None
 
-    def contact(step: Step, frame: BodyFrame) -> ContactNodes:
-        if table is None:
+    @property
+    def has_steps(self) -> bool:
+        """Whether the folder holds a ``results.pvd`` (an analysis that converged no step, or
+        an example without bodies, writes none)."""
+        return (self.directory / "results.pvd").is_file()
+
+    @property
+    def steps(self) -> list[Step]:
+        if self._steps is None:
+            self._steps = read_steps(self.directory)
+        return self._steps
+
+    def step(self, number: int) -> Step:
+        """The step numbered ``number`` (as in the VTU names and contact.csv)."""
+        found = next((s for s in self.steps if s.step == number), None)
+        if found is None:
+            raise InputError(f"{self.directory}: summary.json names step {number}, which "
+                             "results.pvd does not list")
+        return found
+
+    def contact(self, step: Step, frame: BodyFrame) -> ContactNodes:
+        """The contact candidate nodes of ``frame``'s body at ``step``."""
+        if self._table is None:
+            path = self.directory / "contact.csv"
+            self._table = read_contact_csv(path) if path.is_file() else {}
+        if not self._table:
             return _contact_nodes(frame)
-        c = table.get((step.step, frame.name))
+        c = self._table.get((step.step, frame.name))
         if c is None:  # body names in the pvd may be the file-safe ones (older files)
-            c = next((v for (s, n), v in table.items() if s == step.step and _safe(n) ==
+            c = next((v for (s, n), v in self._table.items() if s == step.step and _safe(n) ==
                       frame.name), None)
         if c is None:
             e = np.zeros(0)
@@ -217,16 +243,156 @@ def plot_results(directory: Path | str) -> list[Path]:
                                 e.astype(bool))
         return c
 
-    written = _deformed(directory, steps, contact)
-    written.append(_pressure(directory, steps, contact,
-                             "contact.csv" if table is not None else "VTU fields"))
-    written.append(_history(directory, steps, summary))
+    @property
+    def contact_source(self) -> str:
+        return "contact.csv" if (self.directory / "contact.csv").is_file() else "VTU fields"
+
+    def frames(self, label: str) -> list[BodyFrame]:
+        """The extra configuration ``label`` an example recorded for its figures
+        (:func:`write_frames`; ``summary.json``'s ``figure_data.frames``), in body order."""
+        files = (self.summary.get("figure_data") or {}).get("frames", {}).get(label)
+        if not files:
+            raise InputError(f"{self.directory}/summary.json records no configuration "
+                             f"{label!r} under figure_data.frames")
+        return [read_vtu(self.directory / f, k, name) for k, (name, f) in enumerate(files.items())]
+
+    def sub(self, name: str) -> Folder:
+        """A sub-folder's results (the wedge's ``caseN``), with no summary of its own."""
+        return Folder(self.directory / name, summary={})
+
+
+def read_summary(directory: Path) -> dict:
+    """``summary.json`` of a results folder ({} when there is none)."""
+    path = Path(directory) / "summary.json"
+    if not path.is_file():
+        return {}
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not valid JSON: {exc}") from None
+    return summary if isinstance(summary, dict) else {}
+
+
+def write_frames(out: Path, label: str, model, displacements: dict[str, np.ndarray]
+                 ) -> dict[str, str]:
+    """Write a configuration that is not a converged step (a linear prediction, contact
+    ignored) as one VTU per body, ``<body>_<label>.vtu`` (displacement only), so the figure
+    that shows it can be redrawn from the folder; returns {body: file name} for
+    ``summary.json``'s ``figure_data.frames[label]``."""
+    files = {}
+    for body in model.bodies:
+        cell_type, conn = body.cells()
+        u = np.asarray(displacements[body.name], dtype=float).reshape(-1, 2)
+        name = f"{_safe(body.name)}_{label}.vtu"
+        m = meshio.Mesh(points=np.column_stack([body.points.T, np.zeros(body.npoints)]),
+                        cells=[(cell_type, conn)],
+                        point_data={"displacement": np.column_stack([u, np.zeros(len(u))])})
+        meshio.write(Path(out) / name, m, file_format="vtu")
+        files[body.name] = name
+    return files
+
+
+def contact_label(summary: dict) -> str:
+    """The contact method and variant a run used, for figure titles: "contact: vfem, paired
+    variant" or "contact: lagrange" (a classical method has no variant). Read from
+    ``summary.json``: ``contact_settings`` (written with the figures), else the input file's
+    ``config.contact``, else the example's ``parameters`` (the defaults where none says)."""
+    for source in (summary.get("contact_settings"),
+                   (summary.get("config") or {}).get("contact"), summary.get("parameters")):
+        if isinstance(source, dict) and ("variant" in source or "method" in source):
+            break
+    else:
+        source = {}
+    method = source.get("method", "vfem")
+    variant = source.get("variant", summary.get("variant", "paired"))
+    return f"contact: vfem, {variant} variant" if method == "vfem" else f"contact: {method}"
+
+
+def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> list[str]:
+    """What a run does once its results are written: record in ``summary`` the ``figure_set``
+    (a built-in example's name or ``"input"``) and ``model``'s contact method and variant
+    (``contact_settings``, for the titles), write ``summary.json``, draw the figures from the
+    folder (:func:`plot_results`, as ``vfem plot`` does) and record their names, relative to
+    ``out``, as ``figures``. Returns those names."""
+    out = Path(out)
+    summary["figure_set"] = figure_set
+    if model is not None:
+        summary["contact_settings"] = {"variant": model.contact.variant,
+                                       "method": model.contact.method}
+    write_summary(out, summary)
+    summary["figures"] = [p.relative_to(out).as_posix() for p in plot_results(out)]
+    write_summary(out, summary)
+    return summary["figures"]
+
+
+def plot_results(directory: Path | str) -> list[Path]:
+    """Draw a results folder's figures from its files; return the paths written.
+
+    Which figures: ``summary.json``'s ``figure_set``, the built-in example whose run wrote the
+    folder (its module's ``figures(folder)``) or ``"input"`` (an input file's run); without one
+    (results written before figure sets were recorded) the generic figures of an input-file run
+    (none for the examples that draw none, springs and patch):
+    ``deformed.png`` (and maybe ``deformed_overall.png``), ``contact_pressure.png``,
+    ``history.png`` and ``von_mises.png``. A run draws its figures by calling this after
+    writing its files, so ``vfem plot`` redraws the same figures from the same data.
+
+    Raises :class:`~vfem.errors.InputError` naming the path when the directory, its
+    ``results.pvd`` or a VTU file it lists is missing or unreadable.
+    """
+    from ..examples import EXAMPLES, load
+
+    folder = Folder(directory)
+    name = folder.summary.get("figure_set")
+    example = folder.summary.get("example")
+    if name is None and example in EXAMPLES and not hasattr(load(example), "figures"):
+        name = example  # an example that draws no figure (springs, patch: no results files)
+    if name not in (None, "input"):
+        if name not in EXAMPLES:
+            raise InputError(f"{folder.directory}/summary.json: figure_set {name!r} is not a "
+                             f"built-in example ({', '.join(EXAMPLES)}) nor 'input'")
+        draw = getattr(load(name), "figures", None)
+        written = draw(folder) if draw is not None else []
+    else:
+        written = generic(folder)
     for p in written:
         log.info("wrote %s", p)
     return written
 
 
-def _deformed(directory: Path, steps: list[Step], contact) -> list[Path]:
+def generic(folder: Folder) -> list[Path]:
+    """The figures of an input file's run (see :func:`plot_results`)."""
+    steps = folder.steps
+    label = contact_label(folder.summary)
+    written = _deformed(folder.directory, steps, folder.contact, label)
+    written.append(_pressure(folder.directory, steps, folder.contact, folder.contact_source,
+                             label))
+    written.append(_history(folder.directory, steps, folder.summary or None))
+    written.append(von_mises(folder, steps[-1], "von_mises.png",
+                             f"von Mises stress, step {steps[-1].step} (load factor "
+                             f"{steps[-1].load_factor:.6g})\n{label}"))
+    return written
+
+
+def von_mises(folder: Folder, step: Step, name: str, title: str,
+              window: tuple[float, float, float, float] | None = None,
+              magnification: float = 1.0) -> Path:
+    """``name``: ``step``'s deformed bodies filled by the VTU's element ``von_mises`` field."""
+    bodies = []
+    for b in step.bodies:
+        vm = _cell_field(b, "von_mises")
+        bodies.append((b.name, b.points, b.polygons, b.displacement, vm))
+    path = folder.directory / name
+    plots.von_mises(path, bodies, title, magnification, window)
+    return path
+
+
+def _cell_field(frame: BodyFrame, name: str) -> np.ndarray:
+    if name not in frame.cell_data:
+        raise InputError(f"{frame.path}: no {name!r} cell field")
+    return np.asarray(frame.cell_data[name], dtype=float)
+
+
+def _deformed(directory: Path, steps: list[Step], contact, method: str) -> list[Path]:
     last = steps[-1]
     bodies = [(b.name, b.points, b.polygons, b.displacement) for b in last.bodies]
     xs = np.vstack([b.points + b.displacement for b in last.bodies])
@@ -241,23 +407,29 @@ def _deformed(directory: Path, steps: list[Step], contact) -> list[Path]:
         clo, chi = touching.min(axis=0), touching.max(axis=0)
         pad = max(0.5 * float((chi - clo).max()), 0.05 * extent)
         window = (clo[0] - pad, chi[0] + pad, clo[1] - pad, chi[1] + pad)
-        plots.configurations(path, [(label, bodies)], "Deformed configuration (true scale), "
-                             "contact zone", window)
+        plots.configurations(path, [(label, bodies)], f"Deformed configuration, contact zone\n"
+                             f"{method}", window, magnification=1.0)
         out.append(path)
         if window[0] > lo[0] or window[1] < hi[0] or window[2] > lo[1] or window[3] < hi[1]:
             whole = directory / "deformed_overall.png"
-            plots.configurations(whole, [(label, bodies)], "Deformed configuration (true scale)")
+            plots.configurations(whole, [(label, bodies)], f"Deformed configuration\n{method}",
+                                 magnification=1.0)
             out.append(whole)
     else:
-        plots.configurations(path, [(label, bodies)], "Deformed configuration (true scale), "
-                             "no node in contact")
+        plots.configurations(path, [(label, bodies)], "Deformed configuration, no node in "
+                             f"contact\n{method}", magnification=1.0)
         out.append(path)
     return out
 
 
-def _pressure(directory: Path, steps: list[Step], contact, source: str) -> Path:
+#: The most steps the generic pressure figure draws (more would not be told apart).
+MAX_PROFILES = 6
+
+
+def _pressure(directory: Path, steps: list[Step], contact, source: str, method: str) -> Path:
+    # every step up to MAX_PROFILES; beyond, that many spread evenly, the title says so
     last = len(steps) - 1
-    shown = sorted({int(round(k)) for k in np.linspace(0, last, 4)}) if last else [0]
+    shown = sorted({int(round(k)) for k in np.linspace(0, last, min(len(steps), MAX_PROFILES))})
     nodes = {(k, b.name): contact(steps[k], b) for k in shown for b in steps[k].bodies}
     # against x, unless the nodes in contact clearly lie along y (a vertical contact)
     xy = np.vstack([c.x[c.contact] for c in nodes.values()] + [np.zeros((0, 2))])
@@ -273,9 +445,11 @@ def _pressure(directory: Path, steps: list[Step], contact, source: str) -> Path:
                  c.pressure[on]))
     path = directory / "contact_pressure.png"
     plots.contact_pressure_profiles(
-        path, profiles, "Contact pressure at the nodes in contact\n(nominal: normal force / "
-        f"undeformed length; from {source})", xlabel=f"{'xy'[axis]} (undeformed)",
-        ylabel="contact pressure")
+        path, profiles, "Contact pressure at the nodes in contact"
+        + ("" if len(shown) == len(steps) else f", {len(shown)} of {len(steps)} steps")
+        + f"\n(nominal: normal force / undeformed length; from {source})\n{method}",
+        xlabel=f"{'xy'[axis]}, undeformed ({plots.LENGTH})",
+        ylabel=f"nominal contact pressure ({plots.LENGTH})")
     return path
 
 
