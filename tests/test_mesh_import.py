@@ -277,6 +277,15 @@ def test_mixed_types(msh, tmp_path):
     raises(write_inp(tmp_path / "two.inp"), None, "quad", "triangle", "cells =")
 
 
+def test_a_chosen_group_that_mixes_types_is_not_told_to_choose_itself(tmp_path):
+    """Issue 17: the remedy for a group of mixed elements selected with ``cells`` is to change
+    the mesh, not to select that same group again."""
+    path = write_inp(tmp_path / "two.inp")
+    path.write_text(path.read_text() + "*Elset, elset=both, generate\n1, 16, 1\n")
+    message = raises(path, "both", "mixes quad and triangle", "one element type")
+    assert "cells = 'both'" not in message
+
+
 @pytest.mark.parametrize("name, content", [
     ("garbage.msh", b"this is not a mesh\n"),
     ("binary.msh", bytes(range(256)) * 4),

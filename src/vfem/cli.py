@@ -13,6 +13,7 @@ import difflib
 import inspect
 import json
 import logging
+import shlex
 import shutil
 import signal
 import sys
@@ -22,6 +23,7 @@ from . import linalg
 from .contact.settings import ContactSettings
 from .errors import InputError, VfemError
 from .examples import EXAMPLES, load
+from .io.folders import ResultsFolder, default_folder, run_description
 
 log = logging.getLogger("vfem")
 
@@ -85,8 +87,20 @@ class Progress:
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
         self.done = 0  # scheduled steps completed (a cut step completes only at its target)
         self.steps_seen = 0  # converged steps, cut ones included
+        self.label = ""  # the case under way, in a run of several (wedge): "case 3: "
+        self.after_step = None  # called after each converged step (the results folder's record)
+
+    def start_case(self, name: str) -> None:
+        """A run of several analyses (the wedge's cases) starts the next one, ``name``: its
+        progress lines are prefixed with it and count its steps from the start."""
+        if self.enabled and self.tty and self.steps_seen:
+            self.stream.write("\n")
+        self.label = f"{name}: "
+        self.done = self.steps_seen = 0
 
     def __call__(self, step) -> None:
+        if self.after_step is not None:
+            self.after_step()
         if not self.enabled:
             return
         self.steps_seen += 1
@@ -107,6 +121,7 @@ class Progress:
                                     / (self.factors[self.done] - prev)))
             filled = round(width * (self.done + part) / self.total)
             text = f"[{'#' * filled}{'.' * (width - filled)}] {text}"
+        text = self.label + text
         if self.tty:
             self.stream.write("\r\033[K  " + text)
             self.stream.flush()
@@ -117,7 +132,7 @@ class Progress:
         """On a terminal, the contact iteration under way and its errors (Analysis.run)."""
         if not (self.enabled and self.tty):
             return
-        self.stream.write(f"\r\033[K  step {self.steps_seen + 1:3d}  iteration "
+        self.stream.write(f"\r\033[K  {self.label}step {self.steps_seen + 1:3d}  iteration "
                           f"{record.iteration:3d}  penetration {record.max_penetration:.2e}  "
                           f"equilibrium error {record.max_equilibrium_error:.2e}")
         self.stream.flush()
@@ -132,10 +147,10 @@ def _is_input_file(target: str) -> bool:
     return target.endswith(".toml") or Path(target).is_file()
 
 
-def _load_input(path: str):
+def _load_input(path: str, assignments: list[str] = ()):
     from .io.input import load as load_input
 
-    return load_input(path)
+    return load_input(path, assignments)
 
 
 def _example(name: str, alternatives: str = ""):
@@ -165,7 +180,7 @@ def cmd_run(args) -> int:
     params = build_parameters(args.example, args.set or [])
     if hasattr(example, "validate"):
         example.validate(params)  # bad input is reported before anything is written
-    out = _results_directory(args, Path("results") / args.example)
+    out = _results_directory(args, default_folder(args.example, args.set or []))
     resume = {}
     if args.resume:
         if "resume" not in inspect.signature(example.run).parameters:
@@ -181,15 +196,18 @@ def cmd_run(args) -> int:
 
 
 def _with_invariants(lines: list[str], summary: dict) -> list[str]:
-    """A built-in example's closing lines with the invariants line of its steps
-    (:func:`vfem.io.runner.invariants_line`) before the results line (at the end if none)."""
-    from .io.runner import invariants_line
+    """A built-in example's closing lines with, before the results line (at the end if none),
+    each body's contact force and support reactions and how they balance
+    (:func:`vfem.io.runner.reaction_lines`), then the invariants line of its steps
+    (:func:`vfem.io.runner.invariants_line`)."""
+    from .io.runner import invariants_line, reaction_lines
 
-    line = invariants_line(summary.get("steps") or [])
-    if not line:
+    steps = summary.get("steps") or []
+    extra = ["  " + x for x in (*reaction_lines(steps), invariants_line(steps)) if x]
+    if not extra:
         return lines
     at = next((k for k, x in enumerate(lines) if x.lstrip().startswith("results")), len(lines))
-    return [*lines[:at], "  " + line, *lines[at:]]
+    return [*lines[:at], *extra, *lines[at:]]
 
 
 def _writable_folder(out: Path, what: str) -> None:
@@ -208,7 +226,19 @@ def _writable_folder(out: Path, what: str) -> None:
 
 def _results_directory(args, default: Path) -> Path:
     """Where a run writes: ``--resume DIR`` (which must hold an earlier run), else ``--out``,
-    else ``default``."""
+    else ``default``; made ready for the run (:class:`vfem.io.folders.ResultsFolder`: an
+    earlier run's files cleared, another model's refused without ``--overwrite``)."""
+    out = _results_location(args, default)
+    target = args.example if not _is_input_file(args.example) else str(
+        Path(args.example).resolve())
+    args.folder = ResultsFolder(out, run_description(args.command_line, target, args.set or []))
+    args.folder.prepare(overwrite=args.overwrite, resume=bool(args.resume))
+    return out
+
+
+def _results_location(args, default: Path) -> Path:
+    if args.out is not None and not args.out.strip():
+        raise InputError("--out: an empty name; name a folder for the results")
     if not args.resume:
         out = Path(args.out or default)
         _writable_folder(out, "--out" if args.out else "the results folder")
@@ -225,19 +255,28 @@ def _solve_and_report(solve, progress: Progress, report, quiet: bool, args, out:
     """Run ``solve()`` (-> summary) under the progress display, print ``report(summary)``;
     exit status 1 if the analysis did not converge. Interrupted (Ctrl-C, SIGTERM): say where
     the completed steps are and how to continue, exit status 130."""
+    folder = args.folder
+    progress.after_step = folder.update
     try:
         summary = solve()
     except KeyboardInterrupt:
         summary = None
     finally:
         progress.close()
+        folder.update()
+        folder.stamp_summary()
     if summary is None:
-        sets = "".join(f" --set {a}" for a in (args.set or []))
-        print(f"vfem: interrupted; the steps completed are in {out}/. Continue with: vfem run "
-              f"{args.example}{sets} --resume {out}", file=sys.stderr)
+        sets = "".join(f" --set {shlex.quote(a)}" for a in (args.set or []))
+        if any(out.glob("**/checkpoint/step*.npz")):
+            print(f"vfem: interrupted; the steps completed are in {out}/. Continue with: vfem "
+                  f"run {args.example}{sets} --resume {out}", file=sys.stderr)
+        else:
+            print(f"vfem: interrupted before the first step was completed: nothing to resume; "
+                  f"run it again: vfem run {args.example}{sets}", file=sys.stderr)
         return 130
+    summary["run"] = folder.run
     if not quiet:
-        print("\n".join(report(summary)))
+        print("\n".join(_results_line(report(summary), out)))
     if not summary["converged"]:
         print(f"vfem: the analysis did not converge: "
               f"{summary.get('message') or 'see summary.json for each case'}",
@@ -246,11 +285,29 @@ def _solve_and_report(solve, progress: Progress, report, quiet: bool, args, out:
     return 0
 
 
-def _checked_model(path: str):
-    """The input file's description and its model, every check done (nothing solved)."""
+#: What the closing screen says of a results folder's files, in this order (those present).
+_RESULT_FILES = (("summary.json", ""), ("results.pvd", " for ParaView"), ("contact.csv", ""),
+                 ("reactions.csv", ""))
+
+
+def _results_line(lines: list[str], out: Path) -> list[str]:
+    """The report with its ``results:`` line made from the files that are in ``out`` (never
+    one the run did not write: a run that stopped early has no figures)."""
+    names = [n + note for n, note in _RESULT_FILES if (out / n).is_file()]
+    names += sorted(p.name for p in out.glob("*.png"))
+    cases = sorted(p.name + "/" for p in out.iterdir() if p.is_dir() and p.name != "checkpoint"
+                   and any(p.glob("summary.json"))) if out.is_dir() else []
+    line = f"  results: {out}/ (" + ", ".join(names + cases) + ")"
+    kept = [x for x in lines if not x.lstrip().startswith("results")]
+    return [*kept, line]
+
+
+def _checked_model(path: str, assignments: list[str] = ()):
+    """The input file's description and its model, every check done (nothing solved);
+    ``assignments``: ``--set KEY=VALUE`` changes to the file's keys (checked like the file)."""
     from .config import check
 
-    config = _load_input(path)
+    config = _load_input(path, assignments)
     try:
         return config, check(config, Path(path).parent)
     except InputError as exc:
@@ -260,11 +317,10 @@ def _checked_model(path: str):
 def run_input_file(args) -> int:
     from .io import runner
 
-    if args.set:
-        raise InputError("--set changes a built-in example's parameters; edit the input file "
-                         "instead")
-    config, model = _checked_model(args.example)  # bad input reported before anything written
-    out = _results_directory(args, Path(config.output.directory or Path("results") / config.name))
+    # bad input (the --set changes included) reported before anything is written
+    config, model = _checked_model(args.example, args.set or [])
+    out = _results_directory(args, Path(config.output.directory) if config.output.directory
+                             else default_folder(config.name, args.set or []))
     factors = config.steps.factors()
     if not args.quiet:
         print(f"vfem: {config.name} ({args.example}), {len(factors)} "
@@ -277,7 +333,7 @@ def run_input_file(args) -> int:
 
 
 def cmd_check(args) -> int:
-    config, model = _checked_model(args.file)
+    config, model = _checked_model(args.file, args.set or [])
     if not args.quiet:
         n, steps = len(model.bodies), len(model.load_factors)
         print(f"vfem: {args.file}: model {config.name!r} is valid — "
@@ -292,6 +348,8 @@ def example_configs(name: str, assignments: list[str]) -> dict:
     """The built-in example's model(s) as configurations, by key."""
     example = _example(name)
     params = build_parameters(name, assignments)
+    if hasattr(example, "validate"):
+        example.validate(params)  # what run would refuse is not exported either
     if hasattr(example, "configs"):
         return example.configs(params)
     if hasattr(example, "config"):
@@ -347,7 +405,8 @@ def cmd_plot(args) -> int:
 
     written = plot_results(Path(args.results))
     if not args.quiet:
-        print(f"vfem: wrote {', '.join(str(p) for p in written)}")
+        print(f"vfem: wrote {', '.join(str(p) for p in written)}" if written else
+              f"vfem: {args.results}: no figures to draw (its run drew none)")
     return 0
 
 
@@ -436,13 +495,19 @@ def main(argv: list[str] | None = None) -> int:
                      help=f"a built-in example ({', '.join(EXAMPLES)}) or an input file (.toml)")
     run.add_argument("--out", help="results directory (default results/<name>)")
     run.add_argument("--set", action="append", metavar="KEY=VALUE",
-                     help="change a parameter of a built-in example (repeatable)")
+                     help="change a parameter of a built-in example, or a key of the input "
+                          "file (dotted: contact.variant=thesis, "
+                          "bodies.punch.material.youngs_modulus=1e10; repeatable)")
+    run.add_argument("--overwrite", action="store_true",
+                     help="replace the results of another model in the results folder")
     run.add_argument("--solver", default="auto", metavar="NAME", help=SOLVER_HELP)
     run.add_argument("--resume", metavar="RESULTS_DIR",
                      help="continue an interrupted run of the same model from the last step "
                           "completed in RESULTS_DIR (its results directory)")
     check = sub.add_parser("check", help="check an input file without solving")
     check.add_argument("file", help="the input file (.toml)")
+    check.add_argument("--set", action="append", metavar="KEY=VALUE",
+                       help="change a key of the input file first (as vfem run; repeatable)")
     export = sub.add_parser("export", help="write a built-in example as an input file")
     export.add_argument("example", help=", ".join(e for e in EXAMPLES if e != "springs"))
     export.add_argument("--out", help="the file (default: print it), or a folder for an "
@@ -482,6 +547,8 @@ def main(argv: list[str] | None = None) -> int:
                        help="refinement levels with quadratic elements")
     study.add_argument("--out", help="results directory (default results/hertz_study)")
     args = parser.parse_args(argv)
+    args.command_line = "vfem " + " ".join(
+        shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
 
     level = (logging.WARNING if args.verbose == 0 else
              logging.INFO if args.verbose == 1 else logging.DEBUG)

@@ -462,6 +462,33 @@ def predicted_translation(body: Body, load_factor: float) -> np.ndarray:
     return out
 
 
+def platen_approach(moving: tuple[np.ndarray, np.ndarray], fixed: tuple[np.ndarray, np.ndarray],
+                    direction: np.ndarray, chunk: int = 2_000_000) -> float:
+    """How far the facets ``moving`` (ends (s, 2) and (s, 2)) travel along the unit
+    ``direction`` before they first meet the facets ``fixed`` (inf if never): the smallest
+    ray hit of one set's facet ends on the other's facets (``moving``'s ends along
+    ``direction``, ``fixed``'s along its opposite). Where a force-controlled body (a platen)
+    that starts apart from another will touch it; the platen's own motion is not known before
+    the solve, so candidate selection looks there (:func:`select_candidate_facets`)."""
+    best = np.inf
+    for points, (a, b), e in ((np.unique(np.vstack(moving), axis=0), fixed, direction),
+                              (np.unique(np.vstack(fixed), axis=0), moving, -direction)):
+        if len(points) == 0 or len(a) == 0:
+            continue
+        d = b - a
+        denom = d[:, 0] * e[1] - d[:, 1] * e[0]  # cross(d, e): zero for facets along the ray
+        step = max(1, chunk // len(a))
+        for k in range(0, len(points), step):
+            w = a[None, :, :] - points[k:k + step, None, :]  # (points, facets, 2)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = (w[..., 0] * d[:, 1] - w[..., 1] * d[:, 0]) / -denom  # along the ray
+                s = (w[..., 0] * e[1] - w[..., 1] * e[0]) / -denom  # along the facet
+            hit = (denom != 0) & (t >= 0) & (s >= 0) & (s <= 1)
+            if hit.any():
+                best = min(best, float(t[hit].min()))
+    return best
+
+
 def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
                             search_distance: float,
                             load_factors: tuple[float, ...] = ()) -> list[np.ndarray]:
@@ -474,6 +501,9 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
     when, at one of them, its midpoint is within ``search_distance`` plus its half length of
     another body's surface (the exact distance to that body's facets, so that one long facet
     elsewhere does not widen the search) or inside that body (bodies that start overlapping).
+    A body moved by a platen (force control) is also looked at where its platen would first
+    bring it within reach of the other body (:func:`platen_approach`): a cylinder pressed onto
+    a flat from a small gap finds the flat.
     """
     ext = [exterior_facets(b) for b in bodies]
     lf = np.concatenate([[0.0], np.asarray(load_factors, dtype=float)])
@@ -492,6 +522,20 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
             if i == j or frozenset((i, j)) not in pairs or len(ext[j]) == 0 or len(ext[i]) == 0:
                 continue
             relative = moves[i] - moves[j]
+            for mover, other, sign in ((i, j, 1.0), (j, i, -1.0)):
+                platen = bodies[mover].platen
+                if platen is None or len(ext[other]) == 0:
+                    continue
+                # the directions the platen pushes in over the schedule (its load curve may
+                # change sign)
+                for direction in np.unique(np.sign([platen.force_at(x) for x in samples])):
+                    if direction == 0.0:
+                        continue
+                    e = np.zeros(2)
+                    e[COMPONENTS[platen.component]] = direction
+                    t = platen_approach(ends[mover], ends[other], e)
+                    if np.isfinite(t) and t > search_distance:  # else the schedule's reach
+                        relative = np.vstack([relative, relative[:1] + sign * t * e])
             mesh = bodies[j].mesh
             lo, hi = mesh.p.min(axis=1), mesh.p.max(axis=1)
             tri = None  # body j's triangles, made only if a facet may start inside it

@@ -56,8 +56,9 @@ class _Problem(InputError):
 
 # -- reading -------------------------------------------------------------------------------------
 
-def load(path: str | Path) -> ModelConfig:
-    """Read and check an input file."""
+def load(path: str | Path, assignments: Sequence[str] = ()) -> ModelConfig:
+    """Read and check an input file; ``assignments``: ``KEY=VALUE`` changes to its keys first
+    (:func:`apply_assignments`, the command line's ``--set``)."""
     path = Path(path)
     if not path.is_file():
         raise InputError(f"input file {str(path)!r} does not exist" if not path.exists()
@@ -66,19 +67,87 @@ def load(path: str | Path) -> ModelConfig:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: cannot read it ({exc})") from None
-    return loads(text, str(path))
+    return loads(text, str(path), assignments)
 
 
-def loads(text: str, source: str = "<input>") -> ModelConfig:
-    """Check TOML text (``source`` names it in messages)."""
+def loads(text: str, source: str = "<input>", assignments: Sequence[str] = ()) -> ModelConfig:
+    """Check TOML text (``source`` names it in messages), after ``assignments``."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{source}: not valid TOML: {exc}") from None
+    if assignments:
+        apply_assignments(data, assignments)
+        source += " with --set " + " --set ".join(assignments)
     try:
         return from_data(ModelConfig, data, "")
     except _Problem as exc:
         raise InputError(f"{source}: {exc}") from None
+
+
+def apply_assignments(data: dict, assignments: Sequence[str]) -> None:
+    """Change parsed TOML ``data`` in place by ``KEY=VALUE`` assignments (``--set``).
+
+    ``KEY`` is dotted: ``contact.variant``, ``steps.count``; a body by its name or number,
+    ``bodies.punch.material.youngs_modulus``; an entry of an array of tables by its number,
+    ``bodies.punch.prescribed.0.value``. ``VALUE`` is read as a TOML value (``1e10``, ``true``,
+    ``[["x", "y"]]``, ``"text"``), a bare word as a string (``thesis``). Missing tables are
+    made; the keys and values are then checked like the file's own (an unknown key is named).
+    """
+    for item in assignments:
+        if "=" not in item:
+            raise InputError(f"--set expects KEY=VALUE, got {item!r}")
+        key, text = (s.strip() for s in item.split("=", 1))
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text
+        parts = key.split(".")
+        if not all(parts):
+            raise InputError(f"--set {key}: not a key (dotted names, e.g. contact.variant)")
+        node: Any = data
+        for k, part in enumerate(parts[:-1]):
+            here = ".".join(parts[:k + 1])
+            if isinstance(node, list):
+                node = _entry(node, part, here)
+            elif isinstance(node, dict):
+                if part not in node:
+                    node[part] = {}
+                node = node[part]
+            else:
+                raise InputError(f"--set {key}: {'.'.join(parts[:k])} is {_kind(node)}, "
+                                 "not a table")
+        last = parts[-1]
+        if isinstance(node, list):
+            index = _index(node, last, key)
+            node[index] = value
+        elif isinstance(node, dict):
+            node[last] = value
+        else:
+            raise InputError(f"--set {key}: {'.'.join(parts[:-1])} is {_kind(node)}, not a table")
+
+
+def _index(array: list, part: str, where: str) -> int:
+    """The position in an array named by a number or, for tables with names, a name."""
+    if part.lstrip("-").isdigit():
+        i = int(part)
+        if -len(array) <= i < len(array):
+            return i
+        raise InputError(f"--set {where}: the array has {len(array)} entries (0 to "
+                         f"{len(array) - 1})")
+    names = [e.get("name") for e in array if isinstance(e, dict)]
+    if part in names:
+        return names.index(part)
+    listed = ", ".join(repr(n) for n in names if n is not None)
+    raise InputError(f"--set {where}: no entry named {part!r}"
+                     + (f"; there are {listed}" if listed else "; give its number (0, 1, ...)"))
+
+
+def _entry(array: list, part: str, where: str):
+    entry = array[_index(array, part, where)]
+    if not isinstance(entry, (dict, list)):
+        raise InputError(f"--set {where}: {_kind(entry)}, not a table")
+    return entry
 
 
 def from_data(cls, data: Any, where: str):

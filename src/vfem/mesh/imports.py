@@ -317,8 +317,14 @@ def _select(raw, groups: list[_Group], cells: str | None, fmt: str, where: str
         raise InputError(f"{where}: {label} has elements of unsupported type "
                          f"{', '.join(unsupported)}; vfem reads {', '.join(_SUPPORTED)}")
     if len(types) > 1:
-        how = (f"select one body's elements with cells = {bodies[0]!r}" if bodies else
-               f"give each body its own {body_kind} and select one with cells = ...")
+        others = [b for b in bodies if b != cells]
+        if cells is not None:  # the group chosen is itself mixed: the mesh must change
+            how = (f"mesh the group with one element type (in Gmsh, Mesh.RecombineAll or none),"
+                   f" or split it into a {body_kind} per type, one body each")
+        elif others:
+            how = f"select one body's elements with cells = {others[0]!r}"
+        else:
+            how = f"give each body its own {body_kind} and select one with cells = ..."
         raise InputError(f"{where}: {label} mixes {' and '.join(types)} elements, but one body "
                          f"must have one element type; {how} ({listing})")
     t = np.vstack([np.asarray(raw.cells[k].data)[ids] for k, ids in chosen.items()

@@ -1,0 +1,100 @@
+"""Bodies that start apart under force control, and bodies that can never touch (issue 17,
+item 8: "the stop diagnosis names the real cause").
+
+A body pushed by a platen (force control) towards another from a gap wider than the contact
+search distance finds it (:func:`vfem.contact.surface.platen_approach`): Hertz with a gap gives
+Hertz's answer. Bodies that no load brings together are named with their distance, and an
+analysis that fails for lack of contact says so rather than "allow more iterations".
+"""
+
+import numpy as np
+import pytest
+
+import vfem
+from vfem.config import check
+from vfem.contact.surface import platen_approach
+from vfem.examples.hertz import HertzParameters, build
+from vfem.io.input import loads
+
+PUCK = """
+name = "puck"
+[[bodies]]
+name = "block"
+[bodies.mesh]
+shape = "rectangle"
+width = 2.0
+height = 1.0
+nx = 8
+ny = 4
+x0 = -1.0
+y0 = -1.0
+[bodies.material]
+youngs_modulus = 1e9
+poissons_ratio = 0.3
+[[bodies.supports]]
+boundary = "bottom"
+[[bodies]]
+name = "puck"
+[bodies.mesh]
+shape = "rectangle"
+width = 0.5
+height = 0.5
+nx = 4
+ny = 4
+x0 = -0.25
+y0 = 0.2
+[bodies.material]
+youngs_modulus = 1e9
+poissons_ratio = 0.3
+[[bodies.supports]]
+boundary = "top"
+components = ["x"]
+[bodies.platen]
+boundary = "top"
+component = "y"
+force = FORCE
+"""
+
+
+def puck(force: float):
+    return check(loads(PUCK.replace("FORCE", repr(force))), None)
+
+
+def cylinder_force(result) -> np.ndarray:
+    return result.steps[-1].bodies["cylinder"].contact_force.sum(axis=0)
+
+
+def test_hertz_from_a_gap_gives_the_touching_answer():
+    touching = vfem.solve(build(HertzParameters()))
+    apart = vfem.solve(build(HertzParameters(initial_gap=0.05)))  # 2.5 search distances
+    assert apart.converged
+    p0 = touching.steps[-1].bodies["cylinder"].contact_pressure.max()
+    p1 = apart.steps[-1].bodies["cylinder"].contact_pressure.max()
+    assert p1 == pytest.approx(p0, rel=1e-9)
+    assert cylinder_force(apart)[1] == pytest.approx(1530.0, rel=1e-10)
+
+
+def test_a_platen_towards_the_other_body_finds_it():
+    result = vfem.solve(puck(-1e6))
+    assert result.converged
+    block = result.steps[-1].bodies["block"].contact_force.sum(axis=0)
+    assert block[1] == pytest.approx(-1e6, rel=1e-10) and abs(block[0]) < 1e-6
+
+
+def test_bodies_that_cannot_touch_are_named_with_their_distance(caplog):
+    result = vfem.solve(puck(+1e6))  # pulled away: nothing can hold the puck
+    assert not result.converged
+    assert "no contact was found" in result.message
+    assert "'block' and 'puck' are 0.2 apart" in result.message
+    assert "allow more iterations" not in result.message
+    assert any("cannot touch in this analysis" in r.message for r in caplog.records)
+
+
+def test_platen_approach_is_the_ray_distance():
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    moving = (square + [0, 2], np.roll(square, -1, axis=0) + [0, 2])
+    fixed = (square * [3, 1] - [1, 0], np.roll(square * [3, 1] - [1, 0], -1, axis=0))
+    assert platen_approach(moving, fixed, np.array([0.0, -1.0])) == pytest.approx(1.0)
+    assert platen_approach(moving, fixed, np.array([0.0, 1.0])) == np.inf
+    beside = (moving[0] + [5, 0], moving[1] + [5, 0])
+    assert platen_approach(beside, fixed, np.array([0.0, -1.0])) == np.inf
