@@ -174,6 +174,10 @@ def test_a_folder_friction_and_one_body_are_told_plainly(tmp_path, capsys):
     assert main(["check", str(model)]) == 2
     err = capsys.readouterr().err
     assert "friction is not available yet" in err and "did you mean" not in err
+    for example in ("wedge", "hertz"):
+        assert main(["run", example, "--set", "contact.friction=0.3"]) == 2
+        err = capsys.readouterr().err
+        assert "friction is not available yet" in err and "valid keys" not in err
     one = tmp_path / "one.toml"
     one.write_text(text[: text.index('[[bodies]]\nname = "punch"')])
     assert main(["check", str(one)]) == 0

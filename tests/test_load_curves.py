@@ -82,6 +82,22 @@ def test_the_example_follows_its_curve(pressed):
     assert np.abs(last.bodies["punch"].displacement).max() <= 1e-12
 
 
+def test_reactions_equal_the_contact_forces_at_every_step(pressed):
+    """Issue 17's acceptance: loads, holds and unloads; at every step each body's support
+    reaction equals minus its contact force (no other load acts) within 1e-8 of the largest
+    contact force, and the two bodies' reactions balance."""
+    kinematics, _, result = pressed
+    largest = max(np.abs(_forces(s, "block").sum(axis=0)).max() for s in result.steps)
+    for step in result.steps:
+        for name in ("block", "punch"):
+            r = step.bodies[name]
+            assert np.abs(r.reaction_total + r.contact_force.sum(axis=0)).max() <= 1e-8 * largest
+        total = step.bodies["block"].reaction_total + step.bodies["punch"].reaction_total
+        assert np.abs(total).max() <= 1e-8 * largest
+    unloaded = result.steps[-1].bodies["block"].reaction_total
+    assert np.abs(unloaded).max() <= 1e-8 * largest
+
+
 def test_small_kinematics_is_the_proportional_answer_at_the_multiplier(pressed):
     """Path independence: each step equals the proportional model at the curve's multiplier."""
     kinematics, config, result = pressed

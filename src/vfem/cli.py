@@ -24,6 +24,7 @@ from .contact.settings import ContactSettings
 from .errors import InputError, VfemError
 from .examples import EXAMPLES, load
 from .io.folders import ResultsFolder, default_folder, run_description
+from .io.input import NOT_YET
 
 log = logging.getLogger("vfem")
 
@@ -64,6 +65,8 @@ def build_parameters(example: str, assignments: list[str]):
         if key.startswith("contact.") and key[len("contact."):] in names and \
                 key[len("contact."):] in CONTACT_KEYS:
             key = key[len("contact."):]  # the example's parameter that is this contact setting
+        if key not in names and key.split(".")[-1] in NOT_YET:
+            raise InputError(f"--set {key}: {NOT_YET[key.split('.')[-1]]}")
         if key not in names:
             close = difflib.get_close_matches(key, names, n=1)
             hint = f"; did you mean {close[0]!r}?" if close else f"; valid keys: {', '.join(names)}"

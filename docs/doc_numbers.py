@@ -1,0 +1,235 @@
+"""The numbers in the README and docs that a run writes, not a hand (issue 17, item 9).
+
+A block of a Markdown file between
+
+    <!-- numbers: NAME -->
+    ...
+    <!-- /numbers: NAME -->
+
+is the output of the generator NAME below, which runs the command the text names. Regenerate
+after a change that moves them, and check that they are current:
+
+    python3 docs/doc_numbers.py               # check every block: exit 1 and a diff if stale
+    python3 docs/doc_numbers.py --write       # rewrite every block from fresh runs
+    python3 docs/doc_numbers.py --write NAME  # one block (python3 docs/doc_numbers.py --list)
+
+``tests/test_doc_numbers.py`` runs the quick ones in the test suite and the long ones with
+``-m slow``, so a block that is stale fails a test. Comparison ignores what differs from run to
+run and machine to machine: wall-clock times and round-off (numbers below 1e-12).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import difflib
+import functools
+import io
+import json
+import os
+import re
+import sys
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _vfem(*argv: str) -> str:
+    """What ``vfem ARGV`` prints, run in a fresh folder (its results under ``results/``)."""
+    from vfem.cli import main
+
+    here = os.getcwd()
+    with tempfile.TemporaryDirectory() as tmp:
+        os.chdir(tmp)
+        out = io.StringIO()
+        try:
+            with contextlib.redirect_stdout(out):
+                status = main(list(argv))
+        finally:
+            os.chdir(here)
+    if status != 0:
+        raise RuntimeError(f"vfem {' '.join(argv)} exited {status}")
+    return out.getvalue()
+
+
+def readme_hertz() -> str:
+    """README, "What you get": the screen of ``vfem run hertz`` (steps 2 to 4 elided)."""
+    lines = _vfem("run", "hertz").rstrip("\n").splitlines()
+    steps = [k for k, x in enumerate(lines) if x.lstrip().startswith("step ")]
+    if len(steps) > 2:
+        lines = lines[: steps[0] + 1] + ["  ..."] + lines[steps[-1]:]
+    return "```\n$ vfem run hertz\n" + "\n".join(lines) + "\n```\n"
+
+
+def _study(levels: list[int], quadratic: list[int]) -> dict:
+    from vfem.cli import main
+
+    with tempfile.TemporaryDirectory() as tmp:
+        with contextlib.redirect_stdout(io.StringIO()):
+            status = main(["-q", "study", "hertz", "--out", tmp, "--levels",
+                           *map(str, levels), "--quadratic-levels", *map(str, quadratic)])
+        if status != 0:
+            raise RuntimeError(f"vfem study hertz exited {status}")
+        return json.loads((Path(tmp) / "study.json").read_text())
+
+
+def accuracy_hertz_study() -> str:
+    """docs/accuracy.md: the table of ``vfem study hertz`` (defaults: five linear levels, four
+    quadratic)."""
+    series = _study([0, 1, 2, 3, 4], [0, 1, 2, 3])
+    rows = ["| series | facets across a | dofs | p_max | flat p_max | RMS | RMS (averaged) | "
+            "iterations |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for name, runs in series.items():
+        for k, r in enumerate(runs):
+            cells = [name if k == 0 else "", str(r["facets_across_a"]),
+                     _thousands(r["dofs"], 0), _percent(r["p_max_error"], 3, True),
+                     _percent(r["p_max_flat_error"], 3, True),
+                     _percent(r["rms_error_over_p0"], 2), _percent(r["rms_error_averaged"], 2),
+                     str(r["iterations"])]
+            rows.append("|" + "|".join(f" {c} " if c else " " for c in cells) + "|")
+    return "\n".join(rows) + "\n"
+
+
+@functools.cache
+def _summary(*argv: str) -> dict:
+    """``summary.json`` of ``vfem run ARGV`` (run in a fresh folder)."""
+    from vfem.cli import main
+
+    with tempfile.TemporaryDirectory() as tmp:
+        with contextlib.redirect_stdout(io.StringIO()):
+            status = main(["-q", "run", *argv, "--out", tmp])
+        if status != 0:
+            raise RuntimeError(f"vfem run {' '.join(argv)} exited {status}")
+        return json.loads((Path(tmp) / "summary.json").read_text())
+
+
+def _thousands(x: float, digits: int) -> str:
+    return f"{x:,.{digits}f}".replace(",", " ")
+
+
+def _percent(x: float, digits: int, sign: bool = False) -> str:
+    """A fraction as a percentage, with a typographic minus (as the docs' tables write it)."""
+    return f"{100 * x:{'+' if sign else ''}.{digits}f} %".replace("-", "−")
+
+
+def gasket_results() -> str:
+    """docs/examples.md, Gasket: the results table of ``vfem run gasket``."""
+    s = _summary("gasket")
+    steps = s["steps"]
+    overlap = s["overlap_ignoring_contact"][s["first_overlap_step"] - 1]
+    rows = ["| | |", "|---|---|",
+            f"| first overlap (linear prediction) | step {s['first_overlap_step']} "
+            f"({overlap:.4f}) |",
+            f"| largest contact force | {_thousands(s['largest_force'], 2)} at step "
+            f"{s['largest_force_step']} |",
+            f"| mirror error max_k \\|F(k) − F(20−k)\\| / max F | {s['mirror_error']:.1e} |",
+            f"| reversibility: largest \\|u\\| after step {len(steps)} | "
+            f"{s['reversibility']:.1f} |",
+            f"| forces on the two gaskets | balance to {s['max_force_imbalance']:.1e} |",
+            "| residual penetration (algorithm's own) | ≤ "
+            f"{max(x['max_penetration'] for x in steps):.1e} |",
+            f"| contact iterations, {len(steps)} steps | {sum(x['iterations'] for x in steps)} |"]
+    return "\n".join(rows) + "\n"
+
+
+def gasket_steps() -> str:
+    """docs/examples.md, Gasket: the loading steps that carry force (``vfem run gasket``)."""
+    steps = _summary("gasket")["steps"]
+    n = len(steps)
+    rows = ["| step | load factor | F | iterations (loading) | nodes in contact soft/stiff | "
+            "gap bridged | force off normal |", "|---|---|---|---|---|---|---|"]
+    for x in steps:
+        k = x["step"]
+        if x["contact_force"] <= 0 or 2 * k > n:
+            continue
+        c = x["current_configuration"]
+        rows.append(f"| {k if 2 * k == n else f'{k}, {n - k}'} | {x['load_factor']:.1f} | "
+                    f"{_thousands(x['contact_force'], 2)} | {x['iterations']} | "
+                    f"{x['contact_nodes']['soft']}/{x['contact_nodes']['stiff']} | "
+                    f"{c['max_loaded_gap']:.4f} | {c['max_force_angle_deg']:.1f}° |")
+    return "\n".join(rows) + "\n"
+
+
+#: name -> (file, generator, quick: run in the default test suite)
+BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
+    "readme-hertz": ("README.md", readme_hertz, True),
+    "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
+    "gasket-results": ("docs/examples.md", gasket_results, True),
+    "gasket-steps": ("docs/examples.md", gasket_steps, True),
+}
+
+_TIME = re.compile(r"\b\d+(\.\d+)? s\b")
+_ROUND_OFF = re.compile(r"[-+]?\d(\.\d+)?e-(1[3-9]|[2-9]\d|\d{3})\b")
+
+
+def normalised(text: str) -> str:
+    """``text`` with wall-clock times and round-off numbers (below 1e-12) masked."""
+    return _ROUND_OFF.sub("<round-off>", _TIME.sub("<time> s", text))
+
+
+def _span(text: str, name: str) -> tuple[int, int]:
+    begin, end = f"<!-- numbers: {name} -->\n", f"<!-- /numbers: {name} -->"
+    i = text.find(begin)
+    j = text.find(end, i + 1)
+    if i < 0 or j < 0:
+        raise KeyError(f"no block {name!r} (markers {begin.strip()} ... {end})")
+    return i + len(begin), j
+
+
+def current(name: str) -> str:
+    """The block as the file has it now."""
+    path = ROOT / BLOCKS[name][0]
+    text = path.read_text(encoding="utf-8")
+    i, j = _span(text, name)
+    return text[i:j]
+
+
+def stale(name: str) -> str:
+    """A diff of the block against a fresh run ("" if current, times and round-off aside)."""
+    fresh = BLOCKS[name][1]()
+    old = current(name)
+    if normalised(old) == normalised(fresh):
+        return ""
+    return "".join(difflib.unified_diff(old.splitlines(True), fresh.splitlines(True),
+                                        f"{BLOCKS[name][0]} ({name})", "fresh run"))
+
+
+def write(name: str) -> None:
+    path = ROOT / BLOCKS[name][0]
+    text = path.read_text(encoding="utf-8")
+    i, j = _span(text, name)
+    path.write_text(text[:i] + BLOCKS[name][1]() + text[j:], encoding="utf-8")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("names", nargs="*", help="blocks (default: all)")
+    parser.add_argument("--write", action="store_true", help="rewrite them from fresh runs")
+    parser.add_argument("--list", action="store_true", help="list the blocks")
+    args = parser.parse_args(argv)
+    if args.list:
+        for name, (file, _, quick) in BLOCKS.items():
+            print(f"{name:24} {file:20} {'quick' if quick else 'long'}")
+        return 0
+    names = args.names or list(BLOCKS)
+    unknown = [n for n in names if n not in BLOCKS]
+    if unknown:
+        print(f"unknown blocks {unknown}; available: {', '.join(BLOCKS)}", file=sys.stderr)
+        return 2
+    status = 0
+    for name in names:
+        if args.write:
+            write(name)
+            print(f"wrote {name} into {BLOCKS[name][0]}")
+        elif diff := stale(name):
+            print(diff)
+            status = 1
+        else:
+            print(f"{name}: current")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
