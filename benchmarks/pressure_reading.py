@@ -5,9 +5,10 @@ nodal force over the tributary length (the traction averaged with the node's sha
 
 Prints, per mesh (default 12, 24, 48 facets across a), for the cylinder's nodes: p_max against
 p0, the largest error over |x| < 0.8 a, the RMS error over |x| < a and the error at x = 0 (all in
-% of p0); then the same model mirrored into a full one (no symmetry plane), whose node at x = 0
-reads the same as the half model's: the low reading there is the cylinder mesh's (its rings of
-nodes are centred on that point), not the symmetry plane's. docs/method.md §6 quotes these.
+% of p0); then the same model mirrored into a full one (no symmetry plane). With the cylinder's
+contact zone meshed in layers (``vfem.mesh.graded_quarter_disk``) the reading is smooth, with no
+dip at x = 0. docs/method.md §6 holds this table (``python3 docs/doc_numbers.py --write
+method-pressure-reading``).
 """
 
 import sys

@@ -152,10 +152,133 @@ def gasket_steps() -> str:
     return "\n".join(rows) + "\n"
 
 
+def _pct(x: float, digits: int = 3) -> str:
+    return _percent(x, digits, True)
+
+
+def examples_hertz() -> str:
+    """docs/examples.md, Hertz: the default mesh with each variant, method and element order,
+    and with coarser flats (``vfem run hertz --set ...``)."""
+    paired = _summary("hertz")
+    h = paired["hertz"]
+    steps = paired["steps"]
+    tol = max((x["invariants"] or {}).get("allowed", 0.0) for x in steps)
+    flat_diff = h["p_max_flat"] / h["p_max"] - 1
+    lines = [
+        f"Default mesh ({_thousands(paired['dofs'], 0)} dofs, "
+        f"{paired['parameters']['facets_per_half_width']} facets across a), default (paired) "
+        "variant:", "",
+        f"* p_max {_thousands(h['p_max'], 1)} ({_pct(h['p_max_error'])}); half-width "
+        f"{h['a_estimate']:.4f} (theory {h['a_theory']:.4f}, one facet = "
+        f"{h['contact_facet_length']:.4f}).",
+        f"* RMS error over |x| < a {100 * h['rms_error_over_p0']:.2f} % of p0 "
+        f"({100 * h['rms_error_averaged']:.2f} % against Hertz averaged as the nodes read it).",
+        f"* Contact force {h['total_contact_force']:.2f}, carried by the flat exactly "
+        f"({h['total_contact_force_flat']:.2f}); the flat reads p_max "
+        f"{_thousands(h['p_max_flat'], 1)} ({_pct(flat_diff, 2)} from the cylinder's).",
+        f"* {', '.join(str(x['iterations']) for x in steps[:-1])} and {steps[-1]['iterations']} "
+        f"iterations in the {len(steps)} steps; residual penetrations at most "
+        f"{max(x['max_penetration'] for x in steps):.0e} (the invariant check allows "
+        f"{tol:.0e}).", ""]
+    thesis = _summary("hertz", "--set", "variant=thesis")
+    t = thesis["hertz"]
+    lines += ["The thesis variant (`--set variant=thesis`):", "",
+              f"* p_max {_pct(t['p_max_error'])}, half-width {t['a_estimate']:.4f}, RMS "
+              f"{100 * t['rms_error_over_p0']:.2f} %.",
+              f"* {', '.join(str(x['iterations']) for x in thesis['steps'])} iterations.",
+              f"* Its flat reads p_max {_pct(t['p_max_flat'] / t['p_max'] - 1, 1)} from the "
+              f"cylinder's and carries {t['total_contact_force_flat']:.1f}.", ""]
+    base = {m: _summary("hertz", "--set", f"contact.method={m}")["hertz"]
+            for m in ("lagrange", "penalty", "augmented")}
+    lines += ["The classical baselines (`--set contact.method=...`; `baselines.md`; node-to-"
+              "segment, the cylinder's nodes against the flat's facets): p_max "
+              + ", ".join(f"{_pct(b['p_max_error'])} ({m})" for m, b in base.items())
+              + "; the flat, as master, reads p_max "
+              + ", ".join(f"{_pct(b['p_max_flat'] / b['p_max'] - 1, 0)}" for b in base.values())
+              + " from the cylinder's.", ""]
+    quad = _summary("hertz", "--set", "order=2")
+    q = quad["hertz"]
+    lines += [f"Quadratic elements (`--set order=2`: 6-node triangles with the cylinder's arc "
+              "curved through its facet midpoints, 9-node quadrilaterals in the flat; paired "
+              f"variant), default mesh, {_thousands(quad['dofs'], 0)} dofs: p_max "
+              f"{_thousands(q['p_max'], 1)} ({_pct(q['p_max_error'])}), RMS "
+              f"{100 * q['rms_error_over_p0']:.2f} %, the flat reads "
+              f"{_pct(q['p_max_flat'] / q['p_max'] - 1, 2)} from the cylinder's, contact force "
+              f"{q['total_contact_force']:.2f}, {sum(x['iterations'] for x in quad['steps'])} "
+              "iterations.", ""]
+    ratios = {r: _summary("hertz", "--set", f"flat_size_ratio={r}")["hertz"]["p_max_error"]
+              for r in (0.5, 3, 5, 10)}
+    lines += ["With the flat's facets 0.5, 3, 5 and 10 times the cylinder's (`--set "
+              "flat_size_ratio=R`), p_max is " + ", ".join(_pct(e) for e in ratios.values())
+              + " (paired; `tests/test_hertz.py`)."]
+    return "\n".join(lines) + "\n"
+
+
+def method_pressure_reading() -> str:
+    """docs/method.md §6: the table of ``python3 benchmarks/pressure_reading.py``."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "pressure_reading", ROOT / "benchmarks" / "pressure_reading.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    import vfem
+    from vfem.examples.hertz import HertzParameters, build, theory
+
+    rows = ["| facets across a | reading | p_max | largest error, abs(x) < 0.8a | RMS, abs(x) < a "
+            "| at x = 0 |", "|---|---|---|---|---|---|"]
+    for n in (12, 24, 48):
+        p = HertzParameters(facets_per_half_width=n)
+        th = theory(p)
+        runs = [(str(n), build(p))]
+        if n == 12:
+            runs.append(("12, mirrored full model", bench.mirrored(p)))
+        for label, model in runs:
+            for name, e in bench.errors(vfem.solve(model), th["a_theory"],
+                                        th["p0_theory"]).items():
+                rows.append(f"| {label} | {name} | {e[0]:+.3f} | {e[1]:.3f} | {e[2]:.3f} | "
+                            f"{e[3]:+.3f} |".replace("-", "−"))
+    return "\n".join(rows) + "\n"
+
+
+def baselines_hertz() -> str:
+    """docs/baselines.md: each method on the Hertz example's default mesh (level 0), the
+    penalty and augmented Lagrangian at several penalties."""
+    from vfem.contact.settings import ContactSettings
+    from vfem.examples.hertz import HertzParameters, build, evaluate
+    from vfem.solver import Analysis
+
+    default = ContactSettings.penalty_factor
+    cases = [("vfem (paired, for reference)", "vfem", None),
+             ("lagrange", "lagrange", None), ("penalty, ε default", "penalty", 1.0),
+             ("penalty, 10 ε", "penalty", 10.0), ("penalty, 0.1 ε", "penalty", 0.1),
+             ("penalty, 1e-3 ε", "penalty", 1e-3), ("penalty, 1e-5 ε", "penalty", 1e-5),
+             ("augmented, ε default", "augmented", 1.0),
+             ("augmented, 1e-5 ε", "augmented", 1e-5)]
+    rows = ["| method | p_max | solves per step | factorizations | penetration | "
+            "contact force |", "|---|---|---|---|---|---|"]
+    for label, method, scale in cases:
+        p = HertzParameters(method=method, penalty_factor=default * (scale or 1.0))
+        analysis = Analysis(build(p))
+        result = analysis.run()
+        h = evaluate(result, p)
+        solves = ", ".join(str(x.iterations) for x in result.steps)
+        factorizations = getattr(analysis.contact, "factorizations", len(result.model.bodies))
+        penetration = max(x.history[-1].max_penetration for x in result.steps)
+        rows.append(f"| {label} | {_pct(h['p_max_error'], 4)} | {solves}"
+                    + (" (contact iterations)" if method == "vfem" else "")
+                    + f" | {factorizations}" + (" (one per body)" if method == "vfem" else "")
+                    + f" | {max(penetration, 0.0):.1e} | {h['total_contact_force']:.9g} |")
+    return "\n".join(rows) + "\n"
+
+
 #: name -> (file, generator, quick: run in the default test suite)
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
     "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
+    "examples-hertz": ("docs/examples.md", examples_hertz, True),
+    "method-pressure-reading": ("docs/method.md", method_pressure_reading, True),
+    "baselines-hertz": ("docs/baselines.md", baselines_hertz, True),
     "gasket-results": ("docs/examples.md", gasket_results, True),
     "gasket-steps": ("docs/examples.md", gasket_steps, True),
 }

@@ -29,9 +29,10 @@ def test_every_step_converges(hertz_level0):
 
 def test_peak_pressure_half_width_and_profile(hertz_level0):
     _, _, h = hertz_level0
-    assert h["p_max"] == pytest.approx(31848, rel=0.03)
+    # measured +0.099 % (the model's own limit, quadratic elements refined: +0.074 %)
+    assert abs(h["p_max_error"]) < 1e-3
     assert abs(h["a_estimate"] - 0.06117) <= h["contact_facet_length"]
-    assert h["rms_error_over_p0"] < 0.05
+    assert h["rms_error_over_p0"] < 0.012  # measured 1.11 %
 
 
 def test_contact_forces_balance_the_applied_load(hertz_level0):
@@ -107,8 +108,9 @@ def test_thesis_variant_meets_the_core_acceptance_too(hertz_level0):
     assert evaluate(r2, tp)["p_max"] == pytest.approx(ht["p_max"], rel=1e-8)
 
 
-@pytest.mark.parametrize(("ratio", "bound"), [(0.5, 0.01), (3.0, 0.01), (5.0, 0.01),
-                                              (10.0, 0.03)])
+# measured +0.099, +0.097, +0.094, +0.083 %
+@pytest.mark.parametrize(("ratio", "bound"), [(0.5, 1.2e-3), (3.0, 1.2e-3), (5.0, 1.2e-3),
+                                              (10.0, 1.2e-3)])
 def test_flat_facets_up_to_ten_times_the_cylinders(ratio, bound):
     """Thesis §5.6: a 3:1 ratio is easily tolerated; larger ones ask for care."""
     p = HertzParameters(flat_size_ratio=ratio)
@@ -146,25 +148,33 @@ def _pressure_reading():
     return module
 
 
-def test_pointwise_pressure_at_48_facets_and_no_symmetry_plane_effect():
+def test_pointwise_pressure_at_48_facets_and_no_dip_on_the_symmetry_plane():
     """Issue 16, item 5: at 48 facets across a the pressure is within 1 % of Hertz's at every
-    node over |x| < 0.8 a, read either way (measured: nodal reading 0.45 %, traction q 0.82 %).
-    The node at x = 0 reads low on these meshes (1.9 % at 12 facets, halving with each
-    refinement), and a full model, the half mirrored about x = 0, reads the same there
-    (measured 1.86 %): it is the cylinder mesh's centre of rings, not the symmetry plane.
+    node over |x| < 0.8 a, read either way (measured: nodal reading 0.10 %, traction q 0.10 %),
+    and the node at x = 0 reads as its neighbours do (no dip: measured within 0.01 % of p0 at
+    12 and 48 facets; the rings of the former mesh read 1.9 % low there at 12). A full model,
+    the half mirrored about x = 0, reads the same there within 0.1 % of p0 (measured 0.04 %).
     ``benchmarks/pressure_reading.py`` prints the table docs/method.md §6 quotes."""
     import vfem
 
     bench = _pressure_reading()
-    p = HertzParameters(facets_per_half_width=48)
-    th = theory(p)
-    e = bench.errors(vfem.solve(build(p)), th["a_theory"], th["p0_theory"])
-    for name, values in e.items():
-        assert values[1] < 1.0, (name, values)
+    for n in (12, 48):
+        p = HertzParameters(facets_per_half_width=n)
+        th = theory(p)
+        a, p0 = th["a_theory"], th["p0_theory"]
+        result = vfem.solve(build(p))
+        e = bench.errors(result, a, p0)
+        for name, values in e.items():
+            assert values[1] < (1.0 if name.startswith("traction") else 0.2), (n, name, values)
+        s = next(s for s in result.surfaces if s.body.name == "cylinder")
+        x = np.abs(s.X[: s.nc, 0])
+        pressure = result.steps[-1].bodies["cylinder"].contact_pressure[s.nodes[: s.nc]]
+        error = (pressure - p0 * np.sqrt(np.clip(1 - (x / a) ** 2, 0, None))) / p0
+        order = np.argsort(x)
+        assert abs(error[order[0]] - error[order[1:3]].mean()) < 2e-4  # no dip at x = 0
     p = HertzParameters()
     th = theory(p)
     half = bench.errors(vfem.solve(build(p)), th["a_theory"], th["p0_theory"])
     full = bench.errors(vfem.solve(bench.mirrored(p)), th["a_theory"], th["p0_theory"])
     for name in half:
         assert half[name][3] == pytest.approx(full[name][3], abs=0.1)  # % of p0
-        assert half[name][3] < -1.0  # the low reading is there in both

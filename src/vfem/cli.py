@@ -66,7 +66,8 @@ def build_parameters(example: str, assignments: list[str]):
                 key[len("contact."):] in CONTACT_KEYS:
             key = key[len("contact."):]  # the example's parameter that is this contact setting
         if key not in names and key.split(".")[-1] in NOT_YET:
-            raise InputError(f"--set {key}: {NOT_YET[key.split('.')[-1]]}")
+            raise InputError(f"--set {key}: not a parameter of {example}: "
+                             f"{NOT_YET[key.split('.')[-1]]}")
         if key not in names:
             close = difflib.get_close_matches(key, names, n=1)
             hint = f"; did you mean {close[0]!r}?" if close else f"; valid keys: {', '.join(names)}"
