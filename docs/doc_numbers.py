@@ -142,11 +142,11 @@ def gasket_steps() -> str:
             "gap bridged | force off normal |", "|---|---|---|---|---|---|---|"]
     for x in steps:
         k = x["step"]
-        if x["contact_force"] <= 0 or 2 * k > n:
+        if x["force_magnitude"] <= 0 or 2 * k > n:
             continue
         c = x["current_configuration"]
         rows.append(f"| {k if 2 * k == n else f'{k}, {n - k}'} | {x['load_factor']:.1f} | "
-                    f"{_thousands(x['contact_force'], 2)} | {x['iterations']} | "
+                    f"{_thousands(x['force_magnitude'], 2)} | {x['iterations']} | "
                     f"{x['contact_nodes']['soft']}/{x['contact_nodes']['stiff']} | "
                     f"{c['max_loaded_gap']:.4f} | {c['max_force_angle_deg']:.1f}° |")
     return "\n".join(rows) + "\n"
@@ -287,9 +287,15 @@ _TIME = re.compile(r"\b\d+(\.\d+)? s\b")
 _ROUND_OFF = re.compile(r"[-+]?\d(\.\d+)?e-(1[3-9]|[2-9]\d|\d{3})\b")
 
 
+#: Where a round-off figure was largest (which body and step is round-off's choice too).
+_WORST = re.compile(r"\(worst: '[^']*', step \d+\)")
+
+
 def normalised(text: str) -> str:
-    """``text`` with wall-clock times and round-off numbers (below 1e-12) masked."""
-    return _ROUND_OFF.sub("<round-off>", _TIME.sub("<time> s", text))
+    """``text`` with wall-clock times, round-off numbers (below 1e-12) and where the largest
+    round-off was masked."""
+    return _WORST.sub("(worst: <where>)", _ROUND_OFF.sub("<round-off>", _TIME.sub("<time> s",
+                                                                               text)))
 
 
 def _span(text: str, name: str) -> tuple[int, int]:

@@ -48,8 +48,9 @@ SHORT_FRAGMENT = 8  # ... or, failing that, the longest fragment of the message
 
 #: messages with no fragment of their own, (module, message source as written) -> why
 _WRAPPERS_AS_WRITTEN = {
-    ("cli.py", 'f"{path}: {exc}"'):
-        "vfem check/run prefix the input file's path to a model error (catalogued at its source)",
+    ("cli.py", 'f"{path}{changes}: {exc}"'):
+        "vfem check/run prefix the input file's path (and its --set changes) to a model error "
+        "(catalogued at its source)",
     ("config.py", 'f"body {self.name!r}: {exc}"'):
         "names the body in front of a mesh error (mesh shape, mesh file, mesh.curve)",
     ("io/input.py", 'f"{source}: {exc}"'):

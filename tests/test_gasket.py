@@ -76,7 +76,7 @@ def test_first_overlap_at_step_five_and_largest_force_at_step_ten(coarse):
 def test_after_unloading_every_node_is_back_where_it_started(coarse):
     _, s = coarse
     assert s["reversibility"] < 1e-6
-    assert s["steps"][-1]["contact_force"] == 0.0
+    assert s["steps"][-1]["force_magnitude"] == 0.0
 
 
 def test_unloading_mirrors_loading_within_one_percent(coarse):
@@ -138,7 +138,7 @@ def test_the_two_gaskets_receive_equal_and_opposite_forces(coarse):
     _, s = coarse
     assert s["max_force_imbalance"] < 1e-6
     for r in s["steps"]:
-        if r["contact_force"] > 0:
+        if r["force_magnitude"] > 0:
             back = r["back_reaction"]
             # each back holds what contact applies: reaction + contact force = 0
             assert back["soft"][0] == pytest.approx(-r["contact_force_soft"][0], rel=1e-6)
@@ -152,7 +152,7 @@ def test_each_back_holds_the_contact_force_on_its_gasket(coarse):
         for name in ("soft", "stiff"):
             f = np.asarray(r[f"contact_force_{name}"])
             reaction = np.asarray(r["back_reaction"][name])
-            assert reaction == pytest.approx(-f, abs=1e-6 * max(r["contact_force"], 1.0))
+            assert reaction == pytest.approx(-f, abs=1e-6 * max(r["force_magnitude"], 1.0))
 
 
 def test_files_figures_and_report(coarse):

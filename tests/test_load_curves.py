@@ -322,3 +322,25 @@ def test_the_documented_curve_is_the_example_file():
     block = docs.split("loads, holds and unloads a punch under small kinematics:\n\n```toml\n")[1]
     for line in block.split("```")[0].strip().splitlines():
         assert line in example.splitlines(), line
+
+
+def test_a_curve_that_never_loads_is_warned_about_and_an_empty_one_shown_as_written(caplog):
+    import logging
+
+    from vfem.errors import InputError
+    from vfem.solver import Analysis
+
+    config = vfem.load(EXAMPLE)
+    punch = config.bodies[1]
+    idle = dataclasses.replace(punch.prescribed[0], amplitude=((1.0, 0.0), (2.0, 1.0)))
+    model = dataclasses.replace(config, bodies=(config.bodies[0], dataclasses.replace(
+        punch, prescribed=(idle,)))).build(EXAMPLE.parent)
+    with caplog.at_level(logging.WARNING, logger="vfem.solver"):
+        Analysis(model).setup()
+    assert any("is 0 at every load factor of the steps" in r.message and "'punch'" in r.message
+               for r in caplog.records)
+    empty = dataclasses.replace(punch.prescribed[0], amplitude=())
+    with pytest.raises(InputError) as info:
+        dataclasses.replace(config, bodies=(config.bodies[0], dataclasses.replace(
+            punch, prescribed=(empty,)))).build(EXAMPLE.parent)
+    assert "got []" in str(info.value)

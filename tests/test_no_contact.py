@@ -56,8 +56,9 @@ force = FORCE
 """
 
 
-def puck(force: float):
-    return check(loads(PUCK.replace("FORCE", repr(force))), None)
+def puck(force: float, y0: float = 0.2):
+    text = PUCK.replace("FORCE", repr(force)).replace("y0 = 0.2", f"y0 = {y0!r}")
+    return check(loads(text), None)
 
 
 def cylinder_force(result) -> np.ndarray:
@@ -98,3 +99,13 @@ def test_platen_approach_is_the_ray_distance():
     assert platen_approach(moving, fixed, np.array([0.0, 1.0])) == np.inf
     beside = (moving[0] + [5, 0], moving[1] + [5, 0])
     assert platen_approach(beside, fixed, np.array([0.0, -1.0])) == np.inf
+
+
+def test_a_platen_pulling_a_touching_body_away_is_named():
+    """The puck touches the block, its platen pulls it up: no equilibrium exists, and the
+    message says why rather than "allow more iterations"."""
+    result = vfem.solve(puck(+1e6, y0=0.0))
+    assert not result.converged
+    assert "the platen on body 'puck' must move it along +y" in result.message
+    assert "moves it away from every body it may touch" in result.message
+    assert "allow more iterations" not in result.message

@@ -146,17 +146,19 @@ def test_summary_csv_and_vtu_hold_the_same_numbers(solved):
         rows = list(csv.DictReader(f))
     assert list(rows[0]) == ["step", "load_factor", "body", "boundary", "Rx", "Ry"]
     expected = {"base": ["bottom", "left"], "punch": ["top"]}
-    assert len(rows) == len(result.steps) * 3
+    assert len(rows) == len(result.steps) * (3 + 2)  # the boundaries, then each body's total
     for s, written, step in zip(summary["steps"], on_disk["steps"], result.steps):
         assert written["reactions"] == s["reactions"]
         for body in model.bodies:
             rec = s["reactions"][body.name]
             assert list(rec["boundaries"]) == expected[body.name]
             mine = [x for x in rows if int(x["step"]) == step.step and x["body"] == body.name]
-            assert [x["boundary"] for x in mine] == expected[body.name]
+            assert [x["boundary"] for x in mine] == [*expected[body.name], "(total)"]
             for x in mine:
                 assert float(x["load_factor"]) == step.load_factor
-                assert [float(x["Rx"]), float(x["Ry"])] == rec["boundaries"][x["boundary"]]
+                assert [float(x["Rx"]), float(x["Ry"])] == (
+                    rec["total"] if x["boundary"] == "(total)"
+                    else rec["boundaries"][x["boundary"]])
             vtu = meshio.read(out / f"{body.name}_step{step.step:04d}.vtu")
             reaction = vtu.point_data["reaction"]
             assert reaction.shape == (body.npoints, 3) and np.all(reaction[:, 2] == 0)

@@ -31,10 +31,8 @@ def test_a_shorter_run_of_the_same_model_leaves_no_stale_step(tmp_path, capsys):
     assert "count = 3" in model.read_text()
     assert main(["-q", "run", str(model), "--out", str(out), "--set", "steps.count=8"]) == 0
     assert len(vtus(out)) == 16
-    assert main(["-q", "run", str(model), "--out", str(out)]) == 2  # other settings: refused
-    assert "holds the results of another run" in capsys.readouterr().err
-    assert len(vtus(out)) == 16
-    assert main(["-q", "run", str(model), "--out", str(out), "--overwrite"]) == 0
+    # the same model (file) without the --set: its own earlier files cleared, no --overwrite
+    assert main(["-q", "run", str(model), "--out", str(out)]) == 0
     assert vtus(out) == [f"{b}_step000{k}.vtu" for b in ("cylinder", "flat") for k in (1, 2, 3)]
     assert sorted(p.name for p in (out / "checkpoint").iterdir()) == [
         "step0001.npz", "step0002.npz", "step0003.npz"]
@@ -44,7 +42,7 @@ def test_a_shorter_run_of_the_same_model_leaves_no_stale_step(tmp_path, capsys):
     assert "notes.txt" not in record["files"] and "summary.json" in record["files"]
     run = json.loads((out / "summary.json").read_text())["run"]
     assert run["target"] == str(model.resolve()) and run["settings"] == []
-    assert run["command"].endswith("--overwrite") and run["vfem_version"]
+    assert run["command"].endswith(str(out)) and run["vfem_version"]
 
 
 def test_two_models_in_one_folder(tmp_path, capsys):
@@ -95,7 +93,11 @@ def test_set_changes_an_input_file_key_checked_like_the_file(tmp_path, capsys):
                           ("bodies.5.material.youngs_modulus=3", "has 2 entries"),
                           ("steps.count=abc", "steps.count: expected an integer"),
                           ("name.x=1", "is the string"),
-                          ("steps.count", "expects KEY=VALUE")):
+                          ("steps.count", "expects KEY=VALUE"),
+                          ("bodies.-1.name=z", "no entry named '-1'"),
+                          ("bodies.flat.tractions.0.value=1", "the file has no"),
+                          ("steps.load_factors=[0.5, 1.0]", "not both"),
+                          ("contact.variant=foo", "with --set contact.variant=foo:")):
         assert main(["check", str(HERTZ), "--set", change]) == 2
         err = capsys.readouterr().err
         assert words in err and len(err.strip().splitlines()) == 1, err
@@ -132,3 +134,33 @@ def test_the_python_api_keeps_its_folder_the_same_way(tmp_path):
         assert "holds the results of another run" in str(exc)
     vfem.solve(other, out, overwrite=True)
     assert not any(n.startswith("cylinder") for n in vtus(out))
+
+
+def test_a_model_name_cannot_send_results_elsewhere(tmp_path, monkeypatch):
+    from vfem.io.folders import default_folder
+
+    for name in ("../../escaped", "/tmp/abs", "", ".", "..", "a/b\\c"):
+        folder = default_folder(name, [])
+        assert folder.parent == Path("results") and folder.name not in ("", ".", ".."), folder
+
+
+def test_a_refused_resume_changes_nothing_and_a_resume_keeps_the_description(tmp_path, capsys):
+    out = tmp_path / "r"
+    assert main(["-q", "run", str(HERTZ), "--out", str(out)]) == 0
+    record = (out / RECORD).read_text()
+    summary = (out / "summary.json").read_text()
+    assert main(["-q", "run", str(HERTZ), "--resume", str(out), "--set",
+                 "contact.variant=thesis"]) == 2
+    assert "different model" in capsys.readouterr().err
+    assert (out / RECORD).read_text() == record and (out / "summary.json").read_text() == summary
+    assert main(["-q", "run", str(HERTZ), "--resume", str(out)]) == 0
+    run = json.loads((out / "summary.json").read_text())["run"]
+    assert run["command"] == json.loads(record)["command"]  # the run continued
+    assert run["resumed"][-1]["command"].endswith(f"--resume {out}")
+
+
+def test_an_empty_model_and_plotting_a_file_are_told_plainly(capsys):
+    assert main(["run", ""]) == 2
+    assert "no model given" in capsys.readouterr().err
+    assert main(["plot", str(HERTZ)]) == 2
+    assert "is a file, not a results folder" in capsys.readouterr().err

@@ -66,14 +66,22 @@ def check_amplitude(amplitude, where: str) -> None:
         pts = None
     if pts is None or pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 1:
         raise InputError(f"{where}: the amplitude must be [load factor, multiplier] pairs, "
-                         f"e.g. [[0.0, 0.0], [1.0, 1.0]]; got {amplitude!r}")
+                         f"e.g. [[0.0, 0.0], [1.0, 1.0]]; got {_shown(amplitude)}")
     if not np.all(np.isfinite(pts)):
-        raise InputError(f"{where}: the amplitude must hold finite numbers, got {amplitude!r}")
+        raise InputError(f"{where}: the amplitude must hold finite numbers, got "
+                         f"{_shown(amplitude)}")
     bad = np.flatnonzero(np.diff(pts[:, 0]) <= 0)
     if len(bad):
         k = int(bad[0])
         raise InputError(f"{where}: the amplitude must have strictly increasing load factors; "
                          f"{pts[k, 0]:g} is followed by {pts[k + 1, 0]:g}")
+
+
+def _shown(value) -> str:
+    """A value as the input file writes it (tuples as TOML arrays: ``[]``, not ``()``)."""
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_shown(v) for v in value) + "]"
+    return repr(value)
 
 
 def multiplier(amplitude: Amplitude | None, load_factor: float) -> float:

@@ -159,6 +159,9 @@ def _load_input(path: str, assignments: list[str] = ()):
 
 def _example(name: str, alternatives: str = ""):
     """The module of a built-in example; an unknown name is refused with the closest one."""
+    if not name.strip():
+        raise InputError("no model given: name a built-in example "
+                         f"({', '.join(EXAMPLES)}) or an input file (.toml)")
     if name not in EXAMPLES and Path(name).is_dir():
         raise InputError(f"{name} is a folder: give an input file (.toml) or a built-in example "
                          f"({', '.join(EXAMPLES)}); to redraw a results folder's figures: "
@@ -261,14 +264,19 @@ def _solve_and_report(solve, progress: Progress, report, quiet: bool, args, out:
     the completed steps are and how to continue, exit status 130."""
     folder = args.folder
     progress.after_step = folder.update
+    refused = False  # bad input found before solving (a --resume of another model): no trace
     try:
         summary = solve()
     except KeyboardInterrupt:
         summary = None
+    except InputError:
+        refused = True
+        raise
     finally:
         progress.close()
-        folder.update()
-        folder.stamp_summary()
+        if not refused:
+            folder.update()
+            folder.stamp_summary()
     if summary is None:
         sets = "".join(f" --set {shlex.quote(a)}" for a in (args.set or []))
         if any(out.glob("**/checkpoint/step*.npz")):
@@ -276,7 +284,8 @@ def _solve_and_report(solve, progress: Progress, report, quiet: bool, args, out:
                   f"run {args.example}{sets} --resume {out}", file=sys.stderr)
         else:
             print(f"vfem: interrupted before the first step was completed: nothing to resume; "
-                  f"run it again: vfem run {args.example}{sets}", file=sys.stderr)
+                  f"run it again: vfem run {args.example}{sets}"
+                  + (f" --out {shlex.quote(str(out))}" if args.out else ""), file=sys.stderr)
         return 130
     summary["run"] = folder.run
     if not quiet:
@@ -295,12 +304,17 @@ _RESULT_FILES = (("summary.json", ""), ("results.pvd", " for ParaView"), ("conta
 
 
 def _results_line(lines: list[str], out: Path) -> list[str]:
-    """The report with its ``results:`` line made from the files that are in ``out`` (never
-    one the run did not write: a run that stopped early has no figures)."""
-    names = [n + note for n, note in _RESULT_FILES if (out / n).is_file()]
-    names += sorted(p.name for p in out.glob("*.png"))
-    cases = sorted(p.name + "/" for p in out.iterdir() if p.is_dir() and p.name != "checkpoint"
-                   and any(p.glob("summary.json"))) if out.is_dir() else []
+    """The report with its ``results:`` line made from the files this run wrote in ``out``
+    (its record, :mod:`vfem.io.folders`): never a file it did not write (a run that stopped
+    early has no figures; another run's sub-folder is not this one's)."""
+    from .io.folders import read_record
+
+    record = read_record(out) or {}
+    owned = set(record.get("files") or [])
+    names = [n + note for n, note in _RESULT_FILES if n in owned]
+    names += sorted(n for n in owned if "/" not in n and n.endswith(".png"))
+    cases = sorted({n.split("/")[0] + "/" for n in owned if "/" in n
+                    and not n.startswith("checkpoint/")})
     line = f"  results: {out}/ (" + ", ".join(names + cases) + ")"
     kept = [x for x in lines if not x.lstrip().startswith("results")]
     return [*kept, line]
@@ -315,7 +329,8 @@ def _checked_model(path: str, assignments: list[str] = ()):
     try:
         return config, check(config, Path(path).parent)
     except InputError as exc:
-        raise InputError(f"{path}: {exc}") from None
+        changes = " with --set " + " --set ".join(assignments) if assignments else ""
+        raise InputError(f"{path}{changes}: {exc}") from None
 
 
 def run_input_file(args) -> int:

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .bodies import Body
+from .bodies import Body, multiplier
 from .contact.algorithm import (
     ContactState,
     IterationRecord,
@@ -270,6 +270,25 @@ def unreachable_pairs(model: Model, pairs: set[frozenset[int]],
     return notes
 
 
+def idle_load_curves(model: Model) -> list[str]:
+    """A note for every load whose curve (``amplitude``) is zero at every load factor of the
+    steps, so that it is never applied: most likely a curve written for other load factors
+    (``[[1, 0], [2, 1]]`` with steps ending at 1)."""
+    factors = [0.0, *model.load_factors]
+    notes = []
+    for b in model.bodies:
+        loads = [(f"prescribed displacement on {x.boundary!r}", x) for x in b.prescribed]
+        loads += [(f"traction on {x.boundary!r}", x) for x in b.tractions]
+        loads += [(f"platen on {b.platen.boundary!r}", b.platen)] if b.platen else []
+        for what, load in loads:
+            if load.amplitude is not None and all(
+                    multiplier(load.amplitude, lf) == 0.0 for lf in factors):
+                notes.append(f"body {b.name!r}: the load curve of its {what} is 0 at every load "
+                             f"factor of the steps (0 to {max(factors):g}): that load is never "
+                             "applied; check the curve's load factors")
+    return notes
+
+
 def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
               settings: ContactSettings, unreachable: list[str] = ()) -> str:
     """The message of an analysis that stops: which step, what failed (the error names the
@@ -289,6 +308,9 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
     elif isinstance(exc, RindViolation):
         remedy = ("take smaller steps ([steps] count), or give the bodies deeper surface "
                   "elements so a step's overlap stays inside them")
+    elif "moves it away from every body it may touch" in text:
+        remedy = ("give the platen's force the sign that pushes the body onto the other (or "
+                  "hold the body otherwise); no step size or iteration count can help")
     elif "cycles" in text:
         remedy = ("the nodes named switch between contact states: refine the mesh there, take "
                   "smaller steps, or check for a sharp corner meeting the other surface")
@@ -353,7 +375,7 @@ class Analysis:
         bodies = self.model.bodies
         pairs, self.surfaces = self.model.contact_surfaces()
         self.unreachable = unreachable_pairs(self.model, pairs, self.surfaces)
-        for note in self.unreachable:
+        for note in self.unreachable + idle_load_curves(self.model):
             log.warning("%s", note)
         t1 = time.perf_counter()
         check_memory(self.surfaces, pairs)

@@ -42,7 +42,7 @@ import scipy.sparse as sp
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
-from ..errors import RindViolation
+from ..errors import AnalysisError, RindViolation
 from .algorithm import (
     ContactState,
     CycleWatch,
@@ -655,6 +655,15 @@ class PairedContact(VirtualElementContact):
         moves = [d for d in moves if d != 0.0]
         if moves:
             state.platen_displacement += min(moves, key=abs)
+            return
+        body = self.surfaces[self.platen_body].body
+        if body.platen_stiffness == 0.0 and need != 0.0:  # nothing but contact could hold it
+            raise AnalysisError(
+                f"the platen on body {body.name!r} must move it along "
+                f"{'-' if need < 0 else '+'}{body.platen.component} to apply its force "
+                f"({state.platen_force:.6g}), but that moves it away from every body it may "
+                "touch: nothing holds it (a platen force's sign: negative pushes towards -x or "
+                "-y)")
 
     # -- what the results need --------------------------------------------------------------------
 

@@ -426,7 +426,8 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
             f"bodies {a!r} and {b!r} start deeply interpenetrated: node {int(si.nodes[k])} of "
             f"{a!r}, at ({x[0]:.6g}, {x[1]:.6g}), lies {depth:.3g} inside {b!r}, deeper than "
             f"its outer layer of elements there ({rind:.3g}; {count} such node(s) in all); "
-            "contact cannot resolve an overlap that deep. Move the bodies apart (mesh.translate) "
+            "contact cannot resolve an overlap that deep. Move the bodies apart (an input file's "
+            "mesh.translate; a built-in example's own parameters, e.g. hertz's initial_gap >= 0) "
             "so that they start touching, and apply the overlap as a prescribed displacement or "
             "a platen force")
 

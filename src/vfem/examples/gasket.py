@@ -294,7 +294,7 @@ def scheduled_steps(result: AnalysisResult) -> list[StepResult | None]:
 
 def force_history(summary: dict) -> np.ndarray:
     """F[k], the total contact force after step k (F[0] = 0, the initial state)."""
-    return np.r_[0.0, [r["contact_force"] for r in summary["steps"]]]
+    return np.r_[0.0, [r["force_magnitude"] for r in summary["steps"]]]
 
 
 def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
@@ -321,7 +321,8 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
         rows.append({
             **step_record(s),
             "step": k + 1,
-            "contact_force": float(np.linalg.norm(F)),
+            # F, the magnitude ("contact_force" is step_record's (x, y) per body)
+            "force_magnitude": float(np.linalg.norm(F)),
             "contact_force_soft": [float(v) for v in F],
             "contact_force_stiff": [float(v) for v in F_stiff],
             "back_reaction": back,
@@ -342,7 +343,7 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
                                      for lf in model.load_factors[:n]],
     }
     overlap = [r["step"] for r in rows if r["prediction_overlap"] > 0]
-    touch = [r["step"] for r in rows if r["contact_force"] > 0]
+    touch = [r["step"] for r in rows if r["force_magnitude"] > 0]
     summary["first_overlap_step"] = overlap[0] if overlap else None
     summary["first_contact_step"] = touch[0] if touch else None
     F = force_history(summary)
@@ -355,7 +356,7 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
                                              for r in steps[-1].bodies.values()))
     # Newton's third law across the interface: the two resultants must cancel
     imbalance = [float(np.linalg.norm(np.add(r["contact_force_soft"], r["contact_force_stiff"])))
-                 / r["contact_force"] for r in rows if r["contact_force"] > 0]
+                 / r["force_magnitude"] for r in rows if r["force_magnitude"] > 0]
     summary["max_force_imbalance"] = max(imbalance, default=0.0)
     summary["bodies"] = {s.body.name: {"nodes": int(s.body.npoints), "dofs": int(s.body.ndofs),
                                        "contact_candidate_nodes": int(s.nc),

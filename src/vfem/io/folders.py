@@ -11,8 +11,8 @@ model, the ``--set`` changes, the vfem version, when) and the list of files the 
 (updated after every converged step, so a run stopped at any moment still owns its files). A new
 run into a folder
 
-- that holds the record of the *same* model (same example or input file, same ``--set``): clears
-  the files listed there, then writes its own;
+- that holds the record of the *same* model (the same example or input file, whatever its
+  ``--set`` changes or edits): clears the files listed there, then writes its own;
 - that holds another model's results: is refused, naming what is there, unless ``--overwrite``
   is given (then the same clearing);
 - written by a vfem older than the record (``summary.json``, no record): clears only the files
@@ -20,7 +20,9 @@ run into a folder
   ``reactions.csv``, ``checkpoint/step*.npz``);
 - any other file there is left alone.
 
-``--resume`` keeps everything (it continues the same run).
+``--resume`` keeps everything (it continues the same run) and the record's description of the
+run, adding the resuming command under ``resumed``; a command refused before it solved anything
+changes nothing.
 """
 
 from __future__ import annotations
@@ -53,8 +55,9 @@ def run_description(command: str, target: str, settings: list[str]) -> dict:
 
 
 def _same_model(a: dict, b: dict) -> bool:
-    return a.get("target") == b.get("target") and sorted(a.get("settings") or []) == sorted(
-        b.get("settings") or [])
+    """The same example or input file (its ``--set`` changes and edits aside: the user chose
+    this folder for that model again)."""
+    return a.get("target") == b.get("target")
 
 
 def _files(folder: Path) -> set[str]:
@@ -96,7 +99,11 @@ class ResultsFolder:
         if resume:
             owned = set((previous or {}).get("files") or [])
             self.foreign = present - owned
-            self.update()
+            if previous is not None:  # the run continued is still the one described
+                resumed = [*(previous.get("resumed") or []),
+                           {k: self.run[k] for k in ("command", "started") if k in self.run}]
+                self.run = {**{k: v for k, v in previous.items() if k != "files"},
+                            "resumed": resumed}
             return []
         if previous is not None:
             owned = set(previous.get("files") or []) & present
@@ -164,6 +171,9 @@ def describe(run: dict) -> str:
 
 def default_folder(name: str, settings: list[str]) -> Path:
     """``results/<name>``, with the ``--set`` changes in the name (``results/hertz_force=2000``)
-    so that runs with different settings do not share a folder."""
+    so that runs with different settings do not share a folder. Always one folder inside
+    ``results``: a model's name is made file-name safe (``../x`` or ``/tmp/x`` cannot send the
+    results elsewhere; an input file's ``output.directory`` is checked for the same)."""
+    safe = re.sub(r"[^A-Za-z0-9_.=+-]", "-", name).lstrip(".") or "model"
     suffix = "".join("_" + re.sub(r"[^A-Za-z0-9.=+-]", "-", s.replace(" ", "")) for s in settings)
-    return Path("results") / f"{name}{suffix}"
+    return Path("results") / f"{safe}{suffix}"

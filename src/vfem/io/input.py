@@ -112,6 +112,9 @@ def apply_assignments(data: dict, assignments: Sequence[str]) -> None:
                 node = _entry(node, part, here)
             elif isinstance(node, dict):
                 if part not in node:
+                    if parts[k + 1].isdigit():  # an entry of an array the file does not have
+                        raise InputError(f"--set {key}: the file has no {here!r} to take entry "
+                                         f"{parts[k + 1]} of; add it to the file")
                     node[part] = {}
                 node = node[part]
             else:
@@ -129,9 +132,9 @@ def apply_assignments(data: dict, assignments: Sequence[str]) -> None:
 
 def _index(array: list, part: str, where: str) -> int:
     """The position in an array named by a number or, for tables with names, a name."""
-    if part.lstrip("-").isdigit():
+    if part.isdigit():
         i = int(part)
-        if -len(array) <= i < len(array):
+        if i < len(array):
             return i
         raise InputError(f"--set {where}: the array has {len(array)} entries (0 to "
                          f"{len(array) - 1})")
@@ -156,6 +159,8 @@ def from_data(cls, data: Any, where: str):
         raise _Problem(where, f"expected a table, got {_kind(data)}")
     if cls is MeshSpec:
         return _mesh_spec(data, where)
+    if cls is Steps and "count" in data and "load_factors" in data:
+        raise _Problem(where, "give count or load_factors, not both (count would be ignored)")
     hints = typing.get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls)}
     _reject_unknown(data, list(fields), where)

@@ -200,6 +200,9 @@ class Folder:
 
     def __init__(self, directory: Path | str, summary: dict | None = None):
         self.directory = Path(directory)
+        if self.directory.is_file():
+            raise InputError(f"{self.directory} is a file, not a results folder: give the folder "
+                             "a run wrote (vfem run ... writes results/<name>)")
         if not self.directory.is_dir():
             raise InputError(f"results directory {self.directory} does not exist")
         self.summary = read_summary(self.directory) if summary is None else summary
@@ -367,9 +370,14 @@ def generic(folder: Folder) -> list[Path]:
     written.append(_pressure(folder.directory, steps, folder.contact, folder.contact_source,
                              label))
     written.append(_history(folder.directory, steps, folder.summary or None))
-    written.append(von_mises(folder, steps[-1], "von_mises.png",
-                             f"von Mises stress, step {steps[-1].step} (load factor "
-                             f"{steps[-1].load_factor:.6g})\n{label}"))
+    # the most stressed step (a load that is held and then removed ends unloaded)
+    peak = max(steps, key=lambda s: max(float(_cell_field(b, "von_mises").max(initial=0.0))
+                                        for b in s.bodies))
+    scale = magnification_for(steps)
+    written.append(von_mises(folder, peak, "von_mises.png",
+                             f"von Mises stress, step {peak.step} (load factor "
+                             f"{peak.load_factor:.6g}), the most stressed\n{label}",
+                             magnification=scale))
     return written
 
 
@@ -392,8 +400,24 @@ def _cell_field(frame: BodyFrame, name: str) -> np.ndarray:
     return np.asarray(frame.cell_data[name], dtype=float)
 
 
+def magnification_for(steps: list[Step]) -> float:
+    """A magnification that makes the largest displacement of ``steps`` about 5 % of the
+    model's size (1, 2 or 5 times a power of ten; 1 where it already is, or more): small
+    deformations stay visible, large ones are drawn true to scale."""
+    size = max((float(np.ptp(b.points, axis=0).max()) for s in steps for b in s.bodies),
+               default=0.0)
+    largest = max((float(np.linalg.norm(b.displacement, axis=1).max(initial=0.0))
+                   for s in steps for b in s.bodies), default=0.0)
+    if not (size > 0 and largest > 0) or largest >= 0.05 * size:
+        return 1.0
+    wanted = 0.05 * size / largest
+    power = 10.0 ** np.floor(np.log10(wanted))
+    return float(max(m * power for m in (1, 2, 5) if m * power <= wanted))
+
+
 def _deformed(directory: Path, steps: list[Step], contact, method: str) -> list[Path]:
     last = steps[-1]
+    scale = magnification_for(steps)
     bodies = [(b.name, b.points, b.polygons, b.displacement) for b in last.bodies]
     xs = np.vstack([b.points + b.displacement for b in last.bodies])
     lo, hi = xs.min(axis=0), xs.max(axis=0)
@@ -408,16 +432,16 @@ def _deformed(directory: Path, steps: list[Step], contact, method: str) -> list[
         pad = max(0.5 * float((chi - clo).max()), 0.05 * extent)
         window = (clo[0] - pad, chi[0] + pad, clo[1] - pad, chi[1] + pad)
         plots.configurations(path, [(label, bodies)], f"Deformed configuration, contact zone\n"
-                             f"{method}", window, magnification=1.0)
+                             f"{method}", window, magnification=scale)
         out.append(path)
         if window[0] > lo[0] or window[1] < hi[0] or window[2] > lo[1] or window[3] < hi[1]:
             whole = directory / "deformed_overall.png"
             plots.configurations(whole, [(label, bodies)], f"Deformed configuration\n{method}",
-                                 magnification=1.0)
+                                 magnification=scale)
             out.append(whole)
     else:
         plots.configurations(path, [(label, bodies)], "Deformed configuration, no node in "
-                             f"contact\n{method}", magnification=1.0)
+                             f"contact\n{method}", magnification=scale)
         out.append(path)
     return out
 

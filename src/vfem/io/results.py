@@ -28,10 +28,12 @@ contact), ``status`` ``contact`` or ``free``. Numbers are written with 17 signif
 ``reactions.csv``: one row per converged step, body and boundary carrying a support, a prescribed
 displacement or a platen, columns ``step, load_factor, body, boundary, Rx, Ry``: the total force
 that boundary's conditions apply to the body, summed over the dofs they constrain (a corner dof
-two boundaries constrain counts in both rows; the body's total in ``summary.json`` counts it
-once). Sign: the force *on the body*, so with the contact force and the applied loads it sums
-to zero; a platen pushing a body down gives a negative ``Ry``, equal to the platen's force at
-the step (``Platen.force_at``). Same 17 digits as ``contact.csv``.
+two boundaries constrain counts in both rows); then a row ``(total)`` per body and step, the
+body's total, which counts each constrained dof once (as ``summary.json``'s ``total``) and so is
+the sum of the boundaries' rows only where they share no dof. Sign: the force *on the body*,
+so with the contact force and the applied loads it sums to zero; a platen pushing a body down
+gives a negative ``Ry``, equal to the platen's force at the step (``Platen.force_at``). Same 17
+digits as ``contact.csv``.
 
 Files are written as each step converges, into a temporary name first and then renamed, so an
 analysis that fails or is killed later never damages what was already written; with them come
@@ -161,9 +163,14 @@ class ResultsWriter:
     def add_reaction_rows(self, step: StepResult) -> None:
         """Keep the rows of ``step``'s per-boundary support reactions for ``reactions.csv``."""
         for body in self.model.bodies:
-            for boundary, (rx, ry) in step.bodies[body.name].reactions.items():
+            r = step.bodies[body.name]
+            for boundary, (rx, ry) in r.reactions.items():
                 self.reaction_rows.append([str(step.step), _num(step.load_factor), body.name,
                                            boundary, _num(rx), _num(ry)])
+            if r.reactions:  # the body's total: each constrained dof once
+                rx, ry = total(r.reaction)  # as summary.json's total, to the last digit
+                self.reaction_rows.append([str(step.step), _num(step.load_factor), body.name,
+                                           TOTAL_ROW, _num(rx), _num(ry)])
 
     def write_contact_csv(self) -> None:
         _write_csv(self.out / "contact.csv", CONTACT_COLUMNS, self.contact_rows)
@@ -297,6 +304,10 @@ def imbalance(contact: list[float], reaction: list[float], applied: list[float])
     c, r, a = (np.asarray(v, dtype=float) for v in (contact, reaction, applied))
     scale = float(np.linalg.norm(c)) or max(float(np.linalg.norm(r)), float(np.linalg.norm(a)))
     return float(np.linalg.norm(c + r + a)) / scale if scale > 0 else 0.0
+
+
+#: The ``boundary`` of a body's total in ``reactions.csv``.
+TOTAL_ROW = "(total)"
 
 
 def force_record(step: StepResult) -> dict:
