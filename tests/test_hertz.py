@@ -38,17 +38,22 @@ def test_peak_pressure_half_width_and_profile(hertz_level0):
 def test_contact_forces_balance_the_applied_load(hertz_level0):
     """Conservation: the platen's force reaches the flat through the contact."""
     _, _, h = hertz_level0
-    assert h["total_contact_force"] == pytest.approx(1530, rel=0.005)
-    # the flat receives the same total through the virtual elements
-    assert h["total_contact_force_flat"] == pytest.approx(1530, rel=0.01)
+    # the platen's force, to the platen tolerance (measured 4e-14 relative)
+    assert h["total_contact_force"] == pytest.approx(1530, rel=1e-9)
+    # the flat receives the same total through the virtual elements (exact transfer)
+    assert h["total_contact_force_flat"] == pytest.approx(h["total_contact_force"], rel=1e-12)
 
 
 def test_no_node_penetrates_at_convergence(hertz_level0):
+    """Measured independently of the formulation (vfem.contact.check: every node of either
+    body against the other's deformed facets), not the formulation's own gaps (the flat's are
+    zero by construction: it carries equilibrium)."""
     _, result, _ = hertz_level0
-    last = result.steps[-1]
-    for name, body in last.bodies.items():
-        inside = body.penetration[body.contact_status > 0]
-        assert np.all(inside < 1e-6), name  # far below the 0.007 approach
+    for step in result.steps:
+        inv = step.invariants
+        assert inv["passed"] and not inv["failed"], inv
+        assert inv["max_penetration_any_body"] <= 1e-12  # measured 1e-16: round-off
+        assert inv["penetration"] <= inv["allowed"]
 
 
 def test_swapping_the_bodies_changes_nothing(hertz_level0):

@@ -1,0 +1,128 @@
+"""Every example's answers, saved and compared: the "no answer changes" check of a refactoring
+(issue 18).
+
+    python benchmarks/answers.py save DIR            # run every case, write DIR/<case>.json
+    python benchmarks/answers.py compare OLD NEW     # every number alike to 1e-10 relative
+    python benchmarks/answers.py save DIR hertz gasket_large   # some cases only
+
+The cases: springs, hertz, hertz with quadratic elements, patch, wedge, block, gasket (small and
+large kinematics), sliding, and each classical baseline on Hertz; each is ``vfem run`` of the
+built-in example into a fresh folder, and its ``summary.json`` is kept without what differs
+from run to run (wall-clock times, the run's command and date, file names). ``compare`` walks
+both trees: numbers must agree to 1e-10 relative (or 1e-12 absolute near zero), integers
+(iteration counts, steps) and strings exactly; it prints every difference and exits 1 if any.
+Take the "before" snapshot at the commit before the change (a ``git worktree`` of it), the
+"after" one on the change, and compare.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import json
+import math
+import sys
+import tempfile
+from pathlib import Path
+
+CASES: dict[str, list[str]] = {
+    "springs": ["springs"],
+    "hertz": ["hertz"],
+    "hertz_order2": ["hertz", "--set", "order=2"],
+    "patch": ["patch"],
+    "wedge": ["wedge", "--set", "figures=false"],
+    "block": ["block"],
+    "gasket": ["gasket"],
+    "gasket_large": ["gasket", "--set", "kinematics=total"],
+    "sliding": ["sliding"],
+    "hertz_penalty": ["hertz", "--set", "contact.method=penalty"],
+    "hertz_lagrange": ["hertz", "--set", "contact.method=lagrange"],
+    "hertz_augmented": ["hertz", "--set", "contact.method=augmented"],
+}
+
+#: Keys whose values differ from run to run (or name files), dropped wherever they appear.
+VOLATILE = {"timings", "run", "seconds", "figures", "figure_data", "figure_set", "linear_solver",
+            "peak_mib", "input"}
+
+
+def clean(value):
+    """``value`` without the :data:`VOLATILE` keys, at any depth."""
+    if isinstance(value, dict):
+        return {k: clean(v) for k, v in value.items() if k not in VOLATILE}
+    if isinstance(value, list):
+        return [clean(v) for v in value]
+    return value
+
+
+def save(folder: Path, names: list[str]) -> None:
+    from vfem.cli import main
+
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        with tempfile.TemporaryDirectory() as tmp:
+            with contextlib.redirect_stdout(io.StringIO()):
+                status = main(["-q", "run", *CASES[name], "--out", tmp])
+            summary = json.loads((Path(tmp) / "summary.json").read_text())
+        (folder / f"{name}.json").write_text(json.dumps(clean(summary), indent=1) + "\n")
+        print(f"{name}: exit {status}, {folder / (name + '.json')}")
+
+
+def differences(a, b, where: str = "") -> list[str]:
+    """Every place where ``a`` and ``b`` differ beyond round-off."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = [f"{where}.{k}: only before" for k in a.keys() - b.keys()]
+        out += [f"{where}.{k}: only after" for k in b.keys() - a.keys()]
+        for k in a.keys() & b.keys():
+            out += differences(a[k], b[k], f"{where}.{k}")
+        return out
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{where}: {len(a)} entries before, {len(b)} after"]
+        return [d for k, (x, y) in enumerate(zip(a, b)) for d in differences(x, y, f"{where}[{k}]")]
+    if isinstance(a, bool) or isinstance(b, bool) or isinstance(a, int) and isinstance(b, int):
+        return [] if a == b else [f"{where}: {a!r} before, {b!r} after"]
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        if math.isclose(a, b, rel_tol=1e-10, abs_tol=1e-12) or (math.isnan(a) and math.isnan(b)):
+            return []
+        return [f"{where}: {a!r} before, {b!r} after"]
+    return [] if a == b else [f"{where}: {a!r} before, {b!r} after"]
+
+
+def compare(old: Path, new: Path) -> int:
+    status = 0
+    for path in sorted(old.glob("*.json")):
+        other = new / path.name
+        if not other.is_file():
+            print(f"{path.stem}: missing after")
+            status = 1
+            continue
+        diffs = differences(json.loads(path.read_text()), json.loads(other.read_text()))
+        print(f"{path.stem}: {'the same' if not diffs else f'{len(diffs)} differences'}")
+        for d in diffs[:20]:
+            print(f"  {d}")
+        status |= bool(diffs)
+    return status
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("save")
+    s.add_argument("folder", type=Path)
+    s.add_argument("cases", nargs="*", help=f"some of {', '.join(CASES)} (default: all)")
+    c = sub.add_parser("compare")
+    c.add_argument("old", type=Path)
+    c.add_argument("new", type=Path)
+    args = parser.parse_args(argv)
+    if args.command == "save":
+        unknown = [c for c in args.cases if c not in CASES]
+        if unknown:
+            parser.error(f"unknown cases {unknown}; choose from {', '.join(CASES)}")
+        save(args.folder, args.cases or list(CASES))
+        return 0
+    return compare(args.old, args.new)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
