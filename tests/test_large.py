@@ -77,8 +77,13 @@ def test_sliding_ten_facets_keeps_the_normal_reaction_steady(slide):
     assert e["normal_reaction_max_deviation"] < 0.02
     # frictionless: the tangential reaction is a small fraction of the normal one
     assert e["tangential_reaction_max"] < 1e-3 * e["normal_reaction_mean"]
-    # the compatibility side (the softer block) meets the tolerance at every step
-    assert e["largest_residual_penetration"] <= result.penetration_tolerance
+    # the compatibility side (the softer block): none of its nodes inside the punch's deformed
+    # facets at the end, measured by the independent check (not the iteration's own stopping
+    # rule, which a converged run meets by definition; measured -5e-14), and every step passes
+    # the three invariants
+    block = largest_penetrations(result)["block"]["penetration"]
+    assert block <= result.penetration_tolerance
+    assert all(s.invariants["passed"] for s in result.steps)
 
 
 def test_sliding_contact_forces_balance_the_support_reaction(slide):
