@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ._version import __version__  # noqa: F401 (vfem.__version__)
 from .bodies import Body, Platen, PrescribedDisplacement, Support, Traction
 from .config import BodyConfig, MeshSpec, ModelConfig, Steps
 from .contact.settings import ContactSettings
@@ -25,8 +26,6 @@ from .solver import Analysis, AnalysisResult, Model, StepResult
 
 #: The contact settings under the name the input file uses (``[contact]``).
 Contact = ContactSettings
-
-__version__ = "0.1.0"
 
 
 def load(path: str | Path) -> ModelConfig:

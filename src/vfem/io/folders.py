@@ -33,7 +33,9 @@ import logging
 import re
 from pathlib import Path
 
+from .._version import __version__
 from ..errors import InputError
+from .files import _atomic_write
 
 log = logging.getLogger(__name__)
 
@@ -47,8 +49,6 @@ _LEGACY = re.compile(r"(.*_step\d{4}\.vtu|results\.pvd|contact\.csv|reactions\.c
 def run_description(command: str, target: str, settings: list[str]) -> dict:
     """What a run is, for its record and ``summary.json`` (``run``): the command line, the
     example's name or the input file's path, the ``--set`` changes, vfem's version, when."""
-    from .. import __version__
-
     return {"command": command, "target": target, "settings": list(settings),
             "vfem_version": __version__,
             "started": datetime.datetime.now().astimezone().isoformat(timespec="seconds")}
@@ -138,8 +138,6 @@ class ResultsFolder:
         """Write the record: the run and every file in the folder that it did not find there."""
         if not self.path.is_dir():
             return
-        from .results import _atomic_write
-
         record = {**self.run, "files": sorted(_files(self.path) - self.foreign)}
         _atomic_write(self.path / RECORD, lambda p: p.write_text(
             json.dumps(record, indent=1) + "\n", encoding="utf-8"))
@@ -152,8 +150,6 @@ class ResultsFolder:
         except (OSError, ValueError):
             return
         if isinstance(summary, dict) and summary.get("run") != self.run:
-            from .results import _atomic_write
-
             summary["run"] = self.run
             _atomic_write(path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n",
                                                        encoding="utf-8"))

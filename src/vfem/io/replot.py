@@ -39,7 +39,7 @@ import numpy as np
 
 from ..errors import InputError
 from . import plots
-from .results import _safe, write_summary
+from .files import _safe, write_summary
 
 log = logging.getLogger(__name__)
 

@@ -47,9 +47,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import io
-import json
 import logging
-import os
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -59,6 +57,7 @@ import numpy as np
 from ..contact.surface import ContactSurface
 from ..errors import InputError
 from ..solver import Analysis, AnalysisResult, Model, StepResult
+from .files import _atomic_write, _safe, write_summary  # noqa: F401 (write_summary: importers)
 
 log = logging.getLogger(__name__)
 
@@ -67,12 +66,6 @@ _CELL_FIELD = {"sxx": "stress_xx", "syy": "stress_yy", "sxy": "stress_xy", "szz"
 CONTACT_COLUMNS = ("step", "load_factor", "body", "node", "x", "y", "ux", "uy", "pressure",
                    "gap", "status")
 REACTION_COLUMNS = ("step", "load_factor", "body", "boundary", "Rx", "Ry")
-
-
-def _atomic_write(path: Path, write) -> None:
-    tmp = path.with_name(path.name + ".part")
-    write(tmp)
-    os.replace(tmp, path)
 
 
 class ResultsWriter:
@@ -346,19 +339,6 @@ def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
             "linear_solver": result.backend}
 
 
-def write_summary(out: Path, summary: dict) -> Path:
-    Path(out).mkdir(parents=True, exist_ok=True)
-    path = Path(out) / "summary.json"
-    _atomic_write(path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n",
-                                               encoding="utf-8"))
-    return path
-
-
 def _num(x: float) -> str:
     """A float in 17 significant digits (reads back exactly)."""
     return f"{float(x):.17g}"
-
-
-def _safe(name: str) -> str:
-    """A file-name-safe version of a body name."""
-    return "".join(c if c.isalnum() or c in "-_" else "_" for c in name) or "body"
