@@ -48,7 +48,7 @@ as the virtual finite element method (bodies, meshes, supports, loads, platen, l
 A body held only by contact and its platen (the Hertz cylinder) makes the system singular while
 no node touches it: then its closest node is put in the active set, as a seed.
 
-The results are the :class:`~vfem.solver.AnalysisResult` of vfem: nodal contact forces on both
+The results are the :class:`~vfem.result_types.AnalysisResult` of vfem: nodal contact forces on both
 bodies, the nominal pressure read as vfem reads it (a node's normal contact force over its
 undeformed tributary length on its :class:`~vfem.contact.surface.ContactSurface`; on a master
 node the normal is the master's own node normal), the slave nodes' gaps as ``penetration`` (0 on
@@ -518,9 +518,9 @@ class GlobalContact:
     # -- results ----------------------------------------------------------------------------------
 
     def fields(self, load_factor: float, q: np.ndarray, Lam: np.ndarray, g: np.ndarray):
-        """Per body: the :class:`~vfem.solver.BodyStepResult` and the contact forces on its
+        """Per body: the :class:`~vfem.result_types.BodyStepResult` and the contact forces on its
         candidate nodes (nc, 2)."""
-        from ..solver import BodyStepResult, add_reactions
+        from ..result_types import BodyStepResult, add_reactions
 
         U = self.T @ q + self.at(load_factor, self.U_prescribed)
         f_slave = self.c.B_slave.T @ Lam
@@ -572,7 +572,7 @@ class GlobalContact:
         active set does not settle stops the analysis (``converged`` False, the message says
         why); no step is cut, the answer of a linear frictionless problem not depending on the
         path to it."""
-        from ..solver import AnalysisResult, StepResult
+        from ..result_types import AnalysisResult, StepResult
 
         t_start = time.perf_counter()
         model = self.model

@@ -2,7 +2,7 @@
 
 :func:`step_invariants` (and :class:`InvariantCheck`, which keeps each body's boundary between
 steps) takes only the full-mesh results of a step — each body's displacement and contact force
-at every point (:class:`vfem.solver.BodyStepResult`) — and the bodies' meshes and supports;
+at every point (:class:`vfem.result_types.BodyStepResult`) — and the bodies' meshes and supports;
 nothing of the contact formulation's own state (pairings, virtual nodes, multipliers, which side
 carries compatibility). It checks
 
@@ -73,7 +73,7 @@ from .search import project_points
 
 if TYPE_CHECKING:
     from ..bodies import Body
-    from ..solver import AnalysisResult, StepResult
+    from ..result_types import AnalysisResult, StepResult
 
 #: (a): the resultant of all contact forces, relative to the largest body's total contact force
 FORCE_BALANCE_TOLERANCE = 1e-8
@@ -713,7 +713,7 @@ def _loaded_or_next(segments: np.ndarray, forces: np.ndarray) -> np.ndarray:
 def step_invariants(model_or_bodies, pairs, fields: dict, penetration_tolerance: float,
                     **options) -> Invariants:
     """The three invariants of one state (see :class:`InvariantCheck` for the arguments;
-    ``fields``: body name -> its :class:`~vfem.solver.BodyStepResult`, or anything with
+    ``fields``: body name -> its :class:`~vfem.result_types.BodyStepResult`, or anything with
     ``displacement`` and ``contact_force``)."""
     return InvariantCheck(model_or_bodies, pairs, penetration_tolerance, **options)(fields)
 

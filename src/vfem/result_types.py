@@ -1,0 +1,113 @@
+"""What an analysis gives back: per converged step the full-mesh fields of every body, and the
+run as a whole (its steps, the model, timings); and what a run needs to continue after a step.
+
+Their own module (issue 18): the solver fills them, the contact formulations (the classical
+baselines build their own steps) and the independent checks read them, and the writers turn them
+into files, so none of those needs to import the solver.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .contact.algorithm import ContactState, IterationRecord
+
+if TYPE_CHECKING:
+    from .bodies import Body
+    from .contact.surface import ContactSurface
+    from .solver import Model
+
+
+@dataclass
+class BodyStepResult:
+    """The state of one body at the end of a converged step (full mesh fields)."""
+
+    displacement: np.ndarray  # (npoints, 2), at the body's points (Body.points)
+    contact_force: np.ndarray  # (npoints, 2) nodal force applied by the other bodies
+    #: (npoints,) nominal normal pressure: normal nodal contact force / undeformed tributary
+    #: length, i.e. the traction averaged with the node's shape function (int phi q / int phi)
+    contact_pressure: np.ndarray
+    contact_status: np.ndarray  # (npoints,) 0 free, 1 in contact
+    penetration: np.ndarray  # (npoints,) signed penetration at candidate nodes (0 elsewhere)
+    #: (npoints,) the formulation's nominal normal traction at the node (paired variant: the
+    #: unknowns q on the compatibility side, that field read at the other side's nodes); where a
+    #: formulation has none, the nodal reading ``contact_pressure``
+    contact_traction: np.ndarray | None = None
+    #: (npoints, 2) nodal force the supports, prescribed displacements and platen apply to the
+    #: body (:meth:`Body.nodal_reaction`): zero on unconstrained dofs. With the contact force and
+    #: the applied loads it balances the body (:func:`add_reactions`)
+    reaction: np.ndarray | None = None
+    #: per boundary carrying a support, a prescribed displacement or the platen, the total (x, y)
+    #: of ``reaction`` over the dofs that boundary's own conditions constrain
+    #: (:meth:`Body.boundary_reactions`: a shared corner dof counts in each boundary constraining
+    #: it; the body's total, ``reaction.sum(axis=0)``, counts it once)
+    reactions: dict[str, tuple[float, float]] = field(default_factory=dict)
+    #: (2,) resultant (x, y) of the body's applied loads (its tractions) at the step's load factor
+    applied_load: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.contact_traction is None:
+            self.contact_traction = self.contact_pressure
+
+    @property
+    def reaction_total(self) -> np.ndarray:
+        """(2,) the body's total support reaction (x, y): ``reaction`` summed over the nodes,
+        each constrained dof once; zeros where reactions were not computed."""
+        return np.zeros(2) if self.reaction is None else self.reaction.sum(axis=0)
+
+
+def add_reactions(body: Body, r: BodyStepResult, load_factor: float) -> BodyStepResult:
+    """Fill ``r``'s support reactions (``reaction``, ``reactions``, ``applied_load``) from its
+    displacement and contact force at ``load_factor``: one evaluation of the body's stiffness
+    (internal force under large kinematics) per converged step, so every output reads the same
+    numbers. Returns ``r``."""
+    nodal = body.nodal_reaction(np.asarray(r.displacement).ravel(), load_factor,
+                                np.asarray(r.contact_force).ravel())
+    r.reaction = nodal.reshape(-1, 2)
+    r.reactions = body.boundary_reactions(nodal)
+    r.applied_load = body.applied_load(load_factor).reshape(-1, 2).sum(axis=0)
+    return r
+
+
+@dataclass
+class StepResult:
+    step: int
+    load_factor: float
+    iterations: int
+    converged: bool
+    history: list[IterationRecord]
+    platen_displacement: float = 0.0
+    cuts: int = 0
+    fixed_point: bool = False  # stopped where the corrections cancel, with residual errors
+    bodies: dict[str, BodyStepResult] = field(default_factory=dict)
+    #: the invariants of the converged state (``Invariants.record()``: force_balance,
+    #: max_penetration_any_body, allowed, where, tension, ...); empty when not checked
+    invariants: dict = field(default_factory=dict)
+
+
+@dataclass
+class AnalysisResult:
+    model: Model
+    converged: bool
+    steps: list[StepResult]
+    timings: dict[str, float]
+    message: str = ""
+    surfaces: list[ContactSurface] = field(default_factory=list)
+    penetration_tolerance: float = 0.0  # the one the contact iteration used
+    backend: str = ""  # the linear-algebra backend that factorized the bodies (vfem.linalg)
+
+
+@dataclass
+class Checkpoint:
+    """Everything a run needs to continue after a converged step: the steps so far, the
+    contact state, each body's saved state (:meth:`Body.saved_state`) and the step control."""
+
+    steps: list[StepResult]
+    state: ContactState
+    bodies: dict[str, dict[str, np.ndarray]]
+    target: int = 1  # the next scheduled load factor: model.load_factors[target - 1]
+    level: int = 0  # halvings of the scheduled increment now in use
+    easy: int = 0  # easy steps in a row at that level
