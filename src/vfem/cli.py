@@ -24,7 +24,7 @@ from .contact.settings import ContactSettings
 from .errors import InputError, VfemError
 from .examples import EXAMPLES, load
 from .io.folders import ResultsFolder, default_folder, run_description
-from .io.input import NOT_YET
+from .schema import NOT_YET
 
 log = logging.getLogger("vfem")
 

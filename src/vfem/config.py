@@ -30,6 +30,7 @@ from .contact.settings import ContactSettings
 from .errors import InputError
 from .materials import LinearElastic
 from .mesh import parametric, shapes
+from .schema import check_parameters
 from .solver import Model
 
 #: The built-in parametric meshes an input file may name as ``mesh.shape``: each is a function
@@ -127,9 +128,7 @@ def _shape_mesh(shape: str, parameters: tuple[tuple[str, Any], ...]):
     if shape not in SHAPES:
         raise InputError(f"mesh: unknown shape {shape!r}; built-in shapes: "
                          f"{', '.join(SHAPES)}")
-    from .io.input import check_shape_parameters  # (here: the loader imports this module)
-
-    check_shape_parameters(shape, parameters)  # as an input file's: types, pairs, finite
+    check_parameters(SHAPES[shape], parameters, f"mesh shape {shape!r}")  # as a file's
     try:
         return SHAPES[shape](**dict(parameters))
     except (ValueError, TypeError, ArithmeticError) as exc:

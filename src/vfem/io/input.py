@@ -15,12 +15,10 @@ how the built-in examples' input files under ``examples/`` are made (``vfem expo
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import inspect
 import json
 import math
 import tomllib
-import types
 import typing
 from collections.abc import Sequence
 from pathlib import Path
@@ -28,6 +26,16 @@ from typing import Any
 
 from ..config import SHAPES, BodyConfig, Curve, MeshSpec, ModelConfig, Output, Steps
 from ..errors import InputError
+from ..schema import (
+    _join,
+    _kind,
+    _listify,
+    _Problem,
+    _reject_unknown,
+    _suggest,
+    _type_name,
+    convert,
+)
 
 #: Where each configuration class sits in an input file (for messages and the reference).
 SECTIONS = {
@@ -44,14 +52,6 @@ SECTIONS = {
     "Traction": "[[bodies.tractions]]",
     "Platen": "[bodies.platen]",
 }
-
-
-class _Problem(InputError):
-    """A problem at a place in the file; turned into an InputError naming the file (an
-    InputError itself, so that :func:`from_data` called on its own raises one too)."""
-
-    def __init__(self, where: str, message: str):
-        super().__init__(f"{where}: {message}" if where else message)
 
 
 # -- reading -------------------------------------------------------------------------------------
@@ -153,6 +153,11 @@ def _entry(array: list, part: str, where: str):
     return entry
 
 
+def _convert(tp, value, where: str):
+    """``value`` checked against type ``tp``, tables read by :func:`from_data`."""
+    return convert(tp, value, where, from_data)
+
+
 def from_data(cls, data: Any, where: str):
     """An instance of dataclass ``cls`` from parsed TOML ``data``, every key checked."""
     if not isinstance(data, dict):
@@ -231,104 +236,6 @@ def _shape_parameter(shape: str, name: str, value, where: str):
     return _convert(typing.get_type_hints(SHAPES[shape]).get(name, Any), value, where)
 
 
-def check_shape_parameters(shape: str, parameters: Sequence[tuple[str, Any]]) -> None:
-    """Check the parameters of a built-in shape given in Python (``MeshSpec.parameters``) as an
-    input file's are checked: types, the length of pairs, finite numbers. (Unknown names are
-    left to the shape function, which refuses them.)"""
-    for name, value in parameters:
-        if name in inspect.signature(SHAPES[shape]).parameters:
-            _shape_parameter(shape, name, _listify(value), f"mesh shape {shape!r}: {name}")
-
-
-def _convert(tp, value, where: str):
-    """``value`` checked against type ``tp`` (and converted: arrays to tuples)."""
-    origin = typing.get_origin(tp)
-    args = typing.get_args(tp)
-    if tp is Any:
-        return value
-    if origin in (typing.Union, types.UnionType):
-        inner = [a for a in args if a is not type(None)]
-        if len(inner) == 1:
-            return _convert(inner[0], value, where)
-        for a in inner:
-            try:
-                return _convert(a, value, where)
-            except _Problem:
-                continue
-        raise _Problem(where, f"expected {_type_name(tp)}, got {_kind(value)}")
-    if dataclasses.is_dataclass(tp):
-        return from_data(tp, value, where)
-    if origin in (tuple, Sequence) or tp in (tuple, Sequence):
-        if not isinstance(value, list):
-            raise _Problem(where, f"expected {_type_name(tp)}, got {_kind(value)}")
-        if origin is tuple and args and args[-1] is not Ellipsis:
-            if len(value) != len(args):
-                raise _Problem(where, f"expected {len(args)} values, got {len(value)}")
-            return tuple(_convert(a, v, f"{where}[{i}]")
-                         for i, (a, v) in enumerate(zip(args, value)))
-        item = args[0] if args else Any
-        return tuple(_convert(item, v, f"{where}[{i}]") for i, v in enumerate(value))
-    if tp is bool:
-        if not isinstance(value, bool):
-            raise _Problem(where, f"expected true or false, got {_kind(value)}")
-        return value
-    if tp is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise _Problem(where, f"expected an integer, got {_kind(value)}")
-        return value
-    if tp is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise _Problem(where, f"expected a number, got {_kind(value)}")
-        if not math.isfinite(value):
-            raise _Problem(where, f"must be a finite number, got {value!r}")
-        return float(value)
-    if tp is str:
-        if not isinstance(value, str):
-            raise _Problem(where, f"expected a string, got {_kind(value)}")
-        return value
-    raise _Problem(where, f"cannot read a value of type {tp!r}")  # a bug in the classes
-
-
-def _reject_unknown(data: dict, valid: list[str], where: str, owner: str = "") -> None:
-    for key in data:
-        if key not in valid:
-            place = f"{where} ({owner})" if owner else where
-            raise _Problem(place, f"unknown key {key!r}" + _suggest(key, valid)
-                           + f"; valid keys: {', '.join(valid)}")
-
-
-#: Keys a user reaches for that name something vfem does not do yet: said so, not "did you
-#: mean" a key that happens to be spelled alike.
-NOT_YET = {"friction": "friction is not available yet: vfem solves frictionless contact "
-                       "(Coulomb friction is planned)",
-           "self_contact": "contact of a body with itself is not available yet"}
-
-
-def _suggest(key: str, valid: list[str]) -> str:
-    if key in NOT_YET:
-        return f" ({NOT_YET[key]})"
-    close = difflib.get_close_matches(key, valid, n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
-
-
-def _join(where: str, key: str) -> str:
-    return f"{where}.{key}" if where else key
-
-
-def _kind(value) -> str:
-    if isinstance(value, bool):
-        return f"the boolean {str(value).lower()}"
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, list):
-        return "an array"
-    if isinstance(value, str):
-        return f"the string {value!r}"
-    if isinstance(value, (int, float)):
-        return f"the number {value!r}"
-    return type(value).__name__
-
-
 # -- writing -------------------------------------------------------------------------------------
 
 def to_data(obj) -> dict:
@@ -360,10 +267,6 @@ def to_data(obj) -> dict:
         else:
             out[f.name] = _listify(v)
     return out
-
-
-def _listify(v):
-    return [_listify(x) for x in v] if isinstance(v, (list, tuple)) else v
 
 
 def dumps(config: ModelConfig, header: str = "") -> str:
@@ -437,25 +340,6 @@ def help_texts(cls) -> dict[str, str]:
         elif indent < 4:
             break
     return out
-
-
-def _type_name(tp) -> str:
-    origin, args = typing.get_origin(tp), typing.get_args(tp)
-    if origin in (typing.Union, types.UnionType):
-        inner = [a for a in args if a is not type(None)]
-        return " or ".join(_type_name(a) for a in inner)
-    if dataclasses.is_dataclass(tp):
-        return "table"
-    if origin is tuple and args and args[-1] is not Ellipsis:
-        return "[" + ", ".join(_type_name(a) for a in args) + "]"
-    if origin in (tuple, Sequence):
-        item = args[0] if args else Any
-        if dataclasses.is_dataclass(item):
-            return "array of tables"
-        name = _type_name(item)
-        return f"array of {name}" if name.endswith("]") else f"array of {name}s"
-    return {bool: "boolean", int: "integer", float: "number", str: "string",
-            Any: "value"}.get(tp, getattr(tp, "__name__", str(tp)))
 
 
 def _default_text(f) -> str:
