@@ -86,3 +86,13 @@ def test_nothing_under_contact_imports_the_solver():
     graph = import_graph()
     assert not [m for m, targets in graph.items()
                 if m.startswith("vfem.contact") and "vfem.solver" in targets]
+
+
+def test_the_core_never_imports_the_tools():
+    """Benchmarking and the CalculiX comparison are tools around the solver (vfem.tools): only
+    the command line (its bench and study commands) and the tools themselves import them."""
+    graph = import_graph()
+    users = sorted(m for m, targets in graph.items()
+                   if any(t.startswith("vfem.tools") for t in targets)
+                   and not m.startswith("vfem.tools"))
+    assert users == ["vfem.cli"]

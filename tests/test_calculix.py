@@ -1,4 +1,4 @@
-"""vfem.io.calculix: the Hertz model as a CalculiX deck (always checked), and run in ccx when it
+"""vfem.tools.calculix: the Hertz model as a CalculiX deck (always checked), and run in ccx when it
 is installed (p_max against Hertz, the force balance)."""
 
 import shutil
@@ -8,7 +8,7 @@ import pytest
 
 from vfem.errors import InputError, VfemError
 from vfem.examples import hertz
-from vfem.io.calculix import run, write_deck
+from vfem.tools.calculix import run, write_deck
 
 HAVE_CCX = shutil.which("ccx") is not None
 needs_ccx = pytest.mark.skipif(not HAVE_CCX, reason="CalculiX (ccx) is not installed")
@@ -138,14 +138,14 @@ def test_ccx_failure_is_reported(level0, tmp_path):
 
 
 def test_bench_rows_without_ccx():
-    from vfem.bench import calculix_rows
+    from vfem.tools.bench import calculix_rows
 
     assert calculix_rows([0], ccx="no-such-ccx-here") == []
 
 
 @needs_ccx
 def test_bench_rows():
-    from vfem.bench import calculix_rows
+    from vfem.tools.bench import calculix_rows
 
     lines = []
     (row,) = calculix_rows([0], print_row=lines.append)

@@ -430,7 +430,7 @@ def cmd_plot(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from . import bench
+    from .tools import bench
 
     if args.example != "hertz":
         raise InputError(f"no benchmark for {args.example!r}; available: hertz")
@@ -471,8 +471,8 @@ def cmd_bench(args) -> int:
 
 
 def cmd_study(args) -> int:
-    from .bench import speed_benchmark
     from .io.plots import convergence
+    from .tools.bench import speed_benchmark
 
     if args.example != "hertz":
         raise InputError(f"no study for {args.example!r}; available: hertz")

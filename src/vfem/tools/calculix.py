@@ -200,7 +200,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     _, surfaces = model.contact_surfaces()
     size = max(float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in model.bodies)
 
-    out = ["*HEADING", f"vfem model {model.name!r} written by vfem.io.calculix"]
+    out = ["*HEADING", f"vfem model {model.name!r} written by vfem.tools.calculix"]
     decks: list[BodyDeck] = []
     node_off = elem_off = 0
     for b, s in zip(model.bodies, surfaces):

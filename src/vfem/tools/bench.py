@@ -32,9 +32,9 @@ import numpy as np
 from skfem import Basis, ElementVector, asm
 from skfem.models.elasticity import linear_elasticity
 
-from .examples.hertz import HertzParameters, build, evaluate, theory
-from .linalg import factorize, resolve
-from .solver import Analysis
+from ..examples.hertz import HertzParameters, build, evaluate, theory
+from ..linalg import factorize, resolve
+from ..solver import Analysis
 
 #: named sizes of ``vfem bench hertz --dofs``
 SIZES = {"10k": 10_000, "100k": 100_000, "1M": 1_000_000}
@@ -53,7 +53,7 @@ def parse_size(text: str) -> int:
     try:
         value = int(float(number) * scale)
     except ValueError:
-        from .errors import InputError
+        from ..errors import InputError
 
         raise InputError(f"--dofs: expected a number of dofs such as 10k, 100k or 1M, got "
                          f"{text!r}") from None
@@ -157,7 +157,7 @@ def hertz_case(p: HertzParameters, backend: str | None = None, method: str = "vf
 def patch_case(method: str = "vfem", backend: str | None = None) -> dict:
     """The patch test (every case of the patch example) with contact ``method``: the largest
     deviation of the contact pressure from the exact uniform one, over the cases."""
-    from .examples import patch
+    from ..examples import patch
 
     p = patch.Parameters()
     worst, iterations = 0.0, 0
@@ -177,7 +177,7 @@ def run_isolated(kind: str, **kwargs) -> dict:
     fresh Python process; its row (which the process writes to a file)."""
     with tempfile.TemporaryDirectory(prefix="vfem-bench-") as tmp:
         row = Path(tmp) / "row.json"
-        out = subprocess.run([sys.executable, "-m", "vfem.bench", json.dumps([kind, kwargs]),
+        out = subprocess.run([sys.executable, "-m", "vfem.tools.bench", json.dumps([kind, kwargs]),
                               str(row)], capture_output=True, text=True, check=False)
         if out.returncode != 0 or not row.exists():
             from .errors import AnalysisError
@@ -292,7 +292,7 @@ def calculix_rows(levels: list[int | dict], print_row: Callable[[str], None] | N
     """
     if shutil.which(ccx) is None:
         return []
-    from .io.calculix import run, write_deck
+    from .calculix import run, write_deck
 
     rows = []
     if print_row:
@@ -344,7 +344,7 @@ def calculix_rows(levels: list[int | dict], print_row: Callable[[str], None] | N
     return rows
 
 
-if __name__ == "__main__":  # one case: python -m vfem.bench '["hertz", {...}]' ROW.json
+if __name__ == "__main__":  # one case: python -m vfem.tools.bench '["hertz", {...}]' ROW.json
     import logging
 
     logging.basicConfig(level=logging.WARNING)
