@@ -268,7 +268,7 @@ def baselines_hertz() -> str:
         rows.append(f"| {label} | {_pct(h['p_max_error'], 4)} | {solves}"
                     + (" (contact iterations)" if method == "vfem" else "")
                     + f" | {factorizations}" + (" (one per body)" if method == "vfem" else "")
-                    + f" | {max(penetration, 0.0):.1e} | {h['total_contact_force']:.9g} |")
+                    + f" | {max(penetration, 0.0):.1e} | {h['total_contact_force']:.7g} |")
     return "\n".join(rows) + "\n"
 
 
