@@ -23,3 +23,18 @@ def violations(inv: dict) -> list[str]:
                                         "(c)": "tension"}[v[:3]] for v in out):
         out.append(f"the record's failed {inv['failed']} disagrees with its measures")
     return out
+
+
+def step_violations(result) -> list[str]:
+    """Every converged step's broken invariants, one line each (and a step without its
+    invariants recorded)."""
+    out = []
+    for step in result.steps:
+        if not step.converged:
+            continue
+        where = f"step {step.step} (load factor {step.load_factor:.6g})"
+        if not step.invariants:
+            out.append(f"{where}: no invariants recorded")
+            continue
+        out.extend(f"{where}: {v}" for v in violations(step.invariants))
+    return out

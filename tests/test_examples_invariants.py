@@ -45,7 +45,7 @@ from pathlib import Path
 import pytest
 
 import vfem
-from invariant_record import violations
+from invariant_record import step_violations
 from vfem.examples import EXAMPLES
 from vfem.examples import load as load_example
 
@@ -135,24 +135,6 @@ def _model(case, tmp_path: Path):
         make_mesh.build(tmp_path / "hertz.msh")
         case = Path(shutil.copy(case, tmp_path / case.name))
     return vfem.load(case).build(case.parent)  # mesh files are relative to the input file
-
-
-# -- the invariants of a step, read from its record ----------------------------------------------
-
-
-def step_violations(result) -> list[str]:
-    """Every converged step's broken invariants, one line each (and a step without its
-    invariants recorded)."""
-    out = []
-    for step in result.steps:
-        if not step.converged:
-            continue
-        where = f"step {step.step} (load factor {step.load_factor:.6g})"
-        if not step.invariants:
-            out.append(f"{where}: no invariants recorded")
-            continue
-        out.extend(f"{where}: {v}" for v in violations(step.invariants))
-    return out
 
 
 # -- the tests ------------------------------------------------------------------------------------

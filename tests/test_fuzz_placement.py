@@ -58,7 +58,7 @@ from hypothesis import HealthCheck, Phase, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 import vfem  # noqa: E402
-from invariant_record import violations  # noqa: E402
+from invariant_record import step_violations  # noqa: E402
 from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps  # noqa: E402
 from vfem.errors import VfemError  # noqa: E402
 from vfem.io.input import dumps  # noqa: E402
@@ -253,14 +253,7 @@ def outcome(p: Placement) -> tuple[str, list[str]]:
         import traceback
 
         return "raised", [f"raw {type(exc).__name__}: {exc}\n{traceback.format_exc()}"]
-    for step in result.steps:
-        if not step.converged:
-            continue
-        at = f"step {step.step} (load factor {step.load_factor:.6g})"
-        if not step.invariants:
-            problems.append(f"{at}: no invariants recorded")
-            continue
-        problems.extend(f"{at}: {v}" for v in violations(step.invariants))
+    problems.extend(step_violations(result))
     if not result.converged:
         if not result.message.strip():
             problems.append("not converged, and no message")

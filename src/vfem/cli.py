@@ -203,18 +203,14 @@ def cmd_run(args) -> int:
 
 
 def _with_invariants(lines: list[str], summary: dict) -> list[str]:
-    """A built-in example's closing lines with, before the results line (at the end if none),
-    each body's contact force and support reactions and how they balance
-    (:func:`vfem.io.runner.reaction_lines`), then the invariants line of its steps
-    (:func:`vfem.io.runner.invariants_line`)."""
+    """A built-in example's closing lines, then each body's contact force and support
+    reactions and how they balance (:func:`vfem.io.runner.reaction_lines`) and the invariants
+    line of its steps (:func:`vfem.io.runner.invariants_line`); the results line, made from the
+    folder's record, comes after them (:func:`_results_line`)."""
     from .io.runner import invariants_line, reaction_lines
 
     steps = summary.get("steps") or []
-    extra = ["  " + x for x in (*reaction_lines(steps), invariants_line(steps)) if x]
-    if not extra:
-        return lines
-    at = next((k for k, x in enumerate(lines) if x.lstrip().startswith("results")), len(lines))
-    return [*lines[:at], *extra, *lines[at:]]
+    return [*lines, *("  " + x for x in (*reaction_lines(steps), invariants_line(steps)) if x)]
 
 
 def _writable_folder(out: Path, what: str) -> None:
@@ -304,7 +300,7 @@ _RESULT_FILES = (("summary.json", ""), ("results.pvd", " for ParaView"), ("conta
 
 
 def _results_line(lines: list[str], out: Path) -> list[str]:
-    """The report with its ``results:`` line made from the files this run wrote in ``out``
+    """The report and its ``results:`` line, made from the files this run wrote in ``out``
     (its record, :mod:`vfem.io.folders`): never a file it did not write (a run that stopped
     early has no figures; another run's sub-folder is not this one's)."""
     from .io.folders import read_record
@@ -315,9 +311,7 @@ def _results_line(lines: list[str], out: Path) -> list[str]:
     names += sorted(n for n in owned if "/" not in n and n.endswith(".png"))
     cases = sorted({n.split("/")[0] + "/" for n in owned if "/" in n
                     and not n.startswith("checkpoint/")})
-    line = f"  results: {out}/ (" + ", ".join(names + cases) + ")"
-    kept = [x for x in lines if not x.lstrip().startswith("results")]
-    return [*kept, line]
+    return [*lines, f"  results: {out}/ (" + ", ".join(names + cases) + ")"]
 
 
 def _checked_model(path: str, assignments: list[str] = ()):

@@ -226,6 +226,4 @@ def report(s: dict) -> list[str]:
         lines.append(f"  largest residual penetration {b['max_penetration']:.2e} (tolerance "
                      f"{b['penetration_tolerance']:.1e}); any node of either block, checked "
                      f"both ways: {b['largest_penetration_any_node']:.2e}")
-    lines.append("  results: summary.json, results.pvd (ParaView), contact.csv"
-                 + "".join(f", {f}" for f in s.get("figures", [])))
     return lines

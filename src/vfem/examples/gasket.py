@@ -519,6 +519,4 @@ def report(s: dict) -> list[str]:
                          f"{imbalance:.1%} of the force")
         else:
             lines.append(f"  contact forces on the two gaskets balance to {imbalance:.1e}")
-    lines.append("  results: summary.json, results.pvd (ParaView), "
-                 + ", ".join(s.get("figures", [])))
     return lines

@@ -313,6 +313,4 @@ def report(s: dict) -> list[str]:
         lines.append(f"  note: {len(fixed)} of {len(s['steps'])} steps stopped where the "
                      f"compatibility and equilibrium corrections cancel (largest residual "
                      f"penetration {worst['max_penetration']:.2e}); see docs/method.md §5")
-    lines.append("  results: summary.json, results.pvd (ParaView), contact.csv"
-                 + "".join(f", {f}" for f in s.get("figures", [])))
     return lines

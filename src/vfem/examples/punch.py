@@ -286,6 +286,4 @@ def report(s: dict) -> list[str]:
         lines.append(f"  p at the centre {c['p_centre_block']:.4g} (Sadowsky's half-plane "
                      f"{c['p_centre_sadowsky']:.4g}), p_max {c['p_max_block']:.4g} at "
                      f"|x| = {abs(c['p_max_block_at_x']):.4g}")
-    lines.append("  results: summary.json, results.pvd (ParaView), contact.csv"
-                 + "".join(f", {f}" for f in s.get("figures", [])))
     return lines

@@ -263,6 +263,4 @@ def report(s: dict) -> list[str]:
                      f"other's deformed facets: {e['largest_penetration_any_node']:.2e}, punch "
                      "vertices below the block's straight facets that cut across the curved "
                      "contact (faceting, not an iteration error: docs/examples.md, Sliding)")
-    lines.append("  results: summary.json, results.pvd (ParaView), contact.csv"
-                 + "".join(f", {f}" for f in s.get("figures", [])))
     return lines

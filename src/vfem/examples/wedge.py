@@ -498,6 +498,4 @@ def report(s: dict) -> list[str]:
     lines.append("  shares of the tip overlap: the plate's = its tip's downward displacement, "
                  "the wedge's = how far its tip was pushed back up; contact force: vertical, "
                  "on the half model")
-    if s.get("figures"):
-        lines.append(f"  results: summary.json, case*/results.pvd, {', '.join(s['figures'])}")
     return lines

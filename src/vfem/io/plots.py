@@ -162,22 +162,29 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     if len(styles) > 1:  # which line style is which body
         for body_name, ls in styles.items():
             ax.plot([], [], color="0.3", ls=ls, lw=0.9, label=body_name)
+    ratio = _frame(ax, window, lo, hi)
+    fig.set_size_inches(min(12.0, max(7.0, 3.6 * ratio + (2.9 if legend_loc is None else 1.2))),
+                        4.6)
+    ax.set_title(title if magnification is None else magnified(title, scale), fontsize=10)
+    ax.legend(fontsize=8, **({"loc": legend_loc} if legend_loc else OUTSIDE))
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def _frame(ax, window, lo: np.ndarray, hi: np.ndarray) -> float:
+    """Axes of a configuration figure: ``window`` (xmin, xmax, ymin, ymax; default the box
+    ``lo``..``hi`` padded by 3 %), equal scales, coordinate labels. Returns the window's
+    width over its height, for the figure's shape."""
     if window is None:
         pad = 0.03 * (hi - lo).max()
         window = (lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad)
     ax.set_xlim(window[0], window[1])
     ax.set_ylim(window[2], window[3])
     ax.set_aspect("equal")
-    ratio = (window[1] - window[0]) / max(window[3] - window[2], 1e-300)
-    fig.set_size_inches(min(12.0, max(7.0, 3.6 * ratio + (2.9 if legend_loc is None else 1.2))),
-                        4.6)
     ax.set_xlabel(f"x ({LENGTH})")
     ax.set_ylabel(f"y ({LENGTH})")
-    ax.set_title(title if magnification is None else magnified(title, scale), fontsize=10)
-    ax.legend(fontsize=8, **({"loc": legend_loc} if legend_loc else OUTSIDE))
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    return (window[1] - window[0]) / max(window[3] - window[2], 1e-300)
 
 
 def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.ndarray,
@@ -206,17 +213,9 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
         ax.add_collection(LineCollection(x[_outline(np.asarray(t))],
                                          colors=colors[j % len(colors)], linewidths=1.0,
                                          label=name))
-    if window is None:
-        pad = 0.03 * (hi - lo).max()
-        window = (lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad)
-    ax.set_xlim(window[0], window[1])
-    ax.set_ylim(window[2], window[3])
-    ax.set_aspect("equal")
     # a figure shaped like the window (equal axes leave the rest blank)
-    ratio = (window[1] - window[0]) / max(window[3] - window[2], 1e-300)
+    ratio = _frame(ax, window, lo, hi)
     fig.set_size_inches(min(12.0, max(5.5, 3.4 * ratio + 2.4)), 4.6)
-    ax.set_xlabel(f"x ({LENGTH})")
-    ax.set_ylabel(f"y ({LENGTH})")
     ax.set_title(magnified(title, magnification), fontsize=10)
     if mappable is not None:
         fig.colorbar(mappable, ax=ax, label=f"von Mises stress ({LENGTH})", shrink=0.8,

@@ -211,8 +211,5 @@ def report(s: dict, out: Path) -> list[str]:
     for line in (balance_line(s["steps"]), invariants_line(s["steps"])):
         if line:
             lines.append("  " + line)
-    lines.append(f"  results: {out}/ (summary.json, results.pvd for ParaView, contact.csv, "
-                 "reactions.csv"
-                 + (", " + ", ".join(s["figures"]) if s.get("figures") else "") + ")")
     return lines
 
