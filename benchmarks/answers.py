@@ -9,7 +9,8 @@ The cases: springs, hertz, hertz with quadratic elements, patch, wedge, block, g
 large kinematics), sliding, and each classical baseline on Hertz; each is ``vfem run`` of the
 built-in example into a fresh folder, and its ``summary.json`` is kept without what differs
 from run to run (wall-clock times, the run's command and date, file names). ``compare`` walks
-both trees: numbers must agree to 1e-10 relative (or 1e-12 absolute near zero), integers
+both trees: numbers must agree to 1e-10 relative (to the value, or to the largest magnitude the
+same quantity takes in the run where the value is a round-off zero), integers
 (iteration counts, steps) and strings exactly; it prints every difference and exits 1 if any.
 Take the "before" snapshot at the commit before the change (a ``git worktree`` of it), the
 "after" one on the change, and compare.
@@ -22,6 +23,7 @@ import contextlib
 import io
 import json
 import math
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -72,22 +74,55 @@ def save(folder: Path, names: list[str]) -> None:
         print(f"{name}: exit {status}, {folder / (name + '.json')}")
 
 
-def differences(a, b, where: str = "") -> list[str]:
-    """Every place where ``a`` and ``b`` differ beyond round-off."""
+def pattern(where: str) -> str:
+    """The group of quantities a place belongs to: its path with list indices blanked and its
+    last key left out (every step's and node's value of it, and its siblings: a tangential
+    reaction with the normal ones beside it)."""
+    return re.sub(r"\[\d+\]", "[*]", where).rsplit(".", 1)[0]
+
+
+def scales(value, where: str = "", out: dict | None = None) -> dict[str, float]:
+    """Per :func:`pattern`, the largest magnitude the quantity takes (its scale)."""
+    out = {} if out is None else out
+    if isinstance(value, dict):
+        for k, v in value.items():
+            scales(v, f"{where}.{k}", out)
+    elif isinstance(value, list):
+        for k, v in enumerate(value):
+            scales(v, f"{where}[{k}]", out)
+    elif isinstance(value, float) and math.isfinite(value):
+        key = pattern(where)
+        out[key] = max(out.get(key, 0.0), abs(value))
+    return out
+
+
+def differences(a, b, where: str = "", scale: dict[str, float] | None = None) -> list[str]:
+    """Every place where ``a`` and ``b`` differ beyond round-off: 1e-10 relative to the value,
+    or to the largest magnitude of the same quantity over the run (its other steps, nodes and
+    components: a reaction that is zero up to round-off, 1e-11 of the forces of the other
+    steps, is compared at that scale), whichever is larger, and at least 1e-13 absolute."""
+    if scale is None:
+        scale = scales(a)
+        for k, v in scales(b).items():
+            scale[k] = max(scale.get(k, 0.0), v)
     if isinstance(a, dict) and isinstance(b, dict):
         out = [f"{where}.{k}: only before" for k in a.keys() - b.keys()]
         out += [f"{where}.{k}: only after" for k in b.keys() - a.keys()]
         for k in a.keys() & b.keys():
-            out += differences(a[k], b[k], f"{where}.{k}")
+            out += differences(a[k], b[k], f"{where}.{k}", scale)
         return out
     if isinstance(a, list) and isinstance(b, list):
         if len(a) != len(b):
             return [f"{where}: {len(a)} entries before, {len(b)} after"]
-        return [d for k, (x, y) in enumerate(zip(a, b)) for d in differences(x, y, f"{where}[{k}]")]
+        return [d for k, (x, y) in enumerate(zip(a, b))
+                for d in differences(x, y, f"{where}[{k}]", scale)]
     if isinstance(a, bool) or isinstance(b, bool) or isinstance(a, int) and isinstance(b, int):
         return [] if a == b else [f"{where}: {a!r} before, {b!r} after"]
     if isinstance(a, (int, float)) and isinstance(b, (int, float)):
-        if math.isclose(a, b, rel_tol=1e-10, abs_tol=1e-12) or (math.isnan(a) and math.isnan(b)):
+        # (1e-13 absolute: measures that are round-off by definition, as the relative force
+        # imbalances of 1e-15, move with the order of any floating-point sum)
+        floor = max(1e-10 * scale.get(pattern(where), 0.0), 1e-13)
+        if math.isclose(a, b, rel_tol=1e-10, abs_tol=floor) or (math.isnan(a) and math.isnan(b)):
             return []
         return [f"{where}: {a!r} before, {b!r} after"]
     return [] if a == b else [f"{where}: {a!r} before, {b!r} after"]

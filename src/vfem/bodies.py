@@ -43,7 +43,7 @@ from skfem.helpers import sym_grad, trace
 from skfem.mesh.mesh_2d_2 import Mesh2D2
 from skfem.models.elasticity import linear_elasticity
 
-from .errors import InputError
+from .errors import AnalysisError, InputError
 from .linalg import factorize
 from .materials import LinearElastic
 from .mesh.checks import check_mesh
@@ -201,7 +201,8 @@ class Linearization:
         correction: (ndofs) Newton's correction with the contact forces held, the prescribed
             displacements' increments included.
         flexibility: (tracked, candidate) the tangent flexibility rows of the tracked dofs for
-            the candidate dofs (supports kept).
+            the candidate dofs (supports kept): the inverse of the tangent's Schur complement on
+            the tracked dofs, from its factorization (:func:`_tangent_factorization`).
         platen_motion: (ndofs) the motion per unit motion of the platen (1 on its dofs).
         platen_stiffness: the platen's reaction per unit platen motion.
         platen_reaction: the platen's reaction after ``correction``, linearised.
@@ -220,6 +221,35 @@ class Linearization:
     platen_reaction: float
     prescribed_met: bool
     solve: Callable[[np.ndarray], np.ndarray]
+
+
+def _tangent_factorization(K_ff, trailing: np.ndarray, groups: np.ndarray, rhs: np.ndarray,
+                           backend: str | None, name: str):
+    """A large body's tangent on its free dofs, factorized once per linearisation.
+
+    A tangent is positive definite unless the body is near buckling (geometric stiffness under
+    compression). It is first factorized as such with the ``trailing`` (tracked) dofs eliminated
+    last, which also yields the inverse tangent on them (``trailing_inverse``: the tangent
+    flexibility, from the Schur complement, instead of one back-substitution per contact dof).
+    Where that fails (not positive definite) or its solve of ``rhs`` is not accurate (SuperLU
+    factorizes in that order without pivoting), the tangent is factorized as indefinite and
+    ``trailing_inverse`` is None. Returns the factorization and its solution of ``rhs``.
+    """
+    if len(trailing):
+        try:
+            factor = factorize(K_ff, backend, trailing=trailing, groups=groups,
+                               what=f"body {name!r} (tangent)")
+            x = factor.solve(rhs)
+            scale = max(float(np.abs(rhs).max(initial=0.0)), 1e-300)
+            if (factor.trailing_inverse is not None
+                    and float(np.abs(K_ff @ x - rhs).max(initial=0.0)) <= 1e-10 * scale):
+                return factor, x
+        except AnalysisError as exc:
+            log.debug("body %r: tangent not positive definite (%s); factorized as indefinite",
+                      name, exc)
+    factor = factorize(K_ff, backend, spd=False, what=f"body {name!r} (tangent)")
+    factor.trailing_inverse = None
+    return factor, factor.solve(rhs)
 
 
 @dataclass(frozen=True)
@@ -443,9 +473,13 @@ class Body:
         self._equilibrated = None
         R, ref, K, D, pending = self.nonlinear.linearize(load_factor, contact_force)
         free = np.setdiff1d(np.arange(self.ndofs), D)
-        # a tangent may be indefinite (geometric stiffness under compression)
-        factor = factorize(K[free][:, free].tocsc(), backend, spd=False,
-                           what=f"body {self.name!r} (tangent)")
+        K_ff = K[free][:, free].tocsc()
+        # the tracked dofs among the free ones: their block of the inverse tangent is the
+        # inverse of its Schur complement, from the factorization (as for the linear body)
+        pos = np.searchsorted(free, tracked_dofs)
+        held = free[np.minimum(pos, len(free) - 1)] == tracked_dofs
+        factor, step = _tangent_factorization(K_ff, pos[held], free // 2,
+                                              -R[free] - K[free] @ pending, backend, self.name)
 
         def solve(f: np.ndarray) -> np.ndarray:
             out = np.zeros((self.ndofs,) + f.shape[1:])
@@ -453,15 +487,22 @@ class Body:
             return out
 
         correction = pending.copy()
-        correction[free] = factor.solve(-R[free] - K[free] @ pending)
-        # flexibility rows of the tracked dofs for the candidate dofs (supports kept)
-        pos = np.searchsorted(free, candidate_dofs)
-        cols = np.flatnonzero(free[np.minimum(pos, len(free) - 1)] == candidate_dofs)
-        unit = np.zeros((self.ndofs, len(cols)))
-        unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
-        flexibility = np.zeros((len(tracked_dofs), len(candidate_dofs)))
-        if len(cols):
-            flexibility[:, cols] = solve(unit)[tracked_dofs]
+        correction[free] = step
+        # flexibility rows of the tracked dofs for the candidate dofs (supports kept); the
+        # candidate dofs are the first of the tracked ones (ContactSurface.tracked_dofs)
+        nc2 = len(candidate_dofs)
+        flexibility = np.zeros((len(tracked_dofs), nc2))
+        if factor.trailing_inverse is not None:
+            rows = np.flatnonzero(held)
+            cols = rows[rows < nc2]
+            flexibility[np.ix_(rows, cols)] = factor.trailing_inverse[:, : len(cols)]
+        else:  # an indefinite tangent: one back-substitution per candidate dof
+            pos = np.searchsorted(free, candidate_dofs)
+            cols = np.flatnonzero(free[np.minimum(pos, len(free) - 1)] == candidate_dofs)
+            unit = np.zeros((self.ndofs, len(cols)))
+            unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
+            if len(cols):
+                flexibility[:, cols] = solve(unit)[tracked_dofs]
         platen_motion = np.zeros(self.ndofs)
         stiffness = reaction = 0.0
         P = self.platen_dofs

@@ -1,0 +1,77 @@
+"""Total-Lagrangian Hertz timed on two source trees in one run (issue 18: "time before and
+after, measured in one run of both").
+
+    git worktree add /tmp/before <commit>
+    python benchmarks/tl_hertz_speed.py /tmp/before/src src [--repeat 3] [--solver superlu]
+
+Each tree's ``vfem`` runs the Hertz example with ``kinematics = "total"`` on both bodies (the
+large-Hertz benchmark's case at the thesis's force) in a subprocess of its own, the trees taking
+turns ``--repeat`` times; it prints each run's analysis time (set-up and steps, not Python's
+start-up), p_max and the contact iterations, then the median times and their ratio. The p_max of
+the two trees must agree (the restructuring changes no answer).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+CASE = """
+import dataclasses, json, sys, time
+import vfem.linalg
+from vfem.examples import hertz
+from vfem.solver import Analysis
+if sys.argv[1] != "auto":
+    vfem.linalg.use(sys.argv[1])
+config = hertz.config(hertz.HertzParameters(refinement=int(sys.argv[2])))
+config = dataclasses.replace(config, bodies=tuple(
+    dataclasses.replace(b, kinematics="total") for b in config.bodies))
+t0 = time.perf_counter()
+result = Analysis(config.build()).run()
+seconds = time.perf_counter() - t0
+p_max = max(float(b.contact_pressure.max()) for b in result.steps[-1].bodies.values())
+print(json.dumps({"seconds": seconds, "p_max": p_max, "converged": result.converged,
+                  "iterations": sum(s.iterations for s in result.steps)}))
+"""
+
+
+def once(src: str, solver: str, refinement: int) -> dict:
+    env = dict(os.environ, PYTHONPATH=os.path.abspath(src))
+    out = subprocess.run([sys.executable, "-c", CASE, solver, str(refinement)], env=env,
+                         capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("before", help="the src folder of the tree before the change")
+    parser.add_argument("after", help="the src folder of the tree after it")
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--solver", default="auto", help="linear solver (default: auto)")
+    parser.add_argument("--refinement", type=int, default=1,
+                        help="the Hertz example's refinement parameter (default 1)")
+    args = parser.parse_args(argv)
+    times: dict[str, list[float]] = {"before": [], "after": []}
+    answers = {}
+    for k in range(args.repeat):
+        for label, src in (("before", args.before), ("after", args.after)):
+            r = once(src, args.solver, args.refinement)
+            times[label].append(r["seconds"])
+            answers[label] = r
+            print(f"run {k + 1} {label:6s}: {r['seconds']:.3f} s  p_max {r['p_max']:.10g}  "
+                  f"{r['iterations']} contact iterations  converged {r['converged']}")
+    tb, ta = statistics.median(times["before"]), statistics.median(times["after"])
+    print(f"median: before {tb:.3f} s, after {ta:.3f} s, after/before {ta / tb:.3f} "
+          f"({args.solver}, refinement {args.refinement})")
+    pb, pa = answers["before"]["p_max"], answers["after"]["p_max"]
+    print(f"p_max before {pb:.12g}, after {pa:.12g}, relative difference "
+          f"{abs(pa - pb) / abs(pb):.2e}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
