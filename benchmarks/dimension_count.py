@@ -24,7 +24,8 @@ from pathlib import Path
 
 #: name -> the regular expression of one form of the 2D assumption
 PATTERNS: dict[str, str] = {
-    "dofs 2n, 2n+1": r"\b2 \* \w+(\[[^\]]*\])?(, | \+ 1)|\b2 \* \w+ \+ 1\b|2 \* s\.nc|2 \* self\.nc",
+    "dofs 2n, 2n+1": (r"\b2 \* \w+(\[[^\]]*\])?(, | \+ 1)|\b2 \* \w+ \+ 1\b"
+                      r"|2 \* s\.nc|2 \* self\.nc"),
     "two columns": r"zeros\(\(\w[\w.\[\]\s:+*-]*, 2\)|reshape\(\(?[-\w.]+, 2\b|\(\w+\.nc, 2\)",
     "strided dofs": r"::2\b|\d::2|\+ d::2|d:[\w\[\] +]*:2\b",
     "90-degree normal": r"\[:, 1\], -|-\w+\[:, 1\], \w+\[:, 0\]|\[:, \[1, 0\]\]",

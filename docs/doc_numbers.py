@@ -284,7 +284,9 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
 }
 
 _TIME = re.compile(r"\b\d+(\.\d+)? s\b")
-_ROUND_OFF = re.compile(r"[-+]?\d(\.\d+)?e-(1[3-9]|[2-9]\d|\d{3})\b")
+#: (an exact zero, 0.0e+00, is round-off's too: where one linear solver leaves 7e-17, another
+#: may leave nothing)
+_ROUND_OFF = re.compile(r"[-+]?\d(\.\d+)?e-(1[3-9]|[2-9]\d|\d{3})\b|[-+]?0(\.0+)?e[-+]00\b")
 
 
 #: Where a round-off figure was largest (which body and step is round-off's choice too).

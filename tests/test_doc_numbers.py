@@ -27,6 +27,8 @@ def test_the_comparison_masks_only_times_and_round_off():
     a = "converged in 5 steps, 23 contact iterations, 1950 dofs, 0.5 s  penetration 4.2e-14"
     assert numbers.normalised(a) == numbers.normalised(a.replace("0.5 s", "12.25 s")
                                                        .replace("4.2e-14", "1.0e-19"))
+    assert numbers.normalised(a) == numbers.normalised(a.replace("4.2e-14", "0.0e+00"))
+    assert numbers.normalised(a) != numbers.normalised(a.replace("4.2e-14", "1.0e+00"))
     for changed in (a.replace("23 contact", "24 contact"), a.replace("1950", "1951"),
                     a.replace("4.2e-14", "4.2e-11")):
         assert numbers.normalised(a) != numbers.normalised(changed)

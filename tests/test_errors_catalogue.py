@@ -35,13 +35,15 @@ SRC = ROOT / "src" / "vfem"
 CATALOGUE = ROOT / "docs" / "errors.md"
 
 #: call -> index of the argument holding the message
-MESSAGE_ARGUMENT = {"InputError": 0, "AnalysisError": 0, "RindViolation": 0, "VfemError": 0,
-                    "_Inverted": 0, "_Problem": 1, "need": 1}
+MESSAGE_ARGUMENT = {"failure": 0, "InputError": 0, "AnalysisError": 0, "RindViolation": 0,
+                    "VfemError": 0, "_Inverted": 0, "_Problem": 1, "need": 1, "ContactCycling": 0,
+                    "ContactNotConverged": 0, "ElementInverted": 0, "NewtonNotConverged": 0,
+                    "PlatenUnheld": 0, "SingularSystem": 0, "ActiveSetNotSettled": 0}
 #: exceptions whose message counts only where they are raised (they are common names)
 RAISED = {"ValueError", "RuntimeError"}
 #: functions whose every string is user-facing text (module relative to src/vfem, name):
 #: the stop message and its remedies, and CycleWatch.__call__'s message
-MESSAGE_FUNCTIONS = {("solver.py", "diagnosis"), ("contact/algorithm.py", "__call__")}
+MESSAGE_FUNCTIONS = {("solver.py", "diagnosis"), ("contact/state.py", "__call__")}
 
 FRAGMENT = 12  # characters a fragment must have
 SHORT_FRAGMENT = 8  # ... or, failing that, the longest fragment of the message
@@ -63,11 +65,16 @@ _WRAPPERS_AS_WRITTEN = {
     ("examples/wedge.py", 'f"wedge: {exc}"'):
         "prefixes 'wedge: ' to a mesh shape's ValueError (catalogued in mesh/shapes.py)",
     ("solver.py", "res.message"):
-        "AnalysisError(res.message): a failed contact solve's SolveResult message",
-    ("contact/algorithm.py", "cycling"):
+        "res.failure(res.message): a failed contact solve's SolveResult message, raised as "
+        "its failure kind",
+    ("contact/iteration.py", "cycling"):
         "SolveResult(False, ..., cycling): the CycleWatch message (catalogued from CycleWatch)",
-    ("contact/paired.py", "cycling"): "as in contact/algorithm.py",
-    ("contact/large.py", "cycling"): "as in contact/algorithm.py",
+    ("contact/iteration.py", "c.unconverged()"):
+        "SolveResult(False, ..., c.unconverged()): each formulation's 'no convergence in' "
+        "message, made by its check (catalogued as 'no convergence in')",
+    ("contact/baselines.py", "str(exc)"):
+        "SingularSystem(str(exc)): the linear solver's factorization failure "
+        "(catalogued at vfem.linalg.factorize)",
 }
 
 

@@ -237,8 +237,8 @@ def unbalanced(monkeypatch, attempts):
     real = Analysis._fields
     calls = []
 
-    def fields(self, state, pairings):
-        out = real(self, state, pairings)
+    def fields(self, state, result):
+        out = real(self, state, result)
         calls.append(state.load_factor)
         if len(calls) <= attempts:
             out["punch"].contact_force *= 1.1
@@ -281,8 +281,8 @@ def test_an_invariant_not_enforced_is_recorded_and_logged(monkeypatch, caplog):
 
     real = Analysis._fields
 
-    def fields(self, state, pairings):
-        out = real(self, state, pairings)
+    def fields(self, state, result):
+        out = real(self, state, result)
         out["punch"].displacement[:, 1] -= 1e-3
         return out
 

@@ -20,7 +20,7 @@ import meshio
 import numpy as np
 import pytest
 
-from vfem.contact.algorithm import CycleWatch, SolveResult
+from vfem.contact.state import CycleWatch, SolveResult
 from vfem.examples import gasket, hertz, wedge
 from vfem.io import checkpoint
 from vfem.io.results import run_writing
@@ -59,10 +59,10 @@ def test_a_failed_step_restarts_from_the_saved_state_exactly(make):
     real = analysis.contact.solve
     saved, seen, calls = {}, {}, []
 
-    def solve(state):
+    def solve(state, on_iteration=None):
         calls.append(state.load_factor)
         if len(calls) == 2:  # step 2, first attempt: really iterate, then fail
-            res = real(state)
+            res = real(state, on_iteration)
             return SolveResult(False, res.iterations, res.history, res.pairings,
                                "injected failure")
         if len(calls) == 3:  # the retry: what does it start from?
@@ -71,7 +71,7 @@ def test_a_failed_step_restarts_from_the_saved_state_exactly(make):
             for b in analysis.model.bodies:
                 if b.large:
                     seen[f"{b.name}.trial"] = b.nonlinear.trial_displacement().copy()
-        return real(state)
+        return real(state, on_iteration)
 
     def on_step(step):
         if step.step == 1:

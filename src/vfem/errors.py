@@ -33,3 +33,37 @@ class InvariantViolation(AnalysisError):
 
     The solver treats it as a failed step: discarded, cut and retried.
     """
+
+
+# -- failure kinds: what the stop diagnosis and the step cutter read (never the message text) ----
+
+
+class ContactCycling(AnalysisError):
+    """The contact iteration keeps switching nodes in and out of contact without the error
+    falling (:class:`~vfem.contact.state.CycleWatch`); the step is cut."""
+
+
+class ContactNotConverged(AnalysisError):
+    """The contact iteration reached ``contact.max_iterations`` without meeting its tolerances."""
+
+
+class ElementInverted(AnalysisError):
+    """An iterate would turn an element inside out (det F <= 0); the step is cut."""
+
+
+class NewtonNotConverged(AnalysisError):
+    """A large-kinematics body's own Newton iteration did not converge."""
+
+
+class PlatenUnheld(AnalysisError):
+    """A force-controlled platen must move its body away from every body it may touch to apply
+    its force: nothing holds it, and no step size can help."""
+
+
+class SingularSystem(AnalysisError):
+    """A classical baseline's global matrix is singular (a body held by nothing but contact,
+    with none of its nodes in contact)."""
+
+
+class ActiveSetNotSettled(AnalysisError):
+    """A classical baseline's active set does not settle, or comes back to one it had left."""

@@ -72,7 +72,7 @@ from skfem import (
 )
 from skfem.helpers import ddot, grad, mul
 
-from .errors import AnalysisError, InputError
+from .errors import AnalysisError, ElementInverted, InputError, NewtonNotConverged
 from .kinematics import (
     change_reference,
     deformation_gradient,
@@ -98,8 +98,8 @@ _QUADRATIC_MESH: dict[type, type] = {MeshTri1: MeshTri2, MeshQuad1: MeshQuad2}
 _MAX_HALVINGS = 8
 
 
-class _Inverted(AnalysisError):
-    """An iterate would turn an element inside out (det F <= 0 at a quadrature point)."""
+#: an iterate would turn an element inside out (det F <= 0 at a quadrature point)
+_Inverted = ElementInverted
 
 
 # -- forms: residual and tangent, assembled by scikit-fem ----------------------------------------
@@ -539,9 +539,10 @@ class NonlinearBody:
         if not record.converged:
             self.steps.append(record)
             self.discard()
-            raise AnalysisError(f"{self.name}: Newton did not converge in {max_iter} iterations "
-                                f"at load factor {load_factor:g} (|R| = {record.residuals[-1]:.3e}"
-                                f", reference {record.reference_force:.3e})")
+            raise NewtonNotConverged(
+                f"{self.name}: Newton did not converge in {max_iter} iterations at load factor "
+                f"{load_factor:g} (|R| = {record.residuals[-1]:.3e}, reference "
+                f"{record.reference_force:.3e})")
         if record.iterations > 1:
             log.info("%s: load factor %.6g, residuals %s (quadratic ratios r_k+1/r_k^2 %s)",
                      self.name, load_factor,

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .contact.algorithm import ContactState, IterationRecord
+from .contact.state import ContactState, IterationRecord
 
 if TYPE_CHECKING:
     from .bodies import Body

@@ -35,23 +35,29 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .bodies import Body, multiplier
-from .contact.algorithm import (
-    ContactState,
-    IterationRecord,
-    Pairing,
-    SolveResult,
-    VirtualElementContact,
-)
 from .contact.check import InvariantCheck, Invariants
+from .contact.formulation import check_capabilities, formulation_class
 from .contact.search import project_points
 from .contact.settings import ContactSettings
+from .contact.state import ContactState, IterationRecord, SolveResult
 from .contact.surface import (
     ContactSurface,
     check_initial_overlap,
     exterior_facets,
     select_candidate_facets,
 )
-from .errors import AnalysisError, InputError, InvariantViolation, RindViolation
+from .errors import (
+    ActiveSetNotSettled,
+    AnalysisError,
+    ContactCycling,
+    ElementInverted,
+    InputError,
+    InvariantViolation,
+    NewtonNotConverged,
+    PlatenUnheld,
+    RindViolation,
+    SingularSystem,
+)
 from .linalg import resolve as resolve_backend
 from .memory import check_memory, memory_guard
 from .result_types import (  # the result types, here too for those who import them from here
@@ -59,7 +65,6 @@ from .result_types import (  # the result types, here too for those who import t
     BodyStepResult,
     Checkpoint,
     StepResult,
-    add_reactions,
 )
 
 log = logging.getLogger(__name__)
@@ -102,26 +107,7 @@ class Model:
                     raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
         for b in self.bodies:
             b.validate()
-            if b.order != 1 and self.contact.variant == "thesis":
-                raise InputError(f"model {self.name!r}, body {b.name!r}: the thesis variant "
-                                 "supports linear elements only (order 1); use the paired "
-                                 "variant for quadratic elements")
-        if any(b.large for b in self.bodies):
-            if self.contact.variant != "paired":
-                raise InputError(f"model {self.name!r}: large kinematics needs the paired "
-                                 "contact variant")
-            quadratic = [b.name for b in self.bodies if b.order != 1]
-            if quadratic:
-                raise InputError(f"model {self.name!r}, body {quadratic[0]!r}: contact with a "
-                                 "large-kinematics body needs linear elements (order 1) on every "
-                                 "body")
-        if self.contact.method != "vfem":
-            for b in self.bodies:
-                if b.large or b.order != 1:
-                    raise InputError(f"model {self.name!r}, body {b.name!r}: the classical "
-                                     f"contact methods (contact.method = "
-                                     f"{self.contact.method!r}) need linear elements (order 1) "
-                                     "and small kinematics; use contact.method = 'vfem'")
+        check_capabilities(self)  # what the formulation supports, as it declares it
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
         self.contact.validate()
@@ -236,21 +222,31 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
     elif isinstance(exc, RindViolation):
         remedy = ("take smaller steps ([steps] count), or give the bodies deeper surface "
                   "elements so a step's overlap stays inside them")
-    elif "moves it away from every body it may touch" in text:
+    elif isinstance(exc, PlatenUnheld):
         remedy = ("give the platen's force the sign that pushes the body onto the other (or "
                   "hold the body otherwise); no step size or iteration count can help")
-    elif "cycles" in text:
+    elif isinstance(exc, ContactCycling):
         remedy = ("the nodes named switch between contact states: refine the mesh there, take "
                   "smaller steps, or check for a sharp corner meeting the other surface")
-    elif "inside out" in text:
+    elif isinstance(exc, ElementInverted):
         remedy = "take smaller steps, or refine the mesh where the elements distort"
-    elif "Newton did not converge" in text:
+    elif isinstance(exc, SingularSystem):
+        remedy = ("bring the bodies within contact.search_distance of each other, or support "
+                  "the body")
+    elif isinstance(exc, ActiveSetNotSettled):
+        remedy = (f"allow more linear solves (contact.max_iterations = "
+                  f"{settings.max_iterations}) or take smaller steps; check that every body is "
+                  "held the way you expect")
+    elif isinstance(exc, NewtonNotConverged):
         remedy = (f"take smaller steps or allow more cuts (contact.max_step_cuts = "
                   f"{settings.max_step_cuts}); check the body's supports and material")
     else:
         remedy = (f"allow more iterations (contact.max_iterations = {settings.max_iterations}), "
                   f"more cuts (contact.max_step_cuts = {settings.max_step_cuts}) or smaller "
                   "steps; check that every body is held the way you expect")
+    if cuts == 0:  # a formulation whose steps are not cut (a baseline)
+        return (f"step {step} (load factor {start:.6g} -> {target:.6g}) failed: {text}. What "
+                f"to change: {remedy}")
     times = "once" if cuts == 1 else f"{cuts} times"
     return (f"step {step} (load factor {start:.6g} -> {target:.6g}) failed with the increment "
             f"cut {times}: {text}. What to change: {remedy}")
@@ -281,8 +277,9 @@ class Analysis:
 
             self.contact = GlobalContact(self.model, self.backend)
             self.surfaces = self.contact.surfaces
-            self.timings.update(self.contact.timings)
-            # recorded per step, not enforced (GlobalContact.run)
+            self.timings.update(self.contact.timings, flexibility_s=0.0,
+                                assemble_factorize_s=self.contact.timings["assemble_s"])
+            # recorded per step, not enforced (its capabilities)
             self.invariant_check = self._invariant_check()
             return
         t0 = time.perf_counter()
@@ -310,17 +307,10 @@ class Analysis:
             self.timings[key] = sum(b.timings[key] for b in bodies)
 
     def _contact(self, pairs: set[frozenset[int]]):
-        """The contact iteration for the model's variant and kinematics."""
-        if any(b.large for b in self.model.bodies):
-            from .contact.large import LargeDeformationContact
-
-            return LargeDeformationContact(self.surfaces, pairs, self.model.contact,
-                                           self.backend)
-        if self.model.contact.variant == "paired":
-            from .contact.paired import PairedContact
-
-            return PairedContact(self.surfaces, pairs, self.model.contact)
-        return VirtualElementContact(self.surfaces, pairs, self.model.contact)
+        """The contact formulation of the model's settings and kinematics
+        (:func:`~vfem.contact.formulation.formulation_class`)."""
+        cls = formulation_class(self.model.contact, any(b.large for b in self.model.bodies))
+        return cls(self.surfaces, pairs, self.model.contact, backend=self.backend)
 
     def _invariant_check(self) -> InvariantCheck:
         """The invariants every converged step must satisfy (:mod:`vfem.contact.check`), to the
@@ -396,10 +386,10 @@ class Analysis:
         state.load_factor = load_factor
         platen = next((b.platen for b in self.model.bodies if b.platen is not None), None)
         state.platen_force = platen.force_at(load_factor) if platen is not None else 0.0
-        res = self.contact.solve(state)
+        res = self.contact.solve(state, self.on_iteration)
         history_out.extend(res.history)
         if not res.converged:
-            raise AnalysisError(res.message)
+            raise res.failure(res.message)  # its kind: what the diagnosis reads
         return state, res
 
     # -- the steps ------------------------------------------------------------------------------
@@ -424,11 +414,13 @@ class Analysis:
         """
         if not hasattr(self, "contact"):
             self.setup()
-        if self.model.contact.method != "vfem":
-            return self.contact.run(self, on_step, start)
-        self.contact.on_iteration = getattr(on_step, "iteration", None)
+        #: called with every contact iteration's record (progress displays)
+        self.on_iteration = getattr(on_step, "iteration", None)
         t_setup = time.perf_counter()
         settings = self.model.contact
+        caps = self.contact.capabilities
+        # a formulation whose failed step is final (a baseline's) is not cut
+        max_cuts = settings.max_step_cuts if caps.cuts_steps else 0
         easy_limit = easy_iterations(settings)
         if start is None:
             state = self.contact.new_state()
@@ -455,13 +447,15 @@ class Analysis:
                 new, res = self.solve_step(state, lf, history)
                 # full-mesh results and the invariants before the bodies commit the step, so
                 # that a state that breaks one is discarded like any failed step
-                fields = self._fields(new, res.pairings)
+                fields = self._fields(new, res)
                 invariants = self.check_invariants(fields, history)
-                if not invariants.ok:
+                # (a baseline's answer is its own: recorded against vfem's invariants, compared,
+                # never a failed step)
+                if not invariants.ok and caps.invariants == "enforced":
                     raise InvariantViolation(
                         "the converged contact state breaks an invariant checked independently "
                         f"of the contact formulation: {invariants.message()}")
-                if invariants.failed():
+                if invariants.failed() and caps.invariants == "recorded":
                     log.warning("step to load factor %.6g: recorded, not enforced: %s violated "
                                 "(summary.json, steps[].invariants)", lf,
                                 ", ".join(invariants.failed()))
@@ -469,7 +463,7 @@ class Analysis:
                 for b in self.model.bodies:
                     b.discard_step()
                 self.easy = 0
-                if self.level >= settings.max_step_cuts:
+                if self.level >= max_cuts:
                     converged = False
                     message = diagnosis(len(steps) + 1, state.load_factor, lf, self.level, exc,
                                         settings, self.unreachable)
@@ -502,6 +496,8 @@ class Analysis:
                 log.info("the increment grows back to %.6g", full / 2**self.level)
             if on_step is not None:
                 on_step(step)
+        # a formulation's own timings (a baseline's factorizations and solves)
+        self.timings.update(getattr(self.contact, "timings", {}))
         self.timings["steps_s"] = time.perf_counter() - t_setup
         self.timings["total_s"] = sum(self.timings[key] for key in
                                       ("search_s", "assemble_factorize_s", "flexibility_s",
@@ -516,29 +512,7 @@ class Analysis:
                           {b.name: b.saved_state() for b in self.model.bodies},
                           self.target, self.level, self.easy)
 
-    def _fields(self, state: ContactState, pairings: list[Pairing]) -> dict[str, BodyStepResult]:
-        """Full-mesh results of a converged state (one back-substitution per body)."""
-        out = {}
-        for s, F, p in zip(self.surfaces, state.forces, pairings):
-            b = s.body
-            f = np.zeros(b.ndofs)
-            f[s.candidate_dofs] = F.ravel()
-            u = b.displacement(state.load_factor, state.platen_displacement, f)
-            nv = b.npoints
-            cand = s.nodes[: s.nc]
-            force = np.zeros((nv, 2))
-            force[cand] = F
-            pressure = np.zeros(nv)
-            pressure[cand] = np.where(p.other >= 0, p.force, 0.0) / s.tributary
-            traction = None
-            if p.pressure is not None:  # the formulation's traction field (paired)
-                traction = np.zeros(nv)
-                traction[cand] = p.pressure
-            status = np.zeros(nv, dtype=int)
-            status[cand] = p.participating & (p.force > 0)
-            pen = np.zeros(nv)
-            pen[cand] = np.where(np.isfinite(p.penetration), p.penetration, 0.0)
-            out[b.name] = add_reactions(
-                b, BodyStepResult(u.reshape(-1, 2), force, pressure, status, pen, traction),
-                state.load_factor)
-        return out
+    def _fields(self, state: ContactState, result: SolveResult) -> dict[str, BodyStepResult]:
+        """Full-mesh results of a converged state (the formulation's
+        :meth:`~vfem.contact.formulation.ContactFormulation.fields`)."""
+        return self.contact.fields(state, result)

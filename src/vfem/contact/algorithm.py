@@ -25,206 +25,40 @@ The platen never moves ahead of the contact, so no node is driven through anothe
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import RindViolation
+from .capabilities import Capabilities
 from .corrections import compatibility_displacement, equilibrium_force
+from .group import SurfaceGroup, bordered_solve
+from .iteration import Check, iterate
 from .search import outward_normals, project_points
-from .settings import ContactSettings
+from .state import (  # noqa: F401 - the shared types, here too for those who import them here
+    ContactState,
+    CycleWatch,
+    IterationRecord,
+    Pairing,
+    SolveResult,
+    closing_motion,
+)
 from .surface import ContactSurface
+from .transfer import traction_from_forces
 
 log = logging.getLogger(__name__)
 
 
-@dataclass
-class Pairing:
-    """The pairs (own node, virtual node) of one body; arrays over its candidate nodes (nc).
+class VirtualElementContact(SurfaceGroup):
+    """Frictionless contact between any number of linear bodies by the virtual element method:
+    the thesis's plain reading (every node of both bodies checked for both conditions)."""
 
-    Forces are normal components in the pair's frame (see ``corrections``): positive is
-    compressive. ``normal`` is the outward normal of the opposing facet at the virtual node.
-    """
-
-    other: np.ndarray  # (nc,) opposing body, -1 where none
-    facet: np.ndarray  # (nc,) facet of the opposing body holding the virtual node
-    t: np.ndarray  # (nc,) local coordinate of the virtual node on that facet
-    normal: np.ndarray  # (nc, 2)
-    penetration: np.ndarray  # (nc,) > 0 inside the other body
-    embedded: np.ndarray  # (nc,) bool, located in the other body's rind
-    stiffness: np.ndarray  # (nc,) own Castigliano normal stiffness
-    virtual_stiffness: np.ndarray  # (nc,) opposing stiffness interpolated at the virtual node
-    force: np.ndarray  # (nc,) own compressive normal force
-    virtual_force: np.ndarray  # (nc,) opposing compressive force re-integrated on own elements
-    participating: np.ndarray  # (nc,) bool: embedded or carrying compressive force
-    #: (nc,) the formulation's normal traction at the node (nominal), where it has one; None:
-    #: the results read nodal force over tributary length
-    pressure: np.ndarray | None = None
-
-    @property
-    def equilibrium_error(self) -> np.ndarray:
-        return self.force - self.virtual_force
-
-
-@dataclass
-class ContactState:
-    """What the contact algorithm changes: the nodal contact forces on each body's candidates."""
-
-    load_factor: float
-    platen_displacement: float
-    forces: list[np.ndarray]  # per body (nc, 2), the force the other bodies apply on it
-    released: list[np.ndarray] = field(default_factory=list)  # nodes released last iteration
-    platen_force: float = 0.0  # the force the platen must apply (Platen.force_at)
-    multipliers: dict = field(default_factory=dict)  # per-pair traction values (paired)
-
-    def copy(self) -> ContactState:
-        return ContactState(self.load_factor, self.platen_displacement,
-                            [f.copy() for f in self.forces], [r.copy() for r in self.released],
-                            self.platen_force,
-                            {k: v.copy() for k, v in self.multipliers.items()})
-
-
-@dataclass
-class IterationRecord:
-    """The errors seen by one check and the corrections that followed (history of a solve)."""
-
-    iteration: int
-    max_penetration: float
-    max_equilibrium_error: float
-    contact_nodes: int
-    tension_nodes: int
-    force_correction: float = 0.0
-    displacement_correction: float = 0.0
-    platen_error: float = 0.0  # platen reaction minus its scheduled force
-
-
-@dataclass
-class SolveResult:
-    converged: bool
-    iterations: int
-    history: list[IterationRecord]
-    pairings: list[Pairing]
-    message: str = ""
-    fixed_point: bool = False  # stopped where corrections cancel, errors above tolerance
-
-
-class CycleWatch:
-    """Notices a contact iteration that cycles, so the step is cut instead of iterated to its
-    limit: the same contact set coming back after others (not merely staying the same, which is
-    how an iteration converges) without the error having fallen since it was last seen there.
-
-    Call once per iteration with the in-contact masks; returns a message naming the nodes that
-    keep switching once that has happened ``limit`` times, else None.
-    """
-
-    def __init__(self, limit: int = 3):
-        self.limit = limit
-        self.seen: dict[bytes, float] = {}  # contact set -> the smallest error seen with it
-        self.last: bytes | None = None
-        self.last_sets: list[np.ndarray] | None = None
-        self.flipping: list[set[int]] = []
-        self.count = 0
-
-    def __call__(self, sets: list[tuple[str, np.ndarray, np.ndarray]], error: float,
-                 iteration: int) -> str | None:
-        """``sets``: per side (body name, its node numbers, bool in-contact mask)."""
-        masks = [np.asarray(m, dtype=bool) for _, _, m in sets]
-        key = b"|".join(np.packbits(m).tobytes() + len(m).to_bytes(4, "little") for m in masks)
-        if self.last_sets is not None and key != self.last:
-            if not self.flipping:
-                self.flipping = [set() for _ in sets]
-            for k, (m0, m1) in enumerate(zip(self.last_sets, masks)):
-                self.flipping[k].update(np.flatnonzero(m0 != m1).tolist())
-            if key in self.seen and error >= self.seen[key]:
-                self.count += 1
-        self.seen[key] = min(error, self.seen.get(key, np.inf))
-        self.last, self.last_sets = key, masks
-        if self.count < self.limit:
-            return None
-        names = []
-        for (body, nodes, _), flips in zip(sets, self.flipping):
-            if flips:
-                listed = ", ".join(str(int(nodes[i])) for i in sorted(flips)[:8])
-                more = f" and {len(flips) - 8} more" if len(flips) > 8 else ""
-                names.append(f"node{'s' if len(flips) > 1 else ''} {listed}{more} of body "
-                             f"{body!r}")
-        return (f"the contact iteration cycles: {'; '.join(names) or 'some nodes'} keep "
-                f"switching in and out of contact while the error stays at {error:.3g} "
-                f"(iteration {iteration})")
-
-
-def closing_motion(penetration: np.ndarray, rate: np.ndarray, need: float) -> float:
-    """The platen motion that just closes the smallest gap when nothing touches yet.
-
-    ``rate`` is each node's change of penetration per unit platen motion; the platen moves the
-    way its missing force points (the sign of ``need``). Zero when no gap can be closed so.
-    """
-    with np.errstate(divide="ignore", invalid="ignore"):
-        d = np.where(np.isfinite(penetration) & (rate != 0), -penetration / rate, np.nan)
-    ok = np.isfinite(d) & (np.sign(d) == np.sign(need))
-    return float(d[ok][np.argmin(np.abs(d[ok]))]) if ok.any() else 0.0
-
-
-class VirtualElementContact:
-    """Frictionless contact between any number of linear bodies by the virtual element method."""
-
-    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]],
-                 settings: ContactSettings):
-        self.surfaces = surfaces
-        self.pairs = pairs
-        self.settings = settings
-        lengths = np.concatenate([s.lengths for s in surfaces if len(s.lengths)] or [[1.0]])
-        self.penetration_tolerance = (settings.penetration_tolerance
-                                      if settings.penetration_tolerance is not None
-                                      else 1e-5 * float(lengths.min()))
-        platens = [i for i, s in enumerate(surfaces) if s.body.platen is not None]
-        self.platen_body = platens[0] if platens else None
-        # each body's candidate-node motion per unit platen motion (zero but for the platen's)
-        self.platen_motion = [s.body.u_platen[s.candidate_dofs].reshape(-1, 2) for s in surfaces]
-
-    # -- state ----------------------------------------------------------------------------------
-
-    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
-                  ) -> ContactState:
-        return ContactState(load_factor, platen_displacement,
-                            [np.zeros((s.nc, 2)) for s in self.surfaces],
-                            [np.zeros(s.nc, dtype=bool) for s in self.surfaces])
-
-    def positions(self, state: ContactState) -> list[np.ndarray]:
-        """Current coordinates of every body's tracked nodes: X + u(load, platen, forces)."""
-        out = []
-        for s, F in zip(self.surfaces, state.forces):
-            b = s.body
-            dofs = s.tracked_dofs
-            u = (b.load_displacement(state.load_factor, dofs) + state.platen_displacement
-                 * b.u_platen[dofs] + s.G @ F.ravel())
-            out.append(s.X + u.reshape(-1, 2))
-        return out
-
-    def platen_reaction(self, state: ContactState) -> float:
-        """Reaction of the platen (force it applies to its body), linear in the state."""
-        if self.platen_body is None:
-            return 0.0
-        s = self.surfaces[self.platen_body]
-        b = s.body
-        return (b.platen_load_reaction_at(state.load_factor)
-                + state.platen_displacement * b.platen_stiffness
-                + float(s.platen_row @ state.forces[self.platen_body].ravel()))
-
-    def platen_met(self, state: ContactState) -> bool:
-        """Whether the platen's reaction is on its scheduled force (always, without a platen)."""
-        if self.platen_body is None:
-            return True
-        error = self.platen_reaction(state) - state.platen_force
-        return abs(error) <= self.settings.platen_tolerance * max(abs(state.platen_force), 1e-300)
+    capabilities = Capabilities(
+        name="thesis", orders=(1,), kinematics=("small",), dimensions=(2,),
+        friction=("frictionless",), invariants="recorded")
 
     def _platen_motion(self, nodes: np.ndarray, normal: np.ndarray) -> np.ndarray:
         """Normal displacement of candidate nodes of the platen body per unit platen motion."""
         return np.einsum("ij,ij->i", self.platen_motion[self.platen_body][nodes], normal)
-
-    def opponents(self, i: int) -> list[int]:
-        return [j for j in range(len(self.surfaces))
-                if j != i and frozenset((i, j)) in self.pairs and len(self.surfaces[j].facets)]
 
     # -- detect ---------------------------------------------------------------------------------
 
@@ -306,21 +140,8 @@ class VirtualElementContact:
                        virtual_force=virtual_force, participating=participating)
 
     def _traction(self, s: ContactSurface, F: np.ndarray) -> np.ndarray:
-        """Redistribute nodal contact forces into a continuous traction: N* q = Q (§4.4).
-
-        Facets none of whose nodes carry force are left out of N* (the thesis's N*), so the
-        traction may jump at the edge of contact; nodes on no loaded facet get q = 0.
-        """
-        q = np.zeros_like(F)
-        loaded = np.abs(F).sum(axis=1) > 0
-        if not loaded.any():
-            return q
-        facet_on = loaded[s.facets].any(axis=1).astype(float)
-        N = s.mass_matrix(facet_on)
-        nodes = np.unique(s.facets[facet_on > 0])
-        Nd = N[nodes][:, nodes].toarray()
-        q[nodes] = np.linalg.solve(Nd, F[nodes])
-        return q
+        """The continuous traction of nodal forces ``F`` (:func:`.traction_from_forces`)."""
+        return traction_from_forces(s, F)
 
     def _virtual_forces(self, i: int, x: list[np.ndarray], tractions: list[np.ndarray]
                         ) -> np.ndarray:
@@ -442,7 +263,7 @@ class VirtualElementContact:
                 if len(idx):
                     du = omega * compatibility_displacement(
                         p.stiffness[idx], p.virtual_stiffness[idx], p.penetration[idx])
-                    mu = np.linalg.solve(self._normal_flexibility(s, idx, n[idx]), du)
+                    mu = np.linalg.solve(s.normal_flexibility(idx, n[idx]), du)
                     dF_comp[idx] = mu[:, None] * n[idx]
             out.append(dF + dF_comp)
         return out, d_platen
@@ -461,7 +282,7 @@ class VirtualElementContact:
         """
         s = self.surfaces[self.platen_body]
         n = p.normal
-        dF = np.zeros((s.nc, 2))
+        dF = np.zeros((s.nc, s.dim))
         b = s.body
         r_platen = b.platen_stiffness
         need = (state.platen_force - self.platen_reaction(state)
@@ -482,37 +303,19 @@ class VirtualElementContact:
         du = omega * compatibility_displacement(p.stiffness[idx], p.virtual_stiffness[idx],
                                                 p.penetration[idx])
         a = self._platen_motion(idx, n[idx])
-        row = s.platen_row.reshape(-1, 2)[idx]
+        row = s.platen_row.reshape(-1, s.dim)[idx]
         bvec = np.einsum("ij,ij->i", row, n[idx])
-        m = len(idx)
-        A = np.zeros((m + 1, m + 1))
-        A[:m, :m] = self._normal_flexibility(s, idx, n[idx])
-        A[:m, m] = a
-        A[m, :m] = bvec
-        A[m, m] = r_platen
         # when the force is already met, keep it met while correcting compatibility
-        rhs = np.concatenate([du, [need if off else 0.0]])
-        sol = np.linalg.lstsq(A, rhs, rcond=None)[0]
-        dF[idx] = sol[:m, None] * n[idx]
-        return dF, float(sol[m])
-
-    @staticmethod
-    def _normal_flexibility(s: ContactSurface, nodes: np.ndarray, n: np.ndarray) -> np.ndarray:
-        """n_s^T C_st n_t over the given candidate nodes."""
-        C = s.C
-        ix, iy = 2 * nodes, 2 * nodes + 1
-        return (n[:, 0, None] * C[np.ix_(ix, ix)] * n[None, :, 0]
-                + n[:, 0, None] * C[np.ix_(ix, iy)] * n[None, :, 1]
-                + n[:, 1, None] * C[np.ix_(iy, ix)] * n[None, :, 0]
-                + n[:, 1, None] * C[np.ix_(iy, iy)] * n[None, :, 1])
+        mu, d = bordered_solve(s.normal_flexibility(idx, n[idx]), a, bvec, r_platen, du,
+                               need if off else 0.0)
+        dF[idx] = mu[:, None] * n[idx]
+        return dF, d
 
     # -- solve ----------------------------------------------------------------------------------
 
-    #: called with each iteration's record as it is made (progress displays)
-    on_iteration = None
-
-    def solve(self, state: ContactState) -> SolveResult:
-        """Iterate from ``state`` (modified in place) until the contact state has converged.
+    def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
+        """Iterate from ``state`` (modified in place) until the contact state has converged
+        (:func:`~vfem.contact.iteration.iterate`); ``on_iteration`` gets every record.
 
         Stopping rules (``ContactSettings.convergence``):
 
@@ -530,56 +333,59 @@ class VirtualElementContact:
           the largest (thesis §5.6); that last increment is not applied.
         """
         cfg = self.settings
-        history: list[IterationRecord] = []
-        max_df = max_du = 0.0
-        pen = eq = 0.0
-        watch = CycleWatch()
-        for k in range(cfg.max_iterations + 1):
+        tol = self.penetration_tolerance
+        largest = {"df": 0.0, "du": 0.0}  # the largest corrections of the solve so far
+        seen: dict = {}
+
+        def check(k: int) -> Check:
             pairings = self.detect(state)
             pen, eq, eq_tol, contact, tension = self.errors(pairings)
-            platen_error = self.platen_reaction(state) - state.platen_force
-            rec = IterationRecord(k, pen, eq, contact, tension, platen_error=platen_error)
-            history.append(rec)
-            if self.on_iteration is not None:
-                self.on_iteration(rec)
             platen_ok = self.platen_met(state)
-            if pen <= self.penetration_tolerance and eq <= eq_tol and tension == 0 and platen_ok:
-                return SolveResult(True, k, history, pairings)
-            if k == cfg.max_iterations:
-                break
-            sets = [(s.body.name, s.nodes[: s.nc], p.participating & (p.force > 0))
-                    for s, p in zip(self.surfaces, pairings)]
-            cycling = watch(sets, max(pen, eq), k)
-            if cycling:
-                return SolveResult(False, k, history, pairings, cycling)
-            dF, d_platen = self.corrections(state, pairings, k)
-            dU = [(s.C @ d.ravel()).reshape(-1, 2) for s, d in zip(self.surfaces, dF)]
+            seen.update(pairings=pairings, pen=pen, eq=eq, eq_tol=eq_tol, contact=contact,
+                        tension=tension, platen_ok=platen_ok)
+            rec = IterationRecord(k, pen, eq, contact, tension,
+                                  platen_error=self.platen_reaction(state) - state.platen_force)
+            return Check(
+                rec, pen <= tol and eq <= eq_tol and tension == 0 and platen_ok,
+                lambda: [(s.body.name, s.nodes[: s.nc], p.participating & (p.force > 0))
+                         for s, p in zip(self.surfaces, pairings)],
+                max(pen, eq), lambda: pairings,
+                lambda: (f"no convergence in {cfg.max_iterations} iterations "
+                         f"(penetration {pen:.3g}, equilibrium error {eq:.3g})"))
+
+        def correct(k: int, c: Check):
+            pen, eq, eq_tol = seen["pen"], seen["eq"], seen["eq_tol"]
+            tension, platen_ok = seen["tension"], seen["platen_ok"]
+            dF, d_platen = self.corrections(state, seen["pairings"], k)
+            dU = [(s.C @ d.ravel()).reshape(-1, s.dim) for s, d in zip(self.surfaces, dF)]
             if d_platen:
                 dU[self.platen_body] += d_platen * self.platen_motion[self.platen_body]
             df = float(np.sqrt(sum((d**2).sum() for d in dF)))
             du = float(np.sqrt(sum((d**2).sum() for d in dU)))
-            rec.force_correction, rec.displacement_correction = df, du
+            c.record.force_correction, c.record.displacement_correction = df, du
             if cfg.convergence == "stationary" and tension == 0 and platen_ok:
                 node_df = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dF)
                 node_du = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dU)
-                if node_df <= eq_tol and node_du <= self.penetration_tolerance:
-                    residual = pen > self.penetration_tolerance or eq > eq_tol
+                if node_df <= eq_tol and node_du <= tol:
+                    residual = pen > tol or eq > eq_tol
                     if residual:
                         log.info(
                             "contact stopped at a fixed point of the iteration with residual "
                             "penetration %.3g (tolerance %.3g) and equilibrium error %.3g "
                             "(tolerance %.3g): the corrections cancel each other there "
-                            "(docs/method.md §5)", pen, self.penetration_tolerance, eq, eq_tol)
-                    return SolveResult(True, k, history, pairings, fixed_point=residual)
+                            "(docs/method.md §5)", pen, tol, eq, eq_tol)
+                    return True, residual
             if cfg.convergence == "thesis" and k > 0 and platen_ok and (
-                    df <= cfg.thesis_fraction * max_df or du <= cfg.thesis_fraction * max_du):
-                return SolveResult(True, k, history, pairings)
-            max_df, max_du = max(max_df, df), max(max_du, du)
+                    df <= cfg.thesis_fraction * largest["df"]
+                    or du <= cfg.thesis_fraction * largest["du"]):
+                return True, False
+            largest["df"], largest["du"] = max(largest["df"], df), max(largest["du"], du)
             for F, d in zip(state.forces, dF):
                 F += d
             state.platen_displacement += d_platen
             log.debug("iteration %d: penetration %.3g, equilibrium error %.3g (tol %.3g), "
-                      "%d in contact, %d in tension", k, pen, eq, eq_tol, contact, tension)
-        return SolveResult(False, cfg.max_iterations, history, pairings,
-                           f"no convergence in {cfg.max_iterations} iterations "
-                           f"(penetration {pen:.3g}, equilibrium error {eq:.3g})")
+                      "%d in contact, %d in tension", k, pen, eq, eq_tol, seen["contact"],
+                      tension)
+            return None
+
+        return iterate(cfg, check, correct, on_iteration)

@@ -19,7 +19,9 @@ as the virtual finite element method (bodies, meshes, supports, loads, platen, l
   frictionless; a node over a vertex takes the facet it lies over, then the one facing it
   (:func:`master_projection`: mirrored nodes, mirrored facets). A node whose projection falls
   beyond the end of the master's candidate surface is not over it and has no row
-  (:func:`beyond_the_end`), and a node that is the slave of several bodies (a block under two
+  (:func:`~vfem.contact.surface.beyond` of the master's surface ends: its gap would be
+  measured to the last facet's line extended, which passes through every node of a surface
+  collinear with it), and a node that is the slave of several bodies (a block under two
   punches) keeps only its row on the closest (:func:`closest_master`): one node constrained
   against two bodies made dependent rows and a singular Lagrange system. Its gap, linearised,
 
@@ -65,11 +67,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..bodies import COMPONENTS, curve_key, superpose
-from ..errors import AnalysisError
+from ..errors import ActiveSetNotSettled, AnalysisError, SingularSystem
 from ..linalg import factorize
 from ..memory import memory_guard
-from .algorithm import ContactState, IterationRecord
-from .surface import ContactSurface
+from .capabilities import Capabilities
+from .state import ContactState, IterationRecord, SolveResult
+from .surface import ContactSurface, beyond
 
 log = logging.getLogger(__name__)
 
@@ -173,7 +176,8 @@ def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
             slave=np.full(slave.nc, i), master=np.full(slave.nc, j),
             node=np.arange(slave.nc), segment=seg, t=t, normal=n, g0=g0,
             weight=slave.tributary.copy(), penalty=np.full(slave.nc, eps), distance=dist,
-            outside=(t_free < -1e-9) | (t_free > 1 + 1e-9), off=beyond_the_end(master, seg, t_free),
+            outside=(t_free < -1e-9) | (t_free > 1 + 1e-9),
+            off=beyond(master, seg, t_free, master.surface_ends),
             slave_points=slave.nodes[: slave.nc] + 0, a_points=master.nodes[a],
             b_points=master.nodes[b], slave_offset=offsets[i], master_offset=offsets[j]))
     if not parts:
@@ -226,17 +230,6 @@ def master_projection(slave: ContactSurface, master: ContactSurface, xs: np.ndar
                  for a, b in zip(facing, plain))
 
 
-def beyond_the_end(master: ContactSurface, seg: np.ndarray, t_free: np.ndarray) -> np.ndarray:
-    """Whether each projection falls beyond an end of the master's candidate surface (past the
-    last facet of a chain, whose end node has no other candidate facet): such a node is not
-    over that surface and no contact of it (its gap would be measured to the last facet's
-    line extended, which passes through every node of a surface collinear with it: another
-    punch's face, the block beside a punch whose sides are no candidates)."""
-    count = np.bincount(master.facets.ravel(), minlength=master.nc)
-    return (((t_free < -1e-9) & (count[master.facets[seg, 0]] == 1))
-            | ((t_free > 1 + 1e-9) & (count[master.facets[seg, 1]] == 1)))
-
-
 def closest_master(slave: np.ndarray, node: np.ndarray, distance: np.ndarray,
                    outside: np.ndarray, tie: float) -> np.ndarray:
     """Which rows to keep where a slave node has one row per body it is the slave of (a block
@@ -275,10 +268,31 @@ class _Refined:
         return x + self.factor.solve(b - self.M @ x)
 
 
+class BaselineState(ContactState):
+    """A baseline's state: the contact forces, and its own unknowns, the active set and (for
+    the augmented Lagrangian) the multipliers, kept in ``multipliers`` (as checkpoints save
+    them) under the names :attr:`active` and :attr:`pressures`."""
+
+    @property
+    def pressures(self) -> np.ndarray:
+        """Per constraint row, the multiplier (pressure) the next step starts from."""
+        return self.multipliers[0]
+
+    @property
+    def active(self) -> np.ndarray:
+        """Per constraint row, whether it is in the active set."""
+        return self.multipliers[1] > 0
+
+
 class GlobalContact:
     """A classical baseline (``model.contact.method``: penalty, lagrange or augmented) on the
-    global system of the model's bodies; see the module docstring. ``run`` is what
-    :meth:`vfem.solver.Analysis.run` does for it."""
+    global system of the model's bodies; see the module docstring. A contact formulation
+    (:class:`~vfem.contact.formulation.ContactFormulation`) whose step is one global solve
+    with its active set, run on the solver's own steps."""
+
+    capabilities = Capabilities(
+        name="classical", orders=(1,), kinematics=("small",), dimensions=(2,),
+        friction=("frictionless",), invariants="compared", cuts_steps=False)
 
     def __init__(self, model, backend: str | None = None):
         self.model = model
@@ -411,8 +425,8 @@ class GlobalContact:
                                              what=f"the {self.method} global system")
         except RuntimeError as exc:  # SuperLU: a zero pivot
             if isinstance(exc, AnalysisError):
-                raise
-            raise AnalysisError(
+                raise SingularSystem(str(exc)) from None
+            raise SingularSystem(
                 f"the global matrix of the {self.method} method is singular with "
                 f"{len(A)} nodes in contact ({exc}): a body is held by nothing but contact and "
                 "no node of it can touch (no candidate facets near it?)") from None
@@ -439,7 +453,7 @@ class GlobalContact:
         settings = self.model.contact
         if self.unheld:
             b = self.unheld[0]
-            raise AnalysisError(
+            raise SingularSystem(
                 f"body {b.name!r} is held along {b.platen.component} only by its platen and by "
                 "contact, and none of its nodes can touch another body (no contact candidates "
                 "within contact.search_distance), so the global matrix is singular")
@@ -480,7 +494,7 @@ class GlobalContact:
                 new = (active & (trial > 0)) | (trial > c.penalty * self.gap_tolerance)
             self.timings["solve_s"] += time.perf_counter() - t0
             if not np.all(np.isfinite(q)):
-                raise AnalysisError(
+                raise SingularSystem(
                     f"the {self.method} method's linear solve gave non-finite displacements "
                     f"with {len(A)} nodes in contact: the global matrix is singular (a body "
                     "held by nothing but contact, with no node of it in contact)")
@@ -498,13 +512,13 @@ class GlobalContact:
             key = new.tobytes()
             if key in seen and self.method != "augmented":
                 changed = np.flatnonzero(new != active)
-                raise AnalysisError(
+                raise ActiveSetNotSettled(
                     f"the {self.method} method's active set cycles: it came back to a contact "
                     f"set it had left after {it} linear solves (nodes switching now: "
                     f"{self._name_rows(changed)})")
             seen.add(key)
             active = new
-        raise AnalysisError(
+        raise ActiveSetNotSettled(
             f"the {self.method} method's active set did not settle in {settings.max_iterations} "
             f"linear solves (contact.max_iterations); largest penetration {penetration:.3g}")
 
@@ -517,7 +531,7 @@ class GlobalContact:
 
     # -- results ----------------------------------------------------------------------------------
 
-    def fields(self, load_factor: float, q: np.ndarray, Lam: np.ndarray, g: np.ndarray):
+    def fields_of(self, load_factor: float, q: np.ndarray, Lam: np.ndarray, g: np.ndarray):
         """Per body: the :class:`~vfem.result_types.BodyStepResult` and the contact forces on its
         candidate nodes (nc, 2)."""
         from ..result_types import BodyStepResult, add_reactions
@@ -559,82 +573,37 @@ class GlobalContact:
 
     # -- the steps --------------------------------------------------------------------------------
 
-    def new_state(self) -> ContactState:
+    def new_state(self) -> BaselineState:
         m = len(self.c.node)
-        return ContactState(0.0, 0.0, [np.zeros((s.nc, 2)) for s in self.surfaces],
-                            [np.zeros(s.nc, dtype=bool) for s in self.surfaces], 0.0,
-                            {0: np.zeros(m), 1: np.zeros(m)})
+        return BaselineState(0.0, 0.0, [np.zeros((s.nc, s.dim)) for s in self.surfaces],
+                             [np.zeros(s.nc, dtype=bool) for s in self.surfaces], 0.0,
+                             {0: np.zeros(m), 1: np.zeros(m)})
 
-    def run(self, analysis, on_step=None, start=None):
-        """The steps of ``model.load_factors`` (what :meth:`vfem.solver.Analysis.run` does for
-        a baseline): each solved from the previous one's active set; ``on_step(step)`` after
-        each. ``analysis`` keeps the steps and state so far (its ``checkpoint``). A step whose
-        active set does not settle stops the analysis (``converged`` False, the message says
-        why); no step is cut, the answer of a linear frictionless problem not depending on the
-        path to it."""
-        from ..result_types import AnalysisResult, StepResult
-
-        t_start = time.perf_counter()
-        model = self.model
+    def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
+        """One step: the global solve at ``state``'s load factor from its active set (and
+        multipliers), which becomes the new state (modified in place); the result carries the
+        full-mesh fields of the global solution. Raises :class:`~vfem.errors.SingularSystem`
+        or :class:`~vfem.errors.ActiveSetNotSettled` when the step cannot be solved."""
         m = len(self.c.node)
-        if start is None:
-            state, steps, target = self.new_state(), [], 1
-        else:
-            state, steps, target = start.state.copy(), list(start.steps), start.target
-            if any(len(state.multipliers.get(k, ())) != m for k in (0, 1)):
-                state.multipliers = self.new_state().multipliers
-        analysis.state, analysis.steps = state, steps
-        analysis.target, analysis.level, analysis.easy = target, 0, 0
-        schedule = [0.0, *model.load_factors]
-        converged, message = True, ""
-        while analysis.target < len(schedule):
-            lf = schedule[analysis.target]
-            active = state.multipliers[1] > 0
-            lam = state.multipliers[0]
-            before = self.factorizations
-            try:
-                q, Lam, g, active, lam, history = self.solve_step(lf, active, lam)
-            except AnalysisError as exc:
-                converged = False
-                remedy = ("bring the bodies within contact.search_distance of each other, or "
-                          "support the body" if "singular" in str(exc) else
-                          f"allow more linear solves (contact.max_iterations = "
-                          f"{model.contact.max_iterations}) or take smaller steps; check that "
-                          "every body is held the way you expect")
-                message = (f"step {len(steps) + 1} (load factor {state.load_factor:.6g} -> "
-                           f"{lf:.6g}) failed: {exc}. What to change: {remedy}")
-                log.info(message)
-                break
-            fields, forces = self.fields(lf, q, Lam, g)
-            platen = float(q[-1]) if self.platen_body is not None else 0.0
-            force = (model.bodies[self.platen_body].platen.force_at(lf)
-                     if self.platen_body is not None else 0.0)
-            state = ContactState(lf, platen, forces,
-                                 [np.zeros(s.nc, dtype=bool) for s in self.surfaces],
-                                 force, {0: lam, 1: active.astype(float)})
-            step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=len(history),
-                              converged=True, history=history, platen_displacement=platen)
-            step.bodies = fields
-            analysis.warn_large_strain(step)  # every baseline body has small kinematics
-            check = getattr(analysis, "invariant_check", None)
-            if check is not None:  # recorded, not enforced: a baseline's answer is its own
-                step.invariants = analysis.check_invariants(fields, history).record()
-            steps.append(step)
-            analysis.state = state
-            analysis.target += 1
-            log.info("step %d (load factor %.4g): %s converged in %d linear solves "
-                     "(%d factorizations), %d nodes in contact, largest penetration %.3g",
-                     step.step, lf, self.method, len(history), self.factorizations - before,
-                     int(active.sum()), history[-1].max_penetration)
-            if on_step is not None:
-                on_step(step)
-        timings = dict(analysis.timings)
-        timings.update(self.timings)
-        timings["steps_s"] = time.perf_counter() - t_start
-        timings["total_s"] = timings["search_s"] + timings["assemble_s"] + timings["steps_s"]
-        analysis.timings = timings
-        log.info("%s: %d steps, %d linear solves, %d factorizations, %.3g s", self.method,
-                 len(steps), sum(s.iterations for s in steps), self.factorizations,
-                 timings["total_s"])
-        return AnalysisResult(model, converged, steps, timings, message, self.surfaces,
-                              self.penetration_tolerance)
+        if any(len(state.multipliers.get(k, ())) != m for k in (0, 1)):  # another model's
+            state.multipliers = self.new_state().multipliers
+        lf = state.load_factor
+        before = self.factorizations
+        # (a state read back from a checkpoint is a plain ContactState: its multipliers hold
+        # the pressures and the active set, as BaselineState names them)
+        q, Lam, g, active, lam, history = self.solve_step(lf, state.multipliers[1] > 0,
+                                                          state.multipliers[0])
+        fields, forces = self.fields_of(lf, q, Lam, g)
+        state.platen_displacement = float(q[-1]) if self.platen_body is not None else 0.0
+        state.forces[:] = forces
+        state.released[:] = [np.zeros(s.nc, dtype=bool) for s in self.surfaces]
+        state.multipliers = {0: lam, 1: active.astype(float)}
+        log.info("load factor %.4g: %s converged in %d linear solves (%d factorizations), %d "
+                 "nodes in contact, largest penetration %.3g", lf, self.method, len(history),
+                 self.factorizations - before, int(active.sum()), history[-1].max_penetration)
+        return SolveResult(True, len(history), history, [], fields=fields)
+
+    def fields(self, state: ContactState, result: SolveResult):
+        """The full-mesh results of the step's global solution (:meth:`fields_of`)."""
+        return result.fields
+

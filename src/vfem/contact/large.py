@@ -65,20 +65,19 @@ its constant flexibility, always in equilibrium with its contact forces.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import numpy as np
 
 from ..errors import AnalysisError, InputError
-from .algorithm import (
-    ContactState,
-    CycleWatch,
-    IterationRecord,
-    SolveResult,
-    closing_motion,
-)
-from .paired import PairedContact, virtual_nodes
+from .capabilities import Capabilities
+from .group import bordered_solve
+from .iteration import Check, iterate
+from .paired import PairSet
+from .pairing import overlap, virtual_nodes
 from .search import project_points
+from .state import ContactState, IterationRecord, SolveResult, closing_motion
 from .surface import ContactSurface
 
 log = logging.getLogger(__name__)
@@ -127,14 +126,8 @@ def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: fl
         q = np.zeros(n)
         d = 0.0
         if platen:
-            A = np.zeros((len(a) + 1, len(a) + 1))
-            A[:-1, :-1] = W[np.ix_(a, a)]
-            A[:-1, -1] = -dp_dplaten[a]
-            A[-1, :-1] = dR[a]
-            A[-1, -1] = stiffness
-            rhs = np.concatenate([p[a] + Wq0[a], [need + float(dR @ q0)]])
-            sol = np.linalg.lstsq(A, rhs, rcond=None)[0]
-            q[a], d = sol[:-1], float(sol[-1])
+            q[a], d = bordered_solve(W[np.ix_(a, a)], -dp_dplaten[a], dR[a], stiffness,
+                                     p[a] + Wq0[a], need + float(dR @ q0))
         elif len(a):
             q[a] = np.linalg.solve(W[np.ix_(a, a)], p[a] + Wq0[a])
         pen = p - W @ (q - q0) + (d * dp_dplaten if platen else 0.0)
@@ -161,8 +154,12 @@ def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: fl
     return np.maximum(q, 0.0), d
 
 
-class LargeDeformationContact(PairedContact):
+class LargeDeformationContact(PairSet):
     """Frictionless contact with large displacements and sliding (see the module docstring)."""
+
+    capabilities = Capabilities(
+        name="paired", orders=(1,), kinematics=("small", "large"), dimensions=(2,),
+        friction=("frictionless",))
 
     keep_all_nodes = True  # which nodes are over the other surface changes as bodies slide
 
@@ -172,9 +169,12 @@ class LargeDeformationContact(PairedContact):
             if s.order != 1:
                 raise InputError(f"body {s.body.name!r}: large-displacement contact needs "
                                  "linear elements (order 1)")
-        super().__init__(surfaces, pairs, settings)
-        self.backend = backend
-        self._offsets = np.cumsum([0] + [2 * s.nc for s in surfaces])
+        super().__init__(surfaces, pairs, settings, backend)
+        #: the pairs as built on the undeformed geometry (which side carries compatibility,
+        #: which nodes): kept as they are; ``contact_pairs`` follow the current configuration
+        self.undeformed_pairs = tuple(self.contact_pairs)
+        self.contact_pairs = [dataclasses.replace(p) for p in self.undeformed_pairs]
+        self._offsets = np.cumsum([0] + [s.dim * s.nc for s in surfaces])
 
     # -- the bodies' current state ----------------------------------------------------------------
 
@@ -191,7 +191,7 @@ class LargeDeformationContact(PairedContact):
         for i, s in enumerate(self.surfaces):
             if s.body.large:
                 u = s.body.nonlinear.trial_displacement()
-                x[i] = s.X + u[s.tracked_dofs].reshape(-1, 2)
+                x[i] = s.X + u[s.tracked_dofs].reshape(-1, s.dim)
         return x
 
     def pairing_positions(self, state: ContactState) -> list[np.ndarray]:
@@ -208,7 +208,7 @@ class LargeDeformationContact(PairedContact):
         out = []
         for k, pair in enumerate(self.contact_pairs):
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            geo = self._overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes)
+            geo = overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes)
             if geo is None:  # the surfaces no longer face each other anywhere
                 pair.carries = np.zeros(len(pair.nodes), dtype=bool)
                 pair.mass = np.zeros_like(pair.mass)
@@ -229,19 +229,17 @@ class LargeDeformationContact(PairedContact):
 
     # -- the iteration ----------------------------------------------------------------------------
 
-    def solve(self, state: ContactState) -> SolveResult:
-        """Newton's method on the bodies and the traction values together (module docstring).
+    def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
+        """Newton's method on the bodies and the traction values together (module docstring),
+        by :func:`~vfem.contact.iteration.iterate`.
 
         The history records, per iteration, the largest penetration and, as its equilibrium
         error, the largest out-of-balance force of a body relative to its reference force.
         """
         cfg = self.settings
         tol = self.penetration_tolerance
-        history: list[IterationRecord] = []
-        pen_err = body_err = 0.0
-        tension = 0
-        watch = CycleWatch()
-        for it in range(cfg.max_iterations + 1):
+
+        def check(it: int) -> Check:
             pens = self.penetrations(state)
             self.assemble_forces(state)  # the tractions along the current normals
             lins = self._linearize(state)
@@ -255,26 +253,24 @@ class LargeDeformationContact(PairedContact):
             need, _, _ = self._platen_terms(state, lins)
             platen_ok = (self.platen_body is None or abs(need) <= cfg.platen_tolerance
                          * max(abs(state.platen_force), 1e-300))
-            history.append(IterationRecord(it, pen_err, body_err, contact, tension,
-                                           platen_error=-need))
-            if self.on_iteration is not None:
-                self.on_iteration(history[-1])
-            if (pen_err <= tol and tension == 0 and platen_ok and settled
-                    and body_err <= BODY_TOLERANCE):
-                self._finish(state)
-                return SolveResult(True, it, history, self.pairings(state, pens))
-            if it == cfg.max_iterations:
-                break
-            cycling = watch(self.contact_sets(lams), max(pen_err, body_err), it)
-            if cycling:
-                return SolveResult(False, it, history, self.pairings(state, pens), cycling)
+            return Check(
+                IterationRecord(it, pen_err, body_err, contact, tension, platen_error=-need),
+                (pen_err <= tol and tension == 0 and platen_ok and settled
+                 and body_err <= BODY_TOLERANCE),
+                lambda: self.contact_sets(lams), max(pen_err, body_err),
+                lambda: self.pairings(state, pens),
+                lambda: (f"no convergence in {cfg.max_iterations} iterations (penetration "
+                         f"{pen_err:.3g}{self.worst_node(errs)}, body residual "
+                         f"{body_err:.3g}, {tension} nodes in tension)"),
+                finish=lambda: self._finish(state), extra=(pens, lins))
+
+        def correct(it: int, c: Check) -> None:
+            pens, lins = c.extra
             if it > 0:  # the first iterate is the last converged state, at the new loads
                 self._check_rind(pens)
             self._correct_all(state, pens, lins)
-        return SolveResult(False, cfg.max_iterations, history, self.pairings(state, pens),
-                           f"no convergence in {cfg.max_iterations} iterations (penetration "
-                           f"{pen_err:.3g}{self.worst_node(errs)}, body residual "
-                           f"{body_err:.3g}, {tension} nodes in tension)")
+
+        return iterate(cfg, check, correct, on_iteration)
 
     def _linearize(self, state: ContactState) -> list:
         """Newton's system of every large-kinematics body (None for the others)."""
@@ -316,7 +312,7 @@ class LargeDeformationContact(PairedContact):
         """All bodies' candidate nodal forces (stacked) of the state's traction values with the
         bodies' tracked nodes at ``x``: the traction acts along the opposing surface's normal at
         the virtual node, wherever that now is (the transfer held)."""
-        out = [np.zeros((s.nc, 2)) for s in self.surfaces]
+        out = [np.zeros((s.nc, s.dim)) for s in self.surfaces]
         for k, pair in enumerate(self.contact_pairs):
             q = self._q(state, k)
             on = np.flatnonzero(q != 0)
@@ -351,8 +347,7 @@ class LargeDeformationContact(PairedContact):
             near = np.isin(sc.facets, sc.facets[seg]).any(axis=1)  # the facets and neighbours
             for body, nodes in ((pair.fine, pair.nodes[on]), (pair.coarse, sc.facets[near])):
                 nodes = np.unique(nodes)
-                coords.update((off[body] + np.column_stack([2 * nodes, 2 * nodes + 1])).ravel()
-                              .tolist())
+                coords.update((off[body] + self.surfaces[body].dofs_of(nodes)).tolist())
         J = np.array(sorted(coords), dtype=int)
         if not len(J):
             return J, np.zeros((off[-1], 0))
@@ -363,7 +358,8 @@ class LargeDeformationContact(PairedContact):
         for col, (j, b) in enumerate(zip(J, body_of)):
             xp = list(x)
             xp[b] = x[b].copy()
-            xp[b][(j - off[b]) // 2, (j - off[b]) % 2] += h
+            dim = self.surfaces[b].dim
+            xp[b][(j - off[b]) // dim, (j - off[b]) % dim] += h
             Bj[:, col] = (self._forces_at(state, xp) - base) / h
         return J, Bj
 
@@ -383,10 +379,10 @@ class LargeDeformationContact(PairedContact):
         tol = self.penetration_tolerance
         off = self._offsets
         nt = off[-1]
-        C = [lin.flexibility[: 2 * s.nc] if lin is not None else s.C
+        C = [lin.flexibility[: s.dim * s.nc] if lin is not None else s.C
              for s, lin in zip(self.surfaces, lins)]
         a = np.concatenate([lin.correction[s.candidate_dofs] if lin is not None
-                            else np.zeros(2 * s.nc) for s, lin in zip(self.surfaces, lins)])
+                            else np.zeros(s.dim * s.nc) for s, lin in zip(self.surfaces, lins)])
         J, Bj = self._follower_stiffness(state)
         CB = np.zeros((nt, len(J)))
         for b in range(len(self.surfaces)):
@@ -417,10 +413,11 @@ class LargeDeformationContact(PairedContact):
             pair = self.contact_pairs[k]
             n = pair.normal[s_]
             cols = slice(col, col + len(s_))
-            for d in range(2):
-                A[off[pair.fine] + d:off[pair.fine + 1]:2, cols] += (
+            dim = self.surfaces[pair.fine].dim
+            for d in range(dim):  # component d of every node's force: every dim-th dof
+                A[off[pair.fine] + d:off[pair.fine + 1]:dim, cols] += (
                     pair.mass[:, pair.nodes[s_]] * n[:, d])
-                A[off[pair.coarse] + d:off[pair.coarse + 1]:2, cols] -= (
+                A[off[pair.coarse] + d:off[pair.coarse + 1]:dim, cols] -= (
                     pair.transfer[:, pair.nodes[s_]] * n[:, d])
             col += len(s_)
         CA = np.zeros((nt, m))
@@ -466,15 +463,15 @@ class LargeDeformationContact(PairedContact):
                 du = du + dplaten * lin.platen_motion
             moves.append(du)
         self._move(state, sets, dq, dplaten, moves,
-                   [dF[off[i]:off[i + 1]].reshape(-1, 2) for i in range(len(self.surfaces))])
+                   [dF[off[i]:off[i + 1]].reshape(-1, s.dim) for i, s in enumerate(self.surfaces)])
 
     def _normal_motion(self, pair, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:
         """Penetration decrease n . (u_fine - u_coarse at the virtual node) of the pair's nodes
         for stacked candidate motions u (vector or columns)."""
         off = self._offsets
         sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-        uf = u[off[pair.fine]:off[pair.fine + 1]].reshape((sf.nc, 2) + u.shape[1:])
-        uc = u[off[pair.coarse]:off[pair.coarse + 1]].reshape((sc.nc, 2) + u.shape[1:])
+        uf = u[off[pair.fine]:off[pair.fine + 1]].reshape((sf.nc, sf.dim) + u.shape[1:])
+        uc = u[off[pair.coarse]:off[pair.coarse + 1]].reshape((sc.nc, sc.dim) + u.shape[1:])
         rel = uf[pair.nodes[nodes]] - np.tensordot(pair.interp[nodes], uc, axes=(1, 0))
         return np.einsum("id,id...->i...", pair.normal[nodes], rel)
 

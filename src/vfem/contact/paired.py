@@ -35,197 +35,46 @@ virtual nodes, normals and transfer are fixed, the gap is linear in the displace
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from skfem.quadrature import get_quadrature
-from skfem.refdom import RefLine
 
-from ..errors import AnalysisError, RindViolation
-from .algorithm import (
-    ContactState,
-    CycleWatch,
-    IterationRecord,
-    Pairing,
-    SolveResult,
-    VirtualElementContact,
-    closing_motion,
+from ..errors import PlatenUnheld, RindViolation
+from .capabilities import Capabilities
+from .group import SurfaceGroup, bordered_solve
+from .iteration import Check, iterate
+from .pairing import (  # noqa: F401 - the pairing's parts, here too for those who import them here
+    EDGE_RATIO,
+    FACET_READINGS,
+    FACING,
+    ContactPair,
+    Overlap,
+    beyond,
+    common_normal,
+    facing,
+    overlap,
+    patch_ends,
+    read_facets,
+    virtual_nodes,
 )
 from .search import outward_normals
+from .state import ContactState, IterationRecord, Pairing, SolveResult, closing_motion
 from .surface import ContactSurface
 
 log = logging.getLogger(__name__)
 
 
-@dataclass
-class ContactPair:
-    """A compatibility surface ("fine") against an equilibrium one ("coarse"), undeformed geometry.
+class PairSet(SurfaceGroup):
+    """The paired variant's parts shared by small and large displacements: the contact pairs
+    (which side carries compatibility, their nodes, normals, gaps and transfer), the traction
+    values that are its unknowns, the forces they make, its errors and its output fields.
 
-    Arrays over the pair's nodes of the compatibility side (m of them, ``nodes`` in its local
-    numbering).
-    """
+    :class:`PairedContact` (small displacements) and
+    :class:`~vfem.contact.large.LargeDeformationContact` are built on it."""
 
-    fine: int  # body index
-    coarse: int
-    nodes: np.ndarray  # (m,) candidate nodes of the fine body in this pair
-    normal: np.ndarray  # (m, 2) outward normal of the coarse surface at the virtual node
-    gap0: np.ndarray  # (m,) undeformed gap (> 0 open)
-    interp: np.ndarray  # (m, nc_coarse) virtual node = interp @ coarse candidate nodes
-    transfer: np.ndarray  # (nc_coarse, nc_fine) coarse nodal force per unit fine traction value
-    mass: np.ndarray  # (nc_fine, nc_fine) the fine surface's N over the overlap
-    rind_depth: np.ndarray  # (m,) thickness of the coarse element under each virtual node
-    carries: np.ndarray  # (m,) whose traction reaches the other surface
-    patches: tuple[np.ndarray, np.ndarray] | None  # each side's facets facing the other
-    platen_rate: np.ndarray | None = None  # (m,) penetration change per unit platen motion
-
-
-#: A facet faces the other body when its outward normal and the other surface's normal where
-#: it is closest make an angle of at least 120 degrees (cosine <= -0.5). A flat punch's sides
-#: (90 degrees to the block it presses) so do not face the block, and its corners end its
-#: contact surface; the facets of a smooth or mildly angled surface (a faceted cylinder, a
-#: shallow wedge, a chamfer up to 60 degrees) all do.
-FACING = 0.5
-
-#: A surface with an edge inside the contact zone (an end of its patch over the other surface)
-#: carries compatibility unless it gives way this many times less per unit length than the
-#: other: a node-free corner of the equilibrium side would otherwise indent the compatibility
-#: side between its nodes (measured on the thesis's block example, equal materials: 2.7e-4, a
-#: thousand times the penetration tolerance). A much stiffer surface with the edge (a rigid
-#: punch) stays on the equilibrium side: as compatibility side it would hold a traction the
-#: soft surface cannot control.
-EDGE_RATIO = 4.0
-
-
-def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray) -> np.ndarray:
-    """The candidate facets of ``s`` (at tracked positions ``x``) that face the body of ``so``
-    (at ``xo``): its patch in their pair (:data:`FACING`)."""
-    if len(s.facets) == 0 or len(so.facets) == 0:
-        return np.zeros(0, dtype=int)
-    a, b = s.segments(x)
-    n = outward_normals(a, b)
-    faces = np.zeros(len(s.facets), dtype=bool)
-    for _, m, _ in _read_facets(s, np.arange(len(s.facets)), x, so, xo, None, n):
-        faces |= np.einsum("ij,ij->i", n, m) <= -FACING
-    # and a facet over which a vertex of the other surface lies, facing it: a punch's corner
-    # that has slid past the end of the face it pressed presses the block's facet beyond (left
-    # out, the corner went into the block unheld: large kinematics, equal stiffness, 3e-3 deep)
-    verts = np.unique(so.facets[:, :2])
-    vn = so.node_normals(xo)[verts]
-    seg, _, dist, _, tf = s.closest(xo[verts], x, None, vn)
-    reach = 2.0 * (s.lengths.max() + so.lengths.max())
-    over = ((tf > 1e-9) & (tf < 1 - 1e-9) & (dist < reach)
-            & (np.einsum("ij,ij->i", vn, n[seg]) <= -FACING))
-    faces[seg[over]] = True
-    return np.flatnonzero(faces)
-
-
-#: Where a facet is read against the other surface: its midpoint and near its ends. A facet
-#: partly under the other body, its midpoint just past the other's corner, faces that corner's
-#: side at its midpoint only (read there alone, such a facet was dropped and the contact missed
-#: altogether: a punch overhanging a block's edge, tests/test_fuzz_placement.py).
-FACET_READINGS = (0.5, 0.05, 0.95)
-
-
-def _read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
-                 so: ContactSurface, xo: np.ndarray | None, ofacets: np.ndarray | None,
-                 normals: np.ndarray):
-    """For each of :data:`FACET_READINGS`: the closest point on ``so`` (its facets
-    ``ofacets``, all if None) of that point of each of ``facets`` of ``s`` (positions ``x``,
-    ``xo``; ties by ``normals``), as (facet of so, its normal there, unclamped t)."""
-    for t in FACET_READINGS:
-        pts, _ = s.curve(facets, np.full(len(facets), t), x)
-        seg, _, _, m, tf = so.closest(pts, xo, ofacets, normals)
-        yield seg, m, tf
-
-
-def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:
-    """(nc,) True at the ends of a patch of facets (vertices on one facet of it)."""
-    return np.bincount(s.facets[patch, :2].ravel(), minlength=s.nc)[: s.nc] == 1
-
-
-def beyond(s: ContactSurface, seg: np.ndarray, t_free: np.ndarray, ends: np.ndarray
-           ) -> np.ndarray:
-    """Points whose closest point on a patch is one of its ends (``ends``), outside the end
-    facet's normal strip (``t_free`` off [0, 1]): they are not over the patch."""
-    e = s.facets[seg]
-    return (((t_free < -1e-9) & ends[e[:, 0]]) | ((t_free > 1 + 1e-9) & ends[e[:, 1]]))
-
-
-def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np.ndarray,
-                  nodes: np.ndarray, fpatch: np.ndarray, cpatch: np.ndarray):
-    """The virtual nodes of ``nodes`` of ``sf`` on the patch ``cpatch`` of ``sc`` (positions
-    ``xf``, ``xc``): (normal, gap, interp, facet, beyond) — see :meth:`PairedContact._overlap`.
-    """
-    pts = xf[nodes]
-    seg, t, _, _, tf = sc.closest(pts, xc, cpatch, sf.node_normals(xf, fpatch)[nodes])
-    closest, _ = sc.curve(seg, t, xc)
-    past = beyond(sc, seg, tf, patch_ends(sc, cpatch))
-    interp = sc.interpolation(seg, t)
-    normal = interp @ sc.node_normals(xc, cpatch)
-    d = pts - closest
-    dn = np.linalg.norm(d, axis=1)
-    normal = np.where((past & (dn > 0))[:, None], d / np.maximum(dn, 1e-300)[:, None], normal)
-    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
-    return normal, np.einsum("ij,ij->i", d, normal), interp, seg, past
-
-
-def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: float,
-                  c_coarse: float) -> None:
-    """Small-strain contact: measure the gaps along one normal that does not depend on which
-    surface carries compatibility (in place on ``geo``, undeformed geometry).
-
-    The normal is the two surfaces' outward normals (the other surface's at the virtual node,
-    minus the node's own), each weighted by its body's stiffness per unit length (the inverse
-    of :meth:`PairedContact._compliance_density`): where the bodies are pressed together the
-    stiffer surface keeps its shape and the interface takes its normal, and two equally stiff
-    ones meet on the mean plane. Swapping the roles gives the same line. **Why**: with the
-    other surface's normal alone, a stiff flat made the compatibility side of the Hertz
-    problem took the cylinder's normals, tilted by up to a/R, and a horizontal contact force
-    of 2.6 % of the load appeared on the half model, where the cylinder as compatibility side
-    has none. Nodes beyond the other surface keep the direction to its end.
-    """
-    if not len(geo.nodes):
-        return
-    total = c_fine + c_coarse
-    w_coarse = c_fine / total if total > 0 else 0.5  # the stiffer surface weighs more
-    own = sf.node_normals(None, geo.fpatch)[geo.nodes]
-    n = w_coarse * geo.normal - (1.0 - w_coarse) * own
-    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-    n = np.where(geo.beyond[:, None], geo.normal, n)
-    d = sf.X[geo.nodes] - geo.interp @ sc.X[: sc.nc]  # from the virtual node to the node
-    geo.normal = n
-    geo.gap = np.einsum("ij,ij->i", d, n)
-
-
-@dataclass
-class Overlap:
-    """The pairing of a compatibility surface's nodes with the other surface (one
-    configuration; :meth:`PairedContact._overlap`). Arrays over ``nodes``."""
-
-    nodes: np.ndarray  # candidate nodes of the compatibility side
-    normal: np.ndarray  # (m, 2) the normal along which the gap is measured
-    gap: np.ndarray  # (m,) > 0 open
-    interp: np.ndarray  # (m, nc_other) virtual node = interp @ the other surface's nodes
-    rind_depth: np.ndarray  # (m,) thickness of the other body's element there
-    beyond: np.ndarray  # (m,) not over the other surface (no virtual node)
-    carries: np.ndarray  # (m,) whose traction reaches the other surface (overlap under it)
-    mass: np.ndarray  # (nc_fine, nc_fine) N over the overlap
-    transfer: np.ndarray  # (nc_other, nc_fine) T over the overlap
-    fpatch: np.ndarray  # the facets of each side that face the other (:func:`facing`)
-    cpatch: np.ndarray
-
-    def subset(self, keep: np.ndarray) -> Overlap:
-        return Overlap(self.nodes[keep], self.normal[keep], self.gap[keep], self.interp[keep],
-                       self.rind_depth[keep], self.beyond[keep], self.carries[keep], self.mass,
-                       self.transfer, self.fpatch, self.cpatch)
-
-
-class PairedContact(VirtualElementContact):
-    """Frictionless contact with one condition per nodal force (see the module docstring)."""
-
-    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings):
-        super().__init__(surfaces, pairs, settings)
+    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
+                 backend: str | None = None):
+        super().__init__(surfaces, pairs, settings, backend)
         self.contact_pairs = [p for p in (self._make_pair(*sorted(pp)) for pp in sorted(
             pairs, key=sorted)) if p is not None]
         # penetration p = -(gap0 + n.(u_fine - u_coarse)): its change per unit platen motion
@@ -233,7 +82,6 @@ class PairedContact(VirtualElementContact):
         for pair in self.contact_pairs:
             pair.platen_rate = np.einsum("id,id->i", pair.normal, pair.interp @ v[pair.coarse]
                                          - v[pair.fine][pair.nodes])
-
     # -- geometry of the pairs (once) -------------------------------------------------------------
 
     #: nodes that keep every candidate node of the compatibility side (large kinematics, where
@@ -262,7 +110,7 @@ class PairedContact(VirtualElementContact):
                     else (j, i)
         sf, sc = self.surfaces[fine], self.surfaces[coarse]
         nodes = (self._facing_nodes(fine, coarse) if self.keep_all_nodes else None)
-        geo = self._overlap(sf, sc, nodes=nodes)
+        geo = overlap(sf, sc, nodes=nodes)
         if geo is None:
             return None
         if not self.keep_all_nodes:  # only the nodes over the other surface take part
@@ -299,7 +147,7 @@ class PairedContact(VirtualElementContact):
         oends = patch_ends(so, opatch)
         normals = outward_normals(*s.segments(s.X))[patch]
         inside = np.zeros(len(patch), dtype=bool)  # a facet over the other surface, even partly
-        for seg, _, tf in _read_facets(s, patch, None, so, None, opatch, normals):
+        for seg, _, tf in read_facets(s, patch, None, so, None, opatch, normals):
             inside |= ~beyond(so, seg, tf, oends)
         over = patch[inside]
         if not len(over):
@@ -332,111 +180,6 @@ class PairedContact(VirtualElementContact):
             closer = d < dist
             best[closer], dist[closer] = j, d[closer]
         return best
-
-    @staticmethod
-    def _overlap(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray | None = None,
-                 xc: np.ndarray | None = None, nodes: np.ndarray | None = None
-                 ) -> Overlap | None:
-        """Where the compatibility surface ``sf`` meets ``sc`` (undeformed, or at tracked
-        positions ``xf`` and ``xc``): each node's virtual node, normal and gap, and the
-        transfer of the traction (thesis §4.4-4.5).
-
-        Each surface takes part with its **patch**: the facets that face the other body
-        (:func:`facing`). A sharp corner of the other body (the edge of a flat punch) so ends
-        the patch, and a point of ``sf`` whose closest point on the patch is its end, beyond
-        which it lies (outside the end facet's normal strip), is not over the other surface:
-        it has no virtual node and its gap is its distance from that end, along the line to it.
-        Elsewhere the normal is the patch's, interpolated between its nodal normals
-        (continuous along a faceted curve; the facet normal on a flat) at the virtual node.
-
-        ``nodes``: the ``sf`` nodes to pair (default: the nodes of its patch).
-        """
-        xf = sf.X if xf is None else xf
-        xc = sc.X if xc is None else xc
-        fpatch, cpatch = facing(sf, xf, sc, xc), facing(sc, xc, sf, xf)
-        if not len(fpatch) or not len(cpatch):
-            return None
-        if nodes is None:
-            nodes = np.unique(sf.facets[fpatch])
-        normal, gap, interp, seg, past = virtual_nodes(sf, sc, xf, xc, nodes, fpatch, cpatch)
-        reach = float(np.abs(gap[~past]).max()) if (~past).any() else 0.0
-        mass, transfer = PairedContact._transfer(sf, sc, fpatch, cpatch,
-                                                 sc.node_normals(xc, cpatch),
-                                                 patch_ends(sc, cpatch), reach, xf, xc)
-        carries = mass[:, nodes].any(axis=0)
-        return Overlap(nodes, normal, gap, interp, sc.rind_depth[seg], past, carries, mass,
-                       transfer, fpatch, cpatch)
-
-    @staticmethod
-    def _transfer(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray,
-                  cpatch: np.ndarray, cnormals: np.ndarray, ends: np.ndarray, gap: float,
-                  xf: np.ndarray, xc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Both sides' nodal forces per unit traction value, from one integral over the overlap.
-
-        ``N[i, k] = int phi_i(y) phi_k(y) dy`` (the compatibility side, eq. 4.4.11) and
-        ``T[c, k] = int phi_c(proj(y)) phi_k(y) dy`` (the equilibrium side: the same traction
-        re-integrated with its shape functions), both over the part of the patch ``fpatch`` of
-        ``sf`` that lies over the patch ``cpatch`` of ``sc`` (points beyond its ends count
-        nothing). Since the shape functions of each side sum to one, the two sides' forces are
-        equal and opposite for any traction, to round-off, and force reaches only nodes whose
-        facets overlap the other surface.
-
-        Integrated over the fine facets, split where the projection onto the coarse patch passes
-        one of its vertices (seen along its nodal normal), with a Gauss rule exact to degree 5
-        on each piece: exact for the piecewise polynomial integrand (degree 4 at most, with
-        quadratic elements) on straight facets, so a uniform traction crosses exactly. On
-        curved (quadratic) facets the points and weights follow the curve; the splits are found
-        on the chords. Positions ``xf``, ``xc`` may be deformed; the measure stays the fine
-        side's undeformed length (the traction is nominal).
-        """
-        fa, fb = sf.segments(xf)
-        fa, fb = fa[fpatch], fb[fpatch]
-        d = fb - fa
-        # the coarse patch's vertices seen along their normals: where they split the fine facets
-        verts = np.unique(sc.facets[cpatch, :2])
-        vn = cnormals[verts]
-        P = xc[verts]
-        # solve fa + s d = P + tau vn for every (facet, coarse vertex)
-        det = d[:, None, 0] * (-vn[None, :, 1]) - d[:, None, 1] * (-vn[None, :, 0])
-        rx = P[None, :, 0] - fa[:, None, 0]
-        ry = P[None, :, 1] - fa[:, None, 1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            s = (rx * (-vn[None, :, 1]) - ry * (-vn[None, :, 0])) / det
-            tau = (d[:, None, 0] * ry - d[:, None, 1] * rx) / det
-        # points farther than this from the coarse surface face something else (``gap``: the
-        # largest gap of the pair's nodes)
-        reach = gap + 2.0 * (sf.lengths.max() + sc.lengths.max())
-        ok = np.isfinite(s) & (s > 1e-12) & (s < 1 - 1e-12) & (np.abs(tau) < reach)
-        X, W = get_quadrature(RefLine, 5)
-        xi, w = X[0], W
-        wts, fac, sloc = [], [], []
-        for k, f in enumerate(fpatch):
-            cuts = np.unique(np.concatenate([[0.0, 1.0], s[k, ok[k]]]))
-            lo, hi = cuts[:-1], cuts[1:]
-            sq = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
-            wts.append(((hi - lo)[:, None] * w[None, :]).ravel())
-            fac.append(np.full(len(sq), f))
-            sloc.append(sq)
-        wts = np.concatenate(wts)
-        fac, sloc = np.concatenate(fac), np.concatenate(sloc)
-        _, tangent = sf.curve(fac, sloc)
-        wts = wts * np.linalg.norm(tangent, axis=1)
-        pts, tangent = sf.curve(fac, sloc, xf)
-        own = np.column_stack([tangent[:, 1], -tangent[:, 0]])
-        own /= np.maximum(np.linalg.norm(own, axis=1), 1e-300)[:, None]
-        seg, tt, dist, _, tf = sc.closest(pts, xc, cpatch, own)
-        wts = np.where(beyond(sc, seg, tf, ends) | (dist > reach), 0.0, wts)
-        N = np.zeros((sf.nc, sf.nc))
-        T = np.zeros((sc.nc, sf.nc))
-        fend, cend = sf.facets[fac], sc.facets[seg]
-        fshape = sf.shape(sloc).T
-        for fi, fw in zip(fend.T, fshape):
-            for ci, cw in zip(cend.T, sc.shape(tt).T):
-                np.add.at(T, (ci, fi), wts * cw * fw)
-            for gi, gw in zip(fend.T, fshape):
-                np.add.at(N, (gi, fi), wts * gw * fw)
-        return N, T
-
     # -- state of the pairs -----------------------------------------------------------------------
 
     def _q(self, state: ContactState, k: int) -> np.ndarray:
@@ -454,54 +197,6 @@ class PairedContact(VirtualElementContact):
             q = self._q(state, k)[:, None] * pair.normal  # traction vector at the fine nodes
             state.forces[pair.fine] += pair.mass[:, pair.nodes] @ q
             state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ q
-
-    def penetrations(self, state: ContactState) -> list[np.ndarray]:
-        """Penetration (> 0 overlap) of every pair's fine nodes, linear kinematics."""
-        x = self.positions(state)
-        out = []
-        for pair in self.contact_pairs:
-            sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            uf = x[pair.fine][pair.nodes] - sf.X[pair.nodes]
-            uc = pair.interp @ (x[pair.coarse][: sc.nc] - sc.X[: sc.nc])
-            out.append(-(pair.gap0 + np.einsum("ij,ij->i", uf - uc, pair.normal)))
-        return out
-
-    # -- the iteration ----------------------------------------------------------------------------
-
-    #: called with each iteration's record as it is made (progress displays)
-    on_iteration = None
-
-    def solve(self, state: ContactState) -> SolveResult:
-        cfg = self.settings
-        tol = self.penetration_tolerance
-        history: list[IterationRecord] = []
-        watch = CycleWatch()
-        self.assemble_forces(state)
-        for it in range(cfg.max_iterations + 1):
-            pens = self.penetrations(state)
-            lams = [self._q(state, k) for k in range(len(self.contact_pairs))]
-            self._check_rind(pens)
-            errs, pen_err, contact, tension = self.compatibility_errors(pens, lams)
-            platen_error = self.platen_reaction(state) - state.platen_force
-            platen_ok = self.platen_met(state)
-            history.append(IterationRecord(it, pen_err, 0.0, contact, tension,
-                                           platen_error=platen_error))
-            if self.on_iteration is not None:
-                self.on_iteration(history[-1])
-            if pen_err <= tol and tension == 0 and platen_ok:
-                return SolveResult(True, it, history, self.pairings(state, pens))
-            if it == cfg.max_iterations:
-                break
-            cycling = watch(self.contact_sets(lams), pen_err, it)
-            if cycling:
-                return SolveResult(False, it, history, self.pairings(state, pens), cycling)
-            self._correct(state, pens, it, platen_ok)
-            self.assemble_forces(state)
-        return SolveResult(False, cfg.max_iterations, history, self.pairings(state, pens),
-                           f"no convergence in {cfg.max_iterations} iterations "
-                           f"(penetration {pen_err:.3g}{self.worst_node(errs)}, {tension} "
-                           "nodes in tension)")
-
     def compatibility_errors(self, pens: list[np.ndarray], lams: list[np.ndarray]
                              ) -> tuple[list[np.ndarray], float, int, int]:
         """Per pair the compatibility error of each node (|penetration| where the node touches
@@ -542,129 +237,6 @@ class PairedContact(VirtualElementContact):
                     f"node {int(sf.nodes[pair.nodes[k]])} of body {sf.body.name!r} went "
                     f"{p[k]:.3g} deep into body {sc.body.name!r}, past its outer layer of "
                     "elements: the step is too large")
-
-    def _correct(self, state: ContactState, pens: list[np.ndarray], it: int,
-                 platen_ok: bool) -> None:
-        """Tension release, then the compatibility correction of every pair at once."""
-        cfg = self.settings
-        tol = self.penetration_tolerance
-        omega = cfg.first_relaxation if it < cfg.relaxed_iterations else cfg.relaxation
-        active, targets = [], []
-        for k, p in enumerate(pens):
-            lam = self._q(state, k)
-            pair = self.contact_pairs[k]
-            released = state.released[pair.fine][pair.nodes]
-            tension = lam < 0
-            frac = np.where(released, 1.0, 1.0 / cfg.release_iterations)
-            lam[tension] -= frac[tension] * lam[tension]
-            state.released[pair.fine][pair.nodes] = tension & (frac < 1.0)
-            S = ~tension & ((lam > 0) | (p > tol))
-            if not platen_ok and not S.any():
-                S = ~tension & (p > -tol)  # touching within tolerance: hold them there
-            active.append(np.flatnonzero(S))
-            targets.append(omega * p[S])
-        self.assemble_forces(state)  # the releases change the forces the platen sees
-        m = sum(len(a) for a in active)
-        if m == 0:
-            if not self.platen_met(state):
-                self._close_gap(state, pens)
-            return
-        W, dp_dplaten, dR = self._pair_flexibility(state, active)
-        rhs = np.concatenate(targets)
-        if self.platen_body is not None and state.platen_force != 0.0:
-            b = self.surfaces[self.platen_body].body
-            A = np.zeros((m + 1, m + 1))
-            A[:m, :m] = W
-            A[:m, m] = -dp_dplaten
-            A[m, :m] = dR
-            A[m, m] = b.platen_stiffness
-            need = state.platen_force - self.platen_reaction(state)
-            b = np.concatenate([rhs, [need]])
-            try:  # an LU solve; least squares (an SVD, ten times dearer) only if singular
-                sol = np.linalg.solve(A, b)
-            except np.linalg.LinAlgError:
-                sol = np.linalg.lstsq(A, b, rcond=None)[0]
-            dlam, dplaten = sol[:m], float(sol[m])
-        else:
-            dlam, dplaten = np.linalg.solve(W, rhs), 0.0
-        pos = 0
-        for k, a in enumerate(active):
-            self._q(state, k)[a] += dlam[pos:pos + len(a)]
-            pos += len(a)
-        state.platen_displacement += dplaten
-
-    def _pair_flexibility(self, state: ContactState, active: list[np.ndarray]):
-        """W = d(penetration reduction)/d(traction value) over the active fine nodes of all pairs.
-
-        Also the penetration change per unit platen motion and the platen reaction per unit
-        traction value: rows and columns of :meth:`_full_flexibility` (the pairs' geometry is
-        fixed under small kinematics, so it is computed once).
-        """
-        if not hasattr(self, "_full"):
-            self._full = self._full_flexibility()
-        W, dp_dplaten, dR, offsets = self._full
-        index = np.concatenate([offsets[k] + a for k, a in enumerate(active)])
-        return W[np.ix_(index, index)], dp_dplaten[index], dR[index]
-
-    def _full_flexibility(self):
-        """W, the penetration change per unit platen motion and the platen reaction per unit
-        traction value over every node of every pair (stacked pair by pair, with the offsets).
-
-        The body forces per unit traction value are sparse (a node's traction reaches the few
-        nodes of its facets and of the opposing facets under it), so each body's motion is its
-        flexibility C times a sparse matrix, computed once.
-        """
-        offsets = np.cumsum([0] + [len(p.nodes) for p in self.contact_pairs])
-        m = int(offsets[-1])
-        parts: list[list] = [[] for _ in self.surfaces]  # (rows, cols, values) per body
-        for k, pair in enumerate(self.contact_pairs):
-            for body, per_node, sign in ((pair.fine, pair.mass, 1.0),
-                                         (pair.coarse, pair.transfer, -1.0)):
-                r, c = np.nonzero(per_node[:, pair.nodes])
-                v = sign * per_node[r, pair.nodes[c]]
-                for d in range(2):  # the force along the normal's components
-                    parts[body].append((2 * r + d, offsets[k] + c, v * pair.normal[c, d]))
-        dF = [sp.csr_matrix((np.concatenate([p[2] for p in ps]) if ps else [],
-                             (np.concatenate([p[0] for p in ps]) if ps else [],
-                              np.concatenate([p[1] for p in ps]) if ps else [])),
-                            shape=(2 * s.nc, m))
-              for s, ps in zip(self.surfaces, parts)]  # body forces per unit traction value
-        du = [np.asarray((f.T @ s.C.T).T).reshape(s.nc, 2, m)
-              for s, f in zip(self.surfaces, dF)]
-        W = np.zeros((m, m))
-        dp_dplaten = np.zeros(m)
-        for k, pair in enumerate(self.contact_pairs):
-            rows = slice(offsets[k], offsets[k + 1])
-            uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
-            coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
-            uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
-            # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dlam
-            W[rows] = np.einsum("id,idm->im", pair.normal, uf - uc)
-            dp_dplaten[rows] = pair.platen_rate
-        dR = np.zeros(m)
-        if self.platen_body is not None:
-            s = self.surfaces[self.platen_body]
-            dR = np.asarray(dF[self.platen_body].T @ s.platen_row).ravel()
-        return W, dp_dplaten, dR, offsets
-
-    def _close_gap(self, state: ContactState, pens: list[np.ndarray]) -> None:
-        """Nothing touches: move the platen just far enough to close the smallest gap."""
-        need = state.platen_force - self.platen_reaction(state)
-        moves = [closing_motion(p, pair.platen_rate, need)
-                 for pair, p in zip(self.contact_pairs, pens)]
-        moves = [d for d in moves if d != 0.0]
-        if moves:
-            state.platen_displacement += min(moves, key=abs)
-            return
-        body = self.surfaces[self.platen_body].body
-        if body.platen_stiffness == 0.0 and need != 0.0:  # nothing but contact could hold it
-            raise AnalysisError(
-                f"the platen on body {body.name!r} must move it along "
-                f"{'-' if need < 0 else '+'}{body.platen.component} to apply its force "
-                f"({state.platen_force:.6g}), but that moves it away from every body it may "
-                "touch: nothing holds it (a platen force's sign: negative pushes towards -x or "
-                "-y)")
-
     # -- what the results need --------------------------------------------------------------------
 
     def pairings(self, state: ContactState, pens: list[np.ndarray] | None = None
@@ -677,7 +249,7 @@ class PairedContact(VirtualElementContact):
             force = np.zeros(nc)
             pen = np.zeros(nc)
             other = np.full(nc, -1)
-            normal = np.zeros((nc, 2))
+            normal = np.zeros((nc, s.dim))
             touching = np.zeros(nc, dtype=bool)
             compat = np.zeros(nc, dtype=bool)  # nodes where this body carries compatibility
             for k, pair in enumerate(self.contact_pairs):
@@ -743,3 +315,178 @@ class PairedContact(VirtualElementContact):
         p[beyond(sf, seg, tf, patch_ends(sf, fpatch))] = 0.0
         out[nodes] = p
         return out
+
+
+class PairedContact(PairSet):
+    """Frictionless contact with one condition per nodal force, small displacements (see the
+    module docstring)."""
+
+    capabilities = Capabilities(
+        name="paired", orders=(1, 2), kinematics=("small",), dimensions=(2,),
+        friction=("frictionless",))
+
+    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
+                 backend: str | None = None):
+        super().__init__(surfaces, pairs, settings, backend)
+        #: W, the penetration change per unit platen motion, the platen reaction per unit
+        #: traction value and the pairs' offsets (:meth:`_full_flexibility`): the pairs'
+        #: geometry is fixed under small kinematics, so they are computed once, when first
+        #: needed
+        self._full = None
+
+    def penetrations(self, state: ContactState) -> list[np.ndarray]:
+        """Penetration (> 0 overlap) of every pair's fine nodes, linear kinematics."""
+        x = self.positions(state)
+        out = []
+        for pair in self.contact_pairs:
+            sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
+            uf = x[pair.fine][pair.nodes] - sf.X[pair.nodes]
+            uc = pair.interp @ (x[pair.coarse][: sc.nc] - sc.X[: sc.nc])
+            out.append(-(pair.gap0 + np.einsum("ij,ij->i", uf - uc, pair.normal)))
+        return out
+    # -- the iteration ----------------------------------------------------------------------------
+
+    def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
+        """Correct the traction values until every pair's compatibility holds
+        (:func:`~vfem.contact.iteration.iterate`); the forces follow from them, equal and
+        opposite by construction (see the module docstring)."""
+        cfg = self.settings
+        tol = self.penetration_tolerance
+        self.assemble_forces(state)
+
+        def check(it: int) -> Check:
+            pens = self.penetrations(state)
+            lams = [self._q(state, k) for k in range(len(self.contact_pairs))]
+            self._check_rind(pens)
+            errs, pen_err, contact, tension = self.compatibility_errors(pens, lams)
+            platen_ok = self.platen_met(state)
+            rec = IterationRecord(it, pen_err, 0.0, contact, tension,
+                                  platen_error=self.platen_reaction(state) - state.platen_force)
+            return Check(rec, pen_err <= tol and tension == 0 and platen_ok,
+                         lambda: self.contact_sets(lams), pen_err,
+                         lambda: self.pairings(state, pens),
+                         lambda: (f"no convergence in {cfg.max_iterations} iterations "
+                                  f"(penetration {pen_err:.3g}{self.worst_node(errs)}, "
+                                  f"{tension} nodes in tension)"),
+                         extra=(pens, platen_ok))
+
+        def correct(it: int, c: Check) -> None:
+            pens, platen_ok = c.extra
+            self._correct(state, pens, it, platen_ok)
+            self.assemble_forces(state)
+
+        return iterate(cfg, check, correct, on_iteration)
+
+    def _correct(self, state: ContactState, pens: list[np.ndarray], it: int,
+                 platen_ok: bool) -> None:
+        """Tension release, then the compatibility correction of every pair at once."""
+        cfg = self.settings
+        tol = self.penetration_tolerance
+        omega = cfg.first_relaxation if it < cfg.relaxed_iterations else cfg.relaxation
+        active, targets = [], []
+        for k, p in enumerate(pens):
+            lam = self._q(state, k)
+            pair = self.contact_pairs[k]
+            released = state.released[pair.fine][pair.nodes]
+            tension = lam < 0
+            frac = np.where(released, 1.0, 1.0 / cfg.release_iterations)
+            lam[tension] -= frac[tension] * lam[tension]
+            state.released[pair.fine][pair.nodes] = tension & (frac < 1.0)
+            S = ~tension & ((lam > 0) | (p > tol))
+            if not platen_ok and not S.any():
+                S = ~tension & (p > -tol)  # touching within tolerance: hold them there
+            active.append(np.flatnonzero(S))
+            targets.append(omega * p[S])
+        self.assemble_forces(state)  # the releases change the forces the platen sees
+        m = sum(len(a) for a in active)
+        if m == 0:
+            if not self.platen_met(state):
+                self._close_gap(state, pens)
+            return
+        W, dp_dplaten, dR = self._pair_flexibility(state, active)
+        rhs = np.concatenate(targets)
+        if self.platen_body is not None and state.platen_force != 0.0:
+            body = self.surfaces[self.platen_body].body
+            dlam, dplaten = bordered_solve(W, -dp_dplaten, dR, body.platen_stiffness, rhs,
+                                           state.platen_force - self.platen_reaction(state),
+                                           lu_first=True)
+        else:
+            dlam, dplaten = np.linalg.solve(W, rhs), 0.0
+        pos = 0
+        for k, a in enumerate(active):
+            self._q(state, k)[a] += dlam[pos:pos + len(a)]
+            pos += len(a)
+        state.platen_displacement += dplaten
+
+    def _pair_flexibility(self, state: ContactState, active: list[np.ndarray]):
+        """W = d(penetration reduction)/d(traction value) over the active fine nodes of all pairs.
+
+        Also the penetration change per unit platen motion and the platen reaction per unit
+        traction value: rows and columns of :meth:`_full_flexibility` (the pairs' geometry is
+        fixed under small kinematics, so it is computed once).
+        """
+        if self._full is None:
+            self._full = self._full_flexibility()
+        W, dp_dplaten, dR, offsets = self._full
+        index = np.concatenate([offsets[k] + a for k, a in enumerate(active)])
+        return W[np.ix_(index, index)], dp_dplaten[index], dR[index]
+
+    def _full_flexibility(self):
+        """W, the penetration change per unit platen motion and the platen reaction per unit
+        traction value over every node of every pair (stacked pair by pair, with the offsets).
+
+        The body forces per unit traction value are sparse (a node's traction reaches the few
+        nodes of its facets and of the opposing facets under it), so each body's motion is its
+        flexibility C times a sparse matrix, computed once.
+        """
+        offsets = np.cumsum([0] + [len(p.nodes) for p in self.contact_pairs])
+        m = int(offsets[-1])
+        parts: list[list] = [[] for _ in self.surfaces]  # (rows, cols, values) per body
+        for k, pair in enumerate(self.contact_pairs):
+            for body, per_node, sign in ((pair.fine, pair.mass, 1.0),
+                                         (pair.coarse, pair.transfer, -1.0)):
+                r, c = np.nonzero(per_node[:, pair.nodes])
+                v = sign * per_node[r, pair.nodes[c]]
+                dim = self.surfaces[body].dim
+                for d in range(dim):  # the force along the normal's components
+                    parts[body].append((dim * r + d, offsets[k] + c, v * pair.normal[c, d]))
+        dF = [sp.csr_matrix((np.concatenate([p[2] for p in ps]) if ps else [],
+                             (np.concatenate([p[0] for p in ps]) if ps else [],
+                              np.concatenate([p[1] for p in ps]) if ps else [])),
+                            shape=(s.dim * s.nc, m))
+              for s, ps in zip(self.surfaces, parts)]  # body forces per unit traction value
+        du = [np.asarray((f.T @ s.C.T).T).reshape(s.nc, s.dim, m)
+              for s, f in zip(self.surfaces, dF)]
+        W = np.zeros((m, m))
+        dp_dplaten = np.zeros(m)
+        for k, pair in enumerate(self.contact_pairs):
+            rows = slice(offsets[k], offsets[k + 1])
+            uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
+            coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
+            uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
+            # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dlam
+            W[rows] = np.einsum("id,idm->im", pair.normal, uf - uc)
+            dp_dplaten[rows] = pair.platen_rate
+        dR = np.zeros(m)
+        if self.platen_body is not None:
+            s = self.surfaces[self.platen_body]
+            dR = np.asarray(dF[self.platen_body].T @ s.platen_row).ravel()
+        return W, dp_dplaten, dR, offsets
+
+    def _close_gap(self, state: ContactState, pens: list[np.ndarray]) -> None:
+        """Nothing touches: move the platen just far enough to close the smallest gap."""
+        need = state.platen_force - self.platen_reaction(state)
+        moves = [closing_motion(p, pair.platen_rate, need)
+                 for pair, p in zip(self.contact_pairs, pens)]
+        moves = [d for d in moves if d != 0.0]
+        if moves:
+            state.platen_displacement += min(moves, key=abs)
+            return
+        body = self.surfaces[self.platen_body].body
+        if body.platen_stiffness == 0.0 and need != 0.0:  # nothing but contact could hold it
+            raise PlatenUnheld(
+                f"the platen on body {body.name!r} must move it along "
+                f"{'-' if need < 0 else '+'}{body.platen.component} to apply its force "
+                f"({state.platen_force:.6g}), but that moves it away from every body it may "
+                "touch: nothing holds it (a platen force's sign: negative pushes towards -x or "
+                "-y)")

@@ -140,15 +140,24 @@ class ContactSurface:
     # -- dofs -----------------------------------------------------------------------------------
 
     @property
+    def dim(self) -> int:
+        """The dimension of the body's space (the columns of ``X``)."""
+        return self.X.shape[1]
+
+    def dofs_of(self, nodes: np.ndarray) -> np.ndarray:
+        """The body's dofs of its points ``nodes``, interleaved by component (x, y[, z] of
+        each point in turn: the body's numbering)."""
+        return (self.dim * np.asarray(nodes)[:, None] + np.arange(self.dim)).ravel()
+
+    @property
     def candidate_dofs(self) -> np.ndarray:
-        """Mesh dofs (interleaved x, y) of the candidate nodes."""
-        n = self.nodes[: self.nc]
-        return np.column_stack([2 * n, 2 * n + 1]).ravel()
+        """Body dofs of the candidate nodes."""
+        return self.dofs_of(self.nodes[: self.nc])
 
     @property
     def tracked_dofs(self) -> np.ndarray:
-        n = self.nodes
-        return np.column_stack([2 * n, 2 * n + 1]).ravel()
+        """Body dofs of the tracked nodes (the candidates first)."""
+        return self.dofs_of(self.nodes)
 
     def compute_flexibility(self) -> None:
         """The flexibility rows of the tracked dofs for the candidate dofs, and the platen row.
@@ -158,7 +167,7 @@ class ContactSurface:
         candidate dof is, by reciprocity, minus that dof's motion under a unit platen motion.
         """
         body = self.body
-        nc2 = 2 * self.nc
+        nc2 = self.dim * self.nc
         if getattr(body, "tracked_flexibility", None) is not None and \
                 len(body.tracked_flexibility) == len(self.tracked_dofs):
             self.G = body.tracked_flexibility[:, :nc2].copy()
@@ -175,7 +184,7 @@ class ContactSurface:
         ids = np.arange(len(self.facets)) if facets is None else np.asarray(facets)
         x = self.X if x is None else x
         n = outward_normals(x[self.facets[ids, 0]], x[self.facets[ids, 1]])
-        out = np.zeros((self.nc, 2))
+        out = np.zeros((self.nc, self.dim))
         for col in self.facets[ids].T:
             np.add.at(out, col, n)
         return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
@@ -204,7 +213,7 @@ class ContactSurface:
     @property
     def C(self) -> np.ndarray:
         """Flexibility on the candidate dofs, (2 nc, 2 nc)."""
-        return self.G[: 2 * self.nc]
+        return self.G[: self.dim * self.nc]
 
     def normal_stiffness(self, nodes: np.ndarray, normal: np.ndarray) -> np.ndarray:
         """Castigliano stiffness of candidate nodes along unit normals: 1 / (n^T C_jj n).
@@ -213,12 +222,27 @@ class ContactSurface:
         free (vfem-method §3.3). A node whose motion along ``n`` is fully prevented by supports
         gets an infinite stiffness.
         """
-        C = self.C
-        i0, i1 = 2 * nodes, 2 * nodes + 1
-        nx, ny = normal[:, 0], normal[:, 1]
-        c = C[i0, i0] * nx * nx + 2 * C[i0, i1] * nx * ny + C[i1, i1] * ny * ny
+        C, k = self.C, self.dim
+        c = 0.0
+        for d in range(k):  # the symmetric form, its off-diagonal terms once, doubled
+            for e in range(d, k):
+                cde = C[k * nodes + d, k * nodes + e]
+                c = c + (cde * normal[:, d] * normal[:, e] if d == e
+                         else 2 * cde * normal[:, d] * normal[:, e])
         with np.errstate(divide="ignore"):
             return np.where(c > 0, 1.0 / np.maximum(c, 1e-300), np.inf)
+
+    def normal_flexibility(self, nodes: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        """n_s^T C_st n_t over the candidate nodes ``nodes`` (their unit normals ``normal``):
+        the normal motion of each node per unit normal force at each (eq. 4.2.4 in matrix
+        form, §4.5.2)."""
+        C, k = self.C, self.dim
+        out = 0.0
+        for d in range(k):
+            for e in range(k):
+                out = out + (normal[:, d, None] * C[np.ix_(k * nodes + d, k * nodes + e)]
+                             * normal[None, :, e])
+        return out
 
     # -- geometry -------------------------------------------------------------------------------
 
@@ -325,6 +349,19 @@ class ContactSurface:
         local[self.nodes[: self.nc]] = np.arange(self.nc)
         rows, cols = local[ones.indices[0][keep]], local[ones.indices[1][keep]]
         return facet, rows, cols, ones.data[keep]
+
+
+def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:
+    """(nc,) True at the ends of a patch of facets (vertices on one facet of it)."""
+    return np.bincount(s.facets[patch, :2].ravel(), minlength=s.nc)[: s.nc] == 1
+
+
+def beyond(s: ContactSurface, seg: np.ndarray, t_free: np.ndarray, ends: np.ndarray
+           ) -> np.ndarray:
+    """Points whose closest point on a patch is one of its ends (``ends``), outside the end
+    facet's normal strip (``t_free`` off [0, 1]): they are not over the patch."""
+    e = s.facets[seg]
+    return (((t_free < -1e-9) & ends[e[:, 0]]) | ((t_free > 1 + 1e-9) & ends[e[:, 1]]))
 
 
 def triangles(t: np.ndarray) -> np.ndarray:

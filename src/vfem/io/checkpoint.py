@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..contact.algorithm import ContactState, IterationRecord
+from ..contact.state import ContactState, IterationRecord
 from ..errors import InputError
 from ..solver import BodyStepResult, Checkpoint, Model, StepResult
 

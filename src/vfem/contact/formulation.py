@@ -1,0 +1,107 @@
+"""The contract between the solver and a contact formulation.
+
+The incremental driver (:class:`vfem.solver.Analysis`) runs the steps; a formulation resolves the
+contact of one step. Every formulation — the paired variant with small
+(:class:`~vfem.contact.paired.PairedContact`) or large displacements
+(:class:`~vfem.contact.large.LargeDeformationContact`), the thesis's plain reading
+(:class:`~vfem.contact.algorithm.VirtualElementContact`) and the classical baselines
+(:class:`~vfem.contact.baselines.GlobalContact`) — implements :class:`ContactFormulation`, and
+declares what it can do as data (:class:`Capabilities`), which the model's checks read
+(:func:`check_capabilities`) instead of a hand-written rule per formulation.
+
+:func:`formulation_class` picks the formulation of a model's settings and kinematics.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Protocol
+
+from ..errors import InputError
+from .capabilities import Capabilities
+
+if TYPE_CHECKING:
+    from ..result_types import BodyStepResult
+    from .state import ContactState, IterationRecord, SolveResult
+    from .surface import ContactSurface
+
+
+class ContactFormulation(Protocol):
+    """What the solver drives (see the module docstring)."""
+
+    capabilities: Capabilities
+    surfaces: list[ContactSurface]
+    #: the penetration the formulation works to (the invariants' allowance)
+    penetration_tolerance: float
+
+    def new_state(self) -> ContactState:
+        """The state before the first step: no contact force."""
+
+    def solve(self, state: ContactState,
+              on_iteration: Callable[[IterationRecord], None] | None = None) -> SolveResult:
+        """Resolve the contact at ``state``'s load factor (and platen force), from ``state``
+        (the last converged one, modified in place into the new one)."""
+
+    def fields(self, state: ContactState, result: SolveResult) -> dict[str, BodyStepResult]:
+        """The full-mesh results of a converged state, per body name."""
+
+
+def formulation_class(settings, large: bool) -> type:
+    """The formulation of the contact settings (``method``, ``variant``) and kinematics."""
+    if settings.method != "vfem":
+        from .baselines import GlobalContact
+
+        return GlobalContact
+    if large:
+        from .large import LargeDeformationContact
+
+        return LargeDeformationContact
+    if settings.variant == "paired":
+        from .paired import PairedContact
+
+        return PairedContact
+    from .algorithm import VirtualElementContact
+
+    return VirtualElementContact
+
+
+def check_capabilities(model) -> None:
+    """Raise :class:`InputError` for a body the model's formulation cannot analyse (its element
+    order, kinematics or dimension), naming the body and what to choose instead."""
+    settings = model.contact
+    large = any(b.large for b in model.bodies)
+    caps = formulation_class(settings, large).capabilities
+    if settings.method != "vfem":
+        for b in model.bodies:
+            if ("large" if b.large else "small") not in caps.kinematics \
+                    or b.order not in caps.orders:
+                raise InputError(f"model {model.name!r}, body {b.name!r}: the classical "
+                                 f"contact methods (contact.method = {settings.method!r}) need "
+                                 f"{_orders(caps)} and small kinematics; use contact.method = "
+                                 "'vfem'")
+    elif large and settings.variant != "paired":
+        raise InputError(f"model {model.name!r}: large kinematics needs the paired contact "
+                         "variant")
+    for b in model.bodies:
+        if b.order not in caps.orders:
+            if large:
+                raise InputError(f"model {model.name!r}, body {b.name!r}: contact with a "
+                                 f"large-kinematics body needs {_orders(caps)} on every body")
+            raise InputError(f"model {model.name!r}, body {b.name!r}: the {caps.name} variant "
+                             f"supports {_orders(caps).replace(' (', ' only (', 1)}; use the "
+                             "paired variant for quadratic elements")
+        dim = b.mesh.p.shape[0]
+        if dim not in caps.dimensions:
+            raise InputError(f"model {model.name!r}, body {b.name!r}: {caps.name} contact "
+                             f"supports {' and '.join(f'{d}D' for d in caps.dimensions)} "
+                             f"bodies, this one is {dim}D")
+
+
+def _orders(caps: Capabilities) -> str:
+    """'linear elements (order 1)' or 'linear or quadratic elements (order 1 or 2)'."""
+    names = {1: "linear", 2: "quadratic"}
+    return (f"{' or '.join(names[o] for o in caps.orders)} elements "
+            f"(order {' or '.join(str(o) for o in caps.orders)})")
+
+
+__all__ = ["Capabilities", "ContactFormulation", "check_capabilities", "formulation_class"]

@@ -1,0 +1,142 @@
+"""What every virtual-element formulation knows of the bodies: their contact surfaces, where the
+tracked nodes are, and the force-controlled platen.
+
+:class:`SurfaceGroup` is the shared part of the thesis variant
+(:class:`~vfem.contact.algorithm.VirtualElementContact`) and the paired variant (small and large
+displacements, :mod:`vfem.contact.paired`, :mod:`vfem.contact.large`); :func:`bordered_solve` is
+the platen's bordered system that each of them solves in its compatibility correction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..result_types import BodyStepResult, add_reactions
+from .settings import ContactSettings
+from .state import ContactState, SolveResult
+from .surface import ContactSurface
+
+
+def bordered_solve(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: float,
+                   rhs: np.ndarray, extra: float, lu_first: bool = False
+                   ) -> tuple[np.ndarray, float]:
+    """The corrections ``x`` and the platen motion ``d`` from the bordered system
+
+        [ W    column ] [x]   [rhs  ]
+        [ row  corner ] [d] = [extra]
+
+    ``W``: the compatibility conditions' flexibility (penetration change per unit force or
+    traction value at the corrected nodes, eq. 4.2.4 in matrix form); ``column``: their change
+    per unit platen motion; ``row``: the platen's reaction per unit correction; ``corner``: the
+    platen's own stiffness (zero for a body only contact holds); ``extra``: the force the platen
+    still lacks. Least squares (the system may be singular: a platen body without a node in
+    contact); ``lu_first``: an LU solve first, least squares (an SVD, ten times dearer) only
+    where that fails.
+    """
+    m = len(rhs)
+    A = np.zeros((m + 1, m + 1))
+    A[:m, :m] = W
+    A[:m, m] = column
+    A[m, :m] = row
+    A[m, m] = corner
+    b = np.concatenate([rhs, [extra]])
+    if lu_first:
+        try:
+            sol = np.linalg.solve(A, b)
+        except np.linalg.LinAlgError:
+            sol = np.linalg.lstsq(A, b, rcond=None)[0]
+    else:
+        sol = np.linalg.lstsq(A, b, rcond=None)[0]
+    return sol[:m], float(sol[m])
+
+
+class SurfaceGroup:
+    """The contact surfaces of all bodies, the pairs of bodies that may touch, the settings, the
+    penetration tolerance and the platen (see the module docstring)."""
+
+    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]],
+                 settings: ContactSettings, backend: str | None = None):
+        self.surfaces = surfaces
+        self.backend = backend  # the linear solver of the bodies' tangents (large kinematics)
+        self.pairs = pairs
+        self.settings = settings
+        lengths = np.concatenate([s.lengths for s in surfaces if len(s.lengths)] or [[1.0]])
+        self.penetration_tolerance = (settings.penetration_tolerance
+                                      if settings.penetration_tolerance is not None
+                                      else 1e-5 * float(lengths.min()))
+        platens = [i for i, s in enumerate(surfaces) if s.body.platen is not None]
+        self.platen_body = platens[0] if platens else None
+        # each body's candidate-node motion per unit platen motion (zero but for the platen's)
+        self.platen_motion = [s.body.u_platen[s.candidate_dofs].reshape(-1, s.dim)
+                              for s in surfaces]
+
+    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
+                  ) -> ContactState:
+        """No contact force on any body."""
+        return ContactState(load_factor, platen_displacement,
+                            [np.zeros((s.nc, s.dim)) for s in self.surfaces],
+                            [np.zeros(s.nc, dtype=bool) for s in self.surfaces])
+
+    def positions(self, state: ContactState) -> list[np.ndarray]:
+        """Current coordinates of every body's tracked nodes: X + u(load, platen, forces), the
+        bodies' linear response (superposition)."""
+        out = []
+        for s, F in zip(self.surfaces, state.forces):
+            b = s.body
+            dofs = s.tracked_dofs
+            u = (b.load_displacement(state.load_factor, dofs) + state.platen_displacement
+                 * b.u_platen[dofs] + s.G @ F.ravel())
+            out.append(s.X + u.reshape(-1, s.dim))
+        return out
+
+    def platen_reaction(self, state: ContactState) -> float:
+        """Reaction of the platen (force it applies to its body), linear in the state."""
+        if self.platen_body is None:
+            return 0.0
+        s = self.surfaces[self.platen_body]
+        b = s.body
+        return (b.platen_load_reaction_at(state.load_factor)
+                + state.platen_displacement * b.platen_stiffness
+                + float(s.platen_row @ state.forces[self.platen_body].ravel()))
+
+    def platen_met(self, state: ContactState) -> bool:
+        """Whether the platen's reaction is on its scheduled force (always, without a platen)."""
+        if self.platen_body is None:
+            return True
+        error = self.platen_reaction(state) - state.platen_force
+        return abs(error) <= self.settings.platen_tolerance * max(abs(state.platen_force), 1e-300)
+
+    def fields(self, state: ContactState, result: SolveResult) -> dict[str, BodyStepResult]:
+        """Full-mesh results of a converged state, per body (one back-substitution each): the
+        displacements under the state's loads, platen motion and contact forces, the contact
+        forces, pressure (nodal force over tributary length), the formulation's traction where
+        it has one, contact status and penetration (``result.pairings``), and the reactions."""
+        out = {}
+        for s, F, p in zip(self.surfaces, state.forces, result.pairings):
+            b = s.body
+            f = np.zeros(b.ndofs)
+            f[s.candidate_dofs] = F.ravel()
+            u = b.displacement(state.load_factor, state.platen_displacement, f)
+            nv = b.npoints
+            cand = s.nodes[: s.nc]
+            force = np.zeros((nv, s.dim))
+            force[cand] = F
+            pressure = np.zeros(nv)
+            pressure[cand] = np.where(p.other >= 0, p.force, 0.0) / s.tributary
+            traction = None
+            if p.pressure is not None:  # the formulation's traction field (paired)
+                traction = np.zeros(nv)
+                traction[cand] = p.pressure
+            status = np.zeros(nv, dtype=int)
+            status[cand] = p.participating & (p.force > 0)
+            pen = np.zeros(nv)
+            pen[cand] = np.where(np.isfinite(p.penetration), p.penetration, 0.0)
+            out[b.name] = add_reactions(
+                b, BodyStepResult(u.reshape(-1, s.dim), force, pressure, status, pen, traction),
+                state.load_factor)
+        return out
+
+    def opponents(self, i: int) -> list[int]:
+        """The bodies body ``i`` may touch that have candidate facets."""
+        return [j for j in range(len(self.surfaces))
+                if j != i and frozenset((i, j)) in self.pairs and len(self.surfaces[j].facets)]

@@ -1,0 +1,202 @@
+"""Pairing and gaps of the paired variant: which facets of two surfaces face each other, each
+compatibility-side node's virtual node on the other surface (its normal, gap and interpolation,
+thesis §4.3), and the overlap of a pair with its traction transfer (:mod:`vfem.contact.transfer`).
+
+Shared by the small-displacement (:mod:`vfem.contact.paired`, once, undeformed) and the
+large-displacement paired variant (:mod:`vfem.contact.large`, every iteration, current
+configuration).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .search import outward_normals
+from .surface import ContactSurface, beyond, patch_ends
+from .transfer import transfer_matrices
+
+
+@dataclass
+class ContactPair:
+    """A compatibility surface ("fine") against an equilibrium one ("coarse"), undeformed geometry.
+
+    Arrays over the pair's nodes of the compatibility side (m of them, ``nodes`` in its local
+    numbering).
+    """
+
+    fine: int  # body index
+    coarse: int
+    nodes: np.ndarray  # (m,) candidate nodes of the fine body in this pair
+    normal: np.ndarray  # (m, 2) outward normal of the coarse surface at the virtual node
+    gap0: np.ndarray  # (m,) undeformed gap (> 0 open)
+    interp: np.ndarray  # (m, nc_coarse) virtual node = interp @ coarse candidate nodes
+    transfer: np.ndarray  # (nc_coarse, nc_fine) coarse nodal force per unit fine traction value
+    mass: np.ndarray  # (nc_fine, nc_fine) the fine surface's N over the overlap
+    rind_depth: np.ndarray  # (m,) thickness of the coarse element under each virtual node
+    carries: np.ndarray  # (m,) whose traction reaches the other surface
+    patches: tuple[np.ndarray, np.ndarray] | None  # each side's facets facing the other
+    platen_rate: np.ndarray | None = None  # (m,) penetration change per unit platen motion
+
+
+#: A facet faces the other body when its outward normal and the other surface's normal where
+#: it is closest make an angle of at least 120 degrees (cosine <= -0.5). A flat punch's sides
+#: (90 degrees to the block it presses) so do not face the block, and its corners end its
+#: contact surface; the facets of a smooth or mildly angled surface (a faceted cylinder, a
+#: shallow wedge, a chamfer up to 60 degrees) all do.
+FACING = 0.5
+
+#: A surface with an edge inside the contact zone (an end of its patch over the other surface)
+#: carries compatibility unless it gives way this many times less per unit length than the
+#: other: a node-free corner of the equilibrium side would otherwise indent the compatibility
+#: side between its nodes (measured on the thesis's block example, equal materials: 2.7e-4, a
+#: thousand times the penetration tolerance). A much stiffer surface with the edge (a rigid
+#: punch) stays on the equilibrium side: as compatibility side it would hold a traction the
+#: soft surface cannot control.
+EDGE_RATIO = 4.0
+
+
+def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray) -> np.ndarray:
+    """The candidate facets of ``s`` (at tracked positions ``x``) that face the body of ``so``
+    (at ``xo``): its patch in their pair (:data:`FACING`)."""
+    if len(s.facets) == 0 or len(so.facets) == 0:
+        return np.zeros(0, dtype=int)
+    a, b = s.segments(x)
+    n = outward_normals(a, b)
+    faces = np.zeros(len(s.facets), dtype=bool)
+    for _, m, _ in read_facets(s, np.arange(len(s.facets)), x, so, xo, None, n):
+        faces |= np.einsum("ij,ij->i", n, m) <= -FACING
+    # and a facet over which a vertex of the other surface lies, facing it: a punch's corner
+    # that has slid past the end of the face it pressed presses the block's facet beyond (left
+    # out, the corner went into the block unheld: large kinematics, equal stiffness, 3e-3 deep)
+    verts = np.unique(so.facets[:, :2])
+    vn = so.node_normals(xo)[verts]
+    seg, _, dist, _, tf = s.closest(xo[verts], x, None, vn)
+    reach = 2.0 * (s.lengths.max() + so.lengths.max())
+    over = ((tf > 1e-9) & (tf < 1 - 1e-9) & (dist < reach)
+            & (np.einsum("ij,ij->i", vn, n[seg]) <= -FACING))
+    faces[seg[over]] = True
+    return np.flatnonzero(faces)
+
+
+#: Where a facet is read against the other surface: its midpoint and near its ends. A facet
+#: partly under the other body, its midpoint just past the other's corner, faces that corner's
+#: side at its midpoint only (read there alone, such a facet was dropped and the contact missed
+#: altogether: a punch overhanging a block's edge, tests/test_fuzz_placement.py).
+FACET_READINGS = (0.5, 0.05, 0.95)
+
+
+def read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
+                 so: ContactSurface, xo: np.ndarray | None, ofacets: np.ndarray | None,
+                 normals: np.ndarray):
+    """For each of :data:`FACET_READINGS`: the closest point on ``so`` (its facets
+    ``ofacets``, all if None) of that point of each of ``facets`` of ``s`` (positions ``x``,
+    ``xo``; ties by ``normals``), as (facet of so, its normal there, unclamped t)."""
+    for t in FACET_READINGS:
+        pts, _ = s.curve(facets, np.full(len(facets), t), x)
+        seg, _, _, m, tf = so.closest(pts, xo, ofacets, normals)
+        yield seg, m, tf
+
+
+def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np.ndarray,
+                  nodes: np.ndarray, fpatch: np.ndarray, cpatch: np.ndarray):
+    """The virtual nodes of ``nodes`` of ``sf`` on the patch ``cpatch`` of ``sc`` (positions
+    ``xf``, ``xc``): (normal, gap, interp, facet, beyond) — see :func:`overlap`.
+    """
+    pts = xf[nodes]
+    seg, t, _, _, tf = sc.closest(pts, xc, cpatch, sf.node_normals(xf, fpatch)[nodes])
+    closest, _ = sc.curve(seg, t, xc)
+    past = beyond(sc, seg, tf, patch_ends(sc, cpatch))
+    interp = sc.interpolation(seg, t)
+    normal = interp @ sc.node_normals(xc, cpatch)
+    d = pts - closest
+    dn = np.linalg.norm(d, axis=1)
+    normal = np.where((past & (dn > 0))[:, None], d / np.maximum(dn, 1e-300)[:, None], normal)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    return normal, np.einsum("ij,ij->i", d, normal), interp, seg, past
+
+
+def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: float,
+                  c_coarse: float) -> None:
+    """Small-strain contact: measure the gaps along one normal that does not depend on which
+    surface carries compatibility (in place on ``geo``, undeformed geometry).
+
+    The normal is the two surfaces' outward normals (the other surface's at the virtual node,
+    minus the node's own), each weighted by its body's stiffness per unit length (the inverse
+    of :meth:`~vfem.contact.paired.PairSet._compliance_density`): where the bodies are pressed
+    together the stiffer surface keeps its shape and the interface takes its normal, and two
+    equally stiff ones meet on the mean plane. Swapping the roles gives the same line.
+    **Why**: with the other surface's normal alone, a stiff flat made the compatibility side of
+    the Hertz problem took the cylinder's normals, tilted by up to a/R, and a horizontal
+    contact force of 2.6 % of the load appeared on the half model, where the cylinder as
+    compatibility side has none. Nodes beyond the other surface keep the direction to its end.
+    """
+    if not len(geo.nodes):
+        return
+    total = c_fine + c_coarse
+    w_coarse = c_fine / total if total > 0 else 0.5  # the stiffer surface weighs more
+    own = sf.node_normals(None, geo.fpatch)[geo.nodes]
+    n = w_coarse * geo.normal - (1.0 - w_coarse) * own
+    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+    n = np.where(geo.beyond[:, None], geo.normal, n)
+    d = sf.X[geo.nodes] - geo.interp @ sc.X[: sc.nc]  # from the virtual node to the node
+    geo.normal = n
+    geo.gap = np.einsum("ij,ij->i", d, n)
+
+
+@dataclass
+class Overlap:
+    """The pairing of a compatibility surface's nodes with the other surface (one
+    configuration; :func:`overlap`). Arrays over ``nodes``."""
+
+    nodes: np.ndarray  # candidate nodes of the compatibility side
+    normal: np.ndarray  # (m, 2) the normal along which the gap is measured
+    gap: np.ndarray  # (m,) > 0 open
+    interp: np.ndarray  # (m, nc_other) virtual node = interp @ the other surface's nodes
+    rind_depth: np.ndarray  # (m,) thickness of the other body's element there
+    beyond: np.ndarray  # (m,) not over the other surface (no virtual node)
+    carries: np.ndarray  # (m,) whose traction reaches the other surface (overlap under it)
+    mass: np.ndarray  # (nc_fine, nc_fine) N over the overlap
+    transfer: np.ndarray  # (nc_other, nc_fine) T over the overlap
+    fpatch: np.ndarray  # the facets of each side that face the other (:func:`facing`)
+    cpatch: np.ndarray
+
+    def subset(self, keep: np.ndarray) -> Overlap:
+        return Overlap(self.nodes[keep], self.normal[keep], self.gap[keep], self.interp[keep],
+                       self.rind_depth[keep], self.beyond[keep], self.carries[keep], self.mass,
+                       self.transfer, self.fpatch, self.cpatch)
+
+
+def overlap(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray | None = None,
+             xc: np.ndarray | None = None, nodes: np.ndarray | None = None
+             ) -> Overlap | None:
+    """Where the compatibility surface ``sf`` meets ``sc`` (undeformed, or at tracked
+    positions ``xf`` and ``xc``): each node's virtual node, normal and gap, and the
+    transfer of the traction (thesis §4.4-4.5).
+
+    Each surface takes part with its **patch**: the facets that face the other body
+    (:func:`facing`). A sharp corner of the other body (the edge of a flat punch) so ends
+    the patch, and a point of ``sf`` whose closest point on the patch is its end, beyond
+    which it lies (outside the end facet's normal strip), is not over the other surface:
+    it has no virtual node and its gap is its distance from that end, along the line to it.
+    Elsewhere the normal is the patch's, interpolated between its nodal normals
+    (continuous along a faceted curve; the facet normal on a flat) at the virtual node.
+
+    ``nodes``: the ``sf`` nodes to pair (default: the nodes of its patch).
+    """
+    xf = sf.X if xf is None else xf
+    xc = sc.X if xc is None else xc
+    fpatch, cpatch = facing(sf, xf, sc, xc), facing(sc, xc, sf, xf)
+    if not len(fpatch) or not len(cpatch):
+        return None
+    if nodes is None:
+        nodes = np.unique(sf.facets[fpatch])
+    normal, gap, interp, seg, past = virtual_nodes(sf, sc, xf, xc, nodes, fpatch, cpatch)
+    reach = float(np.abs(gap[~past]).max()) if (~past).any() else 0.0
+    mass, transfer = transfer_matrices(sf, sc, fpatch, cpatch,
+                                             sc.node_normals(xc, cpatch),
+                                             patch_ends(sc, cpatch), reach, xf, xc)
+    carries = mass[:, nodes].any(axis=0)
+    return Overlap(nodes, normal, gap, interp, sc.rind_depth[seg], past, carries, mass,
+                   transfer, fpatch, cpatch)

@@ -1,0 +1,153 @@
+"""What the contact formulations share with the solver: the state a step starts from and
+ends in, the record of each iteration, a solve's result, and the cycle watch.
+
+Every formulation (:mod:`vfem.contact.formulation`) keeps its contact forces in a
+:class:`ContactState` (or a subclass with its own unknowns: the paired variant's traction
+values, a baseline's active set), reports per body a :class:`Pairing` for the output fields, one
+:class:`IterationRecord` per iteration and a :class:`SolveResult` per solve; a failed solve names
+its failure kind (an :class:`~vfem.errors.AnalysisError` subclass) for the step cutter and the
+stop diagnosis.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import AnalysisError
+
+
+@dataclass
+class Pairing:
+    """The pairs (own node, virtual node) of one body; arrays over its candidate nodes (nc).
+
+    Forces are normal components in the pair's frame (see ``corrections``): positive is
+    compressive. ``normal`` is the outward normal of the opposing facet at the virtual node.
+    """
+
+    other: np.ndarray  # (nc,) opposing body, -1 where none
+    facet: np.ndarray  # (nc,) facet of the opposing body holding the virtual node
+    t: np.ndarray  # (nc,) local coordinate of the virtual node on that facet
+    normal: np.ndarray  # (nc, 2)
+    penetration: np.ndarray  # (nc,) > 0 inside the other body
+    embedded: np.ndarray  # (nc,) bool, located in the other body's rind
+    stiffness: np.ndarray  # (nc,) own Castigliano normal stiffness
+    virtual_stiffness: np.ndarray  # (nc,) opposing stiffness interpolated at the virtual node
+    force: np.ndarray  # (nc,) own compressive normal force
+    virtual_force: np.ndarray  # (nc,) opposing compressive force re-integrated on own elements
+    participating: np.ndarray  # (nc,) bool: embedded or carrying compressive force
+    #: (nc,) the formulation's normal traction at the node (nominal), where it has one; None:
+    #: the results read nodal force over tributary length
+    pressure: np.ndarray | None = None
+
+    @property
+    def equilibrium_error(self) -> np.ndarray:
+        return self.force - self.virtual_force
+
+
+@dataclass
+class ContactState:
+    """What the contact algorithm changes: the nodal contact forces on each body's candidates."""
+
+    load_factor: float
+    platen_displacement: float
+    forces: list[np.ndarray]  # per body (nc, 2), the force the other bodies apply on it
+    released: list[np.ndarray] = field(default_factory=list)  # nodes released last iteration
+    platen_force: float = 0.0  # the force the platen must apply (Platen.force_at)
+    multipliers: dict = field(default_factory=dict)  # per-pair traction values (paired)
+
+    def copy(self) -> ContactState:
+        return type(self)(self.load_factor, self.platen_displacement,
+                            [f.copy() for f in self.forces], [r.copy() for r in self.released],
+                            self.platen_force,
+                            {k: v.copy() for k, v in self.multipliers.items()})
+
+
+@dataclass
+class IterationRecord:
+    """The errors seen by one check and the corrections that followed (history of a solve)."""
+
+    iteration: int
+    max_penetration: float
+    max_equilibrium_error: float
+    contact_nodes: int
+    tension_nodes: int
+    force_correction: float = 0.0
+    displacement_correction: float = 0.0
+    platen_error: float = 0.0  # platen reaction minus its scheduled force
+
+
+@dataclass
+class SolveResult:
+    converged: bool
+    iterations: int
+    history: list[IterationRecord]
+    pairings: list[Pairing]
+    message: str = ""
+    fixed_point: bool = False  # stopped where corrections cancel, errors above tolerance
+    #: the failure kind of an unconverged solve (what the solver raises with ``message``)
+    failure: type[AnalysisError] = AnalysisError
+    #: the full-mesh results, where the solve has them itself (a baseline's global solution)
+    fields: dict | None = None
+
+
+class CycleWatch:
+    """Notices a contact iteration that cycles, so the step is cut instead of iterated to its
+    limit: the same contact set coming back after others (not merely staying the same, which is
+    how an iteration converges) without the error having fallen since it was last seen there.
+
+    Call once per iteration with the in-contact masks; returns a message naming the nodes that
+    keep switching once that has happened ``limit`` times, else None.
+    """
+
+    def __init__(self, limit: int = 3):
+        self.limit = limit
+        self.seen: dict[bytes, float] = {}  # contact set -> the smallest error seen with it
+        self.last: bytes | None = None
+        self.last_sets: list[np.ndarray] | None = None
+        self.flipping: list[set[int]] = []
+        self.count = 0
+
+    def __call__(self, sets: list[tuple[str, np.ndarray, np.ndarray]], error: float,
+                 iteration: int) -> str | None:
+        """``sets``: per side (body name, its node numbers, bool in-contact mask)."""
+        masks = [np.asarray(m, dtype=bool) for _, _, m in sets]
+        key = b"|".join(np.packbits(m).tobytes() + len(m).to_bytes(4, "little") for m in masks)
+        if self.last_sets is not None and key != self.last:
+            if not self.flipping:
+                self.flipping = [set() for _ in sets]
+            for k, (m0, m1) in enumerate(zip(self.last_sets, masks)):
+                self.flipping[k].update(np.flatnonzero(m0 != m1).tolist())
+            if key in self.seen and error >= self.seen[key]:
+                self.count += 1
+        self.seen[key] = min(error, self.seen.get(key, np.inf))
+        self.last, self.last_sets = key, masks
+        if self.count < self.limit:
+            return None
+        names = []
+        for (body, nodes, _), flips in zip(sets, self.flipping):
+            if flips:
+                listed = ", ".join(str(int(nodes[i])) for i in sorted(flips)[:8])
+                more = f" and {len(flips) - 8} more" if len(flips) > 8 else ""
+                names.append(f"node{'s' if len(flips) > 1 else ''} {listed}{more} of body "
+                             f"{body!r}")
+        return (f"the contact iteration cycles: {'; '.join(names) or 'some nodes'} keep "
+                f"switching in and out of contact while the error stays at {error:.3g} "
+                f"(iteration {iteration})")
+
+
+def closing_motion(penetration: np.ndarray, rate: np.ndarray, need: float) -> float:
+    """The platen motion that just closes the smallest gap when nothing touches yet.
+
+    ``rate`` is each node's change of penetration per unit platen motion; the platen moves the
+    way its missing force points (the sign of ``need``). Zero when no gap can be closed so.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.where(np.isfinite(penetration) & (rate != 0), -penetration / rate, np.nan)
+    ok = np.isfinite(d) & (np.sign(d) == np.sign(need))
+    return float(d[ok][np.argmin(np.abs(d[ok]))]) if ok.any() else 0.0
+
+
+__all__ = ["CycleWatch", "ContactState", "IterationRecord", "Pairing", "SolveResult",
+           "closing_motion"]
