@@ -66,9 +66,10 @@ def add_reactions(body: Body, r: BodyStepResult, load_factor: float) -> BodyStep
     numbers. Returns ``r``."""
     nodal = body.nodal_reaction(np.asarray(r.displacement).ravel(), load_factor,
                                 np.asarray(r.contact_force).ravel())
-    r.reaction = nodal.reshape(-1, 2)
+    dim = body.mesh.p.shape[0]
+    r.reaction = nodal.reshape(-1, dim)
     r.reactions = body.boundary_reactions(nodal)
-    r.applied_load = body.applied_load(load_factor).reshape(-1, 2).sum(axis=0)
+    r.applied_load = body.applied_load(load_factor).reshape(-1, dim).sum(axis=0)
     return r
 
 

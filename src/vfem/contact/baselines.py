@@ -544,7 +544,7 @@ class GlobalContact:
             b = s.body
             nv = b.npoints
             part = slice(off, off + b.ndofs)
-            force = (f_slave[part] + f_master[part]).reshape(-1, 2)
+            force = (f_slave[part] + f_master[part]).reshape(-1, s.dim)
             cand = s.nodes[: s.nc]
             mine = self.c.slave == i
             pressure = np.zeros(nv)
@@ -552,7 +552,7 @@ class GlobalContact:
             pressure[cand] = (np.bincount(self.c.node[mine], Lam[mine], minlength=s.nc)
                               / s.tributary)
             # master nodes: the normal component of the forces spread on them / tributary
-            fm = f_master[part].reshape(-1, 2)[cand]
+            fm = f_master[part].reshape(-1, s.dim)[cand]
             p_master = np.zeros(s.nc)
             if s.nc and len(s.facets):
                 p_master = -np.einsum("ij,ij->i", fm, s.node_normals()) / s.tributary
@@ -566,7 +566,7 @@ class GlobalContact:
                 np.maximum.at(depth, self.c.node[mine], -g[mine])
                 pen[cand] = np.where(np.isfinite(depth), depth, 0.0)
             out[b.name] = add_reactions(
-                b, BodyStepResult(U[part].reshape(-1, 2), force, pressure, status, pen),
+                b, BodyStepResult(U[part].reshape(-1, s.dim), force, pressure, status, pen),
                 load_factor)
             forces.append(force[cand])
         return out, forces

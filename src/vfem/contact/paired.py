@@ -154,8 +154,7 @@ class PairSet(SurfaceGroup):
             return 0.0, False
         # ends of the patch at a corner of the body (another candidate facet, not facing j,
         # meets it there), not where the candidates or the boundary stop
-        valence = np.bincount(s.facets[:, :2].ravel(), minlength=s.nc)[: s.nc]
-        ends = np.flatnonzero(patch_ends(s, patch) & (valence >= 2))
+        ends = np.flatnonzero(patch_ends(s, patch) & (s.vertex_valence >= 2))
         normals = s.node_normals(None, patch)
         seg, _, _, _, tf = so.closest(s.X[ends], None, opatch, normals[ends])
         e = so.facets[seg]

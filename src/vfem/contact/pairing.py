@@ -70,7 +70,7 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray)
     # and a facet over which a vertex of the other surface lies, facing it: a punch's corner
     # that has slid past the end of the face it pressed presses the block's facet beyond (left
     # out, the corner went into the block unheld: large kinematics, equal stiffness, 3e-3 deep)
-    verts = np.unique(so.facets[:, :2])
+    verts = so.vertices
     vn = so.node_normals(xo)[verts]
     seg, _, dist, _, tf = s.closest(xo[verts], x, None, vn)
     reach = 2.0 * (s.lengths.max() + so.lengths.max())

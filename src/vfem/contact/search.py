@@ -64,8 +64,14 @@ def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray,
     return out + (tf[first],) if free else out
 
 
+def normal_of_tangent(t: np.ndarray) -> np.ndarray:
+    """The (not normalised) outward normals (t_y, -t_x) of a 2D surface's tangents ``t`` (its
+    facets oriented so, see ``ContactSurface``): where the 2D geometry turns a tangent into a
+    normal (a 3D facet takes the cross product of its two tangents)."""
+    return np.column_stack([t[:, 1], -t[:, 0]])
+
+
 def outward_normals(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Unit outward normals (t_y, -t_x) of oriented facets (see ``ContactSurface``)."""
-    t = b - a
-    n = np.column_stack([t[:, 1], -t[:, 0]])
+    n = normal_of_tangent(b - a)
     return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]

@@ -29,7 +29,7 @@ from skfem.refdom import RefLine
 
 from ..bodies import COMPONENTS, Body
 from ..errors import InputError
-from .search import outward_normals, project_points
+from .search import normal_of_tangent, outward_normals, project_points
 
 log = logging.getLogger(__name__)
 
@@ -94,8 +94,7 @@ class ContactSurface:
         elem = mesh.f2t[0, facet_ids]
         centroid = mesh.p[:, mesh.t[:, elem]].mean(axis=1).T
         a, b = mesh.p[:, fn[:, 0]].T, mesh.p[:, fn[:, 1]].T
-        t = b - a
-        normal = np.column_stack([t[:, 1], -t[:, 0]])
+        normal = normal_of_tangent(b - a)
         flip = np.einsum("ij,ij->i", normal, 0.5 * (a + b) - centroid) < 0
         fn[flip, :2] = fn[flip][:, 1::-1]
 
@@ -203,11 +202,20 @@ class ContactSurface:
         return self._rind_depth
 
     @property
+    def vertex_valence(self) -> np.ndarray:
+        """(nc,) how many candidate facets each candidate node is a vertex of."""
+        return np.bincount(self.facets[:, :2].ravel(), minlength=self.nc)[: self.nc]
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """The candidate facets' vertices (their end nodes, not a quadratic facet's middle)."""
+        return np.unique(self.facets[:, :2])
+
+    @property
     def surface_ends(self) -> np.ndarray:
         """(nc,) True at the ends of the candidate surface (nodes on a single candidate facet)."""
         if not hasattr(self, "_ends"):
-            valence = np.bincount(self.facets[:, :2].ravel(), minlength=self.nc)[: self.nc]
-            self._ends = valence == 1
+            self._ends = self.vertex_valence == 1
         return self._ends
 
     @property
@@ -298,7 +306,7 @@ class ContactSurface:
                 t = np.clip(t - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
                 pos, tangent = self.curve(seg, t, x)
             dist = np.linalg.norm(points - pos, axis=1)
-        normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+        normal = normal_of_tangent(tangent)
         normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
         return seg, t, dist, normal, t_free
 

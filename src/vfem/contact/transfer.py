@@ -15,6 +15,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
+from .search import normal_of_tangent
 from .surface import ContactSurface, beyond
 
 
@@ -72,7 +73,7 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
     _, tangent = sf.curve(fac, sloc)
     wts = wts * np.linalg.norm(tangent, axis=1)
     pts, tangent = sf.curve(fac, sloc, xf)
-    own = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+    own = normal_of_tangent(tangent)
     own /= np.maximum(np.linalg.norm(own, axis=1), 1e-300)[:, None]
     seg, tt, dist, _, tf = sc.closest(pts, xc, cpatch, own)
     wts = np.where(beyond(sc, seg, tf, ends) | (dist > reach), 0.0, wts)
