@@ -286,6 +286,8 @@ def _solve_and_report(solve, progress: Progress, report, quiet: bool, args, out:
     summary["run"] = folder.run
     if not quiet:
         print("\n".join(_results_line(report(summary), out)))
+        if summary.get("figures_not_drawn"):  # no matplotlib (vfem.io.replot.draw_run)
+            print(f"vfem: figures not drawn: {summary['figures_not_drawn']}", file=sys.stderr)
     if not summary["converged"]:
         print(f"vfem: the analysis did not converge: "
               f"{summary.get('message') or 'see summary.json for each case'}",
@@ -428,6 +430,10 @@ def cmd_bench(args) -> int:
 
     if args.example != "hertz":
         raise InputError(f"no benchmark for {args.example!r}; available: hertz")
+    if args.plot:
+        from .io.plots import require_matplotlib
+
+        require_matplotlib()  # before the benchmark, not after it
     solvers = args.solver or ["auto"]
     backends = linalg.available() if "all" in solvers else [linalg.resolve(s) for s in solvers]
     if args.levels:
@@ -465,11 +471,12 @@ def cmd_bench(args) -> int:
 
 
 def cmd_study(args) -> int:
-    from .io.plots import convergence
+    from .io.plots import convergence, require_matplotlib
     from .tools.bench import speed_benchmark
 
     if args.example != "hertz":
         raise InputError(f"no study for {args.example!r}; available: hertz")
+    require_matplotlib()  # its figure is its result: refused before the study, not after it
     out = Path(args.out or Path("results") / "hertz_study")
     out.mkdir(parents=True, exist_ok=True)
     series = {}

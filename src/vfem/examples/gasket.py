@@ -33,7 +33,6 @@ import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from matplotlib.path import Path as PolygonPath
 
 from ..bodies import Body, PrescribedDisplacement, Support
 from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
@@ -186,6 +185,24 @@ def _face(body: Body, centre: tuple[float, float]) -> tuple[np.ndarray, np.ndarr
     return out[0], out[1]
 
 
+def _inside(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Whether each point (n, 2) lies inside the closed ``polygon`` (m, 2), by the even-odd
+    rule: a ray to the right of the point crosses its edges an odd number of times. A point on
+    an edge may go either way (its distance to the face is then zero, whichever sign it gets)."""
+    a = np.asarray(polygon, dtype=float)
+    b = np.roll(a, -1, axis=0)
+    dy = b[:, 1] - a[:, 1]
+    slope = np.divide(b[:, 0] - a[:, 0], dy, out=np.zeros_like(dy), where=dy != 0)
+    points = np.asarray(points, dtype=float)
+    inside = np.zeros(len(points), dtype=bool)
+    for start in range(0, len(points), 512):  # bounded memory: 512 points x m edges at a time
+        x, y = points[start:start + 512, :1], points[start:start + 512, 1:]
+        straddles = (a[:, 1] > y) != (b[:, 1] > y)  # never true for a horizontal edge
+        crossings = straddles & (x < a[:, 0] + (y - a[:, 1]) * slope)
+        inside[start:start + 512] = np.count_nonzero(crossings, axis=1) % 2 == 1
+    return inside
+
+
 def current_contact(model: Model, p: GasketParameters, displacements: dict[str, np.ndarray],
                     forces: dict[str, np.ndarray] | None = None,
                     status: dict[str, np.ndarray] | None = None) -> dict[str, float]:
@@ -228,7 +245,7 @@ def current_contact(model: Model, p: GasketParameters, displacements: dict[str, 
         face_other = ox[oo]
         pts = x[outer]
         _, _, dist = project_points(pts, face_other[:-1], face_other[1:])
-        inside = PolygonPath(outlines[other]).contains_points(pts)
+        inside = _inside(outlines[other], pts)
         gap = np.where(inside, -dist, dist)
         out["min_gap"] = min(out["min_gap"], float(gap.min()))
         out["max_overlap"] = max(out["max_overlap"], float(np.max(-gap, initial=0.0)))

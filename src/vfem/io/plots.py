@@ -1,17 +1,23 @@
-"""Figures of the examples (matplotlib, Agg backend: no display needed)."""
+"""Figures of the examples (matplotlib, Agg backend: no display needed).
+
+matplotlib is needed for the figures only, and imported when the first one is drawn
+(:func:`require_matplotlib`, the one place that checks for it): without it vfem still imports,
+solves and writes every other result; a run records why it drew no figure
+(``summary.json``'s ``figures_not_drawn``, :func:`vfem.io.replot.draw_run`) and ``vfem run``
+says so in one line; ``vfem plot`` stops with the message, exit status 2.
+"""
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
-from matplotlib.colors import Normalize  # noqa: E402
-from matplotlib.ticker import MaxNLocator, NullFormatter  # noqa: E402
+from ..errors import InputError
+
+#: how to get the figures' one optional dependency
+MATPLOTLIB_FIX = 'pip install matplotlib, or pip install -e ".[figures]"'
 
 #: the axis label of a model coordinate (vfem has no unit system: lengths are the model's own)
 LENGTH = "model units"
@@ -21,10 +27,47 @@ OUTSIDE = {"loc": "upper left", "bbox_to_anchor": (1.02, 1.0), "borderaxespad": 
 _LINESTYLES = ("-", "--", ":", "-.")
 
 
+@functools.cache
+def _pyplot():
+    """pyplot, switched to the Agg backend once (no display needed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def matplotlib_missing() -> str | None:
+    """None when matplotlib can be imported (figures can be drawn), else why not and the fix:
+    "matplotlib is not installed (pip install matplotlib, or ...)". The one check for it in
+    vfem (:func:`require_matplotlib` raises with it)."""
+    try:
+        _pyplot()
+    except ImportError as exc:
+        if isinstance(exc, ModuleNotFoundError) and (exc.name or "").split(".")[0] == "matplotlib":
+            why = "is not installed"
+        else:  # installed but broken (a dependency of its own missing, a binary mismatch)
+            why = f"cannot be imported: {(str(exc).splitlines() or [type(exc).__name__])[0]}"
+        return f"matplotlib {why} ({MATPLOTLIB_FIX})"
+    return None
+
+
+def require_matplotlib():
+    """``matplotlib.pyplot`` on the Agg backend, imported on the first call; every figure is
+    drawn through it. Without matplotlib: :class:`~vfem.errors.InputError` "figures not drawn:
+    matplotlib is not installed (...)", naming the fix (:func:`matplotlib_missing`)."""
+    why = matplotlib_missing()
+    if why is not None:
+        raise InputError(f"figures not drawn: {why}")
+    return _pyplot()
+
+
 def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[str, np.ndarray],
                    title: str, method: str = "vfem") -> None:
     """p/p0 against x/a for each body, with Hertz's ellipse (like thesis Fig. 5.3);
     ``method``: the contact method that computed them (the legend's label)."""
+    plt = require_matplotlib()
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     s = np.linspace(0, 1, 200)
     ax.plot(s, np.sqrt(1 - s**2), "k-", lw=1.5, label="Hertz")
@@ -49,6 +92,7 @@ def punch_pressure(path: Path, x: np.ndarray, p: np.ndarray, force: float, a: fl
                    title: str) -> None:
     """Nodal contact pressure against x under a flat punch of half-width ``a``, with Sadowsky's
     rigid punch on a half-plane carrying the same ``force``: P / (pi sqrt(a^2 - x^2))."""
+    plt = require_matplotlib()
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     s = np.linspace(-a, a, 801)[1:-1]
     ax.plot(s, force / (np.pi * np.sqrt(a**2 - s**2)), "k-", lw=1.2,
@@ -78,6 +122,9 @@ def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
     ``rms_error_averaged``. The p_max error is drawn signed (it may cross zero on its way to the
     model's own limit), the RMS error log-log.
     """
+    plt = require_matplotlib()
+    from matplotlib.ticker import NullFormatter
+
     fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.0), sharex=True)
     for (name, rows), marker in zip(series.items(), ("o", "s", "^", "v")):
         n = np.array([r["facets_across_a"] for r in rows], dtype=float)
@@ -128,6 +175,9 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     them. ``magnification``: the displacements are multiplied by it and the title says so
     (None: the title says nothing, for configurations that are not deformed shapes).
     """
+    plt = require_matplotlib()
+    from matplotlib.collections import LineCollection, PolyCollection
+
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     mesh_lines = len(frames) == 1 if mesh_lines is None else mesh_lines
     scale = 1.0 if magnification is None else float(magnification)
@@ -197,6 +247,10 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
     displacement (n, 2), von Mises stress per cell (m,)). Each body's outline is drawn in its
     own colour and named in the legend. One PolyCollection per body (fast on large meshes).
     """
+    plt = require_matplotlib()
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.colors import Normalize
+
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     fig, ax = plt.subplots(figsize=(8.5, 4.6))
     values = [np.asarray(b[4], dtype=float).ravel() for b in bodies]
@@ -238,6 +292,7 @@ def _outline(cells: np.ndarray) -> np.ndarray:
 def history(path: Path, x: np.ndarray, series: dict[str, np.ndarray], xlabel: str, ylabel: str,
             title: str) -> None:
     """Quantities against the step (e.g. the contact force of the gasket's load and unload)."""
+    plt = require_matplotlib()
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
     for (name, y), marker in zip(series.items(), ("o-", "s--", "^-", "v--")):
         ax.plot(x, y, marker, ms=4, label=name)
@@ -261,6 +316,7 @@ def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.n
     ``bodies``: name -> profiles (label, x, pressure), oldest first; the last one is emphasized.
     A body without nodes in contact is listed in the legend as such.
     """
+    plt = require_matplotlib()
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     fig, ax = plt.subplots(figsize=(8.5, 4.2))
     markers = ("o", "s", "^", "v", "D", "x")
@@ -301,6 +357,9 @@ def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarra
     ``panels``: (ylabel, series name -> (x, y), logarithmic y axis). On a logarithmic axis,
     values <= 0 are left out (a panel with none left stays linear).
     """
+    plt = require_matplotlib()
+    from matplotlib.ticker import MaxNLocator
+
     fig, axes = plt.subplots(len(panels), 1, figsize=(6.4, 2.4 * len(panels) + 0.8),
                              sharex=True, squeeze=False)
     for ax, (ylabel, series, log) in zip(axes[:, 0], panels):
@@ -333,6 +392,7 @@ def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarra
 def benchmark_times(path: Path, rows: list[dict], title: str) -> None:
     """Wall time against dofs, log-log: each (method, backend) solve next to the plain linear
     solve of the same mesh with the same backend (dashed), from ``vfem bench`` rows."""
+    plt = require_matplotlib()
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     series: dict[tuple[str, str], list[dict]] = {}
     for r in rows:

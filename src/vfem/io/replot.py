@@ -316,12 +316,24 @@ def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> lis
     (a built-in example's name or ``"input"``) and ``model``'s contact method and variant
     (``contact_settings``, for the titles), write ``summary.json``, draw the figures from the
     folder (:func:`plot_results`, as ``vfem plot`` does) and record their names, relative to
-    ``out``, as ``figures``. Returns those names."""
+    ``out``, as ``figures``. Returns those names.
+
+    Without matplotlib nothing is drawn: ``figures`` is empty and ``figures_not_drawn`` says
+    why and how to get it (:func:`vfem.io.plots.matplotlib_missing`; ``vfem run`` prints it);
+    everything else is written, so ``vfem plot`` draws the figures once it is installed."""
     out = Path(out)
     summary["figure_set"] = figure_set
     if model is not None:
         summary["contact_settings"] = {"variant": model.contact.variant,
                                        "method": model.contact.method}
+    summary.pop("figures_not_drawn", None)
+    missing = plots.matplotlib_missing()
+    if missing is not None:
+        log.info("figures not drawn: %s", missing)
+        summary["figures"] = []
+        summary["figures_not_drawn"] = missing
+        write_summary(out, summary)
+        return []
     write_summary(out, summary)
     summary["figures"] = [p.relative_to(out).as_posix() for p in plot_results(out)]
     write_summary(out, summary)
@@ -340,10 +352,12 @@ def plot_results(directory: Path | str) -> list[Path]:
     writing its files, so ``vfem plot`` redraws the same figures from the same data.
 
     Raises :class:`~vfem.errors.InputError` naming the path when the directory, its
-    ``results.pvd`` or a VTU file it lists is missing or unreadable.
+    ``results.pvd`` or a VTU file it lists is missing or unreadable, and naming the fix when
+    matplotlib is not installed (:func:`vfem.io.plots.require_matplotlib`).
     """
     from ..examples import EXAMPLES, load
 
+    plots.require_matplotlib()
     folder = Folder(directory)
     name = folder.summary.get("figure_set")
     example = folder.summary.get("example")
