@@ -207,3 +207,43 @@ def test_the_model_checks_read_the_declared_capabilities():
         check_capabilities(fake_model(large=True, method="penalty"))
     with pytest.raises(InputError, match="supports 2D bodies, this one is 3D"):
         check_capabilities(fake_model(dim=3))
+
+
+# -- each formulation's own typed state ------------------------------------------------------------
+
+
+def test_a_state_copy_keeps_its_type_and_owns_its_arrays():
+    from vfem.contact.state import STATE_TYPES, BaselineState, TractionState
+
+    base = dict(load_factor=0.5, platen_displacement=0.1, forces=[np.ones((2, 2))],
+                released=[np.zeros(2, dtype=bool)], platen_force=3.0)
+    for state in (TractionState(**base, tractions={0: np.array([1.0, 2.0])}),
+                  BaselineState(**base, pressures=np.array([4.0]), active=np.array([True]))):
+        copied = state.copy()
+        assert type(copied) is type(state) and STATE_TYPES[type(state).__name__] is type(state)
+        for name, value in state.unknowns().items():
+            np.testing.assert_array_equal(copied.unknowns()[name], value)
+            assert copied.unknowns()[name] is not value
+        copied.forces[0][0, 0] = 7.0
+        assert state.forces[0][0, 0] == 1.0
+        rebuilt = type(state)(**base).with_unknowns(state.unknowns())
+        assert sorted(rebuilt.unknowns()) == sorted(state.unknowns())
+
+
+@pytest.mark.parametrize(("method", "expected"), [("vfem", "TractionState"),
+                                                  ("lagrange", "BaselineState")])
+def test_a_checkpoint_written_before_the_states_were_typed_reads_back(method, expected):
+    from vfem.io.checkpoint import _state
+
+    meta = {"load_factor": 1.0, "platen_displacement": 0.0, "platen_force": 0.0,
+            "multipliers": [0, 1]}
+    arrays = {"force_0": np.zeros((2, 2)), "released_0": np.zeros(2, dtype=bool),
+              "multiplier_0": np.array([0.5, 0.0]), "multiplier_1": np.array([1.0, 0.0])}
+    model = SimpleNamespace(bodies=[None], contact=ContactSettings(method=method))
+    state = _state(meta, arrays, model)
+    assert type(state).__name__ == expected
+    if expected == "BaselineState":
+        np.testing.assert_array_equal(state.active, [True, False])
+        np.testing.assert_array_equal(state.pressures, [0.5, 0.0])
+    else:
+        np.testing.assert_array_equal(state.tractions[1], [1.0, 0.0])

@@ -33,8 +33,8 @@ def _arrays(cp) -> dict[str, np.ndarray]:
            "platen": np.array(cp.state.platen_displacement)}
     for i, (f, r) in enumerate(zip(cp.state.forces, cp.state.released)):
         out[f"force{i}"], out[f"released{i}"] = f.copy(), r.copy()
-    for k, lam in cp.state.multipliers.items():
-        out[f"lambda{k}"] = lam.copy()
+    for k, value in cp.state.unknowns().items():
+        out[k] = np.array(value, copy=True)
     for name, state in cp.bodies.items():
         for key, v in state.items():
             out[f"{name}.{key}"] = np.array(v, copy=True)

@@ -71,7 +71,7 @@ from ..errors import ActiveSetNotSettled, AnalysisError, SingularSystem
 from ..linalg import factorize
 from ..memory import memory_guard
 from .capabilities import Capabilities
-from .state import ContactState, IterationRecord, SolveResult
+from .state import BaselineState, IterationRecord, SolveResult
 from .surface import ContactSurface, beyond
 
 log = logging.getLogger(__name__)
@@ -266,22 +266,6 @@ class _Refined:
     def solve(self, b: np.ndarray) -> np.ndarray:
         x = self.factor.solve(b)
         return x + self.factor.solve(b - self.M @ x)
-
-
-class BaselineState(ContactState):
-    """A baseline's state: the contact forces, and its own unknowns, the active set and (for
-    the augmented Lagrangian) the multipliers, kept in ``multipliers`` (as checkpoints save
-    them) under the names :attr:`active` and :attr:`pressures`."""
-
-    @property
-    def pressures(self) -> np.ndarray:
-        """Per constraint row, the multiplier (pressure) the next step starts from."""
-        return self.multipliers[0]
-
-    @property
-    def active(self) -> np.ndarray:
-        """Per constraint row, whether it is in the active set."""
-        return self.multipliers[1] > 0
 
 
 class GlobalContact:
@@ -577,33 +561,30 @@ class GlobalContact:
         m = len(self.c.node)
         return BaselineState(0.0, 0.0, [np.zeros((s.nc, s.dim)) for s in self.surfaces],
                              [np.zeros(s.nc, dtype=bool) for s in self.surfaces], 0.0,
-                             {0: np.zeros(m), 1: np.zeros(m)})
+                             np.zeros(m), np.zeros(m, dtype=bool))
 
-    def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
+    def solve(self, state: BaselineState, on_iteration=None) -> SolveResult:
         """One step: the global solve at ``state``'s load factor from its active set (and
         multipliers), which becomes the new state (modified in place); the result carries the
         full-mesh fields of the global solution. Raises :class:`~vfem.errors.SingularSystem`
         or :class:`~vfem.errors.ActiveSetNotSettled` when the step cannot be solved."""
         m = len(self.c.node)
-        if any(len(state.multipliers.get(k, ())) != m for k in (0, 1)):  # another model's
-            state.multipliers = self.new_state().multipliers
+        if len(state.pressures) != m or len(state.active) != m:  # not this model's rows
+            state.pressures, state.active = np.zeros(m), np.zeros(m, dtype=bool)
         lf = state.load_factor
         before = self.factorizations
-        # (a state read back from a checkpoint is a plain ContactState: its multipliers hold
-        # the pressures and the active set, as BaselineState names them)
-        q, Lam, g, active, lam, history = self.solve_step(lf, state.multipliers[1] > 0,
-                                                          state.multipliers[0])
+        q, Lam, g, active, lam, history = self.solve_step(lf, state.active, state.pressures)
         fields, forces = self.fields_of(lf, q, Lam, g)
         state.platen_displacement = float(q[-1]) if self.platen_body is not None else 0.0
         state.forces[:] = forces
         state.released[:] = [np.zeros(s.nc, dtype=bool) for s in self.surfaces]
-        state.multipliers = {0: lam, 1: active.astype(float)}
+        state.pressures, state.active = lam, active.copy()
         log.info("load factor %.4g: %s converged in %d linear solves (%d factorizations), %d "
                  "nodes in contact, largest penetration %.3g", lf, self.method, len(history),
                  self.factorizations - before, int(active.sum()), history[-1].max_penetration)
         return SolveResult(True, len(history), history, [], fields=fields)
 
-    def fields(self, state: ContactState, result: SolveResult):
+    def fields(self, state: BaselineState, result: SolveResult):
         """The full-mesh results of the step's global solution (:meth:`fields_of`)."""
         return result.fields
 

@@ -214,7 +214,7 @@ class LargeDeformationContact(PairSet):
                 pair.mass = np.zeros_like(pair.mass)
                 pair.transfer = np.zeros_like(pair.transfer)
                 pair.patches = None
-                self._q(state, k)[:] = 0.0
+                self.tractions(state, k)[:] = 0.0
                 out.append(np.full(len(pair.nodes), -np.inf))
                 continue
             pair.normal, pair.interp, pair.rind_depth = geo.normal, geo.interp, geo.rind_depth
@@ -223,7 +223,7 @@ class LargeDeformationContact(PairSet):
             pair.mass, pair.transfer = geo.mass, geo.transfer
             pair.carries = geo.carries & ~geo.beyond
             pair.patches = geo.fpatch, geo.cpatch
-            self._q(state, k)[~pair.carries] = 0.0
+            self.tractions(state, k)[~pair.carries] = 0.0
             out.append(-geo.gap)
         return out
 
@@ -243,8 +243,8 @@ class LargeDeformationContact(PairSet):
             pens = self.penetrations(state)
             self.assemble_forces(state)  # the tractions along the current normals
             lins = self._linearize(state)
-            lams = [self._q(state, k) for k in range(len(pens))]
-            errs, pen_err, contact, tension = self.compatibility_errors(pens, lams)
+            traction_values = [self.tractions(state, k) for k in range(len(pens))]
+            errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
             body_err = max((lin.residual / lin.reference for lin in lins if lin is not None),
                            default=0.0)
             # a body whose prescribed displacements still lack their step's increment (the
@@ -257,7 +257,7 @@ class LargeDeformationContact(PairSet):
                 IterationRecord(it, pen_err, body_err, contact, tension, platen_error=-need),
                 (pen_err <= tol and tension == 0 and platen_ok and settled
                  and body_err <= BODY_TOLERANCE),
-                lambda: self.contact_sets(lams), max(pen_err, body_err),
+                lambda: self.contact_sets(traction_values), max(pen_err, body_err),
                 lambda: self.pairings(state, pens),
                 lambda: (f"no convergence in {cfg.max_iterations} iterations (penetration "
                          f"{pen_err:.3g}{self.worst_node(errs)}, body residual "
@@ -314,7 +314,7 @@ class LargeDeformationContact(PairSet):
         the virtual node, wherever that now is (the transfer held)."""
         out = [np.zeros((s.nc, s.dim)) for s in self.surfaces]
         for k, pair in enumerate(self.contact_pairs):
-            q = self._q(state, k)
+            q = self.tractions(state, k)
             on = np.flatnonzero(q != 0)
             if not len(on):
                 continue
@@ -338,7 +338,7 @@ class LargeDeformationContact(PairSet):
         off = self._offsets
         coords: set[int] = set()
         for k, pair in enumerate(self.contact_pairs):
-            on = np.flatnonzero(self._q(state, k) != 0)
+            on = np.flatnonzero(self.tractions(state, k) != 0)
             if not len(on):
                 continue
             sc = self.surfaces[pair.coarse]
@@ -404,7 +404,8 @@ class LargeDeformationContact(PairSet):
             p = p - self._normal_motion(pair, a, np.arange(len(pair.nodes)))
             reach = max(tol, float(np.max(p, initial=0.0)))
             lin_pens.append(p)
-            sets.append(np.flatnonzero(pair.carries & ((self._q(state, k) != 0) | (p > -reach))))
+            carrying = self.tractions(state, k) != 0
+            sets.append(np.flatnonzero(pair.carries & (carrying | (p > -reach))))
         m = sum(len(s_) for s_ in sets)
         # force patterns per unit traction value, stacked candidate dofs x m
         A = np.zeros((nt, m))
@@ -440,7 +441,7 @@ class LargeDeformationContact(PairSet):
             rows = slice(row, row + len(s_))
             W[rows] = self._normal_motion(pair, M, s_)
             p[rows] = lin_pens[k][s_]
-            q0[rows] = self._q(state, k)[s_]
+            q0[rows] = self.tractions(state, k)[s_]
             row += len(s_)
         rate = _concatenate([r[s_] for r, s_ in zip(rates, sets)])
         dR = -motion @ A[off[self.platen_body]:off[self.platen_body + 1]] if platen else None
@@ -501,7 +502,7 @@ class LargeDeformationContact(PairSet):
                 log.info("contact correction halved (%s)", exc)
         pos = 0
         for k, s_ in enumerate(sets):
-            self._q(state, k)[s_] += fraction * dq[pos:pos + len(s_)]
+            self.tractions(state, k)[s_] += fraction * dq[pos:pos + len(s_)]
             pos += len(s_)
         state.platen_displacement += fraction * dplaten
         for F, d in zip(state.forces, dF):

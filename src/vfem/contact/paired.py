@@ -58,7 +58,14 @@ from .pairing import (  # noqa: F401 - the pairing's parts, here too for those w
     virtual_nodes,
 )
 from .search import outward_normals
-from .state import ContactState, IterationRecord, Pairing, SolveResult, closing_motion
+from .state import (
+    ContactState,
+    IterationRecord,
+    Pairing,
+    SolveResult,
+    TractionState,
+    closing_motion,
+)
 from .surface import ContactSurface
 
 log = logging.getLogger(__name__)
@@ -82,6 +89,14 @@ class PairSet(SurfaceGroup):
         for pair in self.contact_pairs:
             pair.platen_rate = np.einsum("id,id->i", pair.normal, pair.interp @ v[pair.coarse]
                                          - v[pair.fine][pair.nodes])
+
+    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
+                  ) -> TractionState:
+        """No contact force, no traction: the unknowns are the pairs' traction values."""
+        base = super().new_state(load_factor, platen_displacement)
+        return TractionState(base.load_factor, base.platen_displacement, base.forces,
+                             base.released)
+
     # -- geometry of the pairs (once) -------------------------------------------------------------
 
     #: nodes that keep every candidate node of the compatibility side (large kinematics, where
@@ -179,32 +194,35 @@ class PairSet(SurfaceGroup):
             closer = d < dist
             best[closer], dist[closer] = j, d[closer]
         return best
+
     # -- state of the pairs -----------------------------------------------------------------------
 
-    def _q(self, state: ContactState, k: int) -> np.ndarray:
+    def tractions(self, state: TractionState, k: int) -> np.ndarray:
         """The normal traction values of pair k at its compatibility-side nodes (the unknowns)."""
         pair = self.contact_pairs[k]
-        if k not in state.multipliers:
-            state.multipliers[k] = np.zeros(len(pair.nodes))
-        return state.multipliers[k]
+        if k not in state.tractions:
+            state.tractions[k] = np.zeros(len(pair.nodes))
+        return state.tractions[k]
 
     def assemble_forces(self, state: ContactState) -> None:
         """Every body's nodal forces from the pairs' tractions (equilibrium in weak form)."""
         for F in state.forces:
             F[:] = 0.0
         for k, pair in enumerate(self.contact_pairs):
-            q = self._q(state, k)[:, None] * pair.normal  # traction vector at the fine nodes
+            q = self.tractions(state, k)[:, None] * pair.normal  # traction vector at the fine nodes
             state.forces[pair.fine] += pair.mass[:, pair.nodes] @ q
             state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ q
-    def compatibility_errors(self, pens: list[np.ndarray], lams: list[np.ndarray]
+
+    def compatibility_errors(self, pens: list[np.ndarray], traction_values: list[np.ndarray]
                              ) -> tuple[list[np.ndarray], float, int, int]:
         """Per pair the compatibility error of each node (|penetration| where the node touches
         or carries force, else 0); the largest; the nodes carrying force; those in tension."""
         tol = self.penetration_tolerance
-        errs = [np.where((lam > 0) | (p > tol), np.abs(p), 0.0) for p, lam in zip(pens, lams)]
+        errs = [np.where((q > 0) | (p > tol), np.abs(p), 0.0)
+                for p, q in zip(pens, traction_values)]
         largest = max((float(e.max()) for e in errs if len(e)), default=0.0)
-        return (errs, largest, sum(int((lam > 0).sum()) for lam in lams),
-                sum(int((lam < 0).sum()) for lam in lams))
+        return (errs, largest, sum(int((q > 0).sum()) for q in traction_values),
+                sum(int((q < 0).sum()) for q in traction_values))
 
     def worst_node(self, errs: list[np.ndarray]) -> str:
         """Where the largest of ``errs`` (per pair, over its nodes) is, for messages:
@@ -217,13 +235,14 @@ class PairSet(SurfaceGroup):
         node = int(sf.nodes[pair.nodes[int(np.argmax(errs[worst[1]]))]])
         return f" at node {node} of body {sf.body.name!r}"
 
-    def contact_sets(self, lams: list[np.ndarray]) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    def contact_sets(self, traction_values: list[np.ndarray]
+                     ) -> list[tuple[str, np.ndarray, np.ndarray]]:
         """Per pair, the compatibility side's (body name, node numbers, carrying-force mask):
         what :class:`~vfem.contact.algorithm.CycleWatch` compares between iterations."""
         out = []
-        for pair, lam in zip(self.contact_pairs, lams):
+        for pair, q in zip(self.contact_pairs, traction_values):
             sf = self.surfaces[pair.fine]
-            out.append((sf.body.name, sf.nodes[pair.nodes], lam > 0))
+            out.append((sf.body.name, sf.nodes[pair.nodes], q > 0))
         return out
 
     def _check_rind(self, pens: list[np.ndarray]) -> None:
@@ -236,6 +255,7 @@ class PairSet(SurfaceGroup):
                     f"node {int(sf.nodes[pair.nodes[k]])} of body {sf.body.name!r} went "
                     f"{p[k]:.3g} deep into body {sc.body.name!r}, past its outer layer of "
                     "elements: the step is too large")
+
     # -- what the results need --------------------------------------------------------------------
 
     def pairings(self, state: ContactState, pens: list[np.ndarray] | None = None
@@ -258,7 +278,7 @@ class PairSet(SurfaceGroup):
                     f = np.einsum("ij,ij->i", state.forces[i][pair.nodes], pair.normal)
                     on = np.abs(f) > 0
                     force[pair.nodes[on]] = f[on]
-                    touching[pair.nodes] = self._q(state, k) > 0
+                    touching[pair.nodes] = self.tractions(state, k) > 0
                     compat[pair.nodes] = True
                     pen[pair.nodes] = pens[k]
                     other[pair.nodes[on]] = pair.coarse
@@ -278,7 +298,7 @@ class PairSet(SurfaceGroup):
                                pressure=np.zeros(nc)))
         x = self.pairing_positions(state)
         for k, pair in enumerate(self.contact_pairs):
-            q = self._q(state, k)
+            q = self.tractions(state, k)
             out[pair.fine].pressure[pair.nodes] += q
             out[pair.coarse].pressure += self._traction_on_other_side(k, q, x)
         return out
@@ -343,6 +363,7 @@ class PairedContact(PairSet):
             uc = pair.interp @ (x[pair.coarse][: sc.nc] - sc.X[: sc.nc])
             out.append(-(pair.gap0 + np.einsum("ij,ij->i", uf - uc, pair.normal)))
         return out
+
     # -- the iteration ----------------------------------------------------------------------------
 
     def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
@@ -355,14 +376,14 @@ class PairedContact(PairSet):
 
         def check(it: int) -> Check:
             pens = self.penetrations(state)
-            lams = [self._q(state, k) for k in range(len(self.contact_pairs))]
+            traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
             self._check_rind(pens)
-            errs, pen_err, contact, tension = self.compatibility_errors(pens, lams)
+            errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
             platen_ok = self.platen_met(state)
             rec = IterationRecord(it, pen_err, 0.0, contact, tension,
                                   platen_error=self.platen_reaction(state) - state.platen_force)
             return Check(rec, pen_err <= tol and tension == 0 and platen_ok,
-                         lambda: self.contact_sets(lams), pen_err,
+                         lambda: self.contact_sets(traction_values), pen_err,
                          lambda: self.pairings(state, pens),
                          lambda: (f"no convergence in {cfg.max_iterations} iterations "
                                   f"(penetration {pen_err:.3g}{self.worst_node(errs)}, "
@@ -384,14 +405,14 @@ class PairedContact(PairSet):
         omega = cfg.first_relaxation if it < cfg.relaxed_iterations else cfg.relaxation
         active, targets = [], []
         for k, p in enumerate(pens):
-            lam = self._q(state, k)
+            q = self.tractions(state, k)
             pair = self.contact_pairs[k]
             released = state.released[pair.fine][pair.nodes]
-            tension = lam < 0
+            tension = q < 0
             frac = np.where(released, 1.0, 1.0 / cfg.release_iterations)
-            lam[tension] -= frac[tension] * lam[tension]
+            q[tension] -= frac[tension] * q[tension]
             state.released[pair.fine][pair.nodes] = tension & (frac < 1.0)
-            S = ~tension & ((lam > 0) | (p > tol))
+            S = ~tension & ((q > 0) | (p > tol))
             if not platen_ok and not S.any():
                 S = ~tension & (p > -tol)  # touching within tolerance: hold them there
             active.append(np.flatnonzero(S))
@@ -406,14 +427,14 @@ class PairedContact(PairSet):
         rhs = np.concatenate(targets)
         if self.platen_body is not None and state.platen_force != 0.0:
             body = self.surfaces[self.platen_body].body
-            dlam, dplaten = bordered_solve(W, -dp_dplaten, dR, body.platen_stiffness, rhs,
+            dq, dplaten = bordered_solve(W, -dp_dplaten, dR, body.platen_stiffness, rhs,
                                            state.platen_force - self.platen_reaction(state),
                                            lu_first=True)
         else:
-            dlam, dplaten = np.linalg.solve(W, rhs), 0.0
+            dq, dplaten = np.linalg.solve(W, rhs), 0.0
         pos = 0
         for k, a in enumerate(active):
-            self._q(state, k)[a] += dlam[pos:pos + len(a)]
+            self.tractions(state, k)[a] += dq[pos:pos + len(a)]
             pos += len(a)
         state.platen_displacement += dplaten
 
@@ -463,7 +484,7 @@ class PairedContact(PairSet):
             uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
             coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
             uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
-            # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dlam
+            # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dq
             W[rows] = np.einsum("id,idm->im", pair.normal, uf - uc)
             dp_dplaten[rows] = pair.platen_rate
         dR = np.zeros(m)

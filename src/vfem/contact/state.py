@@ -2,8 +2,9 @@
 ends in, the record of each iteration, a solve's result, and the cycle watch.
 
 Every formulation (:mod:`vfem.contact.formulation`) keeps its contact forces in a
-:class:`ContactState` (or a subclass with its own unknowns: the paired variant's traction
-values, a baseline's active set), reports per body a :class:`Pairing` for the output fields, one
+:class:`ContactState`, or in a subclass with its own unknowns: the paired variant's traction
+values (:class:`TractionState`), a baseline's active set and pressures
+(:class:`BaselineState`); reports per body a :class:`Pairing` for the output fields, one
 :class:`IterationRecord` per iteration and a :class:`SolveResult` per solve; a failed solve names
 its failure kind (an :class:`~vfem.errors.AnalysisError` subclass) for the step cutter and the
 stop diagnosis.
@@ -11,6 +12,7 @@ stop diagnosis.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -48,20 +50,69 @@ class Pairing:
 
 @dataclass
 class ContactState:
-    """What the contact algorithm changes: the nodal contact forces on each body's candidates."""
+    """What every formulation's contact solve changes: the nodal contact forces on each body's
+    candidates, the platen's motion and force. A formulation with unknowns of its own keeps
+    them in a subclass (:class:`TractionState`, :class:`BaselineState`), which names them for
+    checkpoints (:meth:`unknowns`, :meth:`with_unknowns`)."""
 
     load_factor: float
     platen_displacement: float
-    forces: list[np.ndarray]  # per body (nc, 2), the force the other bodies apply on it
+    forces: list[np.ndarray]  # per body (nc, dim), the force the other bodies apply on it
     released: list[np.ndarray] = field(default_factory=list)  # nodes released last iteration
     platen_force: float = 0.0  # the force the platen must apply (Platen.force_at)
-    multipliers: dict = field(default_factory=dict)  # per-pair traction values (paired)
 
     def copy(self) -> ContactState:
-        return type(self)(self.load_factor, self.platen_displacement,
-                            [f.copy() for f in self.forces], [r.copy() for r in self.released],
-                            self.platen_force,
-                            {k: v.copy() for k, v in self.multipliers.items()})
+        """A deep copy (every array copied), of the same type."""
+        out = copy.copy(self)
+        out.forces = [f.copy() for f in self.forces]
+        out.released = [r.copy() for r in self.released]
+        return out.with_unknowns({k: v.copy() for k, v in self.unknowns().items()})
+
+    def unknowns(self) -> dict[str, np.ndarray]:
+        """The formulation's own unknowns, by name (none here)."""
+        return {}
+
+    def with_unknowns(self, arrays: dict[str, np.ndarray]) -> ContactState:
+        """This state with its own unknowns set from ``arrays`` (:meth:`unknowns`'s names);
+        returns it."""
+        return self
+
+
+@dataclass
+class TractionState(ContactState):
+    """The paired variant's state: per contact pair (its index), the normal traction values at
+    its compatibility-side nodes, the unknowns of its iteration (thesis §4.4)."""
+
+    tractions: dict[int, np.ndarray] = field(default_factory=dict)
+
+    def unknowns(self) -> dict[str, np.ndarray]:
+        return {f"traction_{k}": v for k, v in self.tractions.items()}
+
+    def with_unknowns(self, arrays: dict[str, np.ndarray]) -> TractionState:
+        self.tractions = {int(k.removeprefix("traction_")): v for k, v in arrays.items()
+                          if k.startswith("traction_")}
+        return self
+
+
+@dataclass
+class BaselineState(ContactState):
+    """A classical baseline's state: per constraint row, whether it is active and the
+    multiplier (pressure) the next step starts from (the augmented Lagrangian's)."""
+
+    pressures: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    active: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+
+    def unknowns(self) -> dict[str, np.ndarray]:
+        return {"pressures": self.pressures, "active": self.active}
+
+    def with_unknowns(self, arrays: dict[str, np.ndarray]) -> BaselineState:
+        self.pressures = arrays.get("pressures", np.zeros(0))
+        self.active = np.asarray(arrays.get("active", np.zeros(0)), dtype=bool)
+        return self
+
+
+#: every state type, by name: how a checkpoint reads a state back
+STATE_TYPES = {cls.__name__: cls for cls in (ContactState, TractionState, BaselineState)}
 
 
 @dataclass
@@ -149,5 +200,5 @@ def closing_motion(penetration: np.ndarray, rate: np.ndarray, need: float) -> fl
     return float(d[ok][np.argmin(np.abs(d[ok]))]) if ok.any() else 0.0
 
 
-__all__ = ["CycleWatch", "ContactState", "IterationRecord", "Pairing", "SolveResult",
-           "closing_motion"]
+__all__ = ["BaselineState", "ContactState", "CycleWatch", "IterationRecord", "Pairing",
+           "STATE_TYPES", "SolveResult", "TractionState", "closing_motion"]

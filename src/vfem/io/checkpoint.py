@@ -23,7 +23,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..contact.state import ContactState, IterationRecord
+from ..contact.state import (
+    STATE_TYPES,
+    BaselineState,
+    ContactState,
+    IterationRecord,
+    TractionState,
+)
 from ..errors import InputError
 from ..solver import BodyStepResult, Checkpoint, Model, StepResult
 
@@ -63,8 +69,8 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
             arrays[f"body_{i}_{key}"] = np.asarray(value)
     for i, (F, rel) in enumerate(zip(state.forces, state.released)):
         arrays[f"force_{i}"], arrays[f"released_{i}"] = F, rel
-    for k, lam in state.multipliers.items():
-        arrays[f"multiplier_{int(k)}"] = lam
+    for name, value in state.unknowns().items():  # the formulation's own unknowns
+        arrays[f"unknown_{name}"] = value
     meta = {
         "fingerprint": model_fingerprint,
         "step": {"step": step.step, "load_factor": step.load_factor,
@@ -77,7 +83,7 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
         "state": {"load_factor": state.load_factor,
                   "platen_displacement": state.platen_displacement,
                   "platen_force": state.platen_force,
-                  "multipliers": sorted(int(k) for k in state.multipliers)},
+                  "type": type(state).__name__, "unknowns": sorted(state.unknowns())},
         "bodies": {b.name: sorted(checkpoint.bodies.get(b.name, {})) for b in model.bodies},
         "control": {"target": checkpoint.target, "level": checkpoint.level,
                     "easy": checkpoint.easy},
@@ -118,15 +124,35 @@ def read(out: Path, model: Model) -> Checkpoint | None:
                              "options as the run that wrote them, or run afresh without "
                              "--resume")
         steps.append(_step(meta["step"], arrays, model, meta.get("reactions", {})))
-    state = ContactState(
-        meta["state"]["load_factor"], meta["state"]["platen_displacement"],
-        [arrays[f"force_{i}"] for i in range(len(model.bodies))],
-        [arrays[f"released_{i}"] for i in range(len(model.bodies))],
-        meta["state"]["platen_force"],
-        {k: arrays[f"multiplier_{k}"] for k in meta["state"]["multipliers"]})
+    state = _state(meta["state"], arrays, model)
     bodies = {b.name: {key: arrays[f"body_{i}_{key}"] for key in meta["bodies"][b.name]}
               for i, b in enumerate(model.bodies)}
     return Checkpoint(steps, state, bodies, **meta["control"])
+
+
+def _state(meta: dict, arrays: dict[str, np.ndarray], model: Model) -> ContactState:
+    """The contact state of a checkpoint, of the type its formulation keeps
+    (:data:`~vfem.contact.state.STATE_TYPES`). A checkpoint written before the states were
+    typed (2026-11-25) kept the formulation's unknowns as numbered "multipliers": a baseline's
+    pressures and active set (0, 1), the paired variant's traction values per pair."""
+    n = len(model.bodies)
+    base = ContactState(meta["load_factor"], meta["platen_displacement"],
+                        [arrays[f"force_{i}"] for i in range(n)],
+                        [arrays[f"released_{i}"] for i in range(n)], meta["platen_force"])
+    if "type" in meta:
+        cls = STATE_TYPES.get(meta["type"], ContactState)
+        unknowns = {k: arrays[f"unknown_{k}"] for k in meta["unknowns"]}
+    else:
+        old = {int(k): arrays[f"multiplier_{k}"] for k in meta.get("multipliers", [])}
+        if model.contact.method != "vfem":
+            cls, unknowns = BaselineState, {"pressures": old.get(0, np.zeros(0)),
+                                            "active": old.get(1, np.zeros(0)) > 0}
+        elif old:
+            cls, unknowns = TractionState, {f"traction_{k}": v for k, v in old.items()}
+        else:
+            cls, unknowns = ContactState, {}
+    fields = {f.name: getattr(base, f.name) for f in dataclasses.fields(ContactState)}
+    return cls(**fields).with_unknowns(unknowns)
 
 
 def _step(meta: dict, arrays: dict[str, np.ndarray], model: Model,
