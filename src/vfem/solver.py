@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .bodies import Body, multiplier
+from .bodies.stresses import max_strain
 from .contact.check import InvariantCheck, Invariants
 from .contact.formulation import check_capabilities, formulation_class
 from .contact.search import project_points
@@ -364,7 +365,7 @@ class Analysis:
         for b in self.model.bodies:
             if b.large or b.name in self.strain_warned or b.name not in step.bodies:
                 continue
-            strain, element = b.max_strain(step.bodies[b.name].displacement.ravel())
+            strain, element = max_strain(b, step.bodies[b.name].displacement.ravel())
             if strain > SMALL_STRAIN_LIMIT:
                 self.strain_warned.add(b.name)
                 x, y = b.mesh.p[:, b.mesh.t[:, element]].mean(axis=1)

@@ -54,6 +54,7 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
+from ..bodies.stresses import stress as body_stress
 from ..contact.surface import ContactSurface
 from ..errors import InputError
 from ..solver import Analysis, AnalysisResult, Model, StepResult
@@ -112,7 +113,7 @@ class ResultsWriter:
             cell_type, conn = body.cells()
             npts = body.npoints
             u = np.column_stack([r.displacement, np.zeros(len(r.displacement))])
-            stress = body.stress(r.displacement.ravel())
+            stress = body_stress(body, r.displacement.ravel())
             name = self._vtu_name(body, step)
             m = meshio.Mesh(
                 points=np.column_stack([body.points.T, np.zeros(npts)]),

@@ -21,7 +21,6 @@ from __future__ import annotations
 import logging
 import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -39,14 +38,20 @@ from skfem import (
     MeshTri,
     asm,
 )
-from skfem.helpers import sym_grad, trace
 from skfem.mesh.mesh_2d_2 import Mesh2D2
 from skfem.models.elasticity import linear_elasticity
 
-from .errors import AnalysisError, InputError
-from .linalg import factorize
-from .materials import LinearElastic
-from .mesh.checks import check_mesh
+from ..errors import InputError
+from ..linalg import factorize
+from ..materials import LinearElastic
+from ..mesh.checks import check_mesh
+from .mechanics import (
+    BodyMechanics,
+    LargeMechanics,
+    Linearization,
+    LinearMechanics,
+    _platen_stiffness,
+)
 
 log = logging.getLogger(__name__)
 
@@ -189,67 +194,6 @@ class Traction:
     boundary: str
     value: tuple[float, float]
     amplitude: tuple[tuple[float, float], ...] | None = None
-
-
-@dataclass
-class Linearization:
-    """Newton's system of a large-kinematics body at its trial state (:meth:`Body.linearize`).
-
-    Attributes:
-        residual: norm of the out-of-balance force ``f_int - f_ext`` on the free dofs.
-        reference: the force it is measured against (:class:`vfem.nonlinear.NewtonStep`).
-        correction: (ndofs) Newton's correction with the contact forces held, the prescribed
-            displacements' increments included.
-        flexibility: (tracked, candidate) the tangent flexibility rows of the tracked dofs for
-            the candidate dofs (supports kept): the inverse of the tangent's Schur complement on
-            the tracked dofs, from its factorization (:func:`_tangent_factorization`).
-        platen_motion: (ndofs) the motion per unit motion of the platen (1 on its dofs).
-        platen_stiffness: the platen's reaction per unit platen motion.
-        platen_reaction: the platen's reaction after ``correction``, linearised.
-        prescribed_met: whether the prescribed displacements (the platen's included) have
-            their values (else ``correction`` applies what they lack).
-        solve: the tangent flexibility applied to nodal forces (ndofs, or ndofs x k): the
-            displacements (zero on the fixed dofs).
-    """
-
-    residual: float
-    reference: float
-    correction: np.ndarray
-    flexibility: np.ndarray
-    platen_motion: np.ndarray
-    platen_stiffness: float
-    platen_reaction: float
-    prescribed_met: bool
-    solve: Callable[[np.ndarray], np.ndarray]
-
-
-def _tangent_factorization(K_ff, trailing: np.ndarray, groups: np.ndarray, rhs: np.ndarray,
-                           backend: str | None, name: str):
-    """A large body's tangent on its free dofs, factorized once per linearisation.
-
-    A tangent is positive definite unless the body is near buckling (geometric stiffness under
-    compression). It is first factorized as such with the ``trailing`` (tracked) dofs eliminated
-    last, which also yields the inverse tangent on them (``trailing_inverse``: the tangent
-    flexibility, from the Schur complement, instead of one back-substitution per contact dof).
-    Where that fails (not positive definite) or its solve of ``rhs`` is not accurate (SuperLU
-    factorizes in that order without pivoting), the tangent is factorized as indefinite and
-    ``trailing_inverse`` is None. Returns the factorization and its solution of ``rhs``.
-    """
-    if len(trailing):
-        try:
-            factor = factorize(K_ff, backend, trailing=trailing, groups=groups,
-                               what=f"body {name!r} (tangent)")
-            x = factor.solve(rhs)
-            scale = max(float(np.abs(rhs).max(initial=0.0)), 1e-300)
-            if (factor.trailing_inverse is not None
-                    and float(np.abs(K_ff @ x - rhs).max(initial=0.0)) <= 1e-10 * scale):
-                return factor, x
-        except AnalysisError as exc:
-            log.debug("body %r: tangent not positive definite (%s); factorized as indefinite",
-                      name, exc)
-    factor = factorize(K_ff, backend, spd=False, what=f"body {name!r} (tangent)")
-    factor.trailing_inverse = None
-    return factor, factor.solve(rhs)
 
 
 @dataclass(frozen=True)
@@ -407,149 +351,64 @@ class Body:
                                               - case.force)[platen_dofs].sum())
             self.platen_load_reaction = sum(c.platen_reaction for c in self.load_cases)
             self.platen_stiffness = _platen_stiffness(self.K, self.u_platen, platen_dofs)
-        if self.large:
-            self._setup_large(fixed)
+        # how the body answers its contact forces: linearly, or under large kinematics
+        self.mechanics = LargeMechanics(self, fixed) if self.large else LinearMechanics(self)
         self.timings.update(constraints_s=self.timings["constraints_s"] + t2 - t1,
                             factorize_s=t3 - t2, load_cases_s=time.perf_counter() - t3)
         log.info("body %s: %d points, %d dofs (%d fixed)", self.name, self.ndofs // 2,
                  self.ndofs, len(self.fixed_dofs))
 
-    # -- large displacements ----------------------------------------------------------------------
+    # -- the body's mechanics (vfem.bodies.mechanics) ---------------------------------------
 
-    def _setup_large(self, fixed: dict[int, float]) -> None:
-        """The hyperelastic body behind a large-kinematics body (:mod:`vfem.nonlinear`).
+    @property
+    def mechanics(self) -> BodyMechanics:
+        """How the body answers its contact forces (:mod:`vfem.bodies.mechanics`): set by
+        :meth:`setup`; linear for a body that was only assembled (a baseline's)."""
+        if "_mechanics" not in self.__dict__:
+            self._mechanics = LinearMechanics(self)
+        return self._mechanics
 
-        Its supports and prescribed displacements are prescribed dofs scaled by the load factor,
-        its tractions dead nodal forces (per undeformed length, as for small kinematics), and a
-        platen's dofs follow the platen displacement the contact iteration sets. The linear
-        quantities set up above are the tangent ones at rest, which is where the first step
-        starts from.
-        """
-        from .materials import NeoHookean, SaintVenantKirchhoff
-        from .nonlinear import NonlinearBody
+    @mechanics.setter
+    def mechanics(self, value: BodyMechanics) -> None:
+        self._mechanics = value
 
-        law = {"saint-venant-kirchhoff": SaintVenantKirchhoff, "neo-hookean": NeoHookean}[self.law]
-        material = law(self.material.youngs_modulus, self.material.poissons_ratio)
-        nl = NonlinearBody(self.mesh, material, formulation=self.kinematics,
-                           name=f"body {self.name!r}")
-        dofs = np.array(sorted(fixed), dtype=int)
-        if len(dofs):
-            nl.prescribe(dofs, np.array([fixed[d] for d in dofs.tolist()]))
-        for pd in self.prescribed:  # later ones win, as in _constraints
-            dofs = self._boundary_dofs(pd.boundary, pd.component)
-            nl.prescribe(dofs, _ramp(pd, len(dofs)))
-        self._platen_value = 0.0
-        if len(self.platen_dofs):
-            nl.prescribe(self.platen_dofs,
-                         lambda lf: np.full(len(self.platen_dofs), self._platen_value))
-        nl.add_nodal_forces(np.arange(self.ndofs), self.f_load)
-        if any(tr.amplitude is not None for tr in self.tractions):  # not proportional
-            nl.set_load_history(self.applied_load)
-        self.nonlinear = nl
-        self._equilibrated: tuple | None = None
+    @property
+    def nonlinear(self):
+        """The hyperelastic body behind a large-kinematics body (:mod:`vfem.nonlinear`)."""
+        return self.mechanics.nonlinear
 
     def equilibrate(self, load_factor: float, platen_displacement: float,
                     contact_force: np.ndarray) -> np.ndarray:
-        """Large kinematics: the equilibrium displacement (ndofs) under the loads at
-        ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
-        (a trial state of the step, see :meth:`commit_step`). Repeated calls with the same
-        arguments cost nothing."""
-        f = np.asarray(contact_force, dtype=float)
-        key = (float(load_factor), float(platen_displacement), f.tobytes())
-        if self._equilibrated != key:
-            self._platen_value = float(platen_displacement)
-            self.nonlinear.equilibrate(load_factor, f)
-            self._equilibrated = key
-        return self.nonlinear.trial_displacement()
+        """Large kinematics: :meth:`LargeMechanics.equilibrate`."""
+        return self.mechanics.equilibrate(load_factor, platen_displacement, contact_force)
 
     def linearize(self, load_factor: float, platen_displacement: float,
                   contact_force: np.ndarray, tracked_dofs: np.ndarray,
                   candidate_dofs: np.ndarray, backend: str | None = None) -> Linearization:
-        """Large kinematics: Newton's system at the trial state under the loads at
-        ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
-        (held), factorized once (see :class:`Linearization`). Move the trial state with
-        :meth:`move`."""
-        self._platen_value = float(platen_displacement)
-        self._equilibrated = None
-        R, ref, K, D, pending = self.nonlinear.linearize(load_factor, contact_force)
-        free = np.setdiff1d(np.arange(self.ndofs), D)
-        K_ff = K[free][:, free].tocsc()
-        # the tracked dofs among the free ones: their block of the inverse tangent is the
-        # inverse of its Schur complement, from the factorization (as for the linear body)
-        pos = np.searchsorted(free, tracked_dofs)
-        held = free[np.minimum(pos, len(free) - 1)] == tracked_dofs
-        factor, step = _tangent_factorization(K_ff, pos[held], free // 2,
-                                              -R[free] - K[free] @ pending, backend, self.name)
-
-        def solve(f: np.ndarray) -> np.ndarray:
-            out = np.zeros((self.ndofs,) + f.shape[1:])
-            out[free] = factor.solve(f[free])
-            return out
-
-        correction = pending.copy()
-        correction[free] = step
-        # flexibility rows of the tracked dofs for the candidate dofs (supports kept); the
-        # candidate dofs are the first of the tracked ones (ContactSurface.tracked_dofs)
-        nc2 = len(candidate_dofs)
-        flexibility = np.zeros((len(tracked_dofs), nc2))
-        if factor.trailing_inverse is not None:
-            rows = np.flatnonzero(held)
-            cols = rows[rows < nc2]
-            flexibility[np.ix_(rows, cols)] = factor.trailing_inverse[:, : len(cols)]
-        else:  # an indefinite tangent: one back-substitution per candidate dof
-            pos = np.searchsorted(free, candidate_dofs)
-            cols = np.flatnonzero(free[np.minimum(pos, len(free) - 1)] == candidate_dofs)
-            unit = np.zeros((self.ndofs, len(cols)))
-            unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
-            if len(cols):
-                flexibility[:, cols] = solve(unit)[tracked_dofs]
-        platen_motion = np.zeros(self.ndofs)
-        stiffness = reaction = 0.0
-        P = self.platen_dofs
-        if len(P):
-            platen_motion[P] = 1.0
-            platen_motion[free] = factor.solve(-(K[free][:, P] @ np.ones(len(P))))
-            stiffness = _platen_stiffness(K, platen_motion, P)
-            reaction = float((R + K @ correction)[P].sum())
-        met = float(np.abs(pending).max(initial=0.0)) <= 1e-13 * self.nonlinear.length
-        return Linearization(float(np.linalg.norm(R[free])), ref, correction, flexibility,
-                             platen_motion, stiffness, reaction, met, solve)
+        """Large kinematics: :meth:`LargeMechanics.linearize`."""
+        return self.mechanics.linearize(load_factor, platen_displacement, contact_force,
+                                        tracked_dofs, candidate_dofs, backend)
 
     def move(self, correction: np.ndarray) -> None:
-        """Large kinematics: add ``correction`` (ndofs) to the trial displacement.
-
-        Raises:
-            AnalysisError: an element would turn inside out; the trial state is unchanged.
-        """
-        self.nonlinear.move(correction)
-        self._equilibrated = None
+        """Large kinematics: :meth:`LargeMechanics.move`."""
+        self.mechanics.move(correction)
 
     def commit_step(self) -> None:
-        """A step converged: its trial state becomes the start of the next (large kinematics;
-        nothing to do for small)."""
-        if self.large:
-            self.nonlinear.accept()
-            self._equilibrated = None
+        """A step converged: keep its state (large kinematics; nothing for small)."""
+        self.mechanics.commit()
 
     def discard_step(self) -> None:
         """A step failed: go back to the last converged state (large kinematics)."""
-        if self.large:
-            self.nonlinear.discard()
-            self._equilibrated = None
+        self.mechanics.discard()
 
     def saved_state(self) -> dict[str, np.ndarray]:
         """The converged state as arrays (empty for small kinematics: a linear body's state is
         the contact forces, platen and load factor, which the contact state holds)."""
-        if not self.large:
-            return {}
-        return {**self.nonlinear.saved_state(), "platen_value": np.array(self._platen_value)}
+        return self.mechanics.saved_state()
 
     def restore_state(self, state: dict[str, np.ndarray]) -> None:
         """Put back a state from :meth:`saved_state` exactly (step cutting, ``--resume``)."""
-        if self.large:
-            self.nonlinear.restore_state(state)
-            self._platen_value = float(state["platen_value"])
-            self._equilibrated = None
+        self.mechanics.restore_state(state)
 
     def check_supports(self) -> None:
         """Without assembling anything: raise :class:`InputError` if the body is invalid or
@@ -790,11 +649,8 @@ class Body:
 
     def displacement(self, load_factor: float, platen_displacement: float,
                      contact_force: np.ndarray) -> np.ndarray:
-        """Full displacement vector (ndofs) for the given state."""
-        if self.large:
-            return self.equilibrate(load_factor, platen_displacement, contact_force).copy()
-        return (self.load_displacement(load_factor) + platen_displacement * self.u_platen
-                + self.response(contact_force))
+        """Full displacement vector (ndofs) for the given state (:attr:`mechanics`)."""
+        return self.mechanics.displacement(load_factor, platen_displacement, contact_force)
 
     def applied_load(self, load_factor: float) -> np.ndarray:
         """The body's applied nodal loads (ndofs: its tractions' load vector) at
@@ -812,7 +668,7 @@ class Body:
         ones, where it is only the solver's residual. Adding it to the loads and contact
         forces balances the body, so its sum is the body's total support reaction, each
         constrained dof counted once."""
-        Ku = self.nonlinear.internal_force_at(u) if self.large else self.K @ u
+        Ku = self.mechanics.internal_force(u)
         r = Ku - self.applied_load(load_factor)
         if contact_force is not None:
             r = r - contact_force
@@ -855,75 +711,6 @@ class Body:
         over the boundary's dofs of that component (zero where none of them is constrained)."""
         r = self.nodal_reaction(u, load_factor, contact_force)
         return float(r[self._boundary_dofs(boundary, component)].sum())
-
-    def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
-        """Element-average stresses: sxx, syy, sxy, szz and von Mises (per element); Cauchy
-        stresses in the deformed configuration under large kinematics."""
-        if self.large:
-            sig, szz = self.nonlinear.cauchy_stress_at(u)
-            avg = {"sxx": sig[:, 0, 0], "syy": sig[:, 1, 1], "sxy": sig[:, 0, 1], "szz": szz}
-            return _with_von_mises(avg)
-        lam, mu = self.material.lame()
-        ui = self.basis.interpolate(u)
-        eps = sym_grad(ui)
-        tr = trace(eps)
-        sig = 2 * mu * eps
-        sig[0, 0] += lam * tr
-        sig[1, 1] += lam * tr
-        w = self.basis.dx
-        avg = {key: (sig[i, j] * w).sum(axis=1) / w.sum(axis=1)
-               for key, (i, j) in {"sxx": (0, 0), "syy": (1, 1), "sxy": (0, 1)}.items()}
-        nu = self.material.poissons_ratio
-        avg["szz"] = (nu * (avg["sxx"] + avg["syy"]) if self.material.plane == "strain"
-                      else np.zeros_like(avg["sxx"]))
-        return _with_von_mises(avg)
-
-    def max_strain(self, u: np.ndarray) -> tuple[float, int]:
-        """The largest strain of displacement ``u`` (ndofs) as small kinematics reads it: the
-        largest absolute principal value of the in-plane small-strain tensor sym(grad u)
-        (``|(exx + eyy) / 2| + sqrt(((exx - eyy) / 2)^2 + exy^2)``) over every quadrature
-        point of the mesh, and the element where it is. Independent of the material; what
-        the solver compares with :data:`vfem.solver.SMALL_STRAIN_LIMIT` after each step. The
-        gradient is summed from the basis's own shape-function gradients, each vector shape
-        function's one nonzero component only (4 times faster than ``basis.interpolate``:
-        0.05 s for 160k dofs; after :meth:`assemble`)."""
-        basis = self.basis
-        ue = np.asarray(u, dtype=float)[basis.element_dofs]  # (shape functions, elements)
-        grad = None  # (component, derivative, element, quadrature point)
-        for i in range(basis.Nbfun):
-            c = i % 2  # ElementVector: shape function i moves component i % 2
-            g = basis.basis[i][0].grad[c]  # (derivative, element, quadrature point)
-            if grad is None:
-                grad = np.zeros((2,) + g.shape)
-            grad[c] += ue[i][:, None] * g
-        exx, eyy, exy = grad[0, 0], grad[1, 1], 0.5 * (grad[0, 1] + grad[1, 0])
-        principal = np.abs(0.5 * (exx + eyy)) + np.sqrt((0.5 * (exx - eyy)) ** 2 + exy**2)
-        per_element = principal.max(axis=1) if principal.size else np.zeros(1)
-        element = int(np.argmax(per_element))
-        return float(per_element[element]), element
-
-
-def _platen_stiffness(K, motion: np.ndarray, platen_dofs: np.ndarray) -> float:
-    """The platen's reaction per unit platen motion (``motion``: the body's response to it).
-
-    A body that only contact holds moves rigidly with its platen: zero up to round-off, which
-    is cleaned to exactly zero (the platen's equations then know nothing else holds the body).
-    """
-    stiffness = float((K @ motion)[platen_dofs].sum())
-    scale = float(K.diagonal()[platen_dofs].sum())
-    return stiffness if abs(stiffness) > 1e-9 * scale else 0.0
-
-
-def _ramp(pd: PrescribedDisplacement, n: int):
-    """The values of ``n`` dofs under ``pd`` as a function of the load factor."""
-    return lambda load_factor: np.full(n, pd.at(load_factor))
-
-
-def _with_von_mises(avg: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    sxx, syy, sxy, szz = avg["sxx"], avg["syy"], avg["sxy"], avg["szz"]
-    avg["von_mises"] = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
-                               + 3 * sxy**2)
-    return avg
 
 
 __all__ = ["Body", "Support", "PrescribedDisplacement", "Traction", "Platen", "Linearization",

@@ -1,0 +1,317 @@
+"""The mechanics behind a body: how it answers the contact forces it carries.
+
+One interface, :class:`BodyMechanics`, two implementations:
+
+* :class:`LinearMechanics` — small kinematics: the superposition of the body's unit solutions and
+  ``K^-1 f_contact`` through its one factorization (:class:`~vfem.bodies.Body`); its flexibility
+  on the contact dofs is constant (the inverse of the Schur complement on them);
+* :class:`LargeMechanics` — large kinematics (thesis Ch. 2-3): the hyperelastic body of
+  :mod:`vfem.nonlinear`, equilibrated under given contact forces, linearised at its trial state
+  (Newton's system and the tangent flexibility on the contact dofs, :class:`Linearization`),
+  moved, committed or discarded step by step.
+
+:class:`~vfem.bodies.Body` keeps the description (mesh, material, supports, loads) and its
+assembly, and hands every kinematics-dependent question to its ``mechanics``.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from ..errors import AnalysisError
+from ..linalg import factorize
+from ..materials import NeoHookean, SaintVenantKirchhoff
+from ..nonlinear import NonlinearBody
+from .stresses import cauchy_stress, small_strain_stress
+
+log = logging.getLogger(__name__)
+
+
+class BodyMechanics(Protocol):
+    """What the solver and the contact formulations ask of a body, whatever its kinematics."""
+
+    def displacement(self, load_factor: float, platen_displacement: float,
+                     contact_force: np.ndarray) -> np.ndarray:
+        """The full displacement (ndofs) under the loads at ``load_factor``, the platen at
+        ``platen_displacement`` and the nodal ``contact_force`` (ndofs)."""
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        """The internal nodal forces (ndofs) at displacement ``u`` (reactions read them)."""
+
+    def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
+        """Element-average stresses of displacement ``u``."""
+
+    def commit(self) -> None:
+        """A step converged: keep its state."""
+
+    def discard(self) -> None:
+        """A step failed: go back to the last converged state."""
+
+    def saved_state(self) -> dict[str, np.ndarray]:
+        """The converged state as arrays (checkpoints, step cutting)."""
+
+    def restore_state(self, state: dict[str, np.ndarray]) -> None:
+        """Put back a state from :meth:`saved_state` exactly."""
+
+
+class LinearMechanics:
+    """Small kinematics: the body's response is linear, its state the contact state's (the
+    contact forces, platen motion and load factor), so there is nothing to commit or save."""
+
+    def __init__(self, body):
+        self.body = body
+
+    def displacement(self, load_factor: float, platen_displacement: float,
+                     contact_force: np.ndarray) -> np.ndarray:
+        b = self.body
+        return (b.load_displacement(load_factor) + platen_displacement * b.u_platen
+                + b.response(contact_force))
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        return self.body.K @ u
+
+    def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
+        """Element-average small-strain stresses
+        (:func:`~vfem.bodies.stresses.small_strain_stress`)."""
+        return small_strain_stress(self.body, u)
+
+    def commit(self) -> None:
+        pass
+
+    def discard(self) -> None:
+        pass
+
+    def saved_state(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def restore_state(self, state: dict[str, np.ndarray]) -> None:
+        pass
+
+
+class LargeMechanics:
+    """Large kinematics (see the module docstring)."""
+
+    def __init__(self, body, fixed: dict[int, float]):
+        """The hyperelastic body behind a large-kinematics body (:mod:`vfem.nonlinear`).
+
+        Its supports and prescribed displacements are prescribed dofs scaled by the load factor,
+        its tractions dead nodal forces (per undeformed length, as for small kinematics), and a
+        platen's dofs follow the platen displacement the contact iteration sets. The linear
+        quantities set up above are the tangent ones at rest, which is where the first step
+        starts from.
+        """
+        self.body = body
+        law = {"saint-venant-kirchhoff": SaintVenantKirchhoff, "neo-hookean": NeoHookean}[body.law]
+        material = law(body.material.youngs_modulus, body.material.poissons_ratio)
+        nl = NonlinearBody(body.mesh, material, formulation=body.kinematics,
+                           name=f"body {body.name!r}")
+        dofs = np.array(sorted(fixed), dtype=int)
+        if len(dofs):
+            nl.prescribe(dofs, np.array([fixed[d] for d in dofs.tolist()]))
+        for pd in body.prescribed:  # later ones win, as in Body._constraints
+            dofs = body._boundary_dofs(pd.boundary, pd.component)
+            nl.prescribe(dofs, _ramp(pd, len(dofs)))
+        self._platen_value = 0.0
+        if len(body.platen_dofs):
+            nl.prescribe(body.platen_dofs,
+                         lambda lf: np.full(len(body.platen_dofs), self._platen_value))
+        nl.add_nodal_forces(np.arange(body.ndofs), body.f_load)
+        if any(tr.amplitude is not None for tr in body.tractions):  # not proportional
+            nl.set_load_history(body.applied_load)
+        self.nonlinear = nl
+        self._equilibrated: tuple | None = None
+
+    def equilibrate(self, load_factor: float, platen_displacement: float,
+                    contact_force: np.ndarray) -> np.ndarray:
+        """The equilibrium displacement (ndofs) under the loads at
+        ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
+        (a trial state of the step, see :meth:`commit_step`). Repeated calls with the same
+        arguments cost nothing."""
+        f = np.asarray(contact_force, dtype=float)
+        key = (float(load_factor), float(platen_displacement), f.tobytes())
+        if self._equilibrated != key:
+            self._platen_value = float(platen_displacement)
+            self.nonlinear.equilibrate(load_factor, f)
+            self._equilibrated = key
+        return self.nonlinear.trial_displacement()
+
+    def linearize(self, load_factor: float, platen_displacement: float,
+                  contact_force: np.ndarray, tracked_dofs: np.ndarray,
+                  candidate_dofs: np.ndarray, backend: str | None = None) -> Linearization:
+        """Newton's system at the trial state under the loads at
+        ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
+        (held), factorized once (see :class:`Linearization`). Move the trial state with
+        :meth:`move`."""
+        self._platen_value = float(platen_displacement)
+        self._equilibrated = None
+        R, ref, K, D, pending = self.nonlinear.linearize(load_factor, contact_force)
+        free = np.setdiff1d(np.arange(self.body.ndofs), D)
+        K_ff = K[free][:, free].tocsc()
+        # the tracked dofs among the free ones: their block of the inverse tangent is the
+        # inverse of its Schur complement, from the factorization (as for the linear body)
+        pos = np.searchsorted(free, tracked_dofs)
+        held = free[np.minimum(pos, len(free) - 1)] == tracked_dofs
+        factor, step = _tangent_factorization(K_ff, pos[held], free // 2,
+                                              -R[free] - K[free] @ pending, backend, self.body.name)
+
+        def solve(f: np.ndarray) -> np.ndarray:
+            out = np.zeros((self.body.ndofs,) + f.shape[1:])
+            out[free] = factor.solve(f[free])
+            return out
+
+        correction = pending.copy()
+        correction[free] = step
+        # flexibility rows of the tracked dofs for the candidate dofs (supports kept); the
+        # candidate dofs are the first of the tracked ones (ContactSurface.tracked_dofs)
+        nc2 = len(candidate_dofs)
+        flexibility = np.zeros((len(tracked_dofs), nc2))
+        if factor.trailing_inverse is not None:
+            rows = np.flatnonzero(held)
+            cols = rows[rows < nc2]
+            flexibility[np.ix_(rows, cols)] = factor.trailing_inverse[:, : len(cols)]
+        else:  # an indefinite tangent: one back-substitution per candidate dof
+            pos = np.searchsorted(free, candidate_dofs)
+            cols = np.flatnonzero(free[np.minimum(pos, len(free) - 1)] == candidate_dofs)
+            unit = np.zeros((self.body.ndofs, len(cols)))
+            unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
+            if len(cols):
+                flexibility[:, cols] = solve(unit)[tracked_dofs]
+        platen_motion = np.zeros(self.body.ndofs)
+        stiffness = reaction = 0.0
+        P = self.body.platen_dofs
+        if len(P):
+            platen_motion[P] = 1.0
+            platen_motion[free] = factor.solve(-(K[free][:, P] @ np.ones(len(P))))
+            stiffness = _platen_stiffness(K, platen_motion, P)
+            reaction = float((R + K @ correction)[P].sum())
+        met = float(np.abs(pending).max(initial=0.0)) <= 1e-13 * self.nonlinear.length
+        return Linearization(float(np.linalg.norm(R[free])), ref, correction, flexibility,
+                             platen_motion, stiffness, reaction, met, solve)
+
+    def move(self, correction: np.ndarray) -> None:
+        """Add ``correction`` (ndofs) to the trial displacement.
+
+        Raises:
+            AnalysisError: an element would turn inside out; the trial state is unchanged.
+        """
+        self.nonlinear.move(correction)
+        self._equilibrated = None
+
+    def commit(self) -> None:
+        """A step converged: its trial state becomes the start of the next."""
+        self.nonlinear.accept()
+        self._equilibrated = None
+
+    def discard(self) -> None:
+        """A step failed: go back to the last converged state."""
+        self.nonlinear.discard()
+        self._equilibrated = None
+
+    def saved_state(self) -> dict[str, np.ndarray]:
+        """The converged state as arrays."""
+        return {**self.nonlinear.saved_state(), "platen_value": np.array(self._platen_value)}
+
+    def restore_state(self, state: dict[str, np.ndarray]) -> None:
+        """Put back a state from :meth:`saved_state` exactly (step cutting, ``--resume``)."""
+        self.nonlinear.restore_state(state)
+        self._platen_value = float(state["platen_value"])
+        self._equilibrated = None
+
+    def displacement(self, load_factor: float, platen_displacement: float,
+                     contact_force: np.ndarray) -> np.ndarray:
+        """The equilibrium displacement (ndofs) for the given state (a copy)."""
+        return self.equilibrate(load_factor, platen_displacement, contact_force).copy()
+
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
+        """The internal nodal forces (ndofs) at displacement ``u``."""
+        return self.nonlinear.internal_force_at(u)
+
+    def stress(self, u: np.ndarray) -> dict[str, np.ndarray]:
+        """Element-average Cauchy stresses in the deformed configuration
+        (:func:`~vfem.bodies.stresses.cauchy_stress`)."""
+        return cauchy_stress(self.nonlinear, u)
+
+
+@dataclass
+class Linearization:
+    """Newton's system of a large-kinematics body at its trial state (:meth:`Body.linearize`).
+
+    Attributes:
+        residual: norm of the out-of-balance force ``f_int - f_ext`` on the free dofs.
+        reference: the force it is measured against (:class:`vfem.nonlinear.NewtonStep`).
+        correction: (ndofs) Newton's correction with the contact forces held, the prescribed
+            displacements' increments included.
+        flexibility: (tracked, candidate) the tangent flexibility rows of the tracked dofs for
+            the candidate dofs (supports kept): the inverse of the tangent's Schur complement on
+            the tracked dofs, from its factorization (:func:`_tangent_factorization`).
+        platen_motion: (ndofs) the motion per unit motion of the platen (1 on its dofs).
+        platen_stiffness: the platen's reaction per unit platen motion.
+        platen_reaction: the platen's reaction after ``correction``, linearised.
+        prescribed_met: whether the prescribed displacements (the platen's included) have
+            their values (else ``correction`` applies what they lack).
+        solve: the tangent flexibility applied to nodal forces (ndofs, or ndofs x k): the
+            displacements (zero on the fixed dofs).
+    """
+
+    residual: float
+    reference: float
+    correction: np.ndarray
+    flexibility: np.ndarray
+    platen_motion: np.ndarray
+    platen_stiffness: float
+    platen_reaction: float
+    prescribed_met: bool
+    solve: Callable[[np.ndarray], np.ndarray]
+
+
+def _tangent_factorization(K_ff, trailing: np.ndarray, groups: np.ndarray, rhs: np.ndarray,
+                           backend: str | None, name: str):
+    """A large body's tangent on its free dofs, factorized once per linearisation.
+
+    A tangent is positive definite unless the body is near buckling (geometric stiffness under
+    compression). It is first factorized as such with the ``trailing`` (tracked) dofs eliminated
+    last, which also yields the inverse tangent on them (``trailing_inverse``: the tangent
+    flexibility, from the Schur complement, instead of one back-substitution per contact dof).
+    Where that fails (not positive definite) or its solve of ``rhs`` is not accurate (SuperLU
+    factorizes in that order without pivoting), the tangent is factorized as indefinite and
+    ``trailing_inverse`` is None. Returns the factorization and its solution of ``rhs``.
+    """
+    if len(trailing):
+        try:
+            factor = factorize(K_ff, backend, trailing=trailing, groups=groups,
+                               what=f"body {name!r} (tangent)")
+            x = factor.solve(rhs)
+            scale = max(float(np.abs(rhs).max(initial=0.0)), 1e-300)
+            if (factor.trailing_inverse is not None
+                    and float(np.abs(K_ff @ x - rhs).max(initial=0.0)) <= 1e-10 * scale):
+                return factor, x
+        except AnalysisError as exc:
+            log.debug("body %r: tangent not positive definite (%s); factorized as indefinite",
+                      name, exc)
+    factor = factorize(K_ff, backend, spd=False, what=f"body {name!r} (tangent)")
+    factor.trailing_inverse = None
+    return factor, factor.solve(rhs)
+
+
+def _platen_stiffness(K, motion: np.ndarray, platen_dofs: np.ndarray) -> float:
+    """The platen's reaction per unit platen motion (``motion``: the body's response to it).
+
+    A body that only contact holds moves rigidly with its platen: zero up to round-off, which
+    is cleaned to exactly zero (the platen's equations then know nothing else holds the body).
+    """
+    stiffness = float((K @ motion)[platen_dofs].sum())
+    scale = float(K.diagonal()[platen_dofs].sum())
+    return stiffness if abs(stiffness) > 1e-9 * scale else 0.0
+
+
+def _ramp(pd, n: int):
+    """The values of ``n`` dofs under ``pd`` as a function of the load factor."""
+    return lambda load_factor: np.full(n, pd.at(load_factor))
+
+
+__all__ = ["BodyMechanics", "LargeMechanics", "LinearMechanics", "Linearization"]
