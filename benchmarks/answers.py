@@ -6,7 +6,9 @@
     python benchmarks/answers.py save DIR hertz gasket_large   # some cases only
 
 The cases: springs, hertz, hertz with quadratic elements, patch, wedge, block, gasket (small and
-large kinematics), sliding, and each classical baseline on Hertz; each is ``vfem run`` of the
+large kinematics), sliding, the thesis variant on Hertz, the block, the wedge and the patch test
+(the block's and the wedge's stop unconverged, before and after: their failures must match too),
+and each classical baseline on Hertz; each is ``vfem run`` of the
 built-in example into a fresh folder, and its ``summary.json`` is kept without what differs
 from run to run (wall-clock times, the run's command and date, file names). ``compare`` walks
 both trees: numbers must agree to 1e-10 relative (to the value, or to the largest magnitude the
@@ -39,6 +41,11 @@ CASES: dict[str, list[str]] = {
     "gasket_large": ["gasket", "--set", "kinematics=total", "--set", "order=1", "--set",
                      "n_through=3", "--set", "back_motion=0.5"],  # as docs/examples.md runs it
     "sliding": ["sliding"],
+    # the thesis's plain reading, kept as reference (issue 18, item 7)
+    "hertz_thesis": ["hertz", "--set", "variant=thesis"],
+    "block_thesis": ["block", "--set", "contact.variant=thesis"],
+    "wedge_thesis": ["wedge", "--set", "figures=false", "--set", "contact.variant=thesis"],
+    "patch_thesis": ["patch", "--set", "contact.variant=thesis"],
     "hertz_penalty": ["hertz", "--set", "contact.method=penalty"],
     "hertz_lagrange": ["hertz", "--set", "contact.method=lagrange"],
     "hertz_augmented": ["hertz", "--set", "contact.method=augmented"],

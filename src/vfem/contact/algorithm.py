@@ -30,7 +30,12 @@ import numpy as np
 
 from ..errors import RindViolation
 from .capabilities import Capabilities
-from .corrections import compatibility_displacement, equilibrium_force
+from .corrections import (
+    compatibility_displacement,
+    equilibrium_force,
+    relaxation,
+    release_tension,
+)
 from .group import SurfaceGroup, bordered_solve
 from .iteration import Check, iterate
 from .search import outward_normals, project_points
@@ -228,20 +233,17 @@ class VirtualElementContact(SurfaceGroup):
         """Corrective nodal forces for every body (and the platen's motion), from one state."""
         cfg = self.settings
         _, _, eq_tol, _, _ = self.errors(pairings)
-        omega = cfg.first_relaxation if iteration < cfg.relaxed_iterations else cfg.relaxation
+        omega = relaxation(cfg, iteration)
         out = []
         d_platen = 0.0
         for i, (s, p) in enumerate(zip(self.surfaces, pairings)):
             F = state.forces[i]
-            dF = np.zeros_like(F)
             part = p.participating
-            # Tension release over several iterations (§5.6); a node released in the previous
-            # iteration and still in tension gives up the rest. Every node that carries a tensile
+            # Tension release over several iterations (§5.6). Every node that carries a tensile
             # force is released, whether or not it still touches the other body.
             tension = p.force < 0
-            frac = np.where(state.released[i], 1.0, 1.0 / cfg.release_iterations)
-            dF[tension] -= frac[tension, None] * F[tension]
-            state.released[i] = tension & (frac < 1.0)
+            dF, state.released[i] = release_tension(F, tension, state.released[i],
+                                                    cfg.release_iterations)
             active = part & ~tension & np.isfinite(p.stiffness)
             n = p.normal
             # Equilibrium (eq. 4.2.7) where the error exceeds its tolerance.

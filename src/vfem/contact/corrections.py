@@ -53,3 +53,27 @@ def equilibrium_force(k_own, k_other, error):
     k_own = np.asarray(k_own, dtype=float)
     k_other = np.asarray(k_other, dtype=float)
     return -k_own * np.asarray(error, dtype=float) / (k_own + k_other)
+
+
+def relaxation(settings, iteration: int) -> float:
+    """The factor on an iteration's corrections (thesis §5.6): ``first_relaxation`` for the
+    first ``relaxed_iterations`` iterations of a solve, ``relaxation`` after them."""
+    if iteration < settings.relaxed_iterations:
+        return settings.first_relaxation
+    return settings.relaxation
+
+
+def release_tension(values: np.ndarray, tension: np.ndarray, released: np.ndarray,
+                    iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """Tension release over several iterations (thesis §5.6): a node in tension gives up
+    ``1 / iterations`` of its contact force (or traction value) in this iteration; one released
+    part-way in the previous iteration and still in tension gives up the rest.
+
+    ``values``: per node (rows) the force or traction; ``tension``, ``released``: per node.
+    Returns the change of ``values`` (zero off ``tension``) and the nodes released part-way now.
+    """
+    frac = np.where(released, 1.0, 1.0 / iterations)
+    change = np.zeros_like(values)
+    share = frac[tension].reshape((-1,) + (1,) * (np.ndim(values) - 1))
+    change[tension] = -(share * values[tension])
+    return change, tension & (frac < 1.0)

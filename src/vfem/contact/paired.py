@@ -41,6 +41,7 @@ import scipy.sparse as sp
 
 from ..errors import PlatenUnheld, RindViolation
 from .capabilities import Capabilities
+from .corrections import relaxation, release_tension
 from .group import SurfaceGroup, bordered_solve
 from .iteration import Check, iterate
 from .pairing import (  # noqa: F401 - the pairing's parts, here too for those who import them here
@@ -402,16 +403,15 @@ class PairedContact(PairSet):
         """Tension release, then the compatibility correction of every pair at once."""
         cfg = self.settings
         tol = self.penetration_tolerance
-        omega = cfg.first_relaxation if it < cfg.relaxed_iterations else cfg.relaxation
+        omega = relaxation(cfg, it)
         active, targets = [], []
         for k, p in enumerate(pens):
             q = self.tractions(state, k)
             pair = self.contact_pairs[k]
-            released = state.released[pair.fine][pair.nodes]
-            tension = q < 0
-            frac = np.where(released, 1.0, 1.0 / cfg.release_iterations)
-            q[tension] -= frac[tension] * q[tension]
-            state.released[pair.fine][pair.nodes] = tension & (frac < 1.0)
+            tension = q < 0  # released over several iterations (thesis §5.6)
+            change, state.released[pair.fine][pair.nodes] = release_tension(
+                q, tension, state.released[pair.fine][pair.nodes], cfg.release_iterations)
+            q += change
             S = ~tension & ((q > 0) | (p > tol))
             if not platen_ok and not S.any():
                 S = ~tension & (p > -tol)  # touching within tolerance: hold them there
