@@ -44,7 +44,7 @@ GROUPS = (
     ("geometry layer (contact/surface.py, contact/search.py)",
      ("contact/surface.py", "contact/search.py")),
     ("bodies and their 2D mechanics (bodies, nonlinear, kinematics, materials, result types)",
-     ("bodies.py", "nonlinear.py", "kinematics.py", "materials/", "result_types.py")),
+     ("bodies.py", "bodies/", "nonlinear.py", "kinematics.py", "materials/", "result_types.py")),
     ("the thesis variant (kept 2D, issue 18 item 7)", ("contact/algorithm.py",)),
     ("the independent invariant check", ("contact/check.py",)),
     ("the classical baselines", ("contact/baselines.py",)),
