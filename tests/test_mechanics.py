@@ -1,0 +1,76 @@
+"""A body's mechanics (vfem.bodies.mechanics): the tangent flexibility of a large-kinematics body
+from the Schur complement of its tangent, checked against the inverse tangent itself, and the
+fall-back for a tangent that is not positive definite."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from skfem import MeshQuad
+
+from vfem.bodies import Body, Support
+from vfem.bodies.mechanics import LargeMechanics, LinearMechanics, _tangent_factorization
+from vfem.materials import LinearElastic
+
+
+def large_block():
+    m = MeshQuad.init_tensor(np.linspace(0, 2, 7), np.linspace(0, 1, 4))
+    m = m.with_boundaries({"bottom": lambda x: x[1] < 1e-9, "top": lambda x: x[1] > 1 - 1e-9})
+    body = Body("block", m, LinearElastic(1000.0, 0.3), supports=(Support("bottom"),),
+                kinematics="total")
+    body.setup()
+    return body
+
+
+def test_each_kinematics_has_its_mechanics():
+    body = large_block()
+    assert isinstance(body.mechanics, LargeMechanics)
+    small = Body("b", body.mesh, body.material, supports=(Support("bottom"),))
+    small.setup()
+    assert isinstance(small.mechanics, LinearMechanics)
+    assert small.saved_state() == {}
+
+
+@pytest.mark.parametrize("stretch", [0.0, 0.05])
+def test_the_tangent_flexibility_is_the_inverse_tangent_on_the_contact_dofs(stretch,
+                                                                            monkeypatch):
+    """Flexibility rows of the tracked dofs (the top's nodes and one more) for the candidate
+    dofs (the top's): the block of the inverse tangent, at rest and stretched (the tangent then
+    has its geometric part)."""
+    body = large_block()
+    top = np.flatnonzero(body.mesh.p[1] > 1 - 1e-9)
+    candidate = np.column_stack([2 * top, 2 * top + 1]).ravel()
+    tracked = np.concatenate([candidate, [2 * 8, 2 * 8 + 1]])  # an interior node as well
+    force = np.zeros(body.ndofs)
+    force[candidate[1::2]] = stretch * 1000.0 / len(top)  # pulls the top up
+    if stretch:
+        body.equilibrate(1.0, 0.0, force)
+    routes = []
+
+    def recorded(*args):
+        factor, x = _tangent_factorization(*args)
+        routes.append(factor.trailing_inverse is not None)
+        return factor, x
+
+    monkeypatch.setattr("vfem.bodies.mechanics._tangent_factorization", recorded)
+    lin = body.linearize(1.0, 0.0, force, tracked, candidate)
+    assert routes == [True]  # positive definite: the Schur complement's route
+    R, ref, K, D, pending = body.nonlinear.linearize(1.0, force)
+    free = np.setdiff1d(np.arange(body.ndofs), D)
+    inverse = np.zeros((body.ndofs, body.ndofs))
+    inverse[np.ix_(free, free)] = np.linalg.inv(K[free][:, free].toarray())
+    expected = inverse[np.ix_(tracked, candidate)]
+    np.testing.assert_allclose(lin.flexibility, expected, rtol=0,
+                               atol=1e-10 * np.abs(expected).max())
+
+
+def test_a_tangent_that_is_not_positive_definite_falls_back_to_back_substitutions():
+    A = sp.csc_matrix(np.array([[2.0, 0.0, 1.0], [0.0, -1.0, 0.5], [1.0, 0.5, 3.0]]))
+    rhs = np.array([1.0, 2.0, 3.0])
+    factor, x = _tangent_factorization(A, np.array([2]), np.arange(3), rhs, None, "test")
+    assert factor.trailing_inverse is None  # indefinite: no Schur complement route
+    np.testing.assert_allclose(A @ x, rhs, rtol=1e-12)
+    spd = sp.csc_matrix(np.array([[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]]))
+    factor, x = _tangent_factorization(spd, np.array([1, 2]), np.arange(3), rhs, None, "test")
+    np.testing.assert_allclose(factor.trailing_inverse,
+                               np.linalg.inv(spd.toarray())[np.ix_([1, 2], [1, 2])], rtol=1e-12)
+    np.testing.assert_allclose(spd @ x, rhs, rtol=1e-12)
