@@ -19,7 +19,7 @@ import signal
 import sys
 from pathlib import Path
 
-from . import linalg
+from . import linalg, threads
 from .contact.settings import ContactSettings
 from .errors import InputError, VfemError
 from .examples import EXAMPLES, load
@@ -509,6 +509,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("-v", "--verbose", action="count", default=0,
                         help="log more (-v: info, -vv: debug)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
+    parser.add_argument("--threads", metavar="N",
+                        help="threads of the sparse factorization (the dense linear algebra "
+                             "runs on one), or off to leave the pools alone; default: "
+                             "VFEM_THREADS, else the cores this process may use")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a built-in example or an input file")
     run.add_argument("example", metavar="EXAMPLE|FILE",
@@ -580,6 +584,7 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError:  # not the main thread (vfem.cli.main called from a worker): no handler
         previous = None
     try:
+        threads.apply(args.threads)  # one thread policy for every command (vfem.threads)
         command = {"run": cmd_run, "check": cmd_check, "export": cmd_export, "plot": cmd_plot,
                    "reference": cmd_reference,
                    "bench": cmd_bench, "study": cmd_study}[args.command]

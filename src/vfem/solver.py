@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import threads
 from .bodies import Body, multiplier
 from .bodies.stresses import max_strain
 from .contact.check import InvariantCheck, Invariants
@@ -273,6 +274,7 @@ class Analysis:
         estimated before anything is factorized (:mod:`vfem.memory`): a model that cannot fit
         is refused, and running out of memory anyway is an :class:`AnalysisError` that says so.
         """
+        threads.ensure()  # the thread pools sized once, unless the caller did (vfem.threads)
         if self.model.contact.method != "vfem":  # a classical baseline: one global system
             from .contact.baselines import GlobalContact
 

@@ -1,0 +1,137 @@
+"""One thread policy for the linear algebra (issue 19): the single place that sizes the thread
+pools vfem's work runs on.
+
+Two pools serve vfem, and each, left alone, starts a thread per core:
+
+* the **dense BLAS** of NumPy and SciPy (OpenBLAS in their wheels): the contact flexibility's
+  small dense blocks, the pair matrix of the contact correction, the Schur complement's inverse.
+  These are many small operations inside the contact iteration, where threads cost more than
+  they give;
+* the **sparse factorization**: MKL's OpenMP threads under PARDISO (and the BLAS under CHOLMOD
+  and MUMPS), where the large work is.
+
+Both pools spinning at once oversubscribe the cores: on the shared 2-core machine the Hertz
+example at 20k dofs took 2.76 s with the default pools and 0.17 s with one thread each (issue 19).
+The policy: the dense BLAS on **one** thread, the sparse factorization on ``threads`` (default
+:func:`default_threads`: the cores this process may use), so the two never compete.
+``vfem --threads N`` (or the ``VFEM_THREADS`` environment variable) sets ``threads``; ``off``
+leaves the pools as the libraries set them. The library applies the default once, when an
+analysis is set up, unless :func:`apply` was called.
+
+Measured on the 2-core machine (2026-11-25, quiet; ``python benchmarks/threads.py``, which
+prints the current figures), Hertz with PARDISO, medians of 3 alternating runs: at 119k dofs the
+library defaults 2.82 s, every pool on one thread 2.72 s, this policy 2.51 s; at 465k dofs
+9.82 s, 10.30 s and 9.38 s. The policy is the fastest of the three at both sizes; on a loaded
+machine the defaults fare far worse (the figures above from issue 19).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+
+from .errors import InputError
+
+log = logging.getLogger(__name__)
+
+#: what :func:`apply` set: ``{"threads": n, "dense": 1}``, or None before it ran
+_applied: dict | None = None
+#: threadpoolctl's limits, kept so that they stay in force
+_limits = []
+
+
+def default_threads() -> int:
+    """The cores this process may use (its CPU affinity), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def requested(value: str | int | None = None) -> int | None:
+    """The thread count ``value`` asks for (``--threads``; else ``VFEM_THREADS``; else the
+    default), checked: a whole number >= 1, or ``"off"`` (None: leave the pools as the
+    libraries set them)."""
+    source = "--threads"
+    if value is None:
+        value, source = os.environ.get("VFEM_THREADS"), "VFEM_THREADS"
+    if value is None or value == "":
+        return default_threads()
+    if str(value).strip().lower() == "off":
+        return None
+    try:
+        n = int(value)
+    except (TypeError, ValueError):
+        n = 0
+    if n < 1 or str(value).strip() != str(n):
+        raise InputError(f"{source} must be a whole number of threads >= 1 (or off), got "
+                         f"{value!r}")
+    return n
+
+
+def apply(threads: int | None = None) -> dict:
+    """Size the pools (see the module docstring): the dense BLAS on one thread, the sparse
+    factorization on ``threads`` (default: :func:`requested`). Returns what it set. Pools of
+    libraries loaded later (MKL, when PARDISO is first used) take the setting as they load
+    (:func:`sparse_threads`)."""
+    global _applied
+    n = requested(threads)
+    if n is None:  # "off": the pools as the libraries set them
+        _applied = {"threads": None, "dense": None}
+        log.info("threads: the pools left as the libraries set them (off)")
+        return dict(_applied)
+    _applied = {"threads": n, "dense": 1}
+    os.environ["MKL_NUM_THREADS"] = str(n)  # read by MKL when it loads (PARDISO)
+    _limit_loaded()
+    log.info("threads: %d for the sparse factorization, 1 for the dense BLAS", n)
+    return dict(_applied)
+
+
+def ensure() -> dict:
+    """:func:`apply` the default policy if nothing has applied one yet (what an analysis does
+    when it is set up); returns what is in force."""
+    return dict(_applied) if _applied is not None else apply()
+
+
+def sparse_threads() -> int:
+    """The threads of the sparse factorization under the policy in force (for a backend that
+    loads its library late)."""
+    return (_applied or {}).get("threads") or default_threads()
+
+
+def after_loading() -> None:
+    """Call when a library with its own thread pool has just loaded (MKL under PARDISO): the
+    policy in force applies to it too."""
+    if _applied is not None and _applied["threads"] is not None:
+        _limit_loaded()
+
+
+def _limit_loaded() -> None:
+    """Set the loaded pools with threadpoolctl (OpenBLAS to 1, MKL and OpenMP to ``threads``);
+    without threadpoolctl, only libraries loaded after this read the environment."""
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:  # pragma: no cover - a dependency; kept working without it
+        log.info("threadpoolctl is not installed: the thread policy applies to libraries "
+                 "loaded from now on only")
+        return
+    n = _applied["threads"]
+    pools = ThreadpoolController()
+    for api, count in (("openblas", 1), ("mkl", n), ("openmp", n)):
+        selected = pools.select(internal_api=api)
+        if selected.lib_controllers:
+            _limits.append(selected.limit(limits=count))
+
+
+def info() -> list[dict]:
+    """The loaded thread pools as threadpoolctl reports them (library, API, threads)."""
+    try:
+        from threadpoolctl import threadpool_info
+    except ImportError:  # pragma: no cover
+        return []
+    return [{"library": i.get("internal_api"), "api": i.get("user_api"),
+             "threads": i.get("num_threads")} for i in threadpool_info()]
+
+
+__all__ = ["after_loading", "apply", "default_threads", "ensure", "info", "requested",
+           "sparse_threads"]
