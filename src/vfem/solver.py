@@ -34,7 +34,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import threads
 from .bodies import Body, multiplier
 from .bodies.stresses import max_strain
 from .contact.check import InvariantCheck, Invariants
@@ -68,6 +67,7 @@ from .result_types import (  # the result types, here too for those who import t
     Checkpoint,
     StepResult,
 )
+from .threads import ensure as ensure_threads
 
 log = logging.getLogger(__name__)
 
@@ -274,7 +274,7 @@ class Analysis:
         estimated before anything is factorized (:mod:`vfem.memory`): a model that cannot fit
         is refused, and running out of memory anyway is an :class:`AnalysisError` that says so.
         """
-        threads.ensure()  # the thread pools sized once, unless the caller did (vfem.threads)
+        ensure_threads()  # the thread pools sized once, unless the caller did (vfem.threads)
         if self.model.contact.method != "vfem":  # a classical baseline: one global system
             from .contact.baselines import GlobalContact
 

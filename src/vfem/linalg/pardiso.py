@@ -16,7 +16,7 @@ import os
 import numpy as np
 import scipy.sparse as sp
 
-from .. import threads
+from ..threads import after_loading
 from .common import spd_inverse
 
 _P64 = ctypes.POINTER(ctypes.c_int64)
@@ -46,7 +46,7 @@ def _library():
                       _P32, _P32, _P32, ctypes.c_void_p, ctypes.c_void_p, _P32]
         f.restype = None
         _pardiso = f
-        threads.after_loading()  # MKL's pool under the thread policy (vfem.threads)
+        after_loading()  # MKL's pool under the thread policy (vfem.threads)
     return _pardiso
 
 
