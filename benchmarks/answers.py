@@ -52,7 +52,7 @@ CASES: dict[str, list[str]] = {
 }
 
 #: Keys whose values differ from run to run (or name files), dropped wherever they appear.
-VOLATILE = {"timings", "run", "seconds", "figures", "figure_data", "figure_set",
+VOLATILE = {"timings", "phases", "run", "seconds", "figures", "figure_data", "figure_set",
             "figures_not_drawn", "linear_solver", "peak_mib", "input"}
 
 

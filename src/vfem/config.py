@@ -18,6 +18,7 @@ description into a :class:`~vfem.solver.Model`.
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path, PureWindowsPath
@@ -287,9 +288,11 @@ class ModelConfig:
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
             raise InputError(f"two bodies are named {dup[0]!r}: body names must be unique")
+        t0 = time.perf_counter()
         model = Model(self.name, [b.build(base) for b in self.bodies], self.contact,
                       self.steps.factors(), self.contact_pairs)
         model.validate()
+        model.build_s = time.perf_counter() - t0
         return model
 
 

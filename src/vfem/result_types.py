@@ -112,3 +112,35 @@ class Checkpoint:
     target: int = 1  # the next scheduled load factor: model.load_factors[target - 1]
     level: int = 0  # halvings of the scheduled increment now in use
     easy: int = 0  # easy steps in a row at that level
+
+
+#: The phases of a run (issue 19): what each takes, from the timings an analysis records
+#: (``AnalysisResult.timings``) and the figures' drawing; label -> the timing keys it sums.
+PHASES = (
+    ("model: meshes, bodies, checks", ("build_s",)),
+    ("contact search", ("search_s",)),
+    ("assembly", ("assemble_s",)),
+    ("factorization and condensation", ("factorize_s", "flexibility_s")),
+    ("contact iterations", ("contact_s",)),
+    ("back-substitution: full-mesh fields", ("fields_s",)),
+    ("invariants", ("invariants_s",)),
+    ("output: VTU, CSV, checkpoints", ("output_s",)),
+    ("figures", ("figures_s",)),
+)
+
+
+def phase_table(timings: dict[str, float]) -> dict[str, float]:
+    """Seconds per phase of a run (:data:`PHASES`), those the run had, in order; "other" is
+    what the timed phases leave of the run's wall time (``run_s``, where the run recorded it,
+    else the analysis's ``total_s`` plus its output and figures)."""
+    out = {}
+    for label, keys in PHASES:
+        if any(k in timings for k in keys):
+            out[label] = float(sum(timings.get(k, 0.0) for k in keys))
+    wall = timings.get("run_s")
+    if wall is None:
+        wall = (timings.get("total_s", 0.0) + timings.get("build_s", 0.0)
+                + timings.get("figures_s", 0.0))
+    out["other"] = max(0.0, float(wall) - sum(out.values()))
+    return out
+

@@ -86,6 +86,8 @@ class Model:
     contact: ContactSettings = field(default_factory=ContactSettings)
     load_factors: tuple[float, ...] = (1.0,)
     contact_pairs: tuple[tuple[str, str], ...] | None = None  # default: every pair may touch
+    #: seconds spent building it (meshes, bodies, checks: ModelConfig.build), for the phases
+    build_s: float = field(default=0.0, compare=False)
 
     def validate(self) -> None:
         names = [b.name for b in self.bodies]
@@ -447,10 +449,14 @@ class Analysis:
                 state.load_factor + increment)
             history: list[IterationRecord] = []
             try:
+                t0 = time.perf_counter()
                 new, res = self.solve_step(state, lf, history)
+                t1 = time.perf_counter()
                 # full-mesh results and the invariants before the bodies commit the step, so
                 # that a state that breaks one is discarded like any failed step
                 fields = self._fields(new, res)
+                self._add_time("contact_s", t1 - t0)
+                self._add_time("fields_s", time.perf_counter() - t1)
                 invariants = self.check_invariants(fields, history)
                 # (a baseline's answer is its own: recorded against vfem's invariants, compared,
                 # never a failed step)
@@ -498,15 +504,21 @@ class Analysis:
                 self.easy = 0
                 log.info("the increment grows back to %.6g", full / 2**self.level)
             if on_step is not None:
-                on_step(step)
+                t0 = time.perf_counter()
+                on_step(step)  # (the results of the step written, by the caller)
+                self._add_time("output_s", time.perf_counter() - t0)
         # a formulation's own timings (a baseline's factorizations and solves)
         self.timings.update(getattr(self.contact, "timings", {}))
         self.timings["steps_s"] = time.perf_counter() - t_setup
+        self.timings["build_s"] = self.model.build_s
         self.timings["total_s"] = sum(self.timings[key] for key in
                                       ("search_s", "assemble_factorize_s", "flexibility_s",
                                        "steps_s"))
         return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
                               self.surfaces, self.contact.penetration_tolerance, self.backend)
+
+    def _add_time(self, key: str, seconds: float) -> None:
+        self.timings[key] = self.timings.get(key, 0.0) + seconds
 
     def checkpoint(self) -> Checkpoint:
         """The last converged state, complete, with the steps so far: what :meth:`run` needs

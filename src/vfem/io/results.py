@@ -48,6 +48,7 @@ import csv
 import dataclasses
 import io
 import logging
+import time
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -57,6 +58,7 @@ import numpy as np
 from ..bodies.stresses import stress as body_stress
 from ..contact.surface import ContactSurface
 from ..errors import InputError
+from ..result_types import phase_table
 from ..solver import Analysis, AnalysisResult, Model, StepResult
 from .files import _atomic_write, _safe, write_summary  # noqa: F401 (write_summary: importers)
 
@@ -251,14 +253,30 @@ def run_example(model: Model, out: Path, summarize, draw=None, on_step=None,
     out = Path(out)
     _, result = run_writing(model, out, on_step, resume)
     summary = summarize(result)
+    summary.setdefault("timings", result.timings)
     write_summary(out, summary)
     if draw:  # a function, or True: the figures need nothing beyond the files
         from .replot import draw_run
 
+        t0 = time.perf_counter()
         if callable(draw):
             draw(model, result, summary)
         draw_run(out, summary, summary["example"], model)
+        summary["timings"]["figures_s"] = time.perf_counter() - t0
+    finish_summary(out, summary)
     return summary
+
+
+def finish_summary(out: Path, summary: dict) -> None:
+    """Add the phase table of the run (:func:`vfem.result_types.phase_table`: seconds per
+    phase, from its ``timings``) to ``summary``, log it (``vfem -v``) and write
+    ``summary.json``."""
+    summary["phases"] = phase_table(summary.get("timings", {}))
+    total = sum(summary["phases"].values()) or 1.0
+    log.info("phases of the run:\n%s", "\n".join(
+        f"  {label:40s} {s:9.3f} s  {100 * s / total:5.1f} %"
+        for label, s in summary["phases"].items()))
+    write_summary(out, summary)
 
 
 def progress_summary(model: Model, steps: list[StepResult], status: str, message: str = ""

@@ -10,6 +10,7 @@ displacement, and the figures of :mod:`vfem.io.replot` drawn from the files writ
 from __future__ import annotations
 
 import logging
+import time
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +18,14 @@ import numpy as np
 from ..config import ModelConfig
 from ..solver import AnalysisResult, Model
 from .input import to_data
-from .results import force_record, run_writing, step_record, total, write_summary
+from .results import (
+    finish_summary,
+    force_record,
+    run_writing,
+    step_record,
+    total,
+    write_summary,
+)
 
 log = logging.getLogger(__name__)
 
@@ -87,7 +95,10 @@ def run(config: ModelConfig, out: Path, base: Path | None = None, on_step=None,
     if (config.output.figures if figures is None else figures) and result.steps:
         from .replot import draw_run
 
+        t0 = time.perf_counter()
         draw_run(out, summary, "input", model)
+        summary["timings"]["figures_s"] = time.perf_counter() - t0
+    finish_summary(out, summary)
     return summary
 
 
