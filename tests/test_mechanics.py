@@ -74,3 +74,32 @@ def test_a_tangent_that_is_not_positive_definite_falls_back_to_back_substitution
     np.testing.assert_allclose(factor.trailing_inverse,
                                np.linalg.inv(spd.toarray())[np.ix_([1, 2], [1, 2])], rtol=1e-12)
     np.testing.assert_allclose(spd @ x, rhs, rtol=1e-12)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_stresses_from_the_average_strain_operator_equal_the_quadrature_average(order):
+    """The stresses of a step by one sparse product (bodies/stresses.py) are the quadrature
+    average of the stress at the points, as scikit-fem interpolates it (quads and triangles)."""
+    from skfem import MeshTri
+    from skfem.helpers import sym_grad, trace
+
+    from vfem.bodies.stresses import stress
+
+    for mesh in (MeshQuad.init_tensor(np.linspace(0, 2, 5), np.linspace(0, 1, 4)),
+                 MeshTri.init_symmetric().refined(2)):
+        mesh = mesh.with_boundaries({"bottom": lambda x: x[1] < 1e-9})
+        body = Body("b", mesh, LinearElastic(1000.0, 0.3), supports=(Support("bottom"),),
+                    order=order)
+        body.setup()
+        u = np.random.default_rng(order).normal(size=body.ndofs)
+        lam, mu = body.material.lame()
+        eps = sym_grad(body.basis.interpolate(u))
+        sig = 2 * mu * eps
+        sig[0, 0] += lam * trace(eps)
+        sig[1, 1] += lam * trace(eps)
+        w = body.basis.dx
+        got = stress(body, u)
+        for key, (i, j) in {"sxx": (0, 0), "syy": (1, 1), "sxy": (0, 1)}.items():
+            expected = (sig[i, j] * w).sum(axis=1) / w.sum(axis=1)
+            np.testing.assert_allclose(got[key], expected, rtol=0,
+                                       atol=1e-12 * np.abs(expected).max())
