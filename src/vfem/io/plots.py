@@ -283,10 +283,16 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
 
 def _outline(cells: np.ndarray) -> np.ndarray:
     """(e, 2) boundary edges of a mesh given by its cells: the edges of one cell only."""
-    edges = np.sort(np.stack([cells, np.roll(cells, -1, axis=1)], axis=-1).reshape(-1, 2),
-                    axis=1)
-    uniq, count = np.unique(edges, axis=0, return_counts=True)
-    return uniq[count == 1]
+    cells = np.asarray(cells)
+    k = cells.shape[1]
+    a, b = cells.ravel(), cells[:, (np.arange(k) + 1) % k].ravel()  # each cell's edges in turn
+    lo, hi = np.minimum(a, b).astype(np.int64), np.maximum(a, b).astype(np.int64)
+    # one integer per edge: a 1D unique, several times faster than np.unique(axis=0) on pairs
+    # (1.5 s of a 465k-dof Hertz run's figures), in the same (lo, hi) order
+    key = lo * (int(hi.max(initial=0)) + 1) + hi
+    _, first, count = np.unique(key, return_index=True, return_counts=True)
+    once = first[count == 1]
+    return np.column_stack([lo[once], hi[once]])
 
 
 def history(path: Path, x: np.ndarray, series: dict[str, np.ndarray], xlabel: str, ylabel: str,
