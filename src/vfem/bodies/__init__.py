@@ -332,6 +332,9 @@ class Body:
             ix = np.flatnonzero(free)
             G[np.ix_(ix, ix)] = self.factor.trailing_inverse
             self.tracked_flexibility = G
+            # the factor's dense copy is not needed for its solves: freed (issue 19, item 4:
+            # three dense copies per body were kept)
+            self.factor.trailing_inverse = None
 
         for case in self.load_cases:
             case.displacement = self._solve_with(case.force, case.prescribed)

@@ -170,6 +170,7 @@ class ContactSurface:
         if getattr(body, "tracked_flexibility", None) is not None and \
                 len(body.tracked_flexibility) == len(self.tracked_dofs):
             self.G = body.tracked_flexibility[:, :nc2].copy()
+            body.tracked_flexibility = None  # the surface keeps the rows it reads (issue 19)
         else:
             cols = body.flexibility_columns(self.candidate_dofs)
             self.G = cols[self.tracked_dofs]
