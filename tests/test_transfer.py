@@ -8,6 +8,7 @@ from vfem.bodies import Body, Support
 from vfem.contact.algorithm import VirtualElementContact
 from vfem.contact.settings import ContactSettings
 from vfem.contact.surface import ContactSurface
+from vfem.contact.transfer import traction_from_forces
 from vfem.materials import LinearElastic
 
 
@@ -38,7 +39,7 @@ def test_uniform_traction_crosses_non_matching_meshes_exactly(n_lower, n_upper):
     F[:, 1] = su.tributary
     state.forces[1] = F
     x = contact.positions(state)
-    tractions = [contact._traction(s, f) for s, f in zip(surfaces, state.forces)]
+    tractions = [traction_from_forces(s, f) for s, f in zip(surfaces, state.forces)]
     np.testing.assert_allclose(tractions[1][:, 1], 1.0, rtol=1e-12)  # N* q = Q recovers it
     virtual = contact._virtual_forces(0, x, tractions)  # on the lower body's virtual elements
     sl = surfaces[0]

@@ -6,10 +6,12 @@ For each step (an increment of the load factor):
    already carries (for linear bodies this is a change of the load factor in the superposition
    ``u = load_factor * u_load + platen * u_platen + K^-1 f_contact``, the first term summed
    over the body's load curves, :meth:`~vfem.bodies.Body.load_displacement`);
-2. **resolve contact** — the variant chosen by ``ContactSettings.variant``
-   (:class:`~vfem.contact.paired.PairedContact` by default, or the thesis's
-   :class:`~vfem.contact.algorithm.VirtualElementContact`) iterates check -> correct until
-   converged, moving a force-controlled platen as it goes;
+2. **resolve contact** — the formulation of the model's settings and kinematics
+   (:func:`~vfem.contact.formulation.formulation_class`: the paired variant by default, small
+   or large displacements, the thesis's plain reading, or a classical baseline) solves the
+   step from the last converged state (:class:`~vfem.contact.formulation.ContactFormulation`),
+   moving a force-controlled platen as it goes; what it supports it declares as data
+   (``capabilities``), which the model's checks and the step loop read;
 3. **check** — three invariants of the converged state's full-mesh results, checked
    independently of the contact formulation (:mod:`vfem.contact.check`): the contact forces of
    all bodies balance, no boundary node lies inside another body, no node carries tension. All
@@ -341,7 +343,7 @@ class Analysis:
         """
         settings = self.model.contact
         extra, force_tolerance, enforced = 0.0, None, None
-        if settings.method == "vfem" and settings.variant == "thesis" and history:
+        if self.contact.capabilities.invariants == "recorded" and history:  # the thesis's
             last = history[-1]
             extra = max(0.0, last.max_penetration - self.contact.penetration_tolerance)
             forces = [np.asarray(r.contact_force) for r in fields.values()]

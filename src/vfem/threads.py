@@ -36,8 +36,6 @@ log = logging.getLogger(__name__)
 
 #: what :func:`apply` set: ``{"threads": n, "dense": 1}``, or None before it ran
 _applied: dict | None = None
-#: threadpoolctl's limits, kept so that they stay in force
-_limits = []
 
 
 def default_threads() -> int:
@@ -71,9 +69,9 @@ def requested(value: str | int | None = None) -> int | None:
 
 def apply(threads: int | None = None) -> dict:
     """Size the pools (see the module docstring): the dense BLAS on one thread, the sparse
-    factorization on ``threads`` (default: :func:`requested`). Returns what it set. Pools of
-    libraries loaded later (MKL, when PARDISO is first used) take the setting as they load
-    (:func:`sparse_threads`)."""
+    factorization on ``threads`` (default: :func:`requested`). Returns what it set. A library
+    loaded later (MKL, when PARDISO is first used) takes the setting as it loads
+    (:func:`after_loading`)."""
     global _applied
     n = requested(threads)
     if n is None:  # "off": the pools as the libraries set them
@@ -91,12 +89,6 @@ def ensure() -> dict:
     """:func:`apply` the default policy if nothing has applied one yet (what an analysis does
     when it is set up); returns what is in force."""
     return dict(_applied) if _applied is not None else apply()
-
-
-def sparse_threads() -> int:
-    """The threads of the sparse factorization under the policy in force (for a backend that
-    loads its library late)."""
-    return (_applied or {}).get("threads") or default_threads()
 
 
 def after_loading() -> None:
@@ -120,7 +112,7 @@ def _limit_loaded() -> None:
     for api, count in (("openblas", 1), ("mkl", n), ("openmp", n)):
         selected = pools.select(internal_api=api)
         if selected.lib_controllers:
-            _limits.append(selected.limit(limits=count))
+            selected.limit(limits=count)  # in force until changed (not a context here)
 
 
 def info() -> list[dict]:
@@ -133,5 +125,4 @@ def info() -> list[dict]:
              "threads": i.get("num_threads")} for i in threadpool_info()]
 
 
-__all__ = ["after_loading", "apply", "default_threads", "ensure", "info", "requested",
-           "sparse_threads"]
+__all__ = ["after_loading", "apply", "default_threads", "ensure", "info", "requested"]

@@ -47,7 +47,6 @@ from .state import (  # noqa: F401 - the shared types, here too for those who im
     SolveResult,
     closing_motion,
 )
-from .surface import ContactSurface
 from .transfer import traction_from_forces
 
 log = logging.getLogger(__name__)
@@ -70,7 +69,7 @@ class VirtualElementContact(SurfaceGroup):
     def detect(self, state: ContactState) -> list[Pairing]:
         """Pair every candidate node with its virtual node in the current configuration."""
         x = self.positions(state)
-        tractions = [self._traction(s, F) for s, F in zip(self.surfaces, state.forces)]
+        tractions = [traction_from_forces(s, F) for s, F in zip(self.surfaces, state.forces)]
         return [self._pair(i, x, state, tractions) for i in range(len(self.surfaces))]
 
     def _opposing(self, i: int, x: list[np.ndarray]):
@@ -143,10 +142,6 @@ class VirtualElementContact(SurfaceGroup):
                        embedded=embedded, stiffness=stiffness,
                        virtual_stiffness=virtual_stiffness, force=force,
                        virtual_force=virtual_force, participating=participating)
-
-    def _traction(self, s: ContactSurface, F: np.ndarray) -> np.ndarray:
-        """The continuous traction of nodal forces ``F`` (:func:`.traction_from_forces`)."""
-        return traction_from_forces(s, F)
 
     def _virtual_forces(self, i: int, x: list[np.ndarray], tractions: list[np.ndarray]
                         ) -> np.ndarray:
@@ -337,14 +332,11 @@ class VirtualElementContact(SurfaceGroup):
         cfg = self.settings
         tol = self.penetration_tolerance
         largest = {"df": 0.0, "du": 0.0}  # the largest corrections of the solve so far
-        seen: dict = {}
 
         def check(k: int) -> Check:
             pairings = self.detect(state)
             pen, eq, eq_tol, contact, tension = self.errors(pairings)
             platen_ok = self.platen_met(state)
-            seen.update(pairings=pairings, pen=pen, eq=eq, eq_tol=eq_tol, contact=contact,
-                        tension=tension, platen_ok=platen_ok)
             rec = IterationRecord(k, pen, eq, contact, tension,
                                   platen_error=self.platen_reaction(state) - state.platen_force)
             return Check(
@@ -353,18 +345,20 @@ class VirtualElementContact(SurfaceGroup):
                          for s, p in zip(self.surfaces, pairings)],
                 max(pen, eq), lambda: pairings,
                 lambda: (f"no convergence in {cfg.max_iterations} iterations "
-                         f"(penetration {pen:.3g}, equilibrium error {eq:.3g})"))
+                         f"(penetration {pen:.3g}, equilibrium error {eq:.3g})"),
+                extra=(pairings, eq_tol, platen_ok))
 
         def correct(k: int, c: Check):
-            pen, eq, eq_tol = seen["pen"], seen["eq"], seen["eq_tol"]
-            tension, platen_ok = seen["tension"], seen["platen_ok"]
-            dF, d_platen = self.corrections(state, seen["pairings"], k)
+            pairings, eq_tol, platen_ok = c.extra
+            rec = c.record
+            pen, eq, tension = rec.max_penetration, rec.max_equilibrium_error, rec.tension_nodes
+            dF, d_platen = self.corrections(state, pairings, k)
             dU = [(s.C @ d.ravel()).reshape(-1, s.dim) for s, d in zip(self.surfaces, dF)]
             if d_platen:
                 dU[self.platen_body] += d_platen * self.platen_motion[self.platen_body]
             df = float(np.sqrt(sum((d**2).sum() for d in dF)))
             du = float(np.sqrt(sum((d**2).sum() for d in dU)))
-            c.record.force_correction, c.record.displacement_correction = df, du
+            rec.force_correction, rec.displacement_correction = df, du
             if cfg.convergence == "stationary" and tension == 0 and platen_ok:
                 node_df = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dF)
                 node_du = max(float(np.linalg.norm(d, axis=1).max(initial=0.0)) for d in dU)
@@ -386,7 +380,7 @@ class VirtualElementContact(SurfaceGroup):
                 F += d
             state.platen_displacement += d_platen
             log.debug("iteration %d: penetration %.3g, equilibrium error %.3g (tol %.3g), "
-                      "%d in contact, %d in tension", k, pen, eq, eq_tol, seen["contact"],
+                      "%d in contact, %d in tension", k, pen, eq, eq_tol, rec.contact_nodes,
                       tension)
             return None
 

@@ -577,7 +577,6 @@ class GlobalContact:
         fields, forces = self.fields_of(lf, q, Lam, g)
         state.platen_displacement = float(q[-1]) if self.platen_body is not None else 0.0
         state.forces[:] = forces
-        state.released[:] = [np.zeros(s.nc, dtype=bool) for s in self.surfaces]
         state.pressures, state.active = lam, active.copy()
         log.info("load factor %.4g: %s converged in %d linear solves (%d factorizations), %d "
                  "nodes in contact, largest penetration %.3g", lf, self.method, len(history),
@@ -587,4 +586,3 @@ class GlobalContact:
     def fields(self, state: BaselineState, result: SolveResult):
         """The full-mesh results of the step's global solution (:meth:`fields_of`)."""
         return result.fields
-

@@ -70,10 +70,13 @@ class SurfaceGroup:
         self.platen_motion = [s.body.u_platen[s.candidate_dofs].reshape(-1, s.dim)
                               for s in surfaces]
 
+    #: the type of the formulation's state (a subclass with its own unknowns, empty at first)
+    state_type: type[ContactState] = ContactState
+
     def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
                   ) -> ContactState:
-        """No contact force on any body."""
-        return ContactState(load_factor, platen_displacement,
+        """No contact force on any body (a :attr:`state_type`)."""
+        return self.state_type(load_factor, platen_displacement,
                             [np.zeros((s.nc, s.dim)) for s in self.surfaces],
                             [np.zeros(s.nc, dtype=bool) for s in self.surfaces])
 

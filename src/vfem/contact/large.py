@@ -65,7 +65,6 @@ its constant flexibility, always in equilibrium with its contact forces.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 
 import numpy as np
@@ -169,11 +168,9 @@ class LargeDeformationContact(PairSet):
             if s.order != 1:
                 raise InputError(f"body {s.body.name!r}: large-displacement contact needs "
                                  "linear elements (order 1)")
+        # (its own pairs, built on the undeformed geometry, which side carries compatibility
+        # and which nodes decided once; :meth:`penetrations` moves them to the current one)
         super().__init__(surfaces, pairs, settings, backend)
-        #: the pairs as built on the undeformed geometry (which side carries compatibility,
-        #: which nodes): kept as they are; ``contact_pairs`` follow the current configuration
-        self.undeformed_pairs = tuple(self.contact_pairs)
-        self.contact_pairs = [dataclasses.replace(p) for p in self.undeformed_pairs]
         self._offsets = np.cumsum([0] + [s.dim * s.nc for s in surfaces])
 
     # -- the bodies' current state ----------------------------------------------------------------

@@ -91,12 +91,8 @@ class PairSet(SurfaceGroup):
             pair.platen_rate = np.einsum("id,id->i", pair.normal, pair.interp @ v[pair.coarse]
                                          - v[pair.fine][pair.nodes])
 
-    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
-                  ) -> TractionState:
-        """No contact force, no traction: the unknowns are the pairs' traction values."""
-        base = super().new_state(load_factor, platen_displacement)
-        return TractionState(base.load_factor, base.platen_displacement, base.forces,
-                             base.released)
+    #: the unknowns are the pairs' traction values
+    state_type = TractionState
 
     # -- geometry of the pairs (once) -------------------------------------------------------------
 

@@ -64,7 +64,7 @@ from .files import _atomic_write, _safe, write_summary  # noqa: F401 (write_summ
 
 log = logging.getLogger(__name__)
 
-# Body.stress keys -> the VTU's cell field names
+# vfem.bodies.stresses.stress keys -> the VTU's cell field names
 _CELL_FIELD = {"sxx": "stress_xx", "syy": "stress_yy", "sxy": "stress_xy", "szz": "stress_zz"}
 CONTACT_COLUMNS = ("step", "load_factor", "body", "node", "x", "y", "ux", "uy", "pressure",
                    "gap", "status")
