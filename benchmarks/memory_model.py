@@ -1,7 +1,8 @@
-"""Measure what vfem.memory models: SuperLU's fill and the peak memory of Analysis.setup.
+"""Measure what vfem.memory models: a backend's fill and the peak memory of Analysis.setup.
 
-    python benchmarks/memory_model.py            # the cases the constants were fitted on
-    python benchmarks/memory_model.py quad 1 80  # one case: element, order, refinement
+    python benchmarks/memory_model.py                    # the fitted cases, SuperLU
+    python benchmarks/memory_model.py quad 1 80          # one case: element, order, refinement
+    python benchmarks/memory_model.py --solver pardiso   # the same with another backend
 
 Each case runs in its own process (peak resident memory is per process): two rectangular bodies
 in contact (the lower 2n x n elements, the upper n x n/2 on part of its top), or, with ``strip``,
@@ -41,37 +42,46 @@ def model(kind: str, order: int, n: int):
              contact_boundaries=("bottom",), order=order)])
 
 
-def measure(kind: str, order: int, n: int) -> dict:
+def measure(kind: str, order: int, n: int, backend: str) -> dict:
     from vfem.memory import estimate, factor_entries
     from vfem.solver import Analysis
 
     m = model(kind, order, n)
     m.validate()
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    analysis = Analysis(m)
+    analysis = Analysis(m, backend)
     analysis.setup()
     peak = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) * 1024
     rows = []
     for s in analysis.surfaces:
-        lu = s.body.factor._lu
-        rows.append({"dofs": s.body.ndofs, "tracked": len(s.tracked_dofs),
-                     "nnz_LU": lu.L.nnz + lu.U.nnz,
-                     "model": round(factor_entries(s.body.ndofs, len(s.tracked_dofs)))})
-    total = estimate(analysis.surfaces, [frozenset((0, 1))])["total"]
+        factor = s.body.factor
+        entries = (factor._lu.L.nnz + factor._lu.U.nnz if hasattr(factor, "_lu")
+                   else getattr(factor, "factor_entries", 0))
+        condensed = len(s.condensed_dofs)
+        rows.append({"dofs": s.body.ndofs, "tracked": condensed, "nnz_LU": entries,
+                     "model": round(factor_entries(s.body.ndofs, condensed, backend))})
+    total = estimate(analysis.surfaces, [frozenset((0, 1))], backend)["total"]
     return {"case": f"{kind} P{order} n={n}", "bodies": rows, "peak_MiB": peak / 2**20,
             "estimate_MiB": total / 2**20}
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 5 and sys.argv[1] == "--one":
-        print(json.dumps(measure(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))))
+    args = sys.argv[1:]
+    backend = "superlu"
+    if "--solver" in args:
+        i = args.index("--solver")
+        backend = args[i + 1]
+        del args[i:i + 2]
+    if len(args) == 4 and args[0] == "--one":
+        print(json.dumps(measure(args[1], int(args[2]), int(args[3]), backend)))
         sys.exit(0)
-    cases = [(sys.argv[1], int(sys.argv[2]), int(sys.argv[3]))] if len(sys.argv) == 4 else CASES
+    cases = [(args[0], int(args[1]), int(args[2]))] if len(args) == 3 else CASES
     for kind, order, n in cases:
-        out = subprocess.run([sys.executable, __file__, "--one", kind, str(order), str(n)],
+        out = subprocess.run([sys.executable, __file__, "--one", kind, str(order), str(n),
+                              "--solver", backend],
                              capture_output=True, text=True, check=True).stdout
         r = json.loads(out)
-        fill = ", ".join(f"{b['dofs']} dofs ({b['tracked']} tracked): nnz(L+U) {b['nnz_LU']} "
+        fill = ", ".join(f"{b['dofs']} dofs ({b['tracked']} condensed): factor {b['nnz_LU']} "
                          f"model x{b['model'] / b['nnz_LU']:.2f}" for b in r["bodies"])
         print(f"{r['case']:>16}: peak {r['peak_MiB']:7.0f} MiB, estimate "
               f"{r['estimate_MiB']:7.0f} MiB (x{r['estimate_MiB'] / r['peak_MiB']:.2f}); {fill}",

@@ -10,7 +10,9 @@ gets through anyway into the same kind of message.
 
 The model (bytes), per body, summed over the bodies:
 
-    FACTOR_BYTES * nnz(L + U)  +  DENSE_BYTES * m**2  +  STIFFNESS_BYTES * nnz(K)
+    FACTOR_BYTES * entries(factor)  +  DENSE_BYTES * m**2  +  STIFFNESS_BYTES * nnz(K)
+
+(``PARDISO_DENSE_BYTES`` for ``DENSE_BYTES`` under PARDISO)
 
 plus ``BASE_BYTES``, plus ``PAIR_BYTES * nc_i * nc_j`` per pair of contact surfaces that may
 touch, plus ``LARGE_BYTES * ndofs * 2 nc`` per large-kinematics body (its tangent flexibility
@@ -19,20 +21,23 @@ for the candidate dofs is dense, ndofs x 2 nc, built in each Newton iteration). 
 * ``nnz(K)`` is its structural count, from the mesh: 4 (points + 2 pairs of points sharing an
   element), the pairs being C(k, 2) per element of k points less those counted twice on shared
   edges;
-* ``m = 2 nt`` is the number of tracked dofs (candidate and rind nodes: ``ContactSurface.nodes``),
-  ordered last in the factorization; the dense inverse on them (and its few temporaries) is
-  what grows fastest when a contact surface is long;
-* ``nnz(L + U)`` is SuperLU's fill with vfem's ordering (minimum degree on the node graph, the
-  tracked dofs last), modelled as ``ndofs * max(20, 22 log2(ndofs) - 140) + 0.6 m**2``: the
-  n log n growth of a minimum-degree factor of a 2D mesh plus the trailing block.
+* ``m`` is the number of condensed dofs (``ContactSurface.condensed_dofs``: the candidate
+  nodes', and the rind's too for the thesis variant), ordered last in the factorization; the
+  dense inverse on them is what grows fastest when a contact surface is long;
+* ``entries(factor)`` is the backend's fill (:func:`factor_entries`), per backend: SuperLU's
+  nnz(L + U) with vfem's ordering (minimum degree on the node graph, the condensed dofs last),
+  modelled as ``ndofs * max(20, 22 log2(ndofs) - 140) + 0.6 m**2``; PARDISO's nnz(L) (nested
+  dissection, Cholesky; the count PARDISO reports), ``ndofs * max(10, 8.4 log2(ndofs) - 48) +
+  0.5 m**2``. Other backends take SuperLU's, the larger.
 
-The constants were fitted (``benchmarks/memory_model.py`` repeats the measurements) to the peak
-resident memory of ``Analysis.setup`` and SuperLU's nnz(L + U) on two rectangular bodies in
-contact, linear and quadratic triangles and quadrilaterals, 460 to 103,000 dofs a body, and on
-two long thin strips whose whole faces are candidates (up to 4,000 tracked dofs a body): the fill
-model gives 1.0 to 1.5 times SuperLU's nnz(L + U), and the whole estimate 1.05 to 1.85 times the
-measured peak (1.05 to 1.5 above 100 MiB), so it errs on the side of caution. Other backends or
-far more irregular meshes fill differently; the estimate is a guide, not a bound.
+The constants were fitted (``benchmarks/memory_model.py [--solver pardiso]`` repeats the
+measurements) to the peak resident memory of ``Analysis.setup`` and the backends' fill on two
+rectangular bodies in contact, linear and quadratic triangles and quadrilaterals, 460 to 103,000
+dofs a body, and on two long thin strips whose whole faces are candidates (up to 4,000 tracked
+dofs a body): SuperLU's fill model gives 1.0 to 1.5 times its nnz(L + U), and the whole
+estimate 1.05 to 1.85 times the measured peak (1.05 to 1.5 above 100 MiB); PARDISO's gives 0.91
+to 1.11 times its count above 20,000 dofs (0.82 to 1.14 at all sizes), the whole estimate 0.85
+to 1.24 times the peak above 100 MiB. Far more irregular meshes fill differently; the estimate is a guide, not a bound.
 """
 
 from __future__ import annotations
@@ -57,22 +62,31 @@ DENSE_BYTES = 28
 #: Bytes per stiffness entry: the assembled matrix, its free block, the reordered copy that is
 #: factorized, and scikit-fem's element-by-element assembly arrays.
 STIFFNESS_BYTES = 64
+#: The same under PARDISO, whose Schur complement vfem inverts in PARDISO's own output array
+#: (:func:`vfem.linalg.common.spd_inverse_in_place`; its factor's dense block is in the fill)
+PARDISO_DENSE_BYTES = 12
 #: Bytes per product of two contact surfaces' candidate counts (the paired variant's transfer
 #: and mass matrices and its condensed flexibility).
 PAIR_BYTES = 32
 #: Bytes per entry of a large-kinematics body's dense tangent flexibility (ndofs x 2 nc) and its
 #: right-hand sides.
 LARGE_BYTES = 24
+#: PARDISO's fill per dof, ``max(MIN, SLOPE log2(ndofs) - OFFSET)``
+PARDISO_MIN, PARDISO_SLOPE, PARDISO_OFFSET = 10.0, 8.4, 48.0
 #: What Python, NumPy and scikit-fem hold besides (measured: about 15 MB).
 BASE_BYTES = 16 * 2**20
 
 
-def factor_entries(ndofs: int, tracked: int) -> float:
-    """Estimated nnz(L + U) of a body's SuperLU factors with ``tracked`` dofs ordered last."""
+def factor_entries(ndofs: int, condensed: int, backend: str | None = None) -> float:
+    """Estimated entries of a body's factors with ``condensed`` dofs ordered last: SuperLU's
+    nnz(L + U), or with ``backend`` ``"pardiso"`` its nnz(L) (nested dissection, Cholesky)."""
     if ndofs <= 0:
         return 0.0
+    if backend == "pardiso":
+        per_dof = max(PARDISO_MIN, PARDISO_SLOPE * math.log2(max(ndofs, 2)) - PARDISO_OFFSET)
+        return ndofs * per_dof + 0.5 * float(condensed) ** 2
     per_dof = max(20.0, 22.0 * math.log2(max(ndofs, 2)) - 140.0)
-    return ndofs * per_dof + 0.6 * float(tracked) ** 2
+    return ndofs * per_dof + 0.6 * float(condensed) ** 2
 
 
 def stiffness_entries(body) -> int:
@@ -85,16 +99,18 @@ def stiffness_entries(body) -> int:
     return 4 * (body.npoints + 2 * pairs)
 
 
-def estimate(surfaces, pairs=()) -> dict[str, float]:
-    """Estimated peak bytes of the set-up, by part: ``{"total", "factors", "dense", "stiffness",
-    "pairs", "large"}`` (see the module docstring for the model)."""
+def estimate(surfaces, pairs=(), backend: str | None = None) -> dict[str, float]:
+    """Estimated peak bytes of the set-up with ``backend`` (SuperLU's model for any other),
+    by part: ``{"total", "factors", "dense", "stiffness", "pairs", "large"}`` (see the module
+    docstring for the model)."""
     parts = dict.fromkeys(("factors", "dense", "stiffness", "pairs", "large"), 0.0)
     for s in surfaces:
         body = s.body
         ndofs = 2 * body.npoints
-        m = 2 * len(s.nodes)
-        parts["factors"] += FACTOR_BYTES * factor_entries(ndofs, m)
-        parts["dense"] += DENSE_BYTES * float(m) ** 2
+        m = len(s.condensed_dofs)
+        parts["factors"] += FACTOR_BYTES * factor_entries(ndofs, m, backend)
+        parts["dense"] += (PARDISO_DENSE_BYTES if backend == "pardiso" else DENSE_BYTES) \
+            * float(m) ** 2
         parts["stiffness"] += STIFFNESS_BYTES * stiffness_entries(body)
         if body.large:
             parts["large"] += LARGE_BYTES * ndofs * 2.0 * s.nc
@@ -151,14 +167,14 @@ def _advice(parts: dict[str, float]) -> str:
     return "the bodies' meshes dominate: coarser meshes away from the contact"
 
 
-def check_memory(surfaces, pairs=()) -> dict[str, float]:
+def check_memory(surfaces, pairs=(), backend: str | None = None) -> dict[str, float]:
     """Log the estimated memory of the set-up and refuse a model that cannot fit.
 
     Raises:
         AnalysisError: the estimate exceeds :func:`available_memory`; the message gives both
             and what to change.
     """
-    parts = estimate(surfaces, pairs)
+    parts = estimate(surfaces, pairs, backend)
     available = available_memory()
     log.info("estimated memory for the set-up: %s (factors %s, dense contact matrices %s, "
              "stiffness %s); available: %s", _size(parts["total"]), _size(parts["factors"]),

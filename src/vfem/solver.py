@@ -293,14 +293,18 @@ class Analysis:
         log.info("linear solver: %s", self.backend)
         bodies = self.model.bodies
         pairs, self.surfaces = self.model.contact_surfaces()
+        # condensed to the candidate dofs alone unless the formulation reads the rind (issue 19)
+        reads_rind = self._formulation().capabilities.reads_rind
+        for s in self.surfaces:
+            s.rind_rows = reads_rind
         self.unreachable = unreachable_pairs(self.model, pairs, self.surfaces)
         for note in self.unreachable + idle_load_curves(self.model):
             log.warning("%s", note)
         t1 = time.perf_counter()
-        check_memory(self.surfaces, pairs)
+        check_memory(self.surfaces, pairs, self.backend)
         with memory_guard("factorizing the bodies and computing their flexibility"):
             for b, s in zip(bodies, self.surfaces):
-                b.setup(self.backend, tracked_dofs=s.tracked_dofs)
+                b.setup(self.backend, condensed_dofs=s.condensed_dofs)
             t2 = time.perf_counter()
             for s in self.surfaces:
                 s.compute_flexibility()
@@ -316,8 +320,12 @@ class Analysis:
     def _contact(self, pairs: set[frozenset[int]]):
         """The contact formulation of the model's settings and kinematics
         (:func:`~vfem.contact.formulation.formulation_class`)."""
-        cls = formulation_class(self.model.contact, any(b.large for b in self.model.bodies))
-        return cls(self.surfaces, pairs, self.model.contact, backend=self.backend)
+        return self._formulation()(self.surfaces, pairs, self.model.contact,
+                                   backend=self.backend)
+
+    def _formulation(self) -> type:
+        """The formulation class of the model's contact settings and kinematics."""
+        return formulation_class(self.model.contact, any(b.large for b in self.model.bodies))
 
     def _invariant_check(self) -> InvariantCheck:
         """The invariants every converged step must satisfy (:mod:`vfem.contact.check`), to the

@@ -305,33 +305,36 @@ class Body:
         self.timings = {"assemble_s": t1 - t0, "constraints_s": time.perf_counter() - t1}
         return fixed
 
-    def setup(self, backend: str | None = None, tracked_dofs: np.ndarray | None = None) -> None:
+    def setup(self, backend: str | None = None, condensed_dofs: np.ndarray | None = None) -> None:
         """Validate, assemble the stiffness (:meth:`assemble`), factorize it and solve the unit
         load cases.
 
-        With ``tracked_dofs`` (the dofs contact follows), the factorization also yields the
-        inverse stiffness among them (``tracked_flexibility``, supports kept: zero on fixed dofs).
+        With ``condensed_dofs`` (the dofs contact follows), the factorization also yields the
+        inverse stiffness among them (``condensed_flexibility``, supports kept: zero on fixed dofs).
         """
         fixed = self.assemble()
         t1 = time.perf_counter()
         platen_dofs = self.platen_dofs
         self.K_ff = self.K[self.free_dofs][:, self.free_dofs].tocsc()
         trailing = None
-        if tracked_dofs is not None:
-            tracked_dofs = np.asarray(tracked_dofs, dtype=int)
-            pos = np.searchsorted(self.free_dofs, tracked_dofs)
-            free = self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == tracked_dofs
+        if condensed_dofs is not None:
+            condensed_dofs = np.asarray(condensed_dofs, dtype=int)
+            pos = np.searchsorted(self.free_dofs, condensed_dofs)
+            free = self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == condensed_dofs
             trailing = pos[free]
         t2 = time.perf_counter()
         self.factor = factorize(self.K_ff, backend, trailing=trailing,
                                 groups=self.free_dofs // 2, what=f"body {self.name!r}")
         t3 = time.perf_counter()
-        self.tracked_flexibility = None
-        if tracked_dofs is not None:
-            G = np.zeros((len(tracked_dofs), len(tracked_dofs)))
-            ix = np.flatnonzero(free)
-            G[np.ix_(ix, ix)] = self.factor.trailing_inverse
-            self.tracked_flexibility = G
+        self.condensed_flexibility = None
+        if condensed_dofs is not None:
+            if free.all():  # the factor's block is the flexibility: no copy
+                G = self.factor.trailing_inverse
+            else:
+                G = np.zeros((len(condensed_dofs), len(condensed_dofs)))
+                ix = np.flatnonzero(free)
+                G[np.ix_(ix, ix)] = self.factor.trailing_inverse
+            self.condensed_flexibility = G
             # the factor's dense copy is not needed for its solves: freed (issue 19, item 4:
             # three dense copies per body were kept)
             self.factor.trailing_inverse = None
@@ -386,11 +389,11 @@ class Body:
         return self.mechanics.equilibrate(load_factor, platen_displacement, contact_force)
 
     def linearize(self, load_factor: float, platen_displacement: float,
-                  contact_force: np.ndarray, tracked_dofs: np.ndarray,
+                  contact_force: np.ndarray, condensed_dofs: np.ndarray,
                   candidate_dofs: np.ndarray, backend: str | None = None) -> Linearization:
         """Large kinematics: :meth:`LargeMechanics.linearize`."""
         return self.mechanics.linearize(load_factor, platen_displacement, contact_force,
-                                        tracked_dofs, candidate_dofs, backend)
+                                        condensed_dofs, candidate_dofs, backend)
 
     def move(self, correction: np.ndarray) -> None:
         """Large kinematics: :meth:`LargeMechanics.move`."""

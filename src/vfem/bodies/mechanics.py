@@ -141,7 +141,7 @@ class LargeMechanics:
         return self.nonlinear.trial_displacement()
 
     def linearize(self, load_factor: float, platen_displacement: float,
-                  contact_force: np.ndarray, tracked_dofs: np.ndarray,
+                  contact_force: np.ndarray, condensed_dofs: np.ndarray,
                   candidate_dofs: np.ndarray, backend: str | None = None) -> Linearization:
         """Newton's system at the trial state under the loads at
         ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
@@ -152,10 +152,10 @@ class LargeMechanics:
         R, ref, K, D, pending = self.nonlinear.linearize(load_factor, contact_force)
         free = np.setdiff1d(np.arange(self.body.ndofs), D)
         K_ff = K[free][:, free].tocsc()
-        # the tracked dofs among the free ones: their block of the inverse tangent is the
+        # the condensed dofs among the free ones: their block of the inverse tangent is the
         # inverse of its Schur complement, from the factorization (as for the linear body)
-        pos = np.searchsorted(free, tracked_dofs)
-        held = free[np.minimum(pos, len(free) - 1)] == tracked_dofs
+        pos = np.searchsorted(free, condensed_dofs)
+        held = free[np.minimum(pos, len(free) - 1)] == condensed_dofs
         factor, step = _tangent_factorization(K_ff, pos[held], free // 2,
                                               -R[free] - K[free] @ pending, backend, self.body.name)
 
@@ -166,10 +166,10 @@ class LargeMechanics:
 
         correction = pending.copy()
         correction[free] = step
-        # flexibility rows of the tracked dofs for the candidate dofs (supports kept); the
-        # candidate dofs are the first of the tracked ones (ContactSurface.tracked_dofs)
+        # flexibility rows of the condensed dofs for the candidate dofs (supports kept); the
+        # candidate dofs are the first of them (ContactSurface.condensed_dofs)
         nc2 = len(candidate_dofs)
-        flexibility = np.zeros((len(tracked_dofs), nc2))
+        flexibility = np.zeros((len(condensed_dofs), nc2))
         if factor.trailing_inverse is not None:
             rows = np.flatnonzero(held)
             cols = rows[rows < nc2]
@@ -180,7 +180,7 @@ class LargeMechanics:
             unit = np.zeros((self.body.ndofs, len(cols)))
             unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
             if len(cols):
-                flexibility[:, cols] = solve(unit)[tracked_dofs]
+                flexibility[:, cols] = solve(unit)[condensed_dofs]
         platen_motion = np.zeros(self.body.ndofs)
         stiffness = reaction = 0.0
         P = self.body.platen_dofs
@@ -246,9 +246,9 @@ class Linearization:
         reference: the force it is measured against (:class:`vfem.nonlinear.NewtonStep`).
         correction: (ndofs) Newton's correction with the contact forces held, the prescribed
             displacements' increments included.
-        flexibility: (tracked, candidate) the tangent flexibility rows of the tracked dofs for
+        flexibility: (condensed, candidate) the tangent flexibility rows of the condensed dofs for
             the candidate dofs (supports kept): the inverse of the tangent's Schur complement on
-            the tracked dofs, from its factorization (:func:`_tangent_factorization`).
+            the condensed dofs, from its factorization (:func:`_tangent_factorization`).
         platen_motion: (ndofs) the motion per unit motion of the platen (1 on its dofs).
         platen_stiffness: the platen's reaction per unit platen motion.
         platen_reaction: the platen's reaction after ``correction``, linearised.

@@ -14,7 +14,11 @@ class Capabilities:
     thesis's plain reading leaves errors by design) or ``"compared"`` (recorded silently: a
     baseline's answer is its own, compared with vfem's). ``cuts_steps``: whether a failed step
     is retried with a smaller increment (a baseline's linear frictionless answer does not depend
-    on the path, so its failure is final).
+    on the path, so its failure is final). ``reads_rind``: whether the formulation needs the
+    current positions of the rind's nodes from the bodies' flexibility (the thesis variant
+    locates nodes in the opposing rind as it iterates); the others read only the candidate
+    nodes, so each body is condensed to its candidate dofs alone (issue 19, item 4: the dense
+    block, its inversion and its memory shrink by about 2, 8 and 4 times on a long surface).
     """
 
     name: str
@@ -24,3 +28,4 @@ class Capabilities:
     friction: tuple[str, ...]
     invariants: str = "enforced"
     cuts_steps: bool = True
+    reads_rind: bool = False

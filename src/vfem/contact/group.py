@@ -10,8 +10,10 @@ the platen's bordered system that each of them solves in its compatibility corre
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 
 from ..result_types import BodyStepResult, add_reactions
+from ..threads import dense_threads
 from .settings import ContactSettings
 from .state import ContactState, SolveResult
 from .surface import ContactSurface
@@ -34,11 +36,7 @@ def bordered_solve(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: f
     where that fails.
     """
     m = len(rhs)
-    A = np.zeros((m + 1, m + 1))
-    A[:m, :m] = W
-    A[:m, m] = column
-    A[m, :m] = row
-    A[m, m] = corner
+    A = bordered_matrix(W, column, row, corner)
     b = np.concatenate([rhs, [extra]])
     if lu_first:
         try:
@@ -48,6 +46,46 @@ def bordered_solve(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: f
     else:
         sol = np.linalg.lstsq(A, b, rcond=None)[0]
     return sol[:m], float(sol[m])
+
+
+def bordered_matrix(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: float
+                    ) -> np.ndarray:
+    """The matrix of :func:`bordered_solve`'s system."""
+    m = len(W)
+    A = np.zeros((m + 1, m + 1))
+    A[:m, :m] = W
+    A[:m, m] = column
+    A[m, :m] = row
+    A[m, m] = corner
+    return A
+
+
+class ReusedFactor:
+    """The LU factors of the last matrix solved, kept for as long as the matrix recurs.
+
+    Under small kinematics the paired variant's pair matrix over an active set is the same
+    whenever that set recurs (its flexibility over every pair node is fixed): in the
+    iterations that only adjust the traction values, and in the steps whose contact set holds.
+    It is factorized when the set changes, not at every solve (issue 19, item 4: the dense solve
+    is O(m^3), seconds at a few thousand nodes). Partial pivoting as ``numpy.linalg.solve``.
+    """
+
+    def __init__(self):
+        self.key = None
+        self.factors = None
+
+    def solve(self, key, matrix, b: np.ndarray) -> np.ndarray | None:
+        """The solution of ``matrix() x = b``, ``matrix`` called only when ``key`` is new;
+        None when the matrix is singular (an exactly zero pivot)."""
+        if key != self.key:
+            A = matrix()
+            with dense_threads(len(A)):
+                lu, piv = sla.lu_factor(A, check_finite=False, overwrite_a=True)
+            self.key = key
+            self.factors = None if (np.diag(lu) == 0.0).any() else (lu, piv)
+        if self.factors is None:
+            return None
+        return sla.lu_solve(self.factors, b, check_finite=False)
 
 
 class SurfaceGroup:
@@ -81,15 +119,16 @@ class SurfaceGroup:
                             [np.zeros(s.nc, dtype=bool) for s in self.surfaces])
 
     def positions(self, state: ContactState) -> list[np.ndarray]:
-        """Current coordinates of every body's tracked nodes: X + u(load, platen, forces), the
-        bodies' linear response (superposition)."""
+        """Current coordinates of every body's condensed nodes (the rows of its flexibility:
+        the tracked nodes, or the candidates alone, :attr:`ContactSurface.rind_rows`):
+        X + u(load, platen, forces), the bodies' linear response (superposition)."""
         out = []
         for s, F in zip(self.surfaces, state.forces):
             b = s.body
-            dofs = s.tracked_dofs
+            dofs = s.condensed_dofs
             u = (b.load_displacement(state.load_factor, dofs) + state.platen_displacement
                  * b.u_platen[dofs] + s.G @ F.ravel())
-            out.append(s.X + u.reshape(-1, s.dim))
+            out.append(s.X[: len(dofs) // s.dim] + u.reshape(-1, s.dim))
         return out
 
     def platen_reaction(self, state: ContactState) -> float:

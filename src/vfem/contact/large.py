@@ -277,7 +277,7 @@ class LargeDeformationContact(PairSet):
                 out.append(None)
                 continue
             out.append(s.body.linearize(state.load_factor, state.platen_displacement,
-                                        self._full_force(i, F), s.tracked_dofs,
+                                        self._full_force(i, F), s.condensed_dofs,
                                         s.candidate_dofs, self.backend))
         return out
 

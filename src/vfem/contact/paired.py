@@ -42,7 +42,7 @@ import scipy.sparse as sp
 from ..errors import PlatenUnheld, RindViolation
 from .capabilities import Capabilities
 from .corrections import relaxation, release_tension
-from .group import SurfaceGroup, bordered_solve
+from .group import ReusedFactor, SurfaceGroup, bordered_matrix, bordered_solve
 from .iteration import Check, iterate
 from .pairing import (  # noqa: F401 - the pairing's parts, here too for those who import them here
     EDGE_RATIO,
@@ -349,6 +349,7 @@ class PairedContact(PairSet):
         #: geometry is fixed under small kinematics, so they are computed once, when first
         #: needed
         self._full = None
+        self._factor = ReusedFactor()  # the pair matrix's factors while the active set holds
 
     def penetrations(self, state: ContactState) -> list[np.ndarray]:
         """Penetration (> 0 overlap) of every pair's fine nodes, linear kinematics."""
@@ -419,20 +420,34 @@ class PairedContact(PairSet):
             if not self.platen_met(state):
                 self._close_gap(state, pens)
             return
-        W, dp_dplaten, dR = self._pair_flexibility(state, active)
-        rhs = np.concatenate(targets)
-        if self.platen_body is not None and state.platen_force != 0.0:
-            body = self.surfaces[self.platen_body].body
-            dq, dplaten = bordered_solve(W, -dp_dplaten, dR, body.platen_stiffness, rhs,
-                                           state.platen_force - self.platen_reaction(state),
-                                           lu_first=True)
-        else:
-            dq, dplaten = np.linalg.solve(W, rhs), 0.0
+        dq, dplaten = self._solve_pairs(state, active, np.concatenate(targets))
         pos = 0
         for k, a in enumerate(active):
             self.tractions(state, k)[a] += dq[pos:pos + len(a)]
             pos += len(a)
         state.platen_displacement += dplaten
+
+    def _solve_pairs(self, state: ContactState, active: list[np.ndarray], rhs: np.ndarray
+                     ) -> tuple[np.ndarray, float]:
+        """The traction value corrections of the active nodes (and the platen's motion under a
+        platen force) that remove the penetrations ``rhs``: the pair matrix W (bordered by the
+        platen's row and column), its factors reused while the active set holds."""
+        W, dp_dplaten, dR = self._pair_flexibility(state, active)
+        bordered = self.platen_body is not None and state.platen_force != 0.0
+        key = (bordered,) + tuple(a.tobytes() for a in active)
+        if not bordered:
+            x = self._factor.solve(key, lambda: W, rhs)
+            if x is None:
+                raise np.linalg.LinAlgError("the pair matrix is singular")
+            return x, 0.0
+        body = self.surfaces[self.platen_body].body
+        extra = state.platen_force - self.platen_reaction(state)
+        x = self._factor.solve(
+            key, lambda: bordered_matrix(W, -dp_dplaten, dR, body.platen_stiffness),
+            np.concatenate([rhs, [extra]]))
+        if x is None:  # singular (no node of the platen's body among them): least squares
+            return bordered_solve(W, -dp_dplaten, dR, body.platen_stiffness, rhs, extra)
+        return x[:-1], float(x[-1])
 
     def _pair_flexibility(self, state: ContactState, active: list[np.ndarray]):
         """W = d(penetration reduction)/d(traction value) over the active fine nodes of all pairs.
@@ -471,8 +486,10 @@ class PairedContact(PairSet):
                               np.concatenate([p[1] for p in ps]) if ps else [])),
                             shape=(s.dim * s.nc, m))
               for s, ps in zip(self.surfaces, parts)]  # body forces per unit traction value
-        du = [np.asarray((f.T @ s.C.T).T).reshape(s.nc, s.dim, m)
-              for s, f in zip(self.surfaces, dF)]
+        # C f as (f^T C^T)^T; C^T is C where the flexibility came symmetric to the bit from the
+        # factorization (no transposed copy of C)
+        du = [np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T).reshape(
+            s.nc, s.dim, m) for s, f in zip(self.surfaces, dF)]
         W = np.zeros((m, m))
         dp_dplaten = np.zeros(m)
         for k, pair in enumerate(self.contact_pairs):

@@ -70,7 +70,9 @@ class ContactSurface:
             2/3 for a quadratic facet's ends and midpoint): nodal force / tributary is the
             nominal pressure.
         rind: (ne, 3) triangles of the rind (quadrilaterals split in two), local node numbers.
-        G: (2 nt, 2 nc) flexibility rows of the tracked dofs for the candidate dofs.
+        G: (2 nr, 2 nc) flexibility rows of the condensed dofs (:attr:`condensed_dofs`: the
+            tracked nodes' with ``rind_rows``, else only the candidates', nr = nc) for the
+            candidate dofs.
         platen_row: (2 nc,) the platen reaction per unit contact force on the candidate dofs.
     """
 
@@ -85,6 +87,11 @@ class ContactSurface:
     rind: np.ndarray
     G: np.ndarray | None = None
     platen_row: np.ndarray | None = None
+    #: whether the flexibility keeps the rows of the rind's nodes (a formulation that
+    #: ``reads_rind``, :class:`~vfem.contact.capabilities.Capabilities`) or only the candidates'
+    rind_rows: bool = True
+    #: whether ``C`` equals its transpose to the last bit (set by :meth:`compute_flexibility`)
+    exactly_symmetric: bool = False
 
     @classmethod
     def build(cls, body: Body, facet_ids: np.ndarray) -> ContactSurface:
@@ -158,22 +165,32 @@ class ContactSurface:
         """Body dofs of the tracked nodes (the candidates first)."""
         return self.dofs_of(self.nodes)
 
-    def compute_flexibility(self) -> None:
-        """The flexibility rows of the tracked dofs for the candidate dofs, and the platen row.
+    @property
+    def condensed_dofs(self) -> np.ndarray:
+        """The body dofs its stiffness is condensed to (ordered last in its factorization): the
+        tracked nodes' with :attr:`rind_rows`, else the candidate nodes' alone."""
+        return self.tracked_dofs if self.rind_rows else self.candidate_dofs
 
-        Taken from the body's factorization (tracked dofs ordered last, see ``vfem.linalg``), or
-        else one back-substitution per candidate dof. The platen's reaction per unit force at a
-        candidate dof is, by reciprocity, minus that dof's motion under a unit platen motion.
+    def compute_flexibility(self) -> None:
+        """The flexibility rows of the condensed dofs for the candidate dofs, and the platen row.
+
+        Taken from the body's factorization (condensed dofs ordered last, see ``vfem.linalg``),
+        or else one back-substitution per candidate dof. The platen's reaction per unit force at
+        a candidate dof is, by reciprocity, minus that dof's motion under a unit platen motion.
         """
         body = self.body
         nc2 = self.dim * self.nc
-        if getattr(body, "tracked_flexibility", None) is not None and \
-                len(body.tracked_flexibility) == len(self.tracked_dofs):
-            self.G = body.tracked_flexibility[:, :nc2].copy()
-            body.tracked_flexibility = None  # the surface keeps the rows it reads (issue 19)
+        rows = self.condensed_dofs
+        if getattr(body, "condensed_flexibility", None) is not None and \
+                len(body.condensed_flexibility) == len(rows):
+            self.G = (body.condensed_flexibility if len(rows) == nc2
+                      else body.condensed_flexibility[:, :nc2].copy())
+            body.condensed_flexibility = None  # the surface keeps the rows it reads (issue 19)
+            self.exactly_symmetric = True  # each backend mirrors its inverse (vfem.linalg)
         else:
             cols = body.flexibility_columns(self.candidate_dofs)
-            self.G = cols[self.tracked_dofs]
+            self.G = cols[rows]
+            self.exactly_symmetric = False  # back-substitutions: symmetric to round-off
         self.platen_row = -body.u_platen[self.candidate_dofs]
 
     def node_normals(self, x: np.ndarray | None = None, facets: np.ndarray | None = None

@@ -16,8 +16,8 @@ import os
 import numpy as np
 import scipy.sparse as sp
 
-from ..threads import after_loading
-from .common import spd_inverse
+from ..threads import after_loading, dense_threads
+from .common import spd_inverse_in_place
 
 _P64 = ctypes.POINTER(ctypes.c_int64)
 _P32 = ctypes.POINTER(ctypes.c_int32)
@@ -83,6 +83,7 @@ class PardisoFactorization:
         iparm[1] = 2  # METIS nested dissection
         iparm[9] = 8  # pivot perturbation 1e-8 (indefinite only)
         iparm[10] = iparm[12] = 0 if spd else 1  # scaling and matching for saddle points
+        iparm[17] = -1  # report the factor's nonzeros (factor_entries: vfem.memory's model)
         iparm[34] = 1  # zero-based indices
         self._iparm = iparm
         self._perm = np.zeros(self.n, dtype=np.int32)
@@ -95,12 +96,15 @@ class PardisoFactorization:
             m = len(trailing)
         x = np.zeros(max(self.n, m * m))
         self._call(12, np.zeros(self.n), x, 1)
+        self.factor_entries = int(iparm[17])
         if m:
             # rows and columns of the Schur complement in increasing dof order
             rank = np.argsort(np.argsort(trailing))
-            S = x[: m * m].reshape(m, m)
-            S = np.triu(S) + np.triu(S, 1).T
-            inv = spd_inverse(S)[np.ix_(rank, rank)]
+            with dense_threads(m):
+                inv = spd_inverse_in_place(x[: m * m].reshape(m, m))  # in PARDISO's output
+            del x
+            if not np.array_equal(rank, np.arange(m)):
+                inv = inv[np.ix_(rank, rank)]
             self.trailing_inverse = inv
 
     def _call(self, phase: int, b: np.ndarray, x: np.ndarray, nrhs: int) -> None:

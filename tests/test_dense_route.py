@@ -1,0 +1,112 @@
+"""The lighter dense route (issue 19, item 4): bodies condensed to the dofs the formulation reads,
+the inverse computed in place, the pair matrix's factors reused, the memory model per backend."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vfem import linalg
+from vfem.contact.group import ReusedFactor
+from vfem.examples.hertz import HertzParameters, build
+from vfem.linalg.common import mirror, spd_inverse, spd_inverse_in_place
+from vfem.memory import factor_entries
+from vfem.solver import Analysis
+
+
+def _setup(rind_rows: bool, backend: str | None = None):
+    """The Hertz example set up with its bodies condensed to the tracked dofs (``rind_rows``)
+    or to the candidates alone."""
+    analysis = Analysis(build(HertzParameters()), backend)
+    pairs, surfaces = analysis.model.contact_surfaces()
+    for s in surfaces:
+        s.rind_rows = rind_rows
+        s.body.setup(analysis.backend, condensed_dofs=s.condensed_dofs)
+        s.compute_flexibility()
+    return surfaces
+
+
+@pytest.mark.parametrize("backend", linalg.available())
+def test_candidates_alone_give_the_candidate_rows_of_the_tracked_flexibility(backend):
+    """Condensing to the candidate dofs (what the paired variant reads) gives the same
+    flexibility on them as condensing to every tracked dof and keeping their rows: the
+    inverse stiffness among the candidates does not depend on which other dofs are condensed
+    with them (round-off aside)."""
+    tracked, candidates = _setup(True, backend), _setup(False, backend)
+    for t, c in zip(tracked, candidates):
+        assert t.G.shape == (2 * len(t.nodes), 2 * t.nc)
+        assert c.G.shape == (2 * c.nc, 2 * c.nc)
+        scale = np.abs(t.C).max()
+        assert np.abs(c.C - t.C).max() <= 1e-10 * scale
+        assert np.array_equal(c.C, c.C.T) and c.exactly_symmetric
+
+
+def test_paired_variant_condenses_to_candidates_and_thesis_variant_to_the_rind():
+    """The analysis condenses each body to what its formulation reads: the thesis variant
+    locates nodes in the rind (its rows kept), the paired variant reads the candidates only."""
+    for variant, rind in (("paired", False), ("thesis", True)):
+        analysis = Analysis(build(HertzParameters(variant=variant)))
+        analysis.setup()
+        for s in analysis.surfaces:
+            assert s.rind_rows is rind
+            rows = len(s.nodes) if rind else s.nc
+            assert s.G.shape == (2 * rows, 2 * s.nc)
+            assert len(analysis.contact.positions(analysis.contact.new_state())[0]) > 0
+
+
+@pytest.mark.parametrize("m", [1, 7, 1030, 2100])
+def test_in_place_inverse_is_the_inverse_to_the_bit(m):
+    """The in-place inverse reads the upper triangle only (the lower may hold anything, as
+    PARDISO's output does), returns the very bits of :func:`spd_inverse` of the symmetric
+    matrix, in the memory it was given."""
+    rng = np.random.default_rng(m)
+    A = rng.standard_normal((m, m))
+    S = A @ A.T + m * np.eye(m)
+    work = S.copy()
+    work[np.tril_indices(m, -1)] = np.nan
+    out = spd_inverse_in_place(work)
+    assert np.shares_memory(out, work)
+    assert np.array_equal(out, spd_inverse(S))
+    assert np.allclose(out @ S, np.eye(m), atol=1e-9)
+
+
+def test_mirror_copies_one_triangle_onto_the_other():
+    A = np.arange(49.0).reshape(7, 7)
+    up = A.copy()
+    mirror(up, from_upper=True, block=3)
+    assert np.array_equal(up, np.triu(A) + np.triu(A, 1).T)
+    low = A.copy()
+    mirror(low, from_upper=False, block=3)
+    assert np.array_equal(low, np.tril(A) + np.tril(A, -1).T)
+
+
+def test_reused_factor_solves_as_numpy_and_factorizes_once_per_matrix():
+    rng = np.random.default_rng(1)
+    W = rng.standard_normal((40, 40)) + 40 * np.eye(40)
+    calls = []
+
+    def matrix():
+        calls.append(1)
+        return W.copy()
+
+    cache = ReusedFactor()
+    for k in range(3):
+        b = rng.standard_normal(40)
+        x = cache.solve(("same",), matrix, b)
+        assert np.allclose(x, np.linalg.solve(W, b), rtol=1e-12, atol=1e-14)
+    assert len(calls) == 1
+    cache.solve(("other",), matrix, b)
+    assert len(calls) == 2
+    assert cache.solve(("singular",), lambda: np.zeros((3, 3)), np.ones(3)) is None
+
+
+@pytest.mark.skipif(not linalg.is_available("pardiso"), reason="PARDISO is not installed")
+def test_pardiso_fill_model_is_near_what_pardiso_reports():
+    """The memory model's PARDISO fill (vfem.memory) against PARDISO's own count of its
+    factor's entries, on both Hertz bodies: within a factor of two either way (fitted on
+    benchmarks/memory_model.py's cases to 0.8 to 1.1)."""
+    for s in _setup(False, "pardiso"):
+        reported = s.body.factor.factor_entries
+        model = factor_entries(s.body.ndofs, len(s.condensed_dofs), "pardiso")
+        assert reported > 0
+        assert 0.5 * reported <= model <= 2.0 * reported
