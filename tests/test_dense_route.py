@@ -90,7 +90,7 @@ def test_reused_factor_solves_as_numpy_and_factorizes_once_per_matrix():
         return W.copy()
 
     cache = ReusedFactor()
-    for k in range(3):
+    for _ in range(3):
         b = rng.standard_normal(40)
         x = cache.solve(("same",), matrix, b)
         assert np.allclose(x, np.linalg.solve(W, b), rtol=1e-12, atol=1e-14)

@@ -37,7 +37,8 @@ dofs a body, and on two long thin strips whose whole faces are candidates (up to
 dofs a body): SuperLU's fill model gives 1.0 to 1.5 times its nnz(L + U), and the whole
 estimate 1.05 to 1.85 times the measured peak (1.05 to 1.5 above 100 MiB); PARDISO's gives 0.91
 to 1.11 times its count above 20,000 dofs (0.82 to 1.14 at all sizes), the whole estimate 0.85
-to 1.24 times the peak above 100 MiB. Far more irregular meshes fill differently; the estimate is a guide, not a bound.
+to 1.24 times the peak above 100 MiB. Far more irregular meshes fill differently; the estimate
+is a guide, not a bound.
 """
 
 from __future__ import annotations
