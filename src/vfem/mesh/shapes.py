@@ -33,7 +33,8 @@ import numpy as np
 from scipy.spatial import Delaunay, QhullError, cKDTree
 from skfem import MeshQuad, MeshTri
 
-from .parametric import check_count, layer_boundaries, march, size_function
+from .parametric import check_count, farther_than, layer_boundaries, march, size_function
+from .topology import named_boundaries, share_topology
 
 __all__ = [
     "block", "gasket", "gasket_pair", "graded_nodes", "rectangle", "wedge", "wedge_grid",
@@ -102,7 +103,7 @@ def wedge(half_width: float = 5.0, edge_thickness: float = 1.0, centre_thickness
                              upper_breaks=(b,) if b < W else ())
     tol = 1e-9 * max(W, T)
     on_top = lambda x: x[1] > T - tol  # noqa: E731
-    return mesh.with_boundaries({
+    return named_boundaries(mesh, {
         "contact": lambda x: (x[1] < T - tol) & (x[0] > tol) & (x[0] < W - tol),
         "symmetry": lambda x: x[0] < tol,
         "top_loaded": lambda x: on_top(x) & (x[0] < b),
@@ -124,7 +125,7 @@ def wedge_plate_grid(half_width: float = 5.0, thickness: float = 1.0, columns: i
         raise ValueError(f"need half_width > 0 and thickness > 0, got {W} and {T}")
     x = _wedge_columns(W, loaded_width, columns)
     tol = 1e-9 * max(W, T)
-    return _mapped_quads(x, lambda s: -T + 0 * s, lambda s: 0 * s, rows).with_boundaries({
+    return named_boundaries(_mapped_quads(x, lambda s: -T + 0 * s, lambda s: 0 * s, rows), {
         "contact": lambda q: q[1] > -tol,
         "bottom": lambda q: q[1] < -T + tol,
         "symmetry": lambda q: q[0] < tol,
@@ -145,7 +146,8 @@ def wedge_grid(half_width: float = 5.0, edge_thickness: float = 1.0,
     x = _wedge_columns(W, loaded_width, columns)
     tol = 1e-9 * max(W, T)
     on_top = lambda q: q[1] > T - tol  # noqa: E731
-    return _mapped_quads(x, lambda s: rise * s / W, lambda s: T + 0 * s, rows).with_boundaries({
+    mesh = _mapped_quads(x, lambda s: rise * s / W, lambda s: T + 0 * s, rows)
+    return named_boundaries(mesh, {
         "contact": lambda q: (q[1] < T - tol) & (q[0] > tol) & (q[0] < W - tol),
         "symmetry": lambda q: q[0] < tol,
         "top_loaded": lambda q: on_top(q) & (q[0] < b),
@@ -239,8 +241,7 @@ def _graded_trapezoid(width: float, lower: tuple[float, float], upper: tuple[flo
     pts, hp = pts[inside], hp[inside]
     d_side = np.min([_distance_to_segment(pts, corners[i], corners[(i + 1) % 4])
                      for i in range(4)], axis=0)
-    d_node, _ = cKDTree(bnd).query(pts)
-    keep = (d_side > 0.45 * hp) & (d_node > 0.6 * hp)
+    keep = (d_side > 0.45 * hp) & farther_than(bnd, pts, 0.6 * hp)
     pts = pts[keep]
 
     p = np.vstack([bnd, pts])
@@ -368,7 +369,7 @@ def block(x0: float, y0: float, width: float, height: float, h: float, *,
     names = {"left": "left", "right": "right"}
     if symmetry is not None:
         names[symmetry] = "symmetry"
-    return mesh.with_boundaries({
+    return named_boundaries(mesh, {
         "top": lambda p: p[1] > y1 - tol,
         "bottom": lambda p: p[1] < y0 + tol,
         names["left"]: lambda p: p[0] < x0 + tol,
@@ -392,7 +393,7 @@ def rectangle(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: floa
     t = _counter_clockwise(grid.p, grid.t)
     mesh = MeshTri(grid.p, t, sort_t=False) if triangles else MeshQuad(grid.p, t)
     tol = 1e-9 * max(width, height)
-    return mesh.with_boundaries({
+    return named_boundaries(mesh, {
         "top": lambda p: p[1] > y0 + height - tol,
         "bottom": lambda p: p[1] < y0 + tol,
         "left": lambda p: p[0] < x0 + tol,
@@ -430,7 +431,7 @@ def rounded_punch(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: 
     t = _counter_clockwise(pts, grid.t)
     mesh = MeshQuad(pts, t)
     tol = 1e-9 * max(width, height)
-    mesh = mesh.with_boundaries({
+    mesh = named_boundaries(mesh, {
         "top": lambda p: p[1] > y0 + height - tol,
         "left": lambda p: p[0] < x0 - half + tol,
         "right": lambda p: p[0] > x0 + half - tol,
@@ -438,7 +439,7 @@ def rounded_punch(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: 
     on_face = iy == 0  # the arc's points (chord midpoints are off the arc)
     bnd = mesh.boundary_facets()
     face = bnd[on_face[mesh.facets[0, bnd]] & on_face[mesh.facets[1, bnd]]]
-    return replace(mesh, _boundaries={**mesh.boundaries, "face": face})
+    return share_topology(mesh, replace(mesh, _boundaries={**mesh.boundaries, "face": face}))
 
 
 def filleted_punch(x0: float = 0.0, y0: float = 0.0, width: float = 1.0, height: float = 0.5,
@@ -553,14 +554,15 @@ def _filleted_punch(x0: float, y0: float, a: float, r: float, h: float, g: float
     t4 = new[np.hstack(quads)]
     on_face = np.zeros(p.shape[1], dtype=bool)
     on_face[new[np.concatenate(face)]] = True
-    mesh = MeshQuad(p, _counter_clockwise(p, t4)).with_boundaries({
+    mesh = named_boundaries(MeshQuad(p, _counter_clockwise(p, t4)), {
         "top": lambda q: q[1] > y0 + h - tol,
         "left": lambda q: q[0] < x0 - a + tol,
         "right": lambda q: q[0] > x0 + a - tol,
     })
     bnd = mesh.boundary_facets()
     face_facets = bnd[on_face[mesh.facets[0, bnd]] & on_face[mesh.facets[1, bnd]]]
-    return replace(mesh, _boundaries={**mesh.boundaries, "face": face_facets})
+    return share_topology(mesh, replace(mesh, _boundaries={**mesh.boundaries,
+                                                           "face": face_facets}))
 
 
 def _geometric(n: int, length: float, ratio: float) -> np.ndarray:
@@ -688,7 +690,7 @@ def gasket(centre: tuple[float, float] = (0.0, 0.0), radius: float = 1.0,
     back = lambda x: np.abs((x[0] - c[0]) * o[0] + (x[1] - c[1]) * o[1]) < tol  # noqa: E731
     dist = lambda x: np.hypot(x[0] - c[0], x[1] - c[1])  # noqa: E731
     mid = radius - 0.5 * thickness
-    return mesh.with_boundaries({
+    return named_boundaries(mesh, {
         "outer": lambda x: ~back(x) & (dist(x) > mid),
         "inner": lambda x: ~back(x) & (dist(x) < mid),
         "back": back,
