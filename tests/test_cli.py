@@ -89,6 +89,31 @@ def test_bench_prints_and_saves_the_table(tmp_path, capsys):
     assert row["dofs"] > 1000 and row["ratio"] > 0 and abs(row["p_max_error"]) < 0.03
 
 
+def test_bench_times_the_whole_run_against_a_plain_run_writing_the_same_files(tmp_path, capsys):
+    """``--whole-run``: the run end to end beside a plain linear run of the same bodies that
+    writes the same VTU series (one file per body and step), with the run's phases."""
+    from vfem.tools.bench import plain_run
+
+    path = tmp_path / "whole.json"
+    assert main(["bench", "hertz", "--whole-run", "--levels", "0", "--json", str(path)]) == 0
+    assert "figures" in capsys.readouterr().out
+    (row,) = json.loads(path.read_text())
+    assert row["converged"] and abs(row["p_max_error"]) < 0.03
+    assert row["run_s"] > 0 and row["plain_run_s"] > 0
+    assert row["ratio"] == pytest.approx(row["run_s"] / row["plain_run_s"])
+    assert abs(sum(row["phase_shares"].values()) - 1) < 1e-9 and "figures" in row["phases"]
+    from vfem.examples.hertz import HertzParameters
+
+    plain_run(HertzParameters(), tmp_path / "plain", "superlu")
+    assert main(["-q", "run", "hertz", "--out", str(tmp_path / "run")]) == 0
+    names = [sorted(f.name for f in (tmp_path / d).glob("*.vtu")) for d in ("plain", "run")]
+    assert names[0] == names[1] and len(names[0]) == 10  # two bodies, five steps
+    plain = meshio.read(tmp_path / "plain" / names[0][-1])
+    run = meshio.read(tmp_path / "run" / names[0][-1])
+    assert set(plain.point_data) == set(run.point_data)
+    assert set(plain.cell_data) == set(run.cell_data)
+
+
 def test_the_thesis_variant_from_the_command_line(tmp_path, capsys):
     assert main(["run", "hertz", "--set", "variant=thesis", "--out", str(tmp_path)]) == 0
     s = json.loads((tmp_path / "summary.json").read_text())

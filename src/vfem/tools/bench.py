@@ -102,8 +102,9 @@ def plain_run(p: HertzParameters, out: Path, backend: str) -> dict[str, float]:
     """A plain linear analysis of the Hertz example's bodies, as a user without contact would
     run one: build the meshes, assemble each body by vfem's own path (:meth:`Body.assemble`),
     factorize, solve once under the body's loads and prescribed displacements (the platen
-    held), and write the same VTU files and PVD a vfem step writes (displacement, reaction,
-    stresses; the contact fields zero). Seconds, by part."""
+    held), and write the same VTU series and PVD the vfem run writes: one file per body and
+    step (displacement, reaction, stresses; the contact fields zero), a linear run's fields
+    scaled by each step's load factor. Seconds, by part."""
     from ..io.results import ResultsWriter
     from ..result_types import BodyStepResult, StepResult
 
@@ -130,7 +131,12 @@ def plain_run(p: HertzParameters, out: Path, backend: str) -> dict[str, float]:
         times["factorize_s"] += tc - tb
         times["solve_s"] += time.perf_counter() - tc
     t2 = time.perf_counter()
-    ResultsWriter(out, model).write_step(StepResult(1, 1.0, 0, True, [], bodies=bodies))
+    writer = ResultsWriter(out, model)
+    for k, factor in enumerate(model.load_factors, start=1):
+        writer.write_step(StepResult(k, factor, 0, True, [], bodies={
+            name: dataclasses.replace(r, displacement=factor * r.displacement,
+                                      reaction=factor * r.reaction)
+            for name, r in bodies.items()}))
     times["output_s"] = time.perf_counter() - t2
     times["total_s"] = time.perf_counter() - t0
     return times
