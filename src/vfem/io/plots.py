@@ -177,6 +177,7 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     """
     plt = require_matplotlib()
     from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.colors import to_rgba
 
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     mesh_lines = len(frames) == 1 if mesh_lines is None else mesh_lines
@@ -200,10 +201,11 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
             if mesh_lines:
                 poly = x[t]
                 if window is not None:  # only the cells near the window (large meshes)
-                    cx, cy = poly[..., 0].mean(axis=1), poly[..., 1].mean(axis=1)
-                    pad = 0.2 * (window[1] - window[0])
-                    poly = poly[(cx > window[0] - pad) & (cx < window[1] + pad)
-                                & (cy > window[2] - pad) & (cy < window[3] + pad)]
+                    poly = poly[_near(poly, window)]
+                    fine = _fine(poly, window)  # too small for their edges to show
+                    if fine.any():
+                        _pixels(ax, window, poly[fine], to_rgba(c))
+                    poly = poly[~fine]
                 ax.add_collection(PolyCollection(poly, facecolors="none", edgecolors=c,
                                                  linewidths=0.4, linestyles=ls, label=name),
                                   autolim=False)  # the limits are _frame's
@@ -250,9 +252,11 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
     own colour and named in the legend. One PolyCollection per body (fast on large meshes).
     """
     plt = require_matplotlib()
+    from matplotlib import colormaps
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.colors import Normalize
 
+    cmap = colormaps["viridis"]
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     fig, ax = plt.subplots(figsize=(8.5, 4.6))
     values = [np.asarray(b[4], dtype=float).ravel() for b in bodies]
@@ -265,12 +269,13 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
         lo, hi = np.minimum(lo, x.min(axis=0)), np.maximum(hi, x.max(axis=0))
         poly = x[np.asarray(t)]
         if window is not None:  # only the cells near the window (large meshes)
-            cx, cy = poly[..., 0].mean(axis=1), poly[..., 1].mean(axis=1)
-            pad = 0.2 * (window[1] - window[0])
-            near = ((cx > window[0] - pad) & (cx < window[1] + pad)
-                    & (cy > window[2] - pad) & (cy < window[3] + pad))
+            near = _near(poly, window)
             poly, v = poly[near], v[near]
-        mappable = PolyCollection(poly, array=v, cmap="viridis", norm=norm,
+            fine = _fine(poly, window)  # drawn as an image's pixels
+            if fine.any():
+                _pixels(ax, window, poly[fine], cmap(norm(v[fine])))
+            poly, v = poly[~fine], v[~fine]
+        mappable = PolyCollection(poly, array=v, cmap=cmap, norm=norm,
                                   edgecolors="face", linewidths=0.2)
         # (autolim=False: the limits are _frame's; matplotlib's extent of every path cost
         # 1.4 s of a 465k-dof Hertz run's figures)
@@ -290,6 +295,65 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+#: in a close-up (a figure with a window), cells narrower than this many of the image's pixels
+#: are drawn as pixels of an image, not as one polygon each: their edges could not be told
+#: apart, and a million polygons take seconds to draw (issue 19, item 3: figures at any size)
+FINE_CELL_PIXELS = 3.0
+#: the columns of that image across the window (about the axes' width in pixels: 8.5 to 12 in
+#: figures at 130 dpi)
+IMAGE_COLUMNS = 1000
+
+
+def _near(poly: np.ndarray, window) -> np.ndarray:
+    """Which cells (polygons (m, k, 2)) lie near ``window`` (centroids within a fifth of its
+    width of it): the cells a close-up draws."""
+    cx, cy = poly[..., 0].mean(axis=1), poly[..., 1].mean(axis=1)
+    pad = 0.2 * (window[1] - window[0])
+    return ((cx > window[0] - pad) & (cx < window[1] + pad)
+            & (cy > window[2] - pad) & (cy < window[3] + pad))
+
+
+def _image_shape(window) -> tuple[int, int]:
+    w, h = window[1] - window[0], window[3] - window[2]
+    return IMAGE_COLUMNS, max(1, min(IMAGE_COLUMNS, round(IMAGE_COLUMNS * h / max(w, 1e-300))))
+
+
+def _fine(poly: np.ndarray, window) -> np.ndarray:
+    """Which cells are narrower than :data:`FINE_CELL_PIXELS` pixels of the close-up's image."""
+    pixel = (window[1] - window[0]) / IMAGE_COLUMNS
+    size = np.maximum(np.ptp(poly[..., 0], axis=1), np.ptp(poly[..., 1], axis=1))
+    return size < FINE_CELL_PIXELS * pixel
+
+
+def _pixels(ax, window, poly: np.ndarray, rgba: np.ndarray) -> None:
+    """Draw the fine cells ``poly`` (m, k, 2) as an image over ``window``: every pixel holding
+    a vertex or the centroid of a cell takes that cell's colour (``rgba``, (m, 4) or one
+    colour), the pixels around them (within a cell's width: one pixel) the colour of the
+    nearest such pixel; the rest transparent. The cost is that of the image, not the mesh."""
+    from scipy import ndimage
+
+    nx, ny = _image_shape(window)
+    pts = np.concatenate([poly, poly.mean(axis=1, keepdims=True)], axis=1)  # (m, k + 1, 2)
+    ix = np.floor((pts[..., 0] - window[0]) / (window[1] - window[0]) * nx).astype(np.int64)
+    iy = np.floor((pts[..., 1] - window[2]) / (window[3] - window[2]) * ny).astype(np.int64)
+    cell = np.broadcast_to(np.arange(len(poly))[:, None], ix.shape)
+    inside = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
+    owner = np.full((ny, nx), -1, dtype=np.int64)
+    owner[iy[inside], ix[inside]] = cell[inside]
+    hit = owner >= 0
+    if not hit.any():
+        return
+    covered = ndimage.binary_dilation(hit, structure=np.ones((3, 3), bool))
+    nearest = ndimage.distance_transform_edt(~hit, return_distances=False,
+                                             return_indices=True)
+    owner = owner[nearest[0], nearest[1]]
+    colours = np.broadcast_to(np.asarray(rgba, dtype=float), (len(poly), 4))
+    image = colours[owner].copy()
+    image[~covered, 3] = 0.0
+    ax.imshow(image, extent=window, origin="lower", interpolation="nearest",
+              aspect="auto", zorder=0.5)
 
 
 def _outline(cells: np.ndarray) -> np.ndarray:

@@ -60,7 +60,14 @@ from ..contact.surface import ContactSurface
 from ..errors import InputError
 from ..result_types import phase_table
 from ..solver import Analysis, AnalysisResult, Model, StepResult
-from .files import _atomic_write, _safe, write_summary  # noqa: F401 (write_summary: importers)
+from .files import (  # noqa: F401 (write_summary: importers)
+    _atomic_write,
+    _safe,
+    forget_vtus,
+    remember_vtu,
+    vtu_compression,
+    write_summary,
+)
 
 log = logging.getLogger(__name__)
 
@@ -109,7 +116,7 @@ class ResultsWriter:
         return f"{_safe(body.name)}_step{step.step:04d}.vtu"
 
     def write_step(self, step: StepResult) -> None:
-        for body in self.model.bodies:
+        for k, body in enumerate(self.model.bodies):
             r = step.bodies[body.name]
             reaction = r.reaction if r.reaction is not None else np.zeros_like(r.contact_force)
             cell_type, conn = body.cells()
@@ -130,8 +137,10 @@ class ResultsWriter:
                             "reaction": np.column_stack([reaction, np.zeros(npts)])},
                 cell_data={_CELL_FIELD.get(k, k): [v] for k, v in stress.items()},
             )
-            _atomic_write(self.out / name,
-                          lambda p, m=m: meshio.write(p, m, file_format="vtu"))
+            with vtu_compression():
+                _atomic_write(self.out / name,
+                              lambda p, m=m: meshio.write(p, m, file_format="vtu"))
+            remember_vtu(self.out / name, m, new_step=k == 0)  # for the run's own figures
             self.entries.append((step.load_factor, body.name, name))
         self.write_pvd()
         if self.surfaces is not None:
@@ -263,6 +272,7 @@ def run_example(model: Model, out: Path, summarize, draw=None, on_step=None,
             draw(model, result, summary)
         draw_run(out, summary, summary["example"], model)
         summary["timings"]["figures_s"] = time.perf_counter() - t0
+    forget_vtus()
     finish_summary(out, summary)
     return summary
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..config import ModelConfig
 from ..solver import AnalysisResult, Model
+from .files import forget_vtus
 from .input import to_data
 from .results import (
     finish_summary,
@@ -98,6 +99,7 @@ def run(config: ModelConfig, out: Path, base: Path | None = None, on_step=None,
         t0 = time.perf_counter()
         draw_run(out, summary, "input", model)
         summary["timings"]["figures_s"] = time.perf_counter() - t0
+    forget_vtus()  # (kept for the figures: vfem.io.files.remember_vtu)
     finish_summary(out, summary)
     return summary
 
