@@ -110,3 +110,35 @@ def test_pardiso_fill_model_is_near_what_pardiso_reports():
         model = factor_entries(s.body.ndofs, len(s.condensed_dofs), "pardiso")
         assert reported > 0
         assert 0.5 * reported <= model <= 2.0 * reported
+
+
+def test_large_kinematics_honours_a_search_distance_along_the_whole_path():
+    """Under large kinematics every facet of the contact boundaries is a candidate by default
+    (bodies may slide anywhere); a search distance given is honoured, with the sliding body
+    followed all along its prescribed path (issue 19, item 7): the block's top facets under
+    the punch's path are candidates, those well beyond either end of it are not."""
+    import dataclasses
+
+    from vfem.examples import sliding
+
+    p = sliding.Parameters()
+    config = sliding.config(p)
+    default = config.build()
+    _, everything = default.contact_surfaces()
+    distance = 0.05
+    limited = dataclasses.replace(config, contact=dataclasses.replace(
+        config.contact, search_distance=distance)).build()
+    _, surfaces = limited.contact_surfaces()
+    block_all, block = everything[0], surfaces[0]
+    assert block.body.name == "block"
+    assert block.nc < block_all.nc  # fewer candidates
+    x = block.X[: block.nc, 0]
+    # the punch's lowest point travels from ``start`` to ``start + slide``; its face reaches
+    # at most half its width either side of it
+    lo, hi = p.start, p.start + p.slide
+    reach = 0.5 * p.punch_width + distance + 2 * p.block_length / p.block_columns
+    path = block_all.X[: block_all.nc, 0]
+    under = path[(path >= lo) & (path <= hi)]
+    assert np.isin(np.round(under, 12), np.round(x, 12)).all()  # the whole path is covered
+    assert x.min() > lo - reach and x.max() < hi + reach
+    assert block_all.X[: block_all.nc, 0].min() < lo - reach  # (the default reaches beyond)

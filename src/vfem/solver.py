@@ -121,8 +121,9 @@ class Model:
     def contact_surfaces(self) -> tuple[set[frozenset[int]], list[ContactSurface]]:
         """The pairs of bodies (by index) that may touch (``contact_pairs``, or every pair) and
         each body's contact surface: candidate facets within ``contact.search_distance`` of a
-        body it may touch (every facet that may touch under large kinematics, where bodies may
-        slide far).
+        body it may touch (by default every facet that may touch under large kinematics, where
+        bodies may slide far; a distance given is honoured there, along the whole path of the
+        prescribed motions).
 
         Depends on the meshes only, so it is also part of ``vfem check``: bodies that start
         deeper into each other than the outer layer of elements are refused here
@@ -134,12 +135,14 @@ class Model:
         else:
             pairs = {frozenset((index[a], index[b])) for a, b in self.contact_pairs}
         distance = self.contact.search_distance
-        if distance is None:
+        large = any(b.large for b in self.bodies)
+        if distance is None and large:  # bodies may slide anywhere: every facet (issue 19:
+            distance = np.inf           # a distance given is honoured, with the path followed)
+        elif distance is None:
             diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in self.bodies]
             distance = 0.02 * min(diag)
-        if any(b.large for b in self.bodies):
-            distance = np.inf
-        facets = select_candidate_facets(self.bodies, pairs, distance, self.load_factors)
+        facets = select_candidate_facets(self.bodies, pairs, distance, self.load_factors,
+                                         follow_path=large)
         surfaces = [ContactSurface.build(b, f) for b, f in zip(self.bodies, facets)]
         check_initial_overlap(surfaces, pairs)
         return pairs, surfaces

@@ -57,8 +57,12 @@ class ContactSettings:
             cause below that fraction of the largest (thesis §5.6).
         thesis_fraction: the fraction of the thesis criterion (1 %).
         search_distance: facets farther than this from another body in the undeformed
-            configuration are not contact candidates. Default (None): 2 % of the smaller of the
-            two bodies' bounding-box diagonals.
+            configuration (moved by the bodies' prescribed motions over the schedule) are not
+            contact candidates. Default (None): 2 % of the smaller of the two bodies'
+            bounding-box diagonals; under large kinematics, every facet of the contact
+            boundaries (bodies may slide anywhere and deform towards each other). Given under
+            large kinematics, it is honoured: it must then also cover how far the surfaces
+            deform towards each other, and a facet it leaves out can never carry contact.
         quadrature_order: polynomial order integrated exactly on the virtual elements.
         size_ratio_limit: when a facet is longer than this many times the opposing facets, the
             quadrature order is raised in proportion (thesis §5.6: 3:1 is easily tolerated).

@@ -553,9 +553,30 @@ def platen_approach(moving: tuple[np.ndarray, np.ndarray], fixed: tuple[np.ndarr
     return best
 
 
+#: the most load factors :func:`select_candidate_facets` samples to follow a long path
+MAX_PATH_SAMPLES = 4097
+
+
+def _path_samples(bodies: list[Body], samples: np.ndarray, search_distance: float
+                  ) -> np.ndarray:
+    """``samples`` refined until no body's predicted translation moves more than half the
+    search distance between two of them (at most :data:`MAX_PATH_SAMPLES`): a body that
+    slides far is looked at all along its way, not only at the schedule's points."""
+    if not np.isfinite(search_distance) or len(samples) < 2:
+        return samples
+    fine = np.linspace(samples.min(), samples.max(), 257)
+    path = max(float(np.linalg.norm(np.diff([predicted_translation(b, x) for x in fine],
+                                            axis=0), axis=1).sum()) for b in bodies)
+    n = min(MAX_PATH_SAMPLES, int(np.ceil(2.0 * path / search_distance)) + 1)
+    if n <= len(samples):
+        return samples
+    return np.unique(np.concatenate([samples, np.linspace(samples.min(), samples.max(), n)]))
+
+
 def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
                             search_distance: float,
-                            load_factors: tuple[float, ...] = ()) -> list[np.ndarray]:
+                            load_factors: tuple[float, ...] = (),
+                            follow_path: bool = False) -> list[np.ndarray]:
     """Per body, the exterior facets within ``search_distance`` of a body it may touch, at any
     load factor of the schedule.
 
@@ -567,11 +588,15 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
     elsewhere does not widen the search) or inside that body (bodies that start overlapping).
     A body moved by a platen (force control) is also looked at where its platen would first
     bring it within reach of the other body (:func:`platen_approach`): a cylinder pressed onto
-    a flat from a small gap finds the flat.
+    a flat from a small gap finds the flat. ``follow_path`` (large kinematics, where a body may
+    slide far): the samples are refined so that no body moves more than half the search
+    distance between two of them (:func:`_path_samples`).
     """
     ext = [exterior_facets(b) for b in bodies]
     lf = np.concatenate([[0.0], np.asarray(load_factors, dtype=float)])
     samples = np.unique(np.concatenate([lf, np.linspace(lf.min(), lf.max(), 17)]))
+    if follow_path:
+        samples = _path_samples(bodies, samples, search_distance)
     moves = [np.array([predicted_translation(b, x) for x in samples]) for b in bodies]
     ends, mids, half = [], [], []
     for b, f in zip(bodies, ext):

@@ -89,11 +89,12 @@ def run(config: ModelConfig, out: Path, base: Path | None = None, on_step=None,
     writing VTU/PVD, contact.csv and reactions.csv per converged step, then ``summary.json``
     and the figures into ``out``."""
     out = Path(out)
+    draw = config.output.figures if figures is None else figures
     model = model or config.build(base)
     _, result = run_writing(model, out, on_step, resume)
     summary = summarize(result, config, source)
     write_summary(out, summary)
-    if (config.output.figures if figures is None else figures) and result.steps:
+    if draw and result.steps:
         from .replot import draw_run
 
         t0 = time.perf_counter()
