@@ -275,8 +275,10 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
             if fine.any():
                 _pixels(ax, window, poly[fine], cmap(norm(v[fine])))
             poly, v = poly[~fine], v[~fine]
-        mappable = PolyCollection(poly, array=v, cmap=cmap, norm=norm,
-                                  edgecolors="face", linewidths=0.2)
+        # filled without antialiasing, which leaves no seams between cells to cover with
+        # edges of their own colour (40 % less drawing; the outlines are antialiased)
+        mappable = PolyCollection(poly, array=v, cmap=cmap, norm=norm, edgecolors="none",
+                                  linewidths=0.0, antialiaseds=False)
         # (autolim=False: the limits are _frame's; matplotlib's extent of every path cost
         # 1.4 s of a 465k-dof Hertz run's figures)
         ax.add_collection(mappable, autolim=False)
