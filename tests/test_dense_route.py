@@ -142,3 +142,28 @@ def test_large_kinematics_honours_a_search_distance_along_the_whole_path():
     assert np.isin(np.round(under, 12), np.round(x, 12)).all()  # the whole path is covered
     assert x.min() > lo - reach and x.max() < hi + reach
     assert block_all.X[: block_all.nc, 0].min() < lo - reach  # (the default reaches beyond)
+
+
+def test_large_dense_operations_get_the_threads_within_the_safe_range():
+    """vfem.threads.dense_threads gives the policy's threads to a dense operation only between
+    DENSE_THREADS_FROM and DENSE_THREADS_UPTO (above it SciPy's OpenBLAS crashes in threaded
+    Cholesky); one thread before and after."""
+    from threadpoolctl import threadpool_info
+
+    from vfem import threads
+
+    threads.apply(2)
+
+    def blas() -> set[int]:
+        return {i["num_threads"] for i in threadpool_info() if i["internal_api"] == "openblas"}
+
+    try:
+        assert blas() == {1}
+        with threads.dense_threads(threads.DENSE_THREADS_FROM):
+            assert blas() == {2}
+        assert blas() == {1}
+        for order in (threads.DENSE_THREADS_FROM - 1, threads.DENSE_THREADS_UPTO + 1):
+            with threads.dense_threads(order):
+                assert blas() == {1}
+    finally:
+        threads.apply()

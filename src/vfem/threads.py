@@ -120,18 +120,22 @@ def _limit_loaded() -> None:
 #: the order of a dense matrix from which one operation on it (an inverse, a factorization)
 #: runs on the policy's threads rather than one: a long contact surface's flexibility
 DENSE_THREADS_FROM = 2000
+#: ... and up to this order only: the threaded Cholesky (potrf) of the OpenBLAS SciPy ships
+#: (0.3.30) crashes the process (a segmentation fault) above about 16,000 on two threads
+#: (measured: 14,500 fine, 16,400 and 17,342 crash; one thread is fine at 17,342)
+DENSE_THREADS_UPTO = 14_000
 
 
 @contextmanager
 def dense_threads(order: int) -> Iterator[None]:
     """The dense BLAS on the policy's ``threads`` while one large dense operation runs (a
-    matrix of ``order`` >= :data:`DENSE_THREADS_FROM`: the inverse of a long contact surface's
-    Schur complement, the pair matrix over it), one thread again after; nothing for smaller
-    ones, whose many calls inside the contact iteration threads would slow (and whose bits
-    stay those of one thread). Measured: the strip of ``benchmarks/strip.py`` at 16,000
+    matrix of :data:`DENSE_THREADS_FROM` <= ``order`` <= :data:`DENSE_THREADS_UPTO`: the
+    inverse of a long contact surface's Schur complement, the pair matrix over it), one thread
+    again after; nothing for smaller ones, whose many calls inside the contact iteration
+    threads would slow (and whose bits stay those of one thread), nor for larger ones. Measured: the strip of ``benchmarks/strip.py`` at 16,000
     contact dofs inverts its two blocks in 12.5 s on both cores against 22 s on one."""
     n = None if _applied is None else _applied["threads"]
-    if n is None or n <= 1 or order < DENSE_THREADS_FROM:
+    if n is None or n <= 1 or not DENSE_THREADS_FROM <= order <= DENSE_THREADS_UPTO:
         yield
         return
     try:
