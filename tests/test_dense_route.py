@@ -167,3 +167,19 @@ def test_large_dense_operations_get_the_threads_within_the_safe_range():
                 assert blas() == {1}
     finally:
         threads.apply()
+
+
+def test_max_strain_of_linear_triangles_from_the_average_strain_equals_the_quadrature():
+    """Linear triangles have a constant strain: the fast reading (one sparse product) gives the
+    largest principal strain and its element as the quadrature-point reading does."""
+    from vfem.bodies import stresses
+
+    model = build(HertzParameters(refinement=1))
+    rng = np.random.default_rng(3)
+    for body in model.bodies:
+        body.assemble()
+        u = rng.normal(size=body.ndofs) * 1e-3
+        fast = stresses.max_strain(body, u)
+        slow = stresses._max_strain_at_quadrature(body, u)
+        assert fast[1] == slow[1]
+        assert fast[0] == pytest.approx(slow[0], rel=1e-12)

@@ -132,8 +132,9 @@ def dense_threads(order: int) -> Iterator[None]:
     matrix of :data:`DENSE_THREADS_FROM` <= ``order`` <= :data:`DENSE_THREADS_UPTO`: the
     inverse of a long contact surface's Schur complement, the pair matrix over it), one thread
     again after; nothing for smaller ones, whose many calls inside the contact iteration
-    threads would slow (and whose bits stay those of one thread), nor for larger ones. Measured: the strip of ``benchmarks/strip.py`` at 16,000
-    contact dofs inverts its two blocks in 12.5 s on both cores against 22 s on one."""
+    threads would slow (and whose bits stay those of one thread), nor for larger ones.
+    Measured: the strip of ``benchmarks/strip.py`` at 16,000 contact dofs inverts its two
+    blocks in 12.5 s on both cores against 22 s on one."""
     n = None if _applied is None else _applied["threads"]
     if n is None or n <= 1 or not DENSE_THREADS_FROM <= order <= DENSE_THREADS_UPTO:
         yield
