@@ -9,6 +9,8 @@ the platen's bordered system that each of them solves in its compatibility corre
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import scipy.linalg as sla
 
@@ -79,7 +81,8 @@ class ReusedFactor:
         None when the matrix is singular (an exactly zero pivot)."""
         if key != self.key:
             A = matrix()
-            with dense_threads(len(A)):
+            with dense_threads(len(A)), warnings.catch_warnings():
+                warnings.simplefilter("ignore", sla.LinAlgWarning)  # singular: None, below
                 lu, piv = sla.lu_factor(A, check_finite=False, overwrite_a=True)
             self.key = key
             self.factors = None if (np.diag(lu) == 0.0).any() else (lu, piv)
