@@ -7,6 +7,7 @@ import pytest
 import scipy.sparse as sp
 from skfem import MeshQuad
 
+from vfem import linalg
 from vfem.bodies import Body, Support
 from vfem.bodies.mechanics import LargeMechanics, LinearMechanics, _tangent_factorization
 from vfem.materials import LinearElastic
@@ -63,11 +64,20 @@ def test_the_tangent_flexibility_is_the_inverse_tangent_on_the_contact_dofs(stre
                                atol=1e-10 * np.abs(expected).max())
 
 
-def test_a_tangent_that_is_not_positive_definite_falls_back_to_back_substitutions():
+@pytest.mark.parametrize("backend", linalg.available())
+def test_a_tangent_that_is_not_positive_definite_falls_back_to_back_substitutions(backend):
+    """An indefinite tangent: a Cholesky backend (PARDISO, CHOLMOD) fails on it and the body
+    falls back to an indefinite factorization (no Schur complement: back-substitutions);
+    SuperLU's LU in the same order may succeed, and then its Schur complement's inverse is the
+    inverse tangent's block all the same. Either way the solve and the flexibility are right."""
     A = sp.csc_matrix(np.array([[2.0, 0.0, 1.0], [0.0, -1.0, 0.5], [1.0, 0.5, 3.0]]))
     rhs = np.array([1.0, 2.0, 3.0])
-    factor, x = _tangent_factorization(A, np.array([2]), np.arange(3), rhs, None, "test")
-    assert factor.trailing_inverse is None  # indefinite: no Schur complement route
+    factor, x = _tangent_factorization(A, np.array([2]), np.arange(3), rhs, backend, "test")
+    if backend in ("pardiso", "cholmod"):
+        assert factor.trailing_inverse is None  # not positive definite: the fallback
+    if factor.trailing_inverse is not None:
+        np.testing.assert_allclose(factor.trailing_inverse,
+                                   np.linalg.inv(A.toarray())[np.ix_([2], [2])], rtol=1e-12)
     np.testing.assert_allclose(A @ x, rhs, rtol=1e-12)
     spd = sp.csc_matrix(np.array([[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]]))
     factor, x = _tangent_factorization(spd, np.array([1, 2]), np.arange(3), rhs, None, "test")
