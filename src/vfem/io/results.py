@@ -121,6 +121,8 @@ class ResultsWriter:
             reaction = r.reaction if r.reaction is not None else np.zeros_like(r.contact_force)
             cell_type, conn = body.cells()
             npts = body.npoints
+            if npts < 2**31:  # 32-bit connectivity, as VTK's own: 8 % less to compress at 1M
+                conn = np.asarray(conn, dtype=np.int32)
             u = np.column_stack([r.displacement, np.zeros(len(r.displacement))])
             stress = body_stress(body, r.displacement.ravel())
             name = self._vtu_name(body, step)
