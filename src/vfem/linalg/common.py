@@ -6,11 +6,11 @@ import numpy as np
 import scipy.linalg as sla
 
 
-def spd_inverse(S: np.ndarray) -> np.ndarray:
-    """The inverse of a symmetric positive definite dense matrix (Cholesky, LAPACK potri),
-    symmetric to the last bit; about twice as fast as a general inverse."""
-    S = np.array(S, dtype=float, order="F")
-    c, info = sla.lapack.dpotrf(S, lower=False, overwrite_a=True, clean=True)
+def _potri_upper(F: np.ndarray) -> np.ndarray:
+    """The inverse of the symmetric positive definite matrix whose upper triangle is that of
+    the Fortran-ordered ``F`` (Cholesky, LAPACK potrf then potri, over ``F`` where LAPACK's
+    wrapper can): valid in the upper triangle of what it returns."""
+    c, info = sla.lapack.dpotrf(F, lower=False, overwrite_a=True, clean=True)
     if info != 0:
         raise np.linalg.LinAlgError(
             f"the stiffness on the contact dofs is not positive definite (LAPACK potrf info "
@@ -18,8 +18,14 @@ def spd_inverse(S: np.ndarray) -> np.ndarray:
     inv, info = sla.lapack.dpotri(c, lower=False, overwrite_c=True)
     if info != 0:
         raise np.linalg.LinAlgError(f"inverting the contact stiffness failed (potri info {info})")
-    return np.triu(inv) + np.triu(inv, 1).T
+    return inv
 
+
+def spd_inverse(S: np.ndarray) -> np.ndarray:
+    """The inverse of a symmetric positive definite dense matrix (Cholesky, LAPACK potri),
+    symmetric to the last bit; about twice as fast as a general inverse."""
+    inv = _potri_upper(np.array(S, dtype=float, order="F"))
+    return np.triu(inv) + np.triu(inv, 1).T
 
 
 def mirror(A: np.ndarray, from_upper: bool, block: int = 1024) -> None:
@@ -46,14 +52,7 @@ def spd_inverse_in_place(S: np.ndarray) -> np.ndarray:
         return spd_inverse(np.triu(S) + np.triu(S, 1).T)
     mirror(S, from_upper=True)
     F = S.T  # Fortran-ordered, the same values (S is symmetric now)
-    c, info = sla.lapack.dpotrf(F, lower=False, overwrite_a=True, clean=True)
-    if info != 0:
-        raise np.linalg.LinAlgError(
-            f"the stiffness on the contact dofs is not positive definite (LAPACK potrf info "
-            f"{info}); is the body held?")
-    inv, info = sla.lapack.dpotri(c, lower=False, overwrite_c=True)
-    if info != 0:
-        raise np.linalg.LinAlgError(f"inverting the contact stiffness failed (potri info {info})")
+    inv = _potri_upper(F)
     if not np.shares_memory(inv, S):  # LAPACK's wrapper copied after all
         F[...] = inv
     # the inverse is in F's upper triangle, which is S's lower
