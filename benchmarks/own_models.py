@@ -1,7 +1,8 @@
 """Models that no issue names, checked for the invariants every converged step must keep
 (issue 18's review): a punch narrower than the block (both its corners inside the contact),
 stiff on soft and soft on stiff, starting apart, mesh ratios 3:1 and 1:3, small and large
-kinematics, the Lagrange baseline and the thesis variant.
+kinematics (pressing, and pressing then sliding with and without a search distance), the
+Lagrange baseline and the thesis variant.
 
     python benchmarks/own_models.py                               # this tree
     PYTHONPATH=/tmp/before/src python benchmarks/own_models.py    # another (a git worktree)
@@ -52,15 +53,20 @@ def case(name, bodies, settings=None, steps=(0.25, 0.5, 0.75, 1.0)):
 
 
 def punch_on_block(gap, ratio, E_punch, E_block, tri, kinematics="small", settings=None,
-                   tag=""):
+                   tag="", slide=0.0):
     block = rect(0, 1, -0.4, 0, 20, 8, "block", E_block, tri=tri, supports=(Support("bottom"),),
                  contact_boundaries=("top",), kinematics=kinematics)
     # a punch narrower than the block: its two corners lie inside the contact zone
     n = max(2, int(round(8 * ratio)))
-    punch = rect(0.3, 0.7, gap, gap + 0.2, n, 4, "punch", E_punch,
-                 supports=(Support("top", ("x",)),),
-                 prescribed=(PrescribedDisplacement("top", "y", -(gap + 0.004)),),
-                 contact_boundaries=("bottom",), kinematics=kinematics)
+    if slide:  # pressed in over the first half of the schedule, then slid along +x
+        motion = (PrescribedDisplacement("top", "y", -(gap + 0.004), ((0, 0), (0.5, 1), (1, 1))),
+                  PrescribedDisplacement("top", "x", slide, ((0, 0), (0.5, 0), (1, 1))))
+        held = ()
+    else:
+        motion = (PrescribedDisplacement("top", "y", -(gap + 0.004)),)
+        held = (Support("top", ("x",)),)
+    punch = rect(0.3, 0.7, gap, gap + 0.2, n, 4, "punch", E_punch, supports=held,
+                 prescribed=motion, contact_boundaries=("bottom",), kinematics=kinematics)
     return case(f"punch E{E_punch:.0e}/block E{E_block:.0e} gap {gap} ratio {ratio} "
                 f"{'tri' if tri else 'quad'} {kinematics}{tag}", [block, punch], settings)
 
@@ -72,6 +78,12 @@ punch_on_block(0.002, 1 / 3, 2e11, 1e9, tri=False)
 punch_on_block(0.0, 2.0, 1e8, 2e11, tri=True)
 # equal stiffness, body order swapped by the names' order does not matter; large kinematics
 punch_on_block(0.001, 1.5, 1e9, 1e9, tri=False, kinematics="total")
+# large kinematics, starting apart, then sliding 0.2 along the block: every top facet a
+# candidate (the default), and a search distance given (issue 19: honoured along the path)
+for distance in (None, 0.02):
+    punch_on_block(0.001, 1.5, 1e9, 1e9, tri=True, kinematics="total", slide=0.2,
+                   settings=ContactSettings(search_distance=distance),
+                   tag=f" slide, search {distance}")
 # the classical Lagrange baseline and the thesis variant on the stiff-on-soft model (recorded)
 punch_on_block(0.002, 3.0, 2e11, 1e9, tri=True, settings=ContactSettings(method="lagrange"),
                tag=" [lagrange]")
