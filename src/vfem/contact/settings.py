@@ -62,7 +62,8 @@ class ContactSettings:
             bounding-box diagonals; under large kinematics, every facet of the contact
             boundaries (bodies may slide anywhere and deform towards each other). Given under
             large kinematics, it is honoured: it must then also cover how far the surfaces
-            deform towards each other, and a facet it leaves out can never carry contact.
+            deform towards each other, and a facet it leaves out can never carry contact (the
+            candidate surface's ends take one-sided normals: keep them clear of the contact).
         quadrature_order: polynomial order integrated exactly on the virtual elements.
         size_ratio_limit: when a facet is longer than this many times the opposing facets, the
             quadrature order is raised in proportion (thesis §5.6: 3:1 is easily tolerated).
