@@ -61,6 +61,35 @@ def test_every_backend_solves_and_gives_the_flexibility(backend):
 
 
 @pytest.mark.parametrize("backend", INSTALLED)
+def test_a_factorization_of_the_same_pattern_takes_over_the_analysis(backend):
+    """A large body's next tangent (same sparsity, same Schur set, new values): given the last
+    factorization as ``analysis``, PARDISO skips its ordering and gives the same solution and
+    Schur inverse as a fresh factorization, bit for bit; the one handed on refuses to solve. A
+    different pattern is factorized afresh; other backends ignore the argument."""
+    K = stiffness()
+    rng = np.random.default_rng(1)
+    trailing = rng.choice(K.shape[0], size=20, replace=False)
+    b = rng.standard_normal(K.shape[0])
+    first = linalg.factorize(K, backend, trailing=trailing)
+    d = 1.0 + 0.1 * rng.random(K.shape[0])
+    K2 = K.copy()  # D K D: new values, the same stored entries, still positive definite
+    K2.data *= d[K2.indices] * np.repeat(d, np.diff(K2.indptr))
+    fresh = linalg.factorize(K2, backend, trailing=trailing)
+    reused = linalg.factorize(K2, backend, trailing=trailing, analysis=first)
+    assert np.array_equal(reused.solve(b), fresh.solve(b))
+    assert np.array_equal(reused.trailing_inverse, fresh.trailing_inverse)
+    if backend == "pardiso":
+        with pytest.raises(RuntimeError, match="handed on"):
+            first.solve(b)
+        other = linalg.factorize(K2, backend, trailing=trailing[:10], analysis=reused)
+        assert np.abs(K2 @ other.solve(b) - b).max() <= 1e-10 * np.abs(b).max()
+        assert np.array_equal(reused.solve(b), fresh.solve(b))  # not taken: still solves
+    else:
+        again = linalg.factorize(K, backend, trailing=trailing)
+        assert np.array_equal(first.solve(b), again.solve(b))  # ignored: still solves
+
+
+@pytest.mark.parametrize("backend", INSTALLED)
 def test_every_backend_solves_a_saddle_point(backend):
     """``spd=False``: symmetric indefinite (a stiffness bordered by a constraint row)."""
     K = stiffness()

@@ -117,6 +117,7 @@ class LargeMechanics:
             dofs = body._boundary_dofs(pd.boundary, pd.component)
             nl.prescribe(dofs, _ramp(pd, len(dofs)))
         self._platen_value = 0.0
+        self._tangent_analysis = None  # the last tangent's factorization (its ordering reused)
         if len(body.platen_dofs):
             nl.prescribe(body.platen_dofs,
                          lambda lf: np.full(len(body.platen_dofs), self._platen_value))
@@ -157,7 +158,9 @@ class LargeMechanics:
         pos = np.searchsorted(free, condensed_dofs)
         held = free[np.minimum(pos, len(free) - 1)] == condensed_dofs
         factor, step = _tangent_factorization(K_ff, pos[held], free // 2,
-                                              -R[free] - K[free] @ pending, backend, self.body.name)
+                                              -R[free] - K[free] @ pending, backend, self.body.name,
+                                              self._tangent_analysis)
+        self._tangent_analysis = factor if factor.trailing_inverse is not None else None
 
         def solve(f: np.ndarray) -> np.ndarray:
             out = np.zeros((self.body.ndofs,) + f.shape[1:])
@@ -270,7 +273,7 @@ class Linearization:
 
 
 def _tangent_factorization(K_ff, trailing: np.ndarray, groups: np.ndarray, rhs: np.ndarray,
-                           backend: str | None, name: str):
+                           backend: str | None, name: str, analysis=None):
     """A large body's tangent on its free dofs, factorized once per linearisation.
 
     A tangent is positive definite unless the body is near buckling (geometric stiffness under
@@ -280,11 +283,13 @@ def _tangent_factorization(K_ff, trailing: np.ndarray, groups: np.ndarray, rhs: 
     Where that fails (not positive definite) or its solve of ``rhs`` is not accurate (SuperLU
     factorizes in that order without pivoting), the tangent is factorized as indefinite and
     ``trailing_inverse`` is None. Returns the factorization and its solution of ``rhs``.
+    ``analysis``: the last iteration's factorization, whose analysis may be taken over
+    (:func:`vfem.linalg.factorize`).
     """
     if len(trailing):
         try:
             factor = factorize(K_ff, backend, trailing=trailing, groups=groups,
-                               what=f"body {name!r} (tangent)")
+                               what=f"body {name!r} (tangent)", analysis=analysis)
             x = factor.solve(rhs)
             scale = max(float(np.abs(rhs).max(initial=0.0)), 1e-300)
             if (factor.trailing_inverse is not None

@@ -93,7 +93,8 @@ def use(name: str) -> str:
 
 
 def factorize(A: sp.spmatrix, backend: str | None = None, trailing: np.ndarray | None = None,
-              groups: np.ndarray | None = None, spd: bool = True, what: str = "a matrix"):
+              groups: np.ndarray | None = None, spd: bool = True, what: str = "a matrix",
+              analysis=None):
     """Factorize the sparse matrix ``A`` with the named backend (see the module docstring).
 
     ``spd=False``: ``A`` is symmetric but indefinite (a saddle-point system of Lagrange
@@ -101,7 +102,12 @@ def factorize(A: sp.spmatrix, backend: str | None = None, trailing: np.ndarray |
     definite matrices only (CHOLMOD) hands the matrix to SuperLU.
 
     A backend that fails (a singular matrix, a library error) raises AnalysisError naming
-    ``what`` (e.g. ``"body 'flat'"``), the backend and its reason."""
+    ``what`` (e.g. ``"body 'flat'"``), the backend and its reason.
+
+    ``analysis``: an earlier factorization by the same backend of a matrix with the same
+    sparsity (and ``trailing``), e.g. a large body's tangent of the last iteration; a backend
+    that can (PARDISO) takes over its ordering and symbolic analysis, and the earlier one can no
+    longer solve. Others ignore it."""
     from ..errors import AnalysisError
 
     name = resolve(backend)
@@ -111,6 +117,8 @@ def factorize(A: sp.spmatrix, backend: str | None = None, trailing: np.ndarray |
     module, cls = BACKENDS[name]
     factory = getattr(importlib.import_module(f".{module}", __name__), cls)
     try:
+        if analysis is not None and getattr(factory, "reuses_analysis", False):
+            return factory(A, trailing=trailing, groups=groups, spd=spd, analysis=analysis)
         return factory(A, trailing=trailing, groups=groups, spd=spd)
     except (np.linalg.LinAlgError, RuntimeError, ValueError) as exc:
         raise AnalysisError(f"{what}: factorizing its stiffness ({A.shape[0]} dofs) with {name} "
