@@ -268,3 +268,47 @@ def test_a_large_step_is_damped_and_still_reaches_the_prescribed_values(caplog):
     assert "correction halved" in caplog.text
     scale = np.abs(bodies[0].displacement).max()
     assert np.abs(bodies[0].displacement - bodies[1].displacement).max() < 1e-8 * scale
+
+
+@pytest.mark.parametrize("element", ["quad1", "tri1", "tri2"])
+def test_whole_array_assembly_gives_scikit_fems_forms(element):
+    """The tangent, the internal force and the displacement gradient that the large-kinematics
+    bodies take from ``_TangentAssembly`` are scikit-fem's assembly of the weak forms
+    ``_tangent_form`` and ``_internal_force_form`` and its interpolation, to round-off, on
+    bilinear quadrilaterals and linear and quadratic triangles (random moduli, not symmetric)."""
+    from skfem import (
+        Basis,
+        ElementQuad1,
+        ElementTriP1,
+        ElementTriP2,
+        ElementVector,
+        MeshQuad,
+        MeshTri,
+        asm,
+    )
+
+    from vfem.nonlinear import _internal_force_form, _tangent_form, _TangentAssembly
+
+    x, y = np.linspace(-1.0, 2.0, 9), np.linspace(0.0, 1.0, 4)
+    mesh, elem = {"quad1": (MeshQuad.init_tensor(x, y), ElementQuad1()),
+                  "tri1": (MeshTri.init_tensor(x, y), ElementTriP1()),
+                  "tri2": (MeshTri.init_tensor(x, y), ElementTriP2())}[element]
+    c, s_ = np.cos(0.3), np.sin(0.3)  # a rotated, sheared mesh: no gradient is axis-aligned
+    mesh = type(mesh)(np.array([[c, -s_], [s_, c]]) @ (mesh.p
+                                                       + 0.2 * mesh.p[[1, 0]]), mesh.t)
+    basis = Basis(mesh, ElementVector(elem))
+    rng = np.random.default_rng(5)
+    ne, nq = basis.nelems, basis.X.shape[-1]
+    A = rng.standard_normal((2, 2, 2, 2, ne, nq))
+    P = rng.standard_normal((2, 2, ne, nq))
+    u = rng.standard_normal(basis.N)
+    fast = _TangentAssembly.of(basis)
+    assert _TangentAssembly.of(basis) is fast  # made once per basis
+    K0 = asm(_tangent_form, basis, A=A).tocsr()
+    K1 = fast.assemble(A)
+    assert abs(K1 - K0).max() <= 1e-14 * abs(K0).max()
+    f0 = asm(_internal_force_form, basis, P=P)
+    assert np.abs(fast.internal_force(P) - f0).max() <= 1e-14 * np.abs(f0).max()
+    g0 = basis.interpolate(u).grad
+    g1 = fast.gradient(u)
+    assert g1.flags.c_contiguous and np.abs(g1 - g0).max() <= 1e-14 * np.abs(g0).max()
