@@ -69,3 +69,40 @@ def test_total_and_updated_lagrangian_agree(crushed):
         for name in a.bodies:
             u, v = a.bodies[name].displacement, b.bodies[name].displacement
             assert np.abs(u - v).max() <= 1e-8 * max(np.abs(u).max(), 1e-3)
+
+
+@pytest.mark.parametrize("model", ["sliding", "gasket"])
+def test_follower_stiffness_coloured_equals_one_coordinate_at_a_time(model, monkeypatch):
+    """Perturbing together the coordinates that move the normals of disjoint sets of loaded
+    nodes (``LargeDeformationContact._follower_moves``) gives the follower stiffness of one
+    perturbation per coordinate, to the round-off of the latter's difference of whole force
+    vectors: in every iteration of a slide (the punch's corner region passing over the block's
+    facets) and of the crushed gasket (curved against curved, the contact zone growing). A
+    coordinate whose reach were drawn too small would miss entries of the size of the matrix."""
+    from vfem.contact.large import LargeDeformationContact
+    from vfem.examples import sliding
+
+    if model == "sliding":
+        p = sliding.Parameters(block_columns=60, block_rows=8, punch_columns=24, punch_rows=6,
+                               slide=0.5, press_steps=2, slide_steps=3, start=-0.5)
+        model_ = sliding.build(p)
+    else:
+        cfg = gasket.config(gasket.Parameters(order=1, n_through=2, n_around=40,
+                                              back_motion=0.5, steps=5))
+        bodies = tuple(dataclasses.replace(b, kinematics="total") for b in cfg.bodies)
+        model_ = dataclasses.replace(cfg, bodies=bodies).build()
+    original = LargeDeformationContact._follower_stiffness
+    worst = []
+
+    def both(self, state, coloured=True):
+        J, B = original(self, state, coloured=True)
+        J1, B1 = original(self, state, coloured=False)
+        assert np.array_equal(J, J1)
+        if len(J):
+            worst.append(np.abs(B - B1).max() / np.abs(B1).max())
+        return J, B
+
+    monkeypatch.setattr(LargeDeformationContact, "_follower_stiffness", both)
+    result = Analysis(model_).run()
+    assert result.converged, result.message
+    assert len(worst) > 10 and max(worst) < 1e-6, max(worst)
