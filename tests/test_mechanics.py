@@ -54,7 +54,10 @@ def test_the_tangent_flexibility_is_the_inverse_tangent_on_the_contact_dofs(stre
 
     monkeypatch.setattr("vfem.bodies.mechanics._tangent_factorization", recorded)
     lin = body.linearize(1.0, 0.0, force, tracked, candidate)
+    assert routes == []  # the residual alone until the system is asked for
+    flexibility = lin.flexibility
     assert routes == [True]  # positive definite: the Schur complement's route
+    assert lin.flexibility is flexibility and routes == [True]  # factorized once
     R, ref, K, D, pending = body.nonlinear.linearize(1.0, force)
     free = np.setdiff1d(np.arange(body.ndofs), D)
     inverse = np.zeros((body.ndofs, body.ndofs))

@@ -675,14 +675,21 @@ class NonlinearBody:
         dofs and what their prescribed values at ``load_factor`` still lack (ndofs, zero off
         ``D``). Move the trial state with :meth:`move`.
         """
+        R, ref, tangent, D, pending = self.residual(load_factor, extra_force)
+        return R, ref, tangent(), D, pending
+
+    def residual(self, load_factor: float, extra_force: np.ndarray | None = None):
+        """As :meth:`linearize`, with a function that assembles the tangent in place of the
+        tangent itself: ``(R, ref, tangent, D, pending)`` (the contact iteration's check needs
+        the residual; the tangent only when it corrects)."""
         D, uD = self._dirichlet(load_factor)
         state = self._trial_state if self._trial_state is not None else self._state(self._delta)
         f_ext = self._loads(load_factor, extra_force)
         f_int = self._internal(state)
         pending = np.zeros(self.ndofs)
         pending[D] = uD - (self._u_at_current + self._delta)[D]
-        return (f_int - f_ext, self._reference_force(f_ext, f_int), self._tangent(state), D,
-                pending)
+        return (f_int - f_ext, self._reference_force(f_ext, f_int),
+                lambda: self._tangent(state), D, pending)
 
     def _loads(self, load_factor: float, extra_force: np.ndarray | None) -> np.ndarray:
         """External nodal forces: the dead loads at ``load_factor`` plus ``extra_force``."""

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -147,54 +146,66 @@ class LargeMechanics:
         """Newton's system at the trial state under the loads at
         ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
         (held), factorized once (see :class:`Linearization`). Move the trial state with
-        :meth:`move`."""
+        :meth:`move`.
+
+        The residual is evaluated at once; the tangent, its factorization and what comes from
+        them when first asked for (:class:`Linearization`): the contact iteration's last check
+        of a step, which finds the bodies in equilibrium, needs no more (in the sliding example
+        one linearisation in six)."""
         self._platen_value = float(platen_displacement)
         self._equilibrated = None
-        R, ref, K, D, pending = self.nonlinear.linearize(load_factor, contact_force)
+        R, ref, tangent, D, pending = self.nonlinear.residual(load_factor, contact_force)
         free = np.setdiff1d(np.arange(self.body.ndofs), D)
-        K_ff = K[free][:, free].tocsc()
-        # the condensed dofs among the free ones: their block of the inverse tangent is the
-        # inverse of its Schur complement, from the factorization (as for the linear body)
-        pos = np.searchsorted(free, condensed_dofs)
-        held = free[np.minimum(pos, len(free) - 1)] == condensed_dofs
-        factor, step = _tangent_factorization(K_ff, pos[held], free // 2,
-                                              -R[free] - K[free] @ pending, backend, self.body.name,
-                                              self._tangent_analysis)
-        self._tangent_analysis = factor if factor.trailing_inverse is not None else None
-
-        def solve(f: np.ndarray) -> np.ndarray:
-            out = np.zeros((self.body.ndofs,) + f.shape[1:])
-            out[free] = factor.solve(f[free])
-            return out
-
-        correction = pending.copy()
-        correction[free] = step
-        # flexibility rows of the condensed dofs for the candidate dofs (supports kept); the
-        # candidate dofs are the first of them (ContactSurface.condensed_dofs)
-        nc2 = len(candidate_dofs)
-        flexibility = np.zeros((len(condensed_dofs), nc2))
-        if factor.trailing_inverse is not None:
-            rows = np.flatnonzero(held)
-            cols = rows[rows < nc2]
-            flexibility[np.ix_(rows, cols)] = factor.trailing_inverse[:, : len(cols)]
-        else:  # an indefinite tangent: one back-substitution per candidate dof
-            pos = np.searchsorted(free, candidate_dofs)
-            cols = np.flatnonzero(free[np.minimum(pos, len(free) - 1)] == candidate_dofs)
-            unit = np.zeros((self.body.ndofs, len(cols)))
-            unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
-            if len(cols):
-                flexibility[:, cols] = solve(unit)[condensed_dofs]
-        platen_motion = np.zeros(self.body.ndofs)
-        stiffness = reaction = 0.0
-        P = self.body.platen_dofs
-        if len(P):
-            platen_motion[P] = 1.0
-            platen_motion[free] = factor.solve(-(K[free][:, P] @ np.ones(len(P))))
-            stiffness = _platen_stiffness(K, platen_motion, P)
-            reaction = float((R + K @ correction)[P].sum())
         met = float(np.abs(pending).max(initial=0.0)) <= 1e-13 * self.nonlinear.length
-        return Linearization(float(np.linalg.norm(R[free])), ref, correction, flexibility,
-                             platen_motion, stiffness, reaction, met, solve)
+
+        def system() -> dict:
+            K = tangent()
+            K_ff = K[free][:, free].tocsc()
+            # the condensed dofs among the free ones: their block of the inverse tangent is
+            # the inverse of its Schur complement, from the factorization (as for the linear
+            # body)
+            pos = np.searchsorted(free, condensed_dofs)
+            held = free[np.minimum(pos, len(free) - 1)] == condensed_dofs
+            factor, step = _tangent_factorization(K_ff, pos[held], free // 2,
+                                                  -R[free] - K[free] @ pending, backend,
+                                                  self.body.name, self._tangent_analysis)
+            self._tangent_analysis = factor if factor.trailing_inverse is not None else None
+
+            def solve(f: np.ndarray) -> np.ndarray:
+                out = np.zeros((self.body.ndofs,) + f.shape[1:])
+                out[free] = factor.solve(f[free])
+                return out
+
+            correction = pending.copy()
+            correction[free] = step
+            # flexibility rows of the condensed dofs for the candidate dofs (supports kept); the
+            # candidate dofs are the first of them (ContactSurface.condensed_dofs)
+            nc2 = len(candidate_dofs)
+            flexibility = np.zeros((len(condensed_dofs), nc2))
+            if factor.trailing_inverse is not None:
+                rows = np.flatnonzero(held)
+                cols = rows[rows < nc2]
+                flexibility[np.ix_(rows, cols)] = factor.trailing_inverse[:, : len(cols)]
+            else:  # an indefinite tangent: one back-substitution per candidate dof
+                pos = np.searchsorted(free, candidate_dofs)
+                cols = np.flatnonzero(free[np.minimum(pos, len(free) - 1)] == candidate_dofs)
+                unit = np.zeros((self.body.ndofs, len(cols)))
+                unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
+                if len(cols):
+                    flexibility[:, cols] = solve(unit)[condensed_dofs]
+            platen_motion = np.zeros(self.body.ndofs)
+            stiffness = reaction = 0.0
+            P = self.body.platen_dofs
+            if len(P):
+                platen_motion[P] = 1.0
+                platen_motion[free] = factor.solve(-(K[free][:, P] @ np.ones(len(P))))
+                stiffness = _platen_stiffness(K, platen_motion, P)
+                reaction = float((R + K @ correction)[P].sum())
+            return {"correction": correction, "flexibility": flexibility,
+                    "platen_motion": platen_motion, "platen_stiffness": stiffness,
+                    "platen_reaction": reaction, "solve": solve}
+
+        return Linearization(float(np.linalg.norm(R[free])), ref, met, system)
 
     def move(self, correction: np.ndarray) -> None:
         """Add ``correction`` (ndofs) to the trial displacement.
@@ -240,13 +251,17 @@ class LargeMechanics:
         return cauchy_stress(self.nonlinear, u)
 
 
-@dataclass
 class Linearization:
     """Newton's system of a large-kinematics body at its trial state (:meth:`Body.linearize`).
+
+    ``residual``, ``reference`` and ``prescribed_met`` are there at once; the others are
+    computed together (the tangent assembled and factorized) when one of them is first read.
 
     Attributes:
         residual: norm of the out-of-balance force ``f_int - f_ext`` on the free dofs.
         reference: the force it is measured against (:class:`vfem.nonlinear.NewtonStep`).
+        prescribed_met: whether the prescribed displacements (the platen's included) have
+            their values (else ``correction`` applies what they lack).
         correction: (ndofs) Newton's correction with the contact forces held, the prescribed
             displacements' increments included.
         flexibility: (condensed, candidate) the tangent flexibility rows of the condensed dofs for
@@ -255,21 +270,26 @@ class Linearization:
         platen_motion: (ndofs) the motion per unit motion of the platen (1 on its dofs).
         platen_stiffness: the platen's reaction per unit platen motion.
         platen_reaction: the platen's reaction after ``correction``, linearised.
-        prescribed_met: whether the prescribed displacements (the platen's included) have
-            their values (else ``correction`` applies what they lack).
         solve: the tangent flexibility applied to nodal forces (ndofs, or ndofs x k): the
             displacements (zero on the fixed dofs).
     """
 
-    residual: float
-    reference: float
-    correction: np.ndarray
-    flexibility: np.ndarray
-    platen_motion: np.ndarray
-    platen_stiffness: float
-    platen_reaction: float
-    prescribed_met: bool
-    solve: Callable[[np.ndarray], np.ndarray]
+    _LAZY = ("correction", "flexibility", "platen_motion", "platen_stiffness",
+             "platen_reaction", "solve")
+
+    def __init__(self, residual: float, reference: float, prescribed_met: bool,
+                 system: Callable[[], dict]):
+        self.residual = residual
+        self.reference = reference
+        self.prescribed_met = prescribed_met
+        self._system = system
+
+    def __getattr__(self, name: str):
+        # only reached for attributes not yet set: the lazy ones, computed together once
+        if name in Linearization._LAZY and "_system" in self.__dict__:
+            self.__dict__.update(self.__dict__.pop("_system")())
+            return self.__dict__[name]
+        raise AttributeError(name)
 
 
 def _tangent_factorization(K_ff, trailing: np.ndarray, groups: np.ndarray, rhs: np.ndarray,
