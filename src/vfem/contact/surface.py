@@ -357,7 +357,17 @@ class ContactSurface:
 
     def _facet_mass_entries(self):
         """(facet, row, col, value) of every nonzero of every facet's mass matrix."""
-        fb = FacetBasis(self.body.mesh, self.body.element(), facets=self.facet_ids)
+        try:
+            fb = FacetBasis(self.body.mesh, self.body.element(), facets=self.facet_ids)
+        except Exception as exc:  # noqa: BLE001 - scikit-fem raises a bare Exception here
+            # its map of the facets' quadrature points into their quadrilaterals (Newton's
+            # iteration on the isoparametric map) failed: an element along the surface so
+            # distorted that the map barely turns (a thin row on a steep part of a curve)
+            raise InputError(
+                f"body {self.body.name!r}: the quadrature points of its contact facets could "
+                f"not be mapped into their elements ({exc}); "
+                f"{_most_distorted(self.body.mesh, self.facet_ids)} is too distorted: refine "
+                "or regrade the mesh along the contact surface") from exc
 
         @BilinearForm
         def mass(u, v, w):
@@ -375,6 +385,18 @@ class ContactSurface:
         local[self.nodes[: self.nc]] = np.arange(self.nc)
         rows, cols = local[ones.indices[0][keep]], local[ones.indices[1][keep]]
         return facet, rows, cols, ones.data[keep]
+
+
+def _most_distorted(mesh, facet_ids: np.ndarray) -> str:
+    """The element behind ``facet_ids`` with the largest ratio of its longest to its shortest
+    edge, named with its corners: for an error message."""
+    elem = np.unique(mesh.f2t[0, facet_ids])
+    corners = mesh.p[:, mesh.t[:, elem]]  # (2, nv, ne)
+    edges = np.linalg.norm(np.roll(corners, -1, axis=1) - corners, axis=0)  # (nv, ne)
+    ratio = edges.max(axis=0) / np.maximum(edges.min(axis=0), 1e-300)
+    k = int(np.argmax(ratio))
+    pts = ", ".join(f"({x:.6g}, {y:.6g})" for x, y in corners[:, :, k].T)
+    return f"element {int(elem[k])} (corners {pts}; edges in ratio {ratio[k]:.3g})"
 
 
 def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:
