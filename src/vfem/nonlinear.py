@@ -49,6 +49,7 @@ there), so they agree to the Newton tolerance.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
@@ -187,13 +188,22 @@ class _TangentAssembly:
 
 @dataclass
 class _State:
-    """Kinematic and stress fields at the quadrature points of ``basis`` for one iterate."""
+    """Kinematic and stress fields at the quadrature points of ``basis`` for one iterate.
+
+    The material tangent ``D`` is computed when first read (``moduli``): an iterate whose
+    tangent is never assembled (the last of a Newton iteration, a halved correction) does
+    not pay for it (about a third of a state's time with the neo-Hookean law)."""
 
     basis: Basis
     F: np.ndarray  # (2, 2, ne, nq) deformation gradient from the reference of the formulation
     S: np.ndarray  # (2, 2, ne, nq) 2nd Piola–Kirchhoff stress relative to that reference
-    D: np.ndarray  # (2, 2, 2, 2, ne, nq) dS/dE
+    moduli: Callable[[], np.ndarray]  # gives D
     S33: np.ndarray  # (ne, nq) out-of-plane S_33 (plane strain)
+
+    @functools.cached_property
+    def D(self) -> np.ndarray:
+        """(2, 2, 2, 2, ne, nq) dS/dE."""
+        return self.moduli()
 
     def first_piola(self) -> np.ndarray:
         return mul(self.F, self.S)
@@ -414,8 +424,8 @@ class NonlinearBody:
             F = deformation_gradient(G0 + g)
             self._check_orientation(F)
             E = strain_increment(G0, g).total
-            S, D = self.material.stress(E)
-            return _State(basis, F, S, D, self.material.out_of_plane_stress(E))
+            return _State(basis, F, self.material.second_piola(E),
+                          lambda: self.material.tangent(E), self.material.out_of_plane_stress(E))
         basis = self.current_basis
         h = _TangentAssembly.of(basis).gradient(delta)
         f = deformation_gradient(h)
@@ -425,8 +435,9 @@ class NonlinearBody:
         return _State(basis, f, S, D, S33)
 
     def _pushed_material(self, E_pseudo: np.ndarray
-                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Stress and tangent conjugate to the pseudo-strain in ``C_1``, per unit volume of ``C_1``.
+                         ) -> tuple[np.ndarray, Callable[[], np.ndarray], np.ndarray]:
+        """Stress and tangent conjugate to the pseudo-strain in ``C_1``, per unit volume of ``C_1``
+        (the tangent as a function, :class:`_State`).
 
         With ``F_1`` the deformation gradient of ``C_1`` the material sees the Green–Lagrange
         strain ``E = F_1^T E_pseudo F_1`` (eq. 2.8.9 read backwards) and the conjugate stress in
@@ -435,9 +446,13 @@ class NonlinearBody:
         """
         V, J1 = self._left_stretch()
         E = mul(V, mul(E_pseudo, V))
-        S, D = self.material.stress(E)
+        S = self.material.second_piola(E)
         S_c = mul(V, mul(S, V)) / J1
-        D_c = np.einsum("iI...,jJ...,IJKL...,kK...,lL...->ijkl...", V, V, D, V, V) / J1
+
+        def D_c() -> np.ndarray:
+            D = self.material.tangent(E)
+            return np.einsum("iI...,jJ...,IJKL...,kK...,lL...->ijkl...", V, V, D, V, V) / J1
+
         return S_c, D_c, self.material.out_of_plane_stress(E) / J1
 
     def _left_stretch(self) -> tuple[np.ndarray, np.ndarray]:

@@ -41,13 +41,15 @@ def _lame(E: float, nu: float) -> tuple[float, float]:
 
 
 def _outer(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """(A (x) B)_ijkl = A_ij B_kl."""
-    return np.einsum("ij...,kl...->ijkl...", A, B)
+    """(A (x) B)_ijkl = A_ij B_kl (by broadcasting: the same products as an einsum, faster on
+    fields at quadrature points)."""
+    return A[:, :, None, None] * B[None, None]
 
 
 def _sym_outer(A: np.ndarray) -> np.ndarray:
     """(A (.) A)_ijkl = (A_ik A_jl + A_il A_jk)/2; for symmetric A, d(A^-1)/dA = -A^-1 (.) A^-1."""
-    return 0.5 * (np.einsum("ik...,jl...->ijkl...", A, A) + np.einsum("il...,jk...->ijkl...", A, A))
+    return 0.5 * (A[:, None, :, None] * A[None, :, None, :]
+                  + A[:, None, None, :] * A[None, :, :, None])
 
 
 @dataclass(frozen=True)
@@ -91,12 +93,19 @@ class SaintVenantKirchhoff(_Isotropic):
 
     def stress(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Second Piola–Kirchhoff stress ``S`` and tangent ``dS/dE`` for Green–Lagrange ``E``."""
+        return self.second_piola(E), self.tangent(E)
+
+    def second_piola(self, E: np.ndarray) -> np.ndarray:
+        """``S`` alone (a state whose tangent may never be asked for)."""
         E = np.asarray(E, dtype=float)
         lam, mu = self.lame()
-        eye = _eye_like(E)
-        S = lam * (E[0, 0] + E[1, 1]) * eye + 2.0 * mu * E
-        D = lam * _outer(eye, eye) + 2.0 * mu * _sym_outer(eye)
-        return S, D
+        return lam * (E[0, 0] + E[1, 1]) * _eye_like(E) + 2.0 * mu * E
+
+    def tangent(self, E: np.ndarray) -> np.ndarray:
+        """``dS/dE`` alone."""
+        eye = _eye_like(np.asarray(E, dtype=float))
+        lam, mu = self.lame()
+        return lam * _outer(eye, eye) + 2.0 * mu * _sym_outer(eye)
 
     def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray:
         """``S_33 = lambda tr(E)`` (plane strain, ``E_33 = 0``)."""
@@ -140,12 +149,21 @@ class NeoHookean(_Isotropic):
 
     def stress(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Second Piola–Kirchhoff stress ``S`` and tangent ``dS/dE`` for Green–Lagrange ``E``."""
+        return self.second_piola(E), self.tangent(E)
+
+    def second_piola(self, E: np.ndarray) -> np.ndarray:
+        """``S`` alone (a state whose tangent may never be asked for)."""
         lam, mu = self.lame()
         C, lnJ = self._right_cauchy_green(E)
         Ci = _inv(C)
-        S = mu * (_eye_like(C) - Ci) + lam * lnJ * Ci
-        D = lam * _outer(Ci, Ci) + 2.0 * (mu - lam * lnJ) * _sym_outer(Ci)
-        return S, D
+        return mu * (_eye_like(C) - Ci) + lam * lnJ * Ci
+
+    def tangent(self, E: np.ndarray) -> np.ndarray:
+        """``dS/dE`` alone."""
+        lam, mu = self.lame()
+        C, lnJ = self._right_cauchy_green(E)
+        Ci = _inv(C)
+        return lam * _outer(Ci, Ci) + 2.0 * (mu - lam * lnJ) * _sym_outer(Ci)
 
     def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray:
         """``S_33 = mu (1 - 1/C_33) + lambda ln J / C_33 = lambda ln J`` (``C_33 = 1``)."""
