@@ -60,16 +60,17 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
     ok = np.isfinite(s) & (s > 1e-12) & (s < 1 - 1e-12) & (np.abs(tau) < reach)
     X, W = get_quadrature(RefLine, 5)
     xi, w = X[0], W
-    wts, fac, sloc = [], [], []
-    for k, f in enumerate(fpatch):
-        cuts = np.unique(np.concatenate([[0.0, 1.0], s[k, ok[k]]]))
-        lo, hi = cuts[:-1], cuts[1:]
-        sq = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
-        wts.append(((hi - lo)[:, None] * w[None, :]).ravel())
-        fac.append(np.full(len(sq), f))
-        sloc.append(sq)
-    wts = np.concatenate(wts)
-    fac, sloc = np.concatenate(fac), np.concatenate(sloc)
+    # each fine facet's pieces between its ends and its cuts, in order along it (all facets at
+    # once: the cuts sorted per row, repeated cuts giving empty pieces that are dropped)
+    cuts = np.sort(np.hstack([np.zeros((len(fpatch), 1)), np.ones((len(fpatch), 1)),
+                              np.where(ok, s, np.nan)]), axis=1)  # NaN (no cut) last
+    lo, hi = cuts[:, :-1], cuts[:, 1:]
+    piece = hi > lo  # False where either is NaN
+    row = np.broadcast_to(np.arange(len(fpatch))[:, None], piece.shape)[piece]
+    lo, hi = lo[piece], hi[piece]
+    sloc = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
+    wts = ((hi - lo)[:, None] * w[None, :]).ravel()
+    fac = np.repeat(np.asarray(fpatch)[row], len(xi))
     _, tangent = sf.curve(fac, sloc)
     wts = wts * np.linalg.norm(tangent, axis=1)
     pts, tangent = sf.curve(fac, sloc, xf)
