@@ -93,10 +93,14 @@ def read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
     """For each of :data:`FACET_READINGS`: the closest point on ``so`` (its facets
     ``ofacets``, all if None) of that point of each of ``facets`` of ``s`` (positions ``x``,
     ``xo``; ties by ``normals``), as (facet of so, its normal there, unclamped t)."""
-    for t in FACET_READINGS:
-        pts, _ = s.curve(facets, np.full(len(facets), t), x)
-        seg, _, _, m, tf = so.closest(pts, xo, ofacets, normals)
-        yield seg, m, tf
+    n = len(facets)
+    k = len(FACET_READINGS)
+    pts, _ = s.curve(np.tile(facets, k), np.repeat(FACET_READINGS, n), x)
+    # one projection for all the readings (each point's is its own)
+    seg, _, _, m, tf = so.closest(pts, xo, ofacets, np.tile(normals, (k, 1)))
+    for i in range(k):
+        part = slice(i * n, (i + 1) * n)
+        yield seg[part], m[part], tf[part]
 
 
 def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np.ndarray,
