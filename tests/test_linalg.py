@@ -144,3 +144,39 @@ def test_the_solver_is_chosen_on_the_command_line_and_recorded(tmp_path):
     finally:
         linalg.use("auto")
     assert json.loads((tmp_path / "summary.json").read_text())["linear_solver"] == "superlu"
+
+
+@pytest.mark.skipif("pardiso" not in INSTALLED, reason="PARDISO is not installed")
+def test_small_pardiso_calls_run_on_one_thread_and_give_the_pool_back():
+    """Under a policy of two threads, a small matrix's factorization and solves ask MKL for one
+    thread for the calling thread only (``mkl_set_num_threads_local``) and restore its setting
+    after each call, so the pool is the policy's again for a large one."""
+    from vfem import threads
+    from vfem.linalg import pardiso
+
+    local = pardiso._local_threads()
+    if local is None:
+        pytest.skip("this MKL has no mkl_set_num_threads_local")
+    seen = []
+    original = pardiso.PardisoFactorization._pardiso
+
+    def spy(self, *args):
+        previous = local(0)  # what the call runs under (and give it back)
+        local(previous)
+        seen.append(previous)
+        return original(self, *args)
+
+    before = threads.sparse_threads()
+    threads.apply(2)
+    initial = local(0)  # the calling thread's setting (0: MKL's global one)
+    local(initial)
+    try:
+        pardiso.PardisoFactorization._pardiso = spy
+        K = stiffness()
+        f = linalg.factorize(K, "pardiso", trailing=np.arange(10))
+        f.solve(np.ones(K.shape[0]))
+    finally:
+        pardiso.PardisoFactorization._pardiso = original
+        threads.apply(before or "off")
+    assert seen[:2] == [1, 1]  # the factorization and the solve: one thread
+    assert local(initial) == initial  # the setting from before, in force again

@@ -13,7 +13,10 @@ Two pools serve vfem, and each, left alone, starts a thread per core:
 Both pools spinning at once oversubscribe the cores: on the shared 2-core machine the Hertz
 example at 20k dofs took 2.76 s with the default pools and 0.17 s with one thread each (issue 19).
 The policy: the dense BLAS on **one** thread, the sparse factorization on ``threads`` (default
-:func:`default_threads`: the cores this process may use), so the two never compete.
+:func:`default_threads`: the cores this process may use), so the two never compete. Small sparse
+work stays on one thread even so: PARDISO's back-substitutions below 200,000 dofs and its
+factorizations below 20,000 (``vfem.linalg.pardiso.SOLVE_ONE_THREAD_BELOW``, measured there),
+which two threads only slow down, ten times over when another process holds the other core.
 ``vfem --threads N`` (or the ``VFEM_THREADS`` environment variable) sets ``threads``; ``off``
 leaves the pools as the libraries set them. The library applies the default once, when an
 analysis is set up, unless :func:`apply` was called.
@@ -91,6 +94,14 @@ def ensure() -> dict:
     """:func:`apply` the default policy if nothing has applied one yet (what an analysis does
     when it is set up); returns what is in force."""
     return dict(_applied) if _applied is not None else apply()
+
+
+def sparse_threads() -> int:
+    """The sparse factorization's threads under the policy in force (0 when it is off or none
+    was applied: the libraries' own setting)."""
+    if _applied is None or _applied["threads"] is None:
+        return 0
+    return int(_applied["threads"])
 
 
 def after_loading() -> None:

@@ -16,12 +16,14 @@ import os
 import numpy as np
 import scipy.sparse as sp
 
-from ..threads import after_loading, dense_threads
+from ..threads import after_loading, dense_threads, sparse_threads
 from .common import spd_inverse_in_place
 
 _P64 = ctypes.POINTER(ctypes.c_int64)
 _P32 = ctypes.POINTER(ctypes.c_int32)
 _pardiso = None
+_runtime_lib = None  # MKL's runtime library (ctypes), once loaded
+_set_local = None  # its mkl_set_num_threads_local, False if it has none
 
 #: PARDISO's error codes (MKL reference, "pardiso"), for messages
 ERRORS = {-1: "input inconsistent", -2: "not enough memory", -3: "reordering problem",
@@ -50,9 +52,41 @@ def _mkl_rt() -> str | None:
     return next((path for path in found if os.path.isfile(path)), None)
 
 
+#: PARDISO's back-substitutions run on one thread below this order and its factorizations
+#: below :data:`FACTOR_ONE_THREAD_BELOW` (issue 19). Measured on the 2-core machine, idle
+#: (2026-11-25, a plane-strain block with a Schur complement on its top): at 3,872 dofs a solve
+#: took 0.25 ms on one thread and 0.75 ms on two, the factorization the same; at 24,080 dofs
+#: 1.65 against 2.08 ms, the factorization 29-34 against 23-31 ms; at 160,200 dofs the solves
+#: alike, the factorization 360 against 255-280 ms. With the other core busy (another process),
+#: a small factorization on two threads was ten times slower: the large contact iteration of
+#: the sliding example spent 7.6 s in PARDISO instead of 0.7 s.
+SOLVE_ONE_THREAD_BELOW = 200_000
+FACTOR_ONE_THREAD_BELOW = 20_000
+
+
+def _local_threads():
+    """MKL's ``mkl_set_num_threads_local`` (threads for the calling thread's next calls;
+    returns the previous setting, 0 for the global one), or None if MKL has none."""
+    global _set_local
+    if _set_local is None:
+        try:
+            f = _runtime().MKL_Set_Num_Threads_Local
+            f.argtypes, f.restype = [ctypes.c_int], ctypes.c_int
+            _set_local = f
+        except (AttributeError, OSError):
+            _set_local = False
+    return _set_local or None
+
+
+def _runtime():
+    """MKL's runtime library (ctypes), as :func:`_library` loads it."""
+    _library()
+    return _runtime_lib
+
+
 def _library():
     """PARDISO's entry point in MKL's runtime library (located by pypardiso)."""
-    global _pardiso
+    global _pardiso, _runtime_lib
     if _pardiso is None:
         # MKL's OpenMP threads otherwise spin for 200 ms after each call, fighting NumPy's
         # BLAS threads for the cores in the dense work between calls (measured: the contact
@@ -60,11 +94,12 @@ def _library():
         os.environ.setdefault("KMP_BLOCKTIME", "0")
         path = _mkl_rt()
         if path is not None:
-            f = ctypes.CDLL(path).pardiso
+            _runtime_lib = ctypes.CDLL(path)
         else:  # pypardiso's own search (the whole of sys.prefix: about a second)
             import pypardiso
 
-            f = pypardiso.PyPardisoSolver().libmkl.pardiso
+            _runtime_lib = pypardiso.PyPardisoSolver().libmkl
+        f = _runtime_lib.pardiso
         f.argtypes = [_P64, _P32, _P32, _P32, _P32, _P32, ctypes.c_void_p, _P32, _P32, _P32,
                       _P32, _P32, _P32, ctypes.c_void_p, ctypes.c_void_p, _P32]
         f.restype = None
@@ -154,6 +189,16 @@ class PardisoFactorization:
         if self._pt is None:
             raise RuntimeError("this PARDISO factorization was handed on to a later one "
                                "(analysis=) and can no longer solve")
+        small = self.n < (SOLVE_ONE_THREAD_BELOW if phase == 33 else FACTOR_ONE_THREAD_BELOW)
+        local = _local_threads() if small and phase > 0 and sparse_threads() > 1 else None
+        previous = local(1) if local is not None else None
+        try:
+            self._pardiso(phase, b, x, nrhs)
+        finally:
+            if local is not None:
+                local(previous)
+
+    def _pardiso(self, phase: int, b: np.ndarray, x: np.ndarray, nrhs: int) -> None:
         err = np.zeros(1, dtype=np.int32)
         _library()(self._pt.ctypes.data_as(_P64), _i32(1).ctypes.data_as(_P32),
                    _i32(1).ctypes.data_as(_P32), _i32(self._mtype).ctypes.data_as(_P32),
