@@ -175,8 +175,9 @@ def test_small_pardiso_calls_run_on_one_thread_and_give_the_pool_back():
         K = stiffness()
         f = linalg.factorize(K, "pardiso", trailing=np.arange(10))
         f.solve(np.ones(K.shape[0]))
+        after = local(initial)  # the setting from before, in force again
     finally:
         pardiso.PardisoFactorization._pardiso = original
         threads.apply(before or "off")
     assert seen[:2] == [1, 1]  # the factorization and the solve: one thread
-    assert local(initial) == initial  # the setting from before, in force again
+    assert after == initial
