@@ -109,6 +109,33 @@ def test_plot_redraws_the_figures_of_an_input_file_run(tmp_path):
     _same(before, after)
 
 
+@pytest.mark.parametrize("example", ["gasket", "input"])
+def test_no_figures_leaves_them_to_vfem_plot_which_draws_the_same(runs, example, tmp_path,
+                                                                   capsys):
+    """``vfem run --no-figures``: every result but the figures, a line saying so, and
+    ``vfem plot`` draws the very figures the run would have drawn (a built-in example whose
+    figures need data from the run, and an input file); a later run draws them again."""
+    if example == "input":
+        model = [str(ROOT / "examples" / "hertz.toml")]
+        drawn = tmp_path / "drawn"
+        assert main(["-q", "run", *model, "--out", str(drawn)]) == 0
+    else:
+        model = [example] + [a for s in SMALL[example] for a in ("--set", s)]
+        drawn = runs[example]
+    out = tmp_path / "deferred"
+    assert main(["run", *model, "--no-figures", "--out", str(out)]) == 0
+    assert "figures not drawn: --no-figures (vfem plot" in capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["figures"] == [] and not list(out.rglob("*.png"))
+    assert (out / "results.pvd").exists()
+    assert main(["-q", "plot", str(out)]) == 0
+    _same(_pngs(drawn), _pngs(out))
+    if example == "input":  # the next run in the process draws its figures again
+        again = tmp_path / "again"
+        assert main(["-q", "run", *model, "--out", str(again)]) == 0
+        assert _pngs(again)
+
+
 def test_a_folder_without_a_figure_set_gets_the_generic_figures(runs, tmp_path, capsys):
     """Results written before figure sets were recorded: the generic figures, no traceback."""
     src = runs["hertz"]

@@ -180,6 +180,9 @@ SOLVER_HELP = ("linear-algebra backend: auto (the fastest installed), superlu, p
 
 def cmd_run(args) -> int:
     chosen = linalg.use(args.solver)
+    from .io.replot import defer
+
+    defer(args.no_figures)  # for this run (main() may run several in one process)
     log.info("linear solver %s -> %s", args.solver, chosen)
     if _is_input_file(args.example):
         return run_input_file(args)
@@ -286,7 +289,7 @@ def _solve_and_report(solve, progress: Progress, report, quiet: bool, args, out:
     summary["run"] = folder.run
     if not quiet:
         print("\n".join(_results_line(report(summary), out)))
-        if summary.get("figures_not_drawn"):  # no matplotlib (vfem.io.replot.draw_run)
+        if summary.get("figures_not_drawn"):  # no matplotlib, or --no-figures (draw_run)
             print(f"vfem: figures not drawn: {summary['figures_not_drawn']}", file=sys.stderr)
     if not summary["converged"]:
         print(f"vfem: the analysis did not converge: "
@@ -537,6 +540,9 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--overwrite", action="store_true",
                      help="replace the results of another model in the results folder")
     run.add_argument("--solver", default="auto", metavar="NAME", help=SOLVER_HELP)
+    run.add_argument("--no-figures", action="store_true",
+                     help="write the results but not the figures (vfem plot RESULTS_DIR draws "
+                          "the same figures later): matplotlib's fixed second kept out of the run")
     run.add_argument("--resume", metavar="RESULTS_DIR",
                      help="continue an interrupted run of the same model from the last step "
                           "completed in RESULTS_DIR (its results directory)")

@@ -327,6 +327,20 @@ def contact_label(summary: dict) -> str:
     return f"contact: vfem, {variant} variant" if method == "vfem" else f"contact: {method}"
 
 
+#: set by :func:`defer`: runs write their results and leave the figures to ``vfem plot``
+_deferred = False
+
+
+def defer(on: bool = True) -> None:
+    """Make every later run in this process leave its figures undrawn (``vfem run
+    --no-figures``): the results, and what the figures need in ``summary.json``, are written as
+    always, and ``vfem plot`` draws the same figures from the folder when asked. matplotlib's
+    fixed costs (its import, text layout, PNG encoding: about a second for a few figures) then
+    stay out of the run, which matters for batches of runs and for small models."""
+    global _deferred
+    _deferred = bool(on)
+
+
 def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> list[str]:
     """What a run does once its results are written: record in ``summary`` the ``figure_set``
     (a built-in example's name or ``"input"``) and ``model``'s contact method and variant
@@ -336,14 +350,16 @@ def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> lis
 
     Without matplotlib nothing is drawn: ``figures`` is empty and ``figures_not_drawn`` says
     why and how to get it (:func:`vfem.io.plots.matplotlib_missing`; ``vfem run`` prints it);
-    everything else is written, so ``vfem plot`` draws the figures once it is installed."""
+    everything else is written, so ``vfem plot`` draws the figures once it is installed. The
+    same when the figures are deferred (:func:`defer`, ``vfem run --no-figures``)."""
     out = Path(out)
     summary["figure_set"] = figure_set
     if model is not None:
         summary["contact_settings"] = {"variant": model.contact.variant,
                                        "method": model.contact.method}
     summary.pop("figures_not_drawn", None)
-    missing = plots.matplotlib_missing()
+    missing = (f"--no-figures (vfem plot {out} draws them)" if _deferred
+               else plots.matplotlib_missing())
     if missing is not None:
         log.info("figures not drawn: %s", missing)
         summary["figures"] = []
