@@ -181,3 +181,39 @@ def test_small_pardiso_calls_run_on_one_thread_and_give_the_pool_back():
         threads.apply(before or "off")
     assert seen[:2] == [1, 1]  # the factorization and the solve: one thread
     assert after == initial
+
+
+@pytest.mark.skipif("pardiso" not in INSTALLED, reason="PARDISO is not installed")
+def test_a_taken_over_analysis_factorizes_again_after_solves_at_its_size():
+    """A large body's tangent between the two thread limits (20,000 to 200,000 dofs): factorized
+    with a Schur complement, solved, then its analysis taken over by the next tangent and that
+    one solved. MKL's PARDISO crashed (a segmentation fault in phase 22) when the solves of a
+    handle ran on other threads than its factorizations: one thread count per matrix, however
+    it is used (``vfem.linalg.pardiso``; found on total-Lagrangian Hertz at refinement 2)."""
+    from skfem import Basis, ElementQuad1, ElementVector, asm
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    from vfem import threads
+
+    mesh = rectangle(0.0, 0.0, 4.0, 1.0, nx=180, ny=60)  # 21,960 dofs free
+    basis = Basis(mesh, ElementVector(ElementQuad1()))
+    K = asm(linear_elasticity(*lame_parameters(1000.0, 0.3)), basis).tocsr()
+    fixed = basis.get_dofs(mesh.boundaries["left"]).all()
+    free = np.setdiff1d(np.arange(K.shape[0]), fixed)
+    K = K[free][:, free].tocsc()
+    top = np.flatnonzero(np.isin(free, basis.get_dofs(mesh.boundaries["top"]).all()))
+    b = np.ones(K.shape[0])
+    before = threads.sparse_threads()
+    threads.apply(2)
+    try:
+        first = linalg.factorize(K, "pardiso", trailing=top)
+        first.solve(b)
+        K2 = K.copy()
+        K2.data *= 1.5
+        second = linalg.factorize(K2, "pardiso", trailing=top, analysis=first)
+        x = second.solve(b)
+        fresh = linalg.factorize(K2, "pardiso", trailing=top).solve(b)
+    finally:
+        threads.apply(before or "off")
+    assert np.array_equal(x, fresh)
+    assert np.abs(K2 @ x - b).max() <= 1e-13 * np.abs(K2).max() * np.abs(x).max()

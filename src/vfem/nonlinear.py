@@ -137,7 +137,6 @@ class _TangentAssembly:
         G = np.array([np.asarray(basis.basis[j][0].grad) for j in range(nb)])
         #: B[e, q, (c, J), i]: d(v_i)_c / dX_J
         self.B = np.ascontiguousarray(G.transpose(3, 4, 1, 2, 0).reshape(ne, nq, dim * dim, nb))
-        self.Bt = np.ascontiguousarray(self.B.transpose(0, 3, 1, 2).reshape(ne, nb, nq * dim * dim))
         self.dx = basis.dx
         self.shape = (ne, nq, dim * dim)
         dofs = basis.element_dofs  # (nb, ne)
@@ -181,7 +180,9 @@ class _TangentAssembly:
         ne, nq, m = self.shape
         Am = (A * self.dx).transpose(4, 5, 0, 1, 2, 3).reshape(ne, nq, m, m)
         AB = (Am @ self.B).reshape(ne, nq * m, -1)
-        Ke = self.Bt @ AB  # (ne, i, j): sum over q and (c, J) of B_i A B_j
+        # (ne, i, j): the sum over q and (c, J) of B_i A B_j (B transposed as a view: no
+        # second copy of the gradients kept, as fast)
+        Ke = np.matmul(self.B.reshape(ne, nq * m, -1).transpose(0, 2, 1), AB)
         data = np.bincount(self.slot, weights=Ke.ravel(), minlength=len(self.indices))
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.N, self.N))
 

@@ -14,9 +14,9 @@ Both pools spinning at once oversubscribe the cores: on the shared 2-core machin
 example at 20k dofs took 2.76 s with the default pools and 0.17 s with one thread each (issue 19).
 The policy: the dense BLAS on **one** thread, the sparse factorization on ``threads`` (default
 :func:`default_threads`: the cores this process may use), so the two never compete. Small sparse
-work stays on one thread even so: PARDISO's back-substitutions below 200,000 dofs and its
-factorizations below 20,000 (``vfem.linalg.pardiso.SOLVE_ONE_THREAD_BELOW``, measured there),
-which two threads only slow down, ten times over when another process holds the other core.
+work stays on one thread even so: PARDISO on matrices below 20,000 dofs, every phase alike
+(``vfem.linalg.pardiso.ONE_THREAD_BELOW``, measured there), which two threads only slow down,
+ten times over when another process holds the other core.
 ``vfem --threads N`` (or the ``VFEM_THREADS`` environment variable) sets ``threads``; ``off``
 leaves the pools as the libraries set them. The library applies the default once, when an
 analysis is set up, unless :func:`apply` was called.

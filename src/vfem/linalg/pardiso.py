@@ -52,16 +52,17 @@ def _mkl_rt() -> str | None:
     return next((path for path in found if os.path.isfile(path)), None)
 
 
-#: PARDISO's back-substitutions run on one thread below this order and its factorizations
-#: below :data:`FACTOR_ONE_THREAD_BELOW` (issue 19). Measured on the 2-core machine, idle
+#: PARDISO works on one thread for matrices of fewer dofs than this (issue 19), all its phases:
+#: the analysis, the factorizations and the back-substitutions of one matrix on the same
+#: threads (MKL's PARDISO crashed in a factorization that took over an analysis after solves
+#: on fewer threads: ``tests/test_linalg.py``). Measured on the 2-core machine, idle
 #: (2026-11-25, a plane-strain block with a Schur complement on its top): at 3,872 dofs a solve
 #: took 0.25 ms on one thread and 0.75 ms on two, the factorization the same; at 24,080 dofs
 #: 1.65 against 2.08 ms, the factorization 29-34 against 23-31 ms; at 160,200 dofs the solves
-#: alike, the factorization 360 against 255-280 ms. With the other core busy (another process),
-#: a small factorization on two threads was ten times slower: the large contact iteration of
-#: the sliding example spent 7.6 s in PARDISO instead of 0.7 s.
-SOLVE_ONE_THREAD_BELOW = 200_000
-FACTOR_ONE_THREAD_BELOW = 20_000
+#: alike, the factorization 360 against 255-280 ms. With the other core busy (another
+#: process), a small factorization on two threads was ten times slower: the large contact
+#: iteration of the sliding example spent 7.6 s in PARDISO instead of 0.7 s.
+ONE_THREAD_BELOW = 20_000
 
 
 def _local_threads():
@@ -189,8 +190,8 @@ class PardisoFactorization:
         if self._pt is None:
             raise RuntimeError("this PARDISO factorization was handed on to a later one "
                                "(analysis=) and can no longer solve")
-        small = self.n < (SOLVE_ONE_THREAD_BELOW if phase == 33 else FACTOR_ONE_THREAD_BELOW)
-        local = _local_threads() if small and phase > 0 and sparse_threads() > 1 else None
+        small = self.n < ONE_THREAD_BELOW  # every phase of this matrix alike
+        local = _local_threads() if small and sparse_threads() > 1 else None
         previous = local(1) if local is not None else None
         try:
             self._pardiso(phase, b, x, nrhs)
