@@ -67,6 +67,37 @@ def test_the_tangent_flexibility_is_the_inverse_tangent_on_the_contact_dofs(stre
                                atol=1e-10 * np.abs(expected).max())
 
 
+def test_the_fallback_flexibility_in_blocks_of_columns_is_the_inverse_tangent(monkeypatch):
+    """A tangent whose Cholesky fails (here made to) gives its flexibility by back-substitutions,
+    a few candidate dofs at a time (``FALLBACK_COLUMNS``, two here, for fourteen): the block of
+    the inverse tangent all the same."""
+    from vfem.bodies import mechanics
+    from vfem.errors import AnalysisError
+
+    body = large_block()
+    top = np.flatnonzero(body.mesh.p[1] > 1 - 1e-9)
+    candidate = np.column_stack([2 * top, 2 * top + 1]).ravel()
+    force = np.zeros(body.ndofs)
+    real = mechanics.factorize
+
+    def no_cholesky(K, backend=None, *, trailing=None, spd=True, **kw):
+        if spd and trailing is not None:
+            raise AnalysisError("made to fail")
+        return real(K, backend, trailing=trailing, spd=spd, **kw)
+
+    monkeypatch.setattr(mechanics, "factorize", no_cholesky)
+    monkeypatch.setattr(mechanics, "FALLBACK_COLUMNS", 2)
+    lin = body.linearize(1.0, 0.0, force, candidate, candidate)
+    R, ref, K, D, pending = body.nonlinear.linearize(1.0, force)
+    free = np.setdiff1d(np.arange(body.ndofs), D)
+    inverse = np.zeros((body.ndofs, body.ndofs))
+    inverse[np.ix_(free, free)] = np.linalg.inv(K[free][:, free].toarray())
+    expected = inverse[np.ix_(candidate, candidate)]
+    assert len(candidate) == 14
+    np.testing.assert_allclose(lin.flexibility, expected, rtol=0,
+                               atol=1e-10 * np.abs(expected).max())
+
+
 @pytest.mark.parametrize("backend", linalg.available())
 def test_a_tangent_that_is_not_positive_definite_falls_back_to_back_substitutions(backend):
     """An indefinite tangent: a Cholesky backend (PARDISO, CHOLMOD) fails on it and the body

@@ -93,6 +93,11 @@ class LinearMechanics:
         pass
 
 
+#: A large body whose tangent is not positive definite takes its flexibility by
+#: back-substitutions, this many candidate dofs at a time.
+FALLBACK_COLUMNS = 128
+
+
 class LargeMechanics:
     """Large kinematics (see the module docstring)."""
 
@@ -188,13 +193,16 @@ class LargeMechanics:
                 rows = np.flatnonzero(held)
                 cols = rows[rows < nc2]
                 flexibility[np.ix_(rows, cols)] = factor.trailing_inverse[:, : len(cols)]
-            else:  # an indefinite tangent: one back-substitution per candidate dof
+            else:  # an indefinite tangent: one back-substitution per candidate dof, in
+                # blocks of columns (all at once held several ndofs x 2 nc arrays: 2.4 GB at
+                # the peak of total-Lagrangian Hertz at 119k dofs)
                 pos = np.searchsorted(free, candidate_dofs)
                 cols = np.flatnonzero(free[np.minimum(pos, len(free) - 1)] == candidate_dofs)
-                unit = np.zeros((self.body.ndofs, len(cols)))
-                unit[candidate_dofs[cols], np.arange(len(cols))] = 1.0
-                if len(cols):
-                    flexibility[:, cols] = solve(unit)[condensed_dofs]
+                for start in range(0, len(cols), FALLBACK_COLUMNS):
+                    block = cols[start:start + FALLBACK_COLUMNS]
+                    unit = np.zeros((self.body.ndofs, len(block)))
+                    unit[candidate_dofs[block], np.arange(len(block))] = 1.0
+                    flexibility[:, block] = solve(unit)[condensed_dofs]
             platen_motion = np.zeros(self.body.ndofs)
             stiffness = reaction = 0.0
             P = self.body.platen_dofs
