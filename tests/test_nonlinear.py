@@ -273,7 +273,7 @@ def test_a_large_step_is_damped_and_still_reaches_the_prescribed_values(caplog):
 @pytest.mark.parametrize("element", ["quad1", "tri1", "tri2"])
 def test_whole_array_assembly_gives_scikit_fems_forms(element):
     """The tangent, the internal force and the displacement gradient that the large-kinematics
-    bodies take from ``_TangentAssembly`` are scikit-fem's assembly of the weak forms
+    bodies take from ``_ElementArrays`` are scikit-fem's assembly of the weak forms
     ``_tangent_form`` and ``_internal_force_form`` and its interpolation, to round-off, on
     bilinear quadrilaterals and linear and quadratic triangles (random moduli, not symmetric)."""
     from skfem import (
@@ -287,7 +287,7 @@ def test_whole_array_assembly_gives_scikit_fems_forms(element):
         asm,
     )
 
-    from vfem.nonlinear import _internal_force_form, _tangent_form, _TangentAssembly
+    from vfem.nonlinear import _ElementArrays, _internal_force_form, _tangent_form
 
     x, y = np.linspace(-1.0, 2.0, 9), np.linspace(0.0, 1.0, 4)
     mesh, elem = {"quad1": (MeshQuad.init_tensor(x, y), ElementQuad1()),
@@ -302,8 +302,8 @@ def test_whole_array_assembly_gives_scikit_fems_forms(element):
     A = rng.standard_normal((2, 2, 2, 2, ne, nq))
     P = rng.standard_normal((2, 2, ne, nq))
     u = rng.standard_normal(basis.N)
-    fast = _TangentAssembly.of(basis)
-    assert _TangentAssembly.of(basis) is fast  # made once per basis
+    fast = _ElementArrays.of(basis)
+    assert _ElementArrays.of(basis) is fast  # made once per basis
     K0 = asm(_tangent_form, basis, A=A).tocsr()
     K1 = fast.assemble(A)
     assert abs(K1 - K0).max() <= 1e-14 * abs(K0).max()

@@ -103,7 +103,9 @@ _MAX_HALVINGS = 8
 _Inverted = ElementInverted
 
 
-# -- forms: residual and tangent, assembled by scikit-fem ----------------------------------------
+# -- forms: residual and tangent, as scikit-fem states them ---------------------------------------
+# (what :class:`_ElementArrays` computes by whole arrays; tests/test_nonlinear.py checks the two
+# against each other)
 
 @LinearForm
 def _internal_force_form(v, w):
@@ -117,8 +119,10 @@ def _tangent_form(du, v, w):
     return ddot(np.einsum("ijkl...,kl...->ij...", np.asarray(w["A"]), grad(du)), grad(v))
 
 
-class _TangentAssembly:
-    """The tangent stiffness of :func:`_tangent_form` on one basis, assembled by whole arrays.
+class _ElementArrays:
+    """A large body's element quantities on one basis by whole arrays: the tangent stiffness of
+    :func:`_tangent_form`, the internal force of :func:`_internal_force_form` and the
+    displacement gradient.
 
     Per element ``K_e = sum_q w_q B_q^T A_q B_q``, ``B_q`` the gradients of the basis functions
     (``grad(v) : X = B_q[:, i] . X`` flattened, from scikit-fem's basis), then one scatter into
@@ -149,7 +153,7 @@ class _TangentAssembly:
         self.N = basis.N
 
     @classmethod
-    def of(cls, basis: Basis) -> _TangentAssembly:
+    def of(cls, basis: Basis) -> _ElementArrays:
         """The assembly for ``basis``, made once and kept on it (a total-Lagrangian body's
         reference basis lives as long as the body, an updated one's basis for its step)."""
         found = getattr(basis, "_vfem_tangent_assembly", None)
@@ -420,20 +424,20 @@ class NonlinearBody:
         """
         if self.formulation == TOTAL:
             basis = self.basis0
-            G0 = _TangentAssembly.of(basis).gradient(self._u_at_current)
-            g = _TangentAssembly.of(basis).gradient(delta)
+            G0 = _ElementArrays.of(basis).gradient(self._u_at_current)
+            g = _ElementArrays.of(basis).gradient(delta)
             F = deformation_gradient(G0 + g)
             self._check_orientation(F)
             E = strain_increment(G0, g).total
             return _State(basis, F, self.material.second_piola(E),
                           lambda: self.material.tangent(E), self.material.out_of_plane_stress(E))
         basis = self.current_basis
-        h = _TangentAssembly.of(basis).gradient(delta)
+        h = _ElementArrays.of(basis).gradient(delta)
         f = deformation_gradient(h)
         self._check_orientation(f)
         E_pseudo = updated_strain_increment(h, self.pseudo_strain).total
-        S, D, S33 = self._pushed_material(E_pseudo)
-        return _State(basis, f, S, D, S33)
+        S, moduli, S33 = self._pushed_material(E_pseudo)
+        return _State(basis, f, S, moduli, S33)
 
     def _pushed_material(self, E_pseudo: np.ndarray
                          ) -> tuple[np.ndarray, Callable[[], np.ndarray], np.ndarray]:
@@ -485,10 +489,10 @@ class NonlinearBody:
     # -- assembled quantities ---------------------------------------------------------------------
 
     def _internal(self, state: _State) -> np.ndarray:
-        return _TangentAssembly.of(state.basis).internal_force(state.first_piola())
+        return _ElementArrays.of(state.basis).internal_force(state.first_piola())
 
     def _tangent(self, state: _State):
-        return _TangentAssembly.of(state.basis).assemble(state.tangent_moduli())
+        return _ElementArrays.of(state.basis).assemble(state.tangent_moduli())
 
     def internal_force(self) -> np.ndarray:
         """Internal nodal forces ``int grad(v) : P`` at the current state (ndofs)."""
@@ -779,7 +783,7 @@ class NonlinearBody:
 
     def second_piola_kirchhoff(self) -> np.ndarray:
         """(2, 2, nelems, nqp) 2nd Piola–Kirchhoff stress relative to the initial mesh."""
-        return self.material.stress(self.green_lagrange_strain())[0]
+        return self.material.second_piola(self.green_lagrange_strain())
 
     def stress(self) -> np.ndarray:
         """(nelems, 2, 2) element averages (over the current volume) of the Cauchy stress."""

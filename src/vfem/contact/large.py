@@ -51,7 +51,8 @@ ring crushed by a stiff one):
 The contact forces' turning with the surfaces (follower forces) enters the linearisation: the
 derivative of the nodal forces with respect to the positions of the nodes in contact and of the
 opposing nodes around their virtual nodes, at fixed traction values, found by differences of the
-pairing (geometry only, :meth:`LargeDeformationContact._forces_at`); the transfer is held in it.
+pairing (geometry only: the loaded nodes' normals, :meth:`LargeDeformationContact._normals_at`,
+the coordinates that move disjoint sets of them perturbed together); the transfer is held in it.
 
 The step's increments of the prescribed displacements enter with the first correction, so the
 first iterate of a step is the tangent prediction of the whole step, contact included: the
@@ -321,18 +322,21 @@ class LargeDeformationContact(PairSet):
     # -- the forces follow the surfaces ----------------------------------------------------------
 
     def _normals_at(self, state: ContactState, x: list[np.ndarray]) -> list:
-        """Per contact pair, the loaded nodes (positions in the pair's nodes, traction nonzero)
-        and the normals their tractions act along with the bodies' tracked nodes at ``x``: the
-        opposing surface's normal at the virtual node, wherever that now is."""
+        """Per contact pair, the loaded nodes (positions in the pair's nodes, traction nonzero),
+        the normals their tractions act along with the bodies' tracked nodes at ``x`` (the
+        opposing surface's normal at the virtual node, wherever that now is) and the facets of
+        the opposing surface their virtual nodes lie on."""
         out = []
         for k, pair in enumerate(self.contact_pairs):
             on = np.flatnonzero(self.tractions(state, k) != 0)
             if not len(on):
-                out.append((on, np.zeros((0, self.surfaces[pair.fine].dim))))
+                out.append((on, np.zeros((0, self.surfaces[pair.fine].dim)),
+                            np.zeros(0, dtype=int)))
                 continue
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            out.append((on, virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse],
-                                          pair.nodes[on], *pair.patches)[0]))
+            normal, _, _, seg, _ = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse],
+                                                 pair.nodes[on], *pair.patches)
+            out.append((on, normal, seg))
         return out
 
     def _forces_at(self, state: ContactState, x: list[np.ndarray]) -> np.ndarray:
@@ -340,8 +344,8 @@ class LargeDeformationContact(PairSet):
         bodies' tracked nodes at ``x``: the traction acts along the opposing surface's normal at
         the virtual node, wherever that now is (the transfer held)."""
         out = [np.zeros((s.nc, s.dim)) for s in self.surfaces]
-        for k, (pair, (on, normal)) in enumerate(zip(self.contact_pairs,
-                                                      self._normals_at(state, x))):
+        for k, (pair, (on, normal, _)) in enumerate(zip(self.contact_pairs,
+                                                         self._normals_at(state, x))):
             if not len(on):
                 continue
             qn = self.tractions(state, k)[on, None] * normal
@@ -404,8 +408,8 @@ class LargeDeformationContact(PairSet):
             for col in range(len(J)):
                 Bj[:, col] = (self._forces_at(state, perturbed([col])) - base) / h
             return J, Bj
-        groups, moves = self._follower_moves(state, x, J, body_of)
         base_n = self._normals_at(state, x)
+        groups, moves = self._follower_moves(base_n, J, body_of)
         for group in groups:
             pert_n = self._normals_at(state, perturbed(group))
             for col in group:
@@ -422,11 +426,12 @@ class LargeDeformationContact(PairSet):
                         Bj[off[side]:off[side + 1], col] += sign * (M[:, nodes] @ dqn).ravel()
         return J, Bj
 
-    def _follower_moves(self, state: ContactState, x: list[np.ndarray], J: np.ndarray,
-                        body_of: np.ndarray) -> tuple[list[list[int]], list[list[np.ndarray]]]:
+    def _follower_moves(self, base: list, J: np.ndarray, body_of: np.ndarray
+                        ) -> tuple[list[list[int]], list[list[np.ndarray]]]:
         """Groups of the columns ``J`` of :meth:`_follower_stiffness` that may be perturbed
-        together, and per pair and column the loaded nodes (positions among the pair's nodes
-        with traction) whose normals the column's coordinate moves.
+        together, and per pair and column the loaded nodes (positions among the pair's loaded
+        nodes) whose normals the column's coordinate moves. ``base``: :meth:`_normals_at` at
+        the unperturbed positions (the loaded nodes and their virtual nodes' facets).
 
         A coordinate of node n moves, in each pair: if n is on the compatibility side, the
         loaded nodes among n and its facet neighbours (n's own virtual node; the neighbours'
@@ -441,13 +446,11 @@ class LargeDeformationContact(PairSet):
         empty = np.zeros(0, dtype=int)
         moves: list[list[np.ndarray]] = [[empty] * len(J) for _ in self.contact_pairs]
         node_of = (J - off[body_of]) // np.array([self.surfaces[b].dim for b in body_of])
-        for k, pair in enumerate(self.contact_pairs):
-            on = np.flatnonzero(self.tractions(state, k) != 0)
+        for k, (pair, (on, _, seg)) in enumerate(zip(self.contact_pairs, base)):
             if not len(on):
                 continue
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
             nodes = pair.nodes[on]
-            seg = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse], nodes, *pair.patches)[3]
             local = np.full(sf.nc, -1)
             local[nodes] = np.arange(len(nodes))
             # coarse node -> the loaded nodes with a virtual node on a facet at it

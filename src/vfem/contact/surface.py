@@ -29,6 +29,7 @@ from skfem.refdom import RefLine
 
 from ..bodies import COMPONENTS, Body
 from ..errors import InputError
+from ..mesh.checks import _corners
 from .search import normal_of_tangent, outward_normals, project_points
 
 log = logging.getLogger(__name__)
@@ -395,8 +396,8 @@ def _most_distorted(mesh, facet_ids: np.ndarray) -> str:
     edges = np.linalg.norm(np.roll(corners, -1, axis=1) - corners, axis=0)  # (nv, ne)
     ratio = edges.max(axis=0) / np.maximum(edges.min(axis=0), 1e-300)
     k = int(np.argmax(ratio))
-    pts = ", ".join(f"({x:.6g}, {y:.6g})" for x, y in corners[:, :, k].T)
-    return f"element {int(elem[k])} (corners {pts}; edges in ratio {ratio[k]:.3g})"
+    return (f"element {int(elem[k])} (corners at {_corners(mesh.p, mesh.t, int(elem[k]))}; "
+            f"edges in ratio {ratio[k]:.3g})")
 
 
 def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:
