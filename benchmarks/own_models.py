@@ -1,8 +1,9 @@
 """Models that no issue names, checked for the invariants every converged step must keep
 (issue 18's review): a punch narrower than the block (both its corners inside the contact),
 stiff on soft and soft on stiff, starting apart, mesh ratios 3:1 and 1:3, small and large
-kinematics (pressing, and pressing then sliding with and without a search distance), the
-Lagrange baseline and the thesis variant.
+kinematics (pressing, and pressing then sliding with and without a search distance; stiff on
+soft and soft on stiff under total and updated Lagrangian, a 21k-dof block), the Lagrange
+baseline and the thesis variant.
 
     python benchmarks/own_models.py                               # this tree
     PYTHONPATH=/tmp/before/src python benchmarks/own_models.py    # another (a git worktree)
@@ -53,9 +54,10 @@ def case(name, bodies, settings=None, steps=(0.25, 0.5, 0.75, 1.0)):
 
 
 def punch_on_block(gap, ratio, E_punch, E_block, tri, kinematics="small", settings=None,
-                   tag="", slide=0.0):
-    block = rect(0, 1, -0.4, 0, 20, 8, "block", E_block, tri=tri, supports=(Support("bottom"),),
-                 contact_boundaries=("top",), kinematics=kinematics)
+                   tag="", slide=0.0, block_mesh=(20, 8)):
+    block = rect(0, 1, -0.4, 0, *block_mesh, "block", E_block, tri=tri,
+                 supports=(Support("bottom"),), contact_boundaries=("top",),
+                 kinematics=kinematics)
     # a punch narrower than the block: its two corners lie inside the contact zone
     n = max(2, int(round(8 * ratio)))
     if slide:  # pressed in over the first half of the schedule, then slid along +x
@@ -84,6 +86,16 @@ for distance in (None, 0.02):
     punch_on_block(0.001, 1.5, 1e9, 1e9, tri=True, kinematics="total", slide=0.2,
                    settings=ContactSettings(search_distance=distance),
                    tag=f" slide, search {distance}")
+# large kinematics as issue 19 reworked it (whole-array tangent, PARDISO analysis taken over,
+# coloured follower differences, lazy linearisation) on models it was not tuned on: stiff on
+# soft starting apart with a 3:1 mesh ratio (total and updated Lagrangian), soft on stiff with
+# 1:3 and sliding, and a block of 21k dofs (PARDISO's threads above 20,000 dofs)
+for kin in ("total", "updated"):
+    punch_on_block(0.002, 3.0, 2e10, 1e9, tri=True, kinematics=kin, tag=" stiff on soft")
+punch_on_block(0.0, 1 / 3, 1e8, 2e9, tri=False, kinematics="updated", slide=0.1,
+               tag=" soft on stiff, slide")
+punch_on_block(0.001, 2.0, 1e10, 1e9, tri=False, kinematics="total", block_mesh=(150, 70),
+               tag=" 21k-dof block")
 # the classical Lagrange baseline and the thesis variant on the stiff-on-soft model (recorded)
 punch_on_block(0.002, 3.0, 2e11, 1e9, tri=True, settings=ContactSettings(method="lagrange"),
                tag=" [lagrange]")
