@@ -34,3 +34,30 @@ def test_surface_orientation_and_rind_location():
     assert found[0] >= 0 and found[3] >= 0  # in the outer layer of elements
     assert found[1] == -1  # outside the body
     assert found[2] == -1  # inside, but deeper than the rind
+
+
+def test_direct_and_tree_candidates_choose_the_same_segments(monkeypatch):
+    """Few pairs take the direct candidate search, many the KD-tree (``DIRECT_PAIRS``): both
+    give the same candidates, so the same segment, t and distance, ties included (points on
+    the vertices two segments share, with normals deciding)."""
+    from vfem.contact import search
+
+    rng = np.random.default_rng(7)
+    for m, s in [(1, 1), (3, 40), (40, 40), (25, 300), (200, 30)]:
+        a = np.cumsum(rng.random((s, 2)) - [0.0, 0.5], axis=0)
+        b = np.vstack([a[1:], a[-1:] + [1.0, 0.0]])
+        pts = a[rng.integers(0, s, m)] + rng.normal(0.0, 0.3, (m, 2))
+        pts[: min(m, 5)] = b[: min(m, 5)]  # on shared vertices: ties
+        normals = rng.normal(size=(m, 2))
+        monkeypatch.setattr(search, "DIRECT_PAIRS", 10**9)
+        direct = project_points(pts, a, b, normals, free=True)
+        monkeypatch.setattr(search, "DIRECT_PAIRS", 0)
+        tree = project_points(pts, a, b, normals, free=True)
+        for x, y in zip(direct, tree):
+            np.testing.assert_array_equal(x, y)
+        # and the closest segment is the nearest one: no nearer point on any segment
+        d = b - a
+        t = np.clip(np.einsum("pmd,md->pm", pts[:, None] - a, d) / np.einsum("md,md->m", d, d),
+                    0, 1)
+        every = np.linalg.norm(pts[:, None] - (a + t[..., None] * d), axis=2)
+        np.testing.assert_allclose(direct[2], every.min(axis=1), rtol=0, atol=1e-12)

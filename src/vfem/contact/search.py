@@ -2,8 +2,16 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from scipy.spatial import cKDTree
+
+#: up to this many point-segment pairs the candidates are found directly, above it by a KD-tree
+#: on the segments' midpoints (issue 19: a large-kinematics iteration projects a few dozen
+#: points onto a few dozen facets thousands of times, where the tree's set-up and its Python
+#: lists were most of the time)
+DIRECT_PAIRS = 8192
 
 
 def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray,
@@ -39,13 +47,21 @@ def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray,
     d = b - a
     L2 = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
     mid = 0.5 * (a + b)
-    tree = cKDTree(mid)
-    d0, _ = tree.query(points)
-    radius = d0 + 0.5 * np.sqrt(L2.max()) * (1 + 1e-9) + 1e-300
-    lists = tree.query_ball_point(points, radius)
-    counts = np.fromiter((len(c) for c in lists), dtype=int, count=m)
-    pt = np.repeat(np.arange(m), counts)
-    sg = np.fromiter((j for c in lists for j in c), dtype=int, count=int(counts.sum()))
+    half = 0.5 * np.sqrt(L2.max()) * (1 + 1e-9) + 1e-300
+    if m * s <= DIRECT_PAIRS:
+        # few points and segments: every pair's midpoint distance at once, the candidates the
+        # tree would give (its set-up and the Python lists it returns cost more here)
+        to_mid = np.hypot(points[:, None, 0] - mid[None, :, 0],
+                          points[:, None, 1] - mid[None, :, 1])
+        pt, sg = np.nonzero(to_mid <= (to_mid.min(axis=1) + half)[:, None])
+    else:
+        tree = cKDTree(mid)
+        d0, _ = tree.query(points)
+        lists = tree.query_ball_point(points, d0 + half)
+        counts = np.fromiter((len(c) for c in lists), dtype=int, count=m)
+        pt = np.repeat(np.arange(m), counts)
+        sg = np.fromiter(itertools.chain.from_iterable(lists), dtype=int,
+                         count=int(counts.sum()))
     tf = np.einsum("ij,ij->i", points[pt] - a[sg], d[sg]) / L2[sg]
     t = np.clip(tf, 0.0, 1.0)
     diff = points[pt] - (a[sg] + t[:, None] * d[sg])
