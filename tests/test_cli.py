@@ -197,14 +197,18 @@ def test_a_folder_friction_and_one_body_are_told_plainly(tmp_path, capsys):
     assert "is a folder" in capsys.readouterr().err
     text = (Path(__file__).parent.parent / "examples" / "punch" / "flat_punch.toml").read_text()
     model = tmp_path / "friction.toml"
+    # Coulomb friction is a contact setting (issue 20); a friction key elsewhere is told where
     model.write_text(text.replace("[steps]", "[contact]\nfriction = 0.3\n\n[steps]"))
+    assert main(["check", str(model)]) == 0
+    capsys.readouterr()
+    model.write_text(text.replace('name = "punch"', 'name = "punch"\nfriction = 0.3'))
     assert main(["check", str(model)]) == 2
     err = capsys.readouterr().err
-    assert "friction is not available yet" in err and "did you mean" not in err
+    assert "contact.friction = mu" in err and "did you mean" not in err
     for example in ("wedge", "hertz"):
         assert main(["run", example, "--set", "contact.friction=0.3"]) == 2
         err = capsys.readouterr().err
-        assert "friction is not available yet" in err and "valid keys" not in err
+        assert "the built-in examples are frictionless" in err and "valid keys" not in err
     one = tmp_path / "one.toml"
     one.write_text(text[: text.index('[[bodies]]\nname = "punch"')])
     assert main(["check", str(one)]) == 0

@@ -57,6 +57,10 @@ def formulation_class(settings, large: bool) -> type:
 
         return LargeDeformationContact
     if settings.variant == "paired":
+        if settings.friction > 0:
+            from .friction import FrictionalPairedContact
+
+            return FrictionalPairedContact
         from .paired import PairedContact
 
         return PairedContact
@@ -82,6 +86,14 @@ def check_capabilities(model) -> None:
     elif large and settings.variant != "paired":
         raise InputError(f"model {model.name!r}: large kinematics needs the paired contact "
                          "variant")
+    if settings.friction > 0 and "coulomb" not in caps.friction:
+        what = ("large kinematics" if large and settings.method == "vfem" else
+                f"contact.method = {settings.method!r}" if settings.method != "vfem" else
+                f"contact.variant = {settings.variant!r}")
+        raise InputError(f"model {model.name!r}: contact.friction = {settings.friction:g} "
+                         f"(Coulomb friction) is available with the paired variant and small "
+                         f"kinematics only, not yet with {what}; set contact.friction = 0 for "
+                         "frictionless contact")
     for b in model.bodies:
         if b.order not in caps.orders:
             if large:

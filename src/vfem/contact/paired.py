@@ -470,17 +470,22 @@ class PairedContact(PairSet):
         nodes of its facets and of the opposing facets under it), so each body's motion is its
         flexibility C times a sparse matrix, computed once.
         """
-        offsets = np.cumsum([0] + [len(p.nodes) for p in self.contact_pairs])
+        directions = [self.directions(k) for k in range(len(self.contact_pairs))]
+        offsets = np.cumsum([0] + [len(p.nodes) * len(dirs)
+                                   for p, dirs in zip(self.contact_pairs, directions)])
         m = int(offsets[-1])
         parts: list[list] = [[] for _ in self.surfaces]  # (rows, cols, values) per body
         for k, pair in enumerate(self.contact_pairs):
+            n = len(pair.nodes)
             for body, per_node, sign in ((pair.fine, pair.mass, 1.0),
                                          (pair.coarse, pair.transfer, -1.0)):
                 r, c = np.nonzero(per_node[:, pair.nodes])
                 v = sign * per_node[r, pair.nodes[c]]
                 dim = self.surfaces[body].dim
-                for d in range(dim):  # the force along the normal's components
-                    parts[body].append((dim * r + d, offsets[k] + c, v * pair.normal[c, d]))
+                for j, direction in enumerate(directions[k]):
+                    for d in range(dim):  # the force along the direction's components
+                        parts[body].append((dim * r + d, offsets[k] + j * n + c,
+                                            v * direction[c, d]))
         dF = [sp.csr_matrix((np.concatenate([p[2] for p in ps]) if ps else [],
                              (np.concatenate([p[0] for p in ps]) if ps else [],
                               np.concatenate([p[1] for p in ps]) if ps else [])),
@@ -493,18 +498,34 @@ class PairedContact(PairSet):
         W = np.zeros((m, m))
         dp_dplaten = np.zeros(m)
         for k, pair in enumerate(self.contact_pairs):
-            rows = slice(offsets[k], offsets[k + 1])
+            n = len(pair.nodes)
             uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
             coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
             uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
-            # penetration p = -(gap0 + n.(u_f - u_c)); W = -dp/dq
-            W[rows] = np.einsum("id,idm->im", pair.normal, uf - uc)
-            dp_dplaten[rows] = pair.platen_rate
+            for j, direction in enumerate(directions[k]):
+                rows = slice(offsets[k] + j * n, offsets[k] + (j + 1) * n)
+                # along the normal: penetration p = -(gap0 + n.(u_f - u_c)), W = -dp/dq; along
+                # a tangent t: the relative displacement t.(u_f - u_c) per unit traction
+                W[rows] = np.einsum("id,idm->im", direction, uf - uc)
+                dp_dplaten[rows] = pair.platen_rate if j == 0 else self._tangent_platen_rate(
+                    k, direction)
         dR = np.zeros(m)
         if self.platen_body is not None:
             s = self.surfaces[self.platen_body]
             dR = np.asarray(dF[self.platen_body].T @ s.platen_row).ravel()
         return W, dp_dplaten, dR, offsets
+
+    def directions(self, k: int) -> list[np.ndarray]:
+        """The directions of pair k's traction unknowns at its nodes, each (nodes, dim): the
+        normal alone (frictionless; a frictional formulation adds the tangents)."""
+        return [self.contact_pairs[k].normal]
+
+    def _tangent_platen_rate(self, k: int, tangent: np.ndarray) -> np.ndarray:
+        """The change of pair k's relative tangential displacement t.(u_f - u_c) per unit
+        platen motion (with friction: :mod:`vfem.contact.friction`)."""
+        pair, v = self.contact_pairs[k], self.platen_motion
+        return np.einsum("id,id->i", tangent, v[pair.fine][pair.nodes]
+                         - pair.interp @ v[pair.coarse])
 
     def _close_gap(self, state: ContactState, pens: list[np.ndarray]) -> None:
         """Nothing touches: move the platen just far enough to close the smallest gap."""

@@ -83,6 +83,12 @@ class ContactSettings:
             in every contact pair it belongs to, instead of the surface chosen by stiffness and
             facet size (for testing that the answer does not depend on the choice beyond
             discretisation error). Default (None): the softer surface, of equals the finer.
+        friction: Coulomb's coefficient of friction μ of every contact pair: a node in contact
+            sticks (no relative tangential motion against its virtual node within the step) while
+            its tangential traction stays within μ times its normal traction, and slips with
+            that traction opposing its slip otherwise (docs/method.md §11). 0 (the default):
+            frictionless, the code path of every analysis before friction. The paired variant
+            with small kinematics only, for now.
     """
 
     method: str = "vfem"
@@ -105,6 +111,7 @@ class ContactSettings:
     penalty_factor: float = 1000.0
     augmented_tolerance: float = 1e-9
     compatibility_side: str | None = None
+    friction: float = 0.0
 
     def validate(self) -> None:
         for f in fields(self):
@@ -117,6 +124,9 @@ class ContactSettings:
         for name in positive:
             if getattr(self, name) <= 0:
                 raise InputError(f"contact.{name} must be > 0, got {getattr(self, name)!r}")
+        if self.friction < 0:
+            raise InputError(f"contact.friction (Coulomb's coefficient) must be >= 0, got "
+                             f"{self.friction!r}")
         for name in ("penetration_tolerance", "search_distance", "penalty"):
             v = getattr(self, name)
             if v is not None and v <= 0:

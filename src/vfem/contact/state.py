@@ -95,6 +95,32 @@ class TractionState(ContactState):
 
 
 @dataclass
+class FrictionState(TractionState):
+    """The frictional paired variant's state (:mod:`vfem.contact.friction`): besides the normal
+    traction values, per contact pair (its index) at its compatibility-side nodes the
+    tangential traction values (``shear``), the relative tangential displacement against the
+    virtual node at the last converged step (``anchor``: a node that sticks keeps it within the
+    step) and the slip accumulated since the start (``slip``). All three are path-dependent
+    history: saved in checkpoints and restored exactly when a step is cut."""
+
+    shear: dict[int, np.ndarray] = field(default_factory=dict)
+    anchor: dict[int, np.ndarray] = field(default_factory=dict)
+    slip: dict[int, np.ndarray] = field(default_factory=dict)
+
+    def unknowns(self) -> dict[str, np.ndarray]:
+        return {**super().unknowns(),
+                **{f"{name}_{k}": v for name in ("shear", "anchor", "slip")
+                   for k, v in getattr(self, name).items()}}
+
+    def with_unknowns(self, arrays: dict[str, np.ndarray]) -> FrictionState:
+        super().with_unknowns(arrays)
+        for name in ("shear", "anchor", "slip"):
+            setattr(self, name, {int(k.removeprefix(f"{name}_")): v for k, v in arrays.items()
+                                 if k.startswith(f"{name}_")})
+        return self
+
+
+@dataclass
 class BaselineState(ContactState):
     """A classical baseline's state: per constraint row, whether it is active and the
     multiplier (pressure) the next step starts from (the augmented Lagrangian's)."""
@@ -112,7 +138,8 @@ class BaselineState(ContactState):
 
 
 #: every state type, by name: how a checkpoint reads a state back
-STATE_TYPES = {cls.__name__: cls for cls in (ContactState, TractionState, BaselineState)}
+STATE_TYPES = {cls.__name__: cls for cls in (ContactState, TractionState, FrictionState,
+                                             BaselineState)}
 
 
 @dataclass
@@ -200,5 +227,5 @@ def closing_motion(penetration: np.ndarray, rate: np.ndarray, need: float) -> fl
     return float(d[ok][np.argmin(np.abs(d[ok]))]) if ok.any() else 0.0
 
 
-__all__ = ["BaselineState", "ContactState", "CycleWatch", "IterationRecord", "Pairing",
-           "STATE_TYPES", "SolveResult", "TractionState", "closing_motion"]
+__all__ = ["BaselineState", "ContactState", "CycleWatch", "FrictionState", "IterationRecord",
+           "Pairing", "STATE_TYPES", "SolveResult", "TractionState", "closing_motion"]

@@ -1,0 +1,322 @@
+"""Coulomb friction in the paired variant: stick and slip, corrected separately from the normal
+contact (thesis §1.10 and §4.3.1; issue 20).
+
+The thesis leaves friction undone but states where it goes: in two or three dimensions "one has
+to consider equilibrium in directions normal and tangent to the contact surface" (§4.3.1), and
+the algorithm is modular for any friction law that needs "only that certain information about
+friction resultants be available at the global level" (§1.10). Here that information is one
+more traction field per contact pair:
+
+* **Unknowns.** At each compatibility-side node of a pair, besides the normal traction value q,
+  a tangential traction value s per tangent direction (dim - 1 of them: one in 2D). Both sides'
+  nodal forces come from the one traction field q n + s t, ``F_fine = N (q n + s t)`` and
+  ``F_coarse = -T (q n + s t)`` (eq. 4.4.11 as for q), so the tangential forces balance to
+  round-off as the normal ones do.
+* **Tangential compatibility** (a node that sticks): its relative tangential displacement
+  against its virtual node, ``w = t.(u_fine - u_virtual)``, keeps the value it had at the last
+  converged step (``FrictionState.anchor``): no slip within the step.
+* **The Coulomb law** (a node that slips): ``|s| = mu q`` with s opposing the slip increment
+  ``w - anchor``. A node sticks while ``|s| < mu q``; a node with no normal traction carries
+  no tangential one.
+* **The correction.** For given sets (in contact; of those, sticking or slipping, and each
+  slipping node's direction σ), the conditions are linear in the traction values: the normal
+  rows ask each contact node's penetration to close (as without friction), the tangential rows
+  each sticking node's slip to vanish, and each slipping node's s is tied to its q by
+  ``s = -mu σ q``. One dense solve (the pair flexibility over normal and tangential unknowns,
+  each body's own factorization behind it, :meth:`PairedContact._full_flexibility`) meets them
+  all; the iteration, as for the normal contact alone, only finds the sets: a sticking node
+  whose tangential traction leaves the cone slips (in the direction that traction opposes),
+  a slipping node whose slip turns back sticks, a node in tension leaves contact (and its
+  tangential traction with it). This is a return map onto the Coulomb cone per node, with no
+  penalty and no parameter to tune.
+* **History.** When a step converges, every node's anchor becomes its relative tangential
+  displacement and the slip is accumulated (``FrictionState.slip``): friction is path
+  dependent, and a step that is cut starts again from the last converged state, anchors
+  included (they are part of the state the checkpoints save).
+
+Small kinematics only for now: the pairs, normals and tangents are those of the undeformed
+configuration, as for the frictionless paired variant.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+
+import numpy as np
+
+from .corrections import relaxation, release_tension
+from .group import bordered_matrix
+from .iteration import Check, iterate
+from .paired import PairedContact
+from .state import ContactState, FrictionState, IterationRecord, SolveResult
+
+log = logging.getLogger(__name__)
+
+#: a node's tangential traction counts as on the Coulomb cone when it is within this fraction
+#: of mu q of it (the cone is met exactly by the correction; round-off only)
+CONE_TOLERANCE = 1e-9
+
+
+def tangents(normal: np.ndarray) -> list[np.ndarray]:
+    """The unit tangent directions at nodes with unit ``normal`` (n, dim): in 2D the normal
+    turned by +90 degrees, (-n_y, n_x); one tangent per direction of the tangent space (dim - 1
+    of them), which is all the tangential code reads."""
+    if normal.shape[1] != 2:
+        raise NotImplementedError("friction in 3D (issue 21)")
+    return [np.column_stack([-normal[:, 1], normal[:, 0]])]
+
+
+def coulomb_status(q: np.ndarray, s: np.ndarray, mu: float) -> np.ndarray:
+    """Per node: 0 no contact (q <= 0), 1 stick (|s| inside the cone mu q), 2 slip (on it)."""
+    status = np.zeros(len(q), dtype=int)
+    on = q > 0
+    slipping = np.abs(s) >= (1.0 - CONE_TOLERANCE) * mu * q
+    status[on & ~slipping] = 1
+    status[on & slipping] = 2
+    return status
+
+
+class FrictionalPairedContact(PairedContact):
+    """The paired variant with Coulomb friction, small displacements (module docstring)."""
+
+    capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
+                                       friction=("frictionless", "coulomb"))
+    state_type = FrictionState
+
+    def __init__(self, surfaces, pairs, settings, backend: str | None = None):
+        super().__init__(surfaces, pairs, settings, backend)
+        self.mu = float(settings.friction)
+        self._tangents = [tangents(pair.normal) for pair in self.contact_pairs]
+
+    def directions(self, k: int) -> list[np.ndarray]:
+        """The normal, then the tangents: the order of each pair's unknowns."""
+        return [self.contact_pairs[k].normal] + self._tangents[k]
+
+    # -- state -----------------------------------------------------------------------------------
+
+    def _values(self, state: FrictionState, name: str, k: int) -> np.ndarray:
+        table = getattr(state, name)
+        if k not in table:
+            table[k] = np.zeros(len(self.contact_pairs[k].nodes))
+        return table[k]
+
+    def shear(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's tangential traction values at its compatibility-side nodes (2D: one)."""
+        return self._values(state, "shear", k)
+
+    def anchor(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's relative tangential displacements at the last converged step."""
+        return self._values(state, "anchor", k)
+
+    def accumulated_slip(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's slip accumulated over the converged steps (length, per node)."""
+        return self._values(state, "slip", k)
+
+    def tangential_displacements(self, state: ContactState) -> list[np.ndarray]:
+        """Per pair, each node's relative tangential displacement against its virtual node,
+        ``w = t.(u_fine - u_virtual)`` (linear kinematics, as the penetrations)."""
+        x = self.positions(state)
+        out = []
+        for k, pair in enumerate(self.contact_pairs):
+            sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
+            uf = x[pair.fine][pair.nodes] - sf.X[pair.nodes]
+            uc = pair.interp @ (x[pair.coarse][: sc.nc] - sc.X[: sc.nc])
+            out.append(np.einsum("ij,ij->i", uf - uc, self._tangents[k][0]))
+        return out
+
+    def assemble_forces(self, state: ContactState) -> None:
+        """Every body's nodal forces from the pairs' normal and tangential tractions."""
+        for F in state.forces:
+            F[:] = 0.0
+        for k, pair in enumerate(self.contact_pairs):
+            traction = (self.tractions(state, k)[:, None] * pair.normal
+                        + self.shear(state, k)[:, None] * self._tangents[k][0])
+            state.forces[pair.fine] += pair.mass[:, pair.nodes] @ traction
+            state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ traction
+
+    # -- the iteration ---------------------------------------------------------------------------
+
+    def friction_errors(self, state: FrictionState, slips: list[np.ndarray]
+                        ) -> tuple[float, float, int, int]:
+        """The largest tangential compatibility error (a sticking node's slip within the step,
+        or a slipping node's slip against the direction its traction opposes), the largest
+        excess of a tangential traction over its cone (relative to the largest mu q), and the
+        nodes sticking and slipping."""
+        err, excess, stick, slip = 0.0, 0.0, 0, 0
+        scale = max((self.mu * float(self.tractions(state, k).max(initial=0.0))
+                     for k in range(len(self.contact_pairs))), default=0.0)
+        for k, dw in enumerate(slips):
+            q, s = self.tractions(state, k), self.shear(state, k)
+            status = coulomb_status(q, s, self.mu)
+            stick += int((status == 1).sum())
+            slip += int((status == 2).sum())
+            if (status == 1).any():
+                err = max(err, float(np.abs(dw[status == 1]).max()))
+            on = status == 2
+            if on.any():
+                sigma = -np.sign(s[on])
+                err = max(err, float(np.maximum(-sigma * dw[on], 0.0).max()))
+            outside = np.abs(s) - self.mu * np.maximum(q, 0.0)
+            if len(outside) and scale > 0:
+                excess = max(excess, float(outside.max()) / scale)
+            elif np.any(s != 0):
+                excess = np.inf  # a tangential traction without a normal one
+        return err, excess, stick, slip
+
+    def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
+        """Correct the normal and tangential traction values until every pair's normal and
+        tangential compatibility and the Coulomb law hold; then move the anchors (the module
+        docstring)."""
+        cfg = self.settings
+        tol = self.penetration_tolerance
+        self.assemble_forces(state)
+
+        def check(it: int) -> Check:
+            pens = self.penetrations(state)
+            dw = [w - self.anchor(state, k)
+                  for k, w in enumerate(self.tangential_displacements(state))]
+            traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
+            self._check_rind(pens)
+            errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
+            fric_err, excess, stick, slip = self.friction_errors(state, dw)
+            platen_ok = self.platen_met(state)
+            rec = IterationRecord(it, max(pen_err, fric_err), 0.0, contact, tension,
+                                  platen_error=self.platen_reaction(state) - state.platen_force)
+            log.debug("friction: iteration %d, penetration %.3g, tangential %.3g, cone excess "
+                      "%.3g, %d sticking, %d slipping", it, pen_err, fric_err, excess, stick,
+                      slip)
+            converged = (pen_err <= tol and fric_err <= tol and excess <= CONE_TOLERANCE
+                         and tension == 0 and platen_ok)
+            return Check(rec, converged,
+                         lambda: self._sets(state), max(pen_err, fric_err),
+                         lambda: self.pairings(state, pens),
+                         lambda: (f"no convergence in {cfg.max_iterations} iterations "
+                                  f"(penetration {pen_err:.3g}{self.worst_node(errs)}, "
+                                  f"tangential slip error {fric_err:.3g}, {tension} nodes in "
+                                  f"tension)"),
+                         finish=lambda: self._converged(state),
+                         extra=(pens, dw, platen_ok))
+
+        def correct(it: int, c: Check) -> None:
+            pens, dw, platen_ok = c.extra
+            self._correct_frictional(state, pens, dw, it)
+            self.assemble_forces(state)
+
+        return iterate(cfg, check, correct, on_iteration)
+
+    def _sets(self, state: FrictionState) -> list[tuple[str, np.ndarray, np.ndarray]]:
+        """The contact set, the slipping nodes and their directions, for the cycle watch."""
+        out = []
+        for k, pair in enumerate(self.contact_pairs):
+            sf = self.surfaces[pair.fine]
+            status = coulomb_status(self.tractions(state, k), self.shear(state, k), self.mu)
+            nodes = sf.nodes[pair.nodes]
+            out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2),
+                    (sf.body.name, nodes, self.shear(state, k) < 0)]
+        return out
+
+    def _converged(self, state: FrictionState) -> None:
+        """A converged step: accumulate each node's slip and anchor it where it now is."""
+        for k, w in enumerate(self.tangential_displacements(state)):
+            anchor = self.anchor(state, k)
+            on = self.tractions(state, k) > 0
+            self.accumulated_slip(state, k)[on] += np.abs(w - anchor)[on]
+            anchor[:] = w
+
+    def _correct_frictional(self, state: FrictionState, pens: list[np.ndarray],
+                            dw: list[np.ndarray], it: int) -> None:
+        """Release tension, sort the contact nodes into sticking and slipping, then one solve of
+        the normal and tangential conditions of every pair together (module docstring)."""
+        cfg = self.settings
+        tol = self.penetration_tolerance
+        omega = relaxation(cfg, it)
+        if self._full is None:
+            self._full = self._full_flexibility()
+        G, dz_dplaten, dR, offsets = self._full
+        m_all = len(G)
+        jump = np.zeros(m_all)  # known changes of the unknowns (cone, release)
+        q_cols, s_cols, rows, rhs = [], [], [], []
+        slip_tie = []  # (column of q, column of s, -mu sigma) of each slipping node
+        for k, pair in enumerate(self.contact_pairs):
+            n = len(pair.nodes)
+            q, s, p = self.tractions(state, k), self.shear(state, k), pens[k]
+            tension = q < 0
+            change, state.released[pair.fine][pair.nodes] = release_tension(
+                q, tension, state.released[pair.fine][pair.nodes], cfg.release_iterations)
+            q += change
+            contact = ~tension & ((q > 0) | (p > tol))
+            # a node on the cone keeps slipping unless its slip has turned back; a node that
+            # comes into contact having moved along the other surface since the last converged
+            # step slips that way (held where it was, it would be pulled back against its
+            # motion: on a sliding block that tore the node off again, over and over)
+            sigma = -np.sign(s)
+            on_cone = (q > 0) & (np.abs(s) >= (1.0 - CONE_TOLERANCE) * self.mu * q) & (s != 0)
+            entering = contact & (q <= 0) & (np.abs(dw[k]) > tol)
+            sigma[entering] = np.sign(dw[k][entering])
+            slipping = contact & ((on_cone & (sigma * dw[k] >= -tol)) | entering)
+            sticking = contact & ~slipping
+            base = offsets[k]
+            jump[base + n + np.flatnonzero(~contact)] = -s[~contact]  # no q, no s
+            for i in np.flatnonzero(contact):
+                q_cols.append(base + i)
+                rows.append(base + i)
+                rhs.append(omega * p[i])  # close the penetration
+            for i in np.flatnonzero(sticking):
+                s_cols.append(base + n + i)
+                rows.append(base + n + i)
+                rhs.append(-omega * dw[k][i])  # undo the slip within the step
+            for i in np.flatnonzero(slipping):
+                tie = -self.mu * sigma[i]
+                jump[base + n + i] = tie * q[i] - s[i]  # onto the cone
+                slip_tie.append((base + i, base + n + i, tie))
+        self.assemble_forces(state)  # the releases change the forces the platen sees
+        if not q_cols:
+            state.shear.update({k: np.zeros(len(p.nodes))
+                                for k, p in enumerate(self.contact_pairs)})
+            self.assemble_forces(state)
+            if not self.platen_met(state):
+                self._close_gap(state, pens)
+            return
+        cols = np.array(q_cols + s_cols)
+        rows = np.array(rows)
+        Gr = G[rows]
+        A = Gr[:, cols].copy()
+        position = {c: j for j, c in enumerate(cols)}
+        for qc, sc, tie in slip_tie:  # s follows q on the cone
+            A[:, position[qc]] += tie * Gr[:, sc]
+        b = np.array(rhs) - Gr @ jump
+        bordered = self.platen_body is not None and state.platen_force != 0.0
+        if bordered:
+            body = self.surfaces[self.platen_body].body
+            row = dR[cols].copy()
+            for qc, sc, tie in slip_tie:
+                row[position[qc]] += tie * dR[sc]
+            extra = state.platen_force - self.platen_reaction(state) - dR @ jump
+            # the rows' change per unit platen motion: penetration reduction (normal rows),
+            # relative tangential displacement (tangential rows)
+            column = np.where(self._normal_rows(rows, offsets), -dz_dplaten[rows],
+                              dz_dplaten[rows])
+            x = np.linalg.solve(bordered_matrix(A, column, row, body.platen_stiffness),
+                                np.concatenate([b, [extra]]))
+            x, dplaten = x[:-1], float(x[-1])
+        else:
+            x, dplaten = np.linalg.solve(A, b), 0.0
+        delta = jump.copy()
+        delta[cols] += x
+        for qc, sc, tie in slip_tie:
+            delta[sc] += tie * x[position[qc]]
+        for k, pair in enumerate(self.contact_pairs):
+            n, base = len(pair.nodes), offsets[k]
+            self.tractions(state, k)[:] += delta[base:base + n]
+            self.shear(state, k)[:] += delta[base + n:base + 2 * n]
+        state.platen_displacement += dplaten
+
+    def _normal_rows(self, rows: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+        """Which of the unknowns' ``rows`` are normal ones (the first n of each pair's 2n)."""
+        k = np.searchsorted(offsets, rows, side="right") - 1
+        n = (offsets[k + 1] - offsets[k]) // 2
+        return rows - offsets[k] < n
+
+
+__all__ = ["CONE_TOLERANCE", "FrictionalPairedContact", "coulomb_status", "tangents"]
