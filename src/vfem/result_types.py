@@ -47,6 +47,22 @@ class BodyStepResult:
     reactions: dict[str, tuple[float, float]] = field(default_factory=dict)
     #: (2,) resultant (x, y) of the body's applied loads (its tractions) at the step's load factor
     applied_load: np.ndarray | None = None
+    # -- with friction (vfem.contact.friction; None without): at the nodes that carry a contact
+    # pair's compatibility (where its traction values live), zero at the others
+    #: (npoints, 2) the tangential traction on the body (x, y), the part of the pair's traction
+    #: field along the contact surface
+    contact_shear: np.ndarray | None = None
+    #: (npoints,) the relative tangential displacement against the virtual node in this step
+    #: (signed along the pair's tangent, the opposing surface's outward normal turned by +90°)
+    slip_increment: np.ndarray | None = None
+    #: (npoints,) the slip accumulated over the converged steps so far (length)
+    accumulated_slip: np.ndarray | None = None
+    #: (npoints,) 0 free, 1 sticking, 2 slipping; -1 at the nodes that carry no pair's
+    #: compatibility (the other side of a pair reads the traction field its partner defines)
+    friction_status: np.ndarray | None = None
+    #: (npoints,) the frictional work dissipated in this step at the node: minus its slip
+    #: increment times its tangential nodal force (>= 0 where it slips, 0 where it sticks)
+    frictional_work: np.ndarray | None = None
 
     def __post_init__(self):
         if self.contact_traction is None:

@@ -100,21 +100,27 @@ class FrictionState(TractionState):
     traction values, per contact pair (its index) at its compatibility-side nodes the
     tangential traction values (``shear``), the relative tangential displacement against the
     virtual node at the last converged step (``anchor``: a node that sticks keeps it within the
-    step) and the slip accumulated since the start (``slip``). All three are path-dependent
-    history: saved in checkpoints and restored exactly when a step is cut."""
+    step), the slip accumulated since the start (``slip``) and the penetration at the last
+    converged step (``penetration``: where a node that comes into contact within a step first
+    touched). All are path-dependent history: saved in checkpoints and restored exactly when a
+    step is cut."""
 
     shear: dict[int, np.ndarray] = field(default_factory=dict)
     anchor: dict[int, np.ndarray] = field(default_factory=dict)
     slip: dict[int, np.ndarray] = field(default_factory=dict)
+    penetration: dict[int, np.ndarray] = field(default_factory=dict)
+
+    #: the history arrays, by their names in :meth:`unknowns`
+    HISTORY = ("shear", "anchor", "slip", "penetration")
 
     def unknowns(self) -> dict[str, np.ndarray]:
         return {**super().unknowns(),
-                **{f"{name}_{k}": v for name in ("shear", "anchor", "slip")
+                **{f"{name}_{k}": v for name in self.HISTORY
                    for k, v in getattr(self, name).items()}}
 
     def with_unknowns(self, arrays: dict[str, np.ndarray]) -> FrictionState:
         super().with_unknowns(arrays)
-        for name in ("shear", "anchor", "slip"):
+        for name in self.HISTORY:
             setattr(self, name, {int(k.removeprefix(f"{name}_")): v for k, v in arrays.items()
                                  if k.startswith(f"{name}_")})
         return self

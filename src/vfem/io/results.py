@@ -11,7 +11,10 @@ nominal traction at the node: in the paired variant its unknowns q on the compat
 read at the other side's nodes; elsewhere as ``contact_pressure``), ``contact_status``
 (1 in contact, 0 free), ``penetration`` (> 0 overlapping), ``reaction`` (3 components, z = 0:
 the nodal force the supports, prescribed displacements and platen apply to the body, zero on
-unconstrained dofs; :attr:`vfem.result_types.BodyStepResult.reaction`). Cell fields:
+unconstrained dofs; :attr:`vfem.result_types.BodyStepResult.reaction`); with friction also
+``contact_shear`` (3 components, z = 0: the tangential traction), ``slip_increment``,
+``accumulated_slip``, ``friction_status`` (0 free, 1 stick, 2 slip, -1 on nodes that carry no
+pair's compatibility) and ``frictional_work`` (:mod:`vfem.contact.friction`). Cell fields:
 ``stress_xx``, ``stress_yy``, ``stress_xy``, ``stress_zz``, ``von_mises`` (element averages).
 Quadratic elements are written as VTK's 6-node triangles and 9-node quadrilaterals, with the
 fields at every node.
@@ -22,8 +25,9 @@ x, y, ux, uy, pressure, gap, status``: ``node`` the point number in the body (th
 index), ``x, y`` its undeformed coordinates, ``ux, uy`` its displacement, ``pressure`` the
 nominal contact pressure (as ``contact_pressure``), ``gap`` = -``penetration`` (negative:
 overlapping; 0 where the contact algorithm measured none, e.g. the coarse side of a paired
-contact), ``status`` ``contact`` or ``free``. Numbers are written with 17 significant digits
-(round-trip exact).
+contact), ``status`` ``contact`` or ``free``; with friction then ``shear_x, shear_y, slip_increment,
+accumulated_slip, friction`` (``stick``, ``slip``, ``free``, or empty on nodes that carry no
+pair's compatibility). Numbers are written with 17 significant digits (round-trip exact).
 
 ``reactions.csv``: one row per converged step, body and boundary carrying a support, a prescribed
 displacement or a platen, columns ``step, load_factor, body, boundary, Rx, Ry``: the total force
@@ -58,7 +62,7 @@ import numpy as np
 from ..bodies.stresses import stress as body_stress
 from ..contact.surface import ContactSurface
 from ..errors import InputError
-from ..result_types import phase_table
+from ..result_types import BodyStepResult, phase_table
 from ..solver import Analysis, AnalysisResult, Model, StepResult
 from .files import (  # noqa: F401 (write_summary: importers)
     _atomic_write,
@@ -75,6 +79,11 @@ log = logging.getLogger(__name__)
 _CELL_FIELD = {"sxx": "stress_xx", "syy": "stress_yy", "sxy": "stress_xy", "szz": "stress_zz"}
 CONTACT_COLUMNS = ("step", "load_factor", "body", "node", "x", "y", "ux", "uy", "pressure",
                    "gap", "status")
+#: contact.csv's further columns under friction (``contact.friction`` > 0)
+FRICTION_COLUMNS = ("shear_x", "shear_y", "slip_increment", "accumulated_slip", "friction")
+#: contact.csv's ``friction`` column: BodyStepResult.friction_status by name (empty where -1:
+#: a node that carries no pair's compatibility)
+FRICTION_STATUS = ("free", "stick", "slip")
 REACTION_COLUMNS = ("step", "load_factor", "body", "boundary", "Rx", "Ry")
 
 
@@ -100,6 +109,8 @@ class ResultsWriter:
                                  f"{', '.join(map(repr, missing))}")
         self.contact_rows: list[list[str]] = []
         self.reaction_rows: list[list[str]] = []
+        #: contact.csv's columns: the friction's too when the model has friction
+        self.friction = float(getattr(model.contact, "friction", 0.0)) > 0
 
     def restore(self, steps: list[StepResult]) -> None:
         """Take up the series of an earlier run whose ``steps`` are already on disk (their
@@ -139,6 +150,13 @@ class ResultsWriter:
                             "reaction": np.column_stack([reaction, np.zeros(npts)])},
                 cell_data={_CELL_FIELD.get(k, k): [v] for k, v in stress.items()},
             )
+            if r.contact_shear is not None:  # friction's fields (vfem.contact.friction)
+                m.point_data.update({
+                    "contact_shear": np.column_stack([r.contact_shear, np.zeros(npts)]),
+                    "slip_increment": r.slip_increment,
+                    "accumulated_slip": r.accumulated_slip,
+                    "friction_status": np.asarray(r.friction_status, dtype=np.int32),
+                    "frictional_work": r.frictional_work})
             with vtu_compression():
                 _atomic_write(self.out / name,
                               lambda p, m=m: meshio.write(p, m, file_format="vtu"))
@@ -165,7 +183,18 @@ class ResultsWriter:
                     [str(step.step), _num(step.load_factor), body.name, str(int(n)),
                      _num(X[k, 0]), _num(X[k, 1]), _num(u[k, 0]), _num(u[k, 1]),
                      _num(r.contact_pressure[n]), _num(gap[k]),
-                     "contact" if r.contact_status[n] > 0 else "free"])
+                     "contact" if r.contact_status[n] > 0 else "free"]
+                    + (self._friction_row(r, n) if self.friction else []))
+
+    @staticmethod
+    def _friction_row(r: BodyStepResult, n: int) -> list[str]:
+        """A contact.csv row's friction columns (:data:`FRICTION_COLUMNS`) for point ``n``."""
+        if r.contact_shear is None:  # a step written without them (an older checkpoint)
+            return ["", "", "", "", ""]
+        status = int(r.friction_status[n])
+        return [_num(r.contact_shear[n, 0]), _num(r.contact_shear[n, 1]),
+                _num(r.slip_increment[n]), _num(r.accumulated_slip[n]),
+                FRICTION_STATUS[status] if status >= 0 else ""]
 
     def add_reaction_rows(self, step: StepResult) -> None:
         """Keep the rows of ``step``'s per-boundary support reactions for ``reactions.csv``."""
@@ -180,7 +209,9 @@ class ResultsWriter:
                                            TOTAL_ROW, _num(rx), _num(ry)])
 
     def write_contact_csv(self) -> None:
-        _write_csv(self.out / "contact.csv", CONTACT_COLUMNS, self.contact_rows)
+        _write_csv(self.out / "contact.csv",
+                   CONTACT_COLUMNS + (FRICTION_COLUMNS if self.friction else ()),
+                   self.contact_rows)
 
     def write_reactions_csv(self) -> None:
         _write_csv(self.out / "reactions.csv", REACTION_COLUMNS, self.reaction_rows)
@@ -362,7 +393,15 @@ def step_record(step: StepResult) -> dict:
             "stopped_at_fixed_point": step.fixed_point,
             "max_penetration": last.max_penetration if last else 0.0,
             "max_equilibrium_error": last.max_equilibrium_error if last else 0.0,
-            "invariants": step.invariants, **force_record(step)}
+            "invariants": step.invariants, **force_record(step), **friction_record(step)}
+
+
+def friction_record(step: StepResult) -> dict:
+    """With friction: ``frictional_work``, the work the friction dissipated in the step (per
+    unit thickness; :attr:`BodyStepResult.frictional_work` summed over every body); nothing
+    without friction (the summaries of frictionless runs stay as they were)."""
+    work = [r.frictional_work for r in step.bodies.values() if r.frictional_work is not None]
+    return {"frictional_work": float(sum(w.sum() for w in work))} if work else {}
 
 
 def total(force: np.ndarray) -> list[float]:

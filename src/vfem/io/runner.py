@@ -79,6 +79,8 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
         "config": to_data(config),
         "timings": result.timings,
         "linear_solver": result.backend,
+        **({"frictional_work_total": float(sum(x["frictional_work"] for x in steps))}
+           if steps and "frictional_work" in steps[0] else {}),
     }
 
 
@@ -225,5 +227,10 @@ def report(s: dict, out: Path) -> list[str]:
     for line in (balance_line(s["steps"]), invariants_line(s["steps"])):
         if line:
             lines.append("  " + line)
+    if "frictional_work_total" in s:
+        mu = (s.get("config") or {}).get("contact", {}).get("friction")
+        lines.append(f"  friction: mu = {mu:g}, work dissipated {s['frictional_work_total']:.4g} "
+                     f"over the run (contact_shear, slip and friction status in contact.csv and "
+                     f"the VTU files)")
     return lines
 

@@ -1,0 +1,71 @@
+"""Cattaneo-Mindlin partial slip, measured (issue 20; docs/method.md §11 quotes this table).
+
+    python benchmarks/cattaneo.py                 # 12 and 17 contact facets across a
+    python benchmarks/cattaneo.py 24 34 48 68     # and finer pairs (upper, lower)
+
+Two elastically similar cylinders (``vfem.examples.cattaneo``) pressed by P, then sheared with
+P held. Per step of the shear: Q/(mu P); the stick zone's half-width c of the theory
+(a sqrt(1 - Q/(mu P))) and the outermost sticking node, in contact facets; the shear traction
+values against Cattaneo-Mindlin's, largest error over |x| < 0.8 a and RMS over |x| < a, in % of
+mu p0. Then the Hertz peak of the normal traction and the full slide's Q/(mu P).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+
+from vfem.examples import cattaneo
+
+
+def shear_theory(p: cattaneo.Parameters, x: np.ndarray, tangential: float) -> np.ndarray:
+    """Cattaneo-Mindlin's shear traction magnitude at ``x`` for the tangential force."""
+    th = cattaneo.theory(p)
+    a, mu_p0 = th["a"], p.friction * th["p0"]
+    c = cattaneo.stick_half_width(p, tangential)
+    out = mu_p0 * np.sqrt(np.clip(1 - (x / a) ** 2, 0, None))
+    if c > 0:
+        out -= np.where(np.abs(x) < c,
+                        mu_p0 * (c / a) * np.sqrt(np.clip(1 - (x / c) ** 2, 0, None)), 0.0)
+    return out
+
+
+def main(pairs: list[tuple[int, int]]) -> None:
+    for upper, lower in pairs:
+        p = cattaneo.Parameters(facets_upper=upper, facets_lower=lower)
+        t0 = time.perf_counter()
+        result, readings = cattaneo.run(p)
+        seconds = time.perf_counter() - t0
+        th = cattaneo.theory(p)
+        a, p0 = th["a"], th["p0"]
+        x = readings[-1].x
+        h = np.diff(np.sort(x[np.abs(x) < a])).max()
+        dofs = sum(b.ndofs for b in result.model.bodies)
+        print(f"\n{upper} / {lower} contact facets across a: {dofs} dofs, {seconds:.1f} s, "
+              f"converged {result.converged}, "
+              f"{sum(s.iterations for s in result.steps)} iterations in {len(result.steps)} steps")
+        print(f"{'Q/(mu P)':>9} {'c theory/a':>10} {'stick node/a':>12} {'(c - it)/h':>10} "
+              f"{'shear max %':>11} {'shear RMS %':>11}")
+        for r in readings:
+            if r.load_factor <= 0.5:
+                continue
+            ratio = abs(r.tangential) / (p.friction * r.normal)
+            c = cattaneo.stick_half_width(p, r.tangential)
+            last = r.last_sticking(p.friction)
+            err = (np.abs(r.s) - shear_theory(p, r.x, r.tangential)) / (p.friction * p0)
+            inner, inside = np.abs(r.x) < 0.8 * a, np.abs(r.x) < a
+            print(f"{ratio:9.4f} {c / a:10.4f} {last / a:12.4f} {(c - last) / h:10.2f} "
+                  f"{100 * np.abs(err[inner]).max():11.2f} "
+                  f"{100 * math.sqrt(np.mean(err[inside] ** 2)):11.2f}")
+        pressed = next(r for r in readings if r.load_factor == 0.5)
+        print(f"Hertz: p_max/p0 - 1 = {100 * (pressed.q.max() / p0 - 1):+.3f} %; "
+              f"full slide Q/(mu P) - 1 = "
+              f"{abs(readings[-1].tangential) / (p.friction * readings[-1].normal) - 1:+.1e}")
+
+
+if __name__ == "__main__":
+    numbers = [int(v) for v in sys.argv[1:]] or [12, 17]
+    main(list(zip(numbers[::2], numbers[1::2])))
