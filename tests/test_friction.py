@@ -325,3 +325,94 @@ def test_friction_output_and_a_resumed_run_equal_to_an_uninterrupted_one(tmp_pat
     assert "frictional_work" not in plain["steps"][0]
     header = (tmp_path / "plain" / "contact.csv").read_text().splitlines()[0]
     assert header == "step,load_factor,body,node,x,y,ux,uy,pressure,gap,status"
+
+
+# -- the friction patch test ---------------------------------------------------------------------
+
+PATCH = """
+name = "friction patch {n_lower}/{n_upper}"
+[contact]
+friction = {mu}
+[[bodies]]
+name = "lower"
+contact_boundaries = ["top"]
+[bodies.mesh]
+shape = "rectangle"
+x0 = 0.0
+y0 = -1.0
+width = 1.0
+height = 1.0
+nx = {n_lower}
+ny = {n_lower}
+[bodies.material]
+youngs_modulus = 1.0e6
+poissons_ratio = 0.0
+[[bodies.supports]]
+boundary = "bottom"
+{sides}
+[[bodies]]
+name = "upper"
+contact_boundaries = ["bottom"]
+[bodies.mesh]
+shape = "rectangle"
+x0 = 0.0
+y0 = 0.0
+width = 1.0
+height = 1.0
+nx = {n_upper}
+ny = {n_upper}
+[bodies.material]
+youngs_modulus = 1.0e6
+poissons_ratio = 0.0
+[[bodies.prescribed]]
+boundary = "top"
+component = "x"
+value = {shift}
+amplitude = [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]
+[bodies.platen]
+boundary = "top"
+component = "y"
+force = {pressure}
+amplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]
+{sides}
+[steps]
+load_factors = [0.5, 1.0]
+"""
+
+SIDES = """[[bodies.tractions]]
+boundary = "left"
+value = [0.0, {minus}]
+amplitude = [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]
+[[bodies.tractions]]
+boundary = "right"
+value = [0.0, {plus}]
+amplitude = [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]"""
+
+
+@pytest.mark.parametrize("n_lower, n_upper", [(4, 7), (7, 4), (2, 10), (10, 2), (1, 5), (5, 1)])
+def test_friction_patch_test_uniform_shear_sticking_and_slipping(n_lower, n_upper):
+    """Two unit blocks (nu = 0, non-matching interface meshes) pressed by a platen with the
+    force p (a uniform pressure), then sheared by moving the upper one's top sideways, with the
+    sides loaded by the shear tau the
+    uniform state has (so that it is the exact answer). Sticking (tau = mu p / 2: the motion
+    2 tau / G, G = E / 2, over the two blocks' heights): every interface node sticks and the
+    shear is uniform; slipping (the motion 3 times that for tau = mu p, sides at mu p): every
+    node slips and the shear is mu p. Both to 1e-8 of mu p, the normal pressure uniform too."""
+    mu, p, E = 0.3, 100.0, 1.0e6
+    for tau, shift, expected in ((0.5 * mu * p, 2 * (0.5 * mu * p) / (E / 2), 1),
+                                 (mu * p, 3 * 2 * (mu * p) / (E / 2), 2)):
+        sides = SIDES.format(minus=-tau, plus=tau)
+        text = PATCH.format(n_lower=n_lower, n_upper=n_upper, mu=mu, shift=shift,
+                            pressure=-p, sides=sides)
+        result = Analysis(loads(text).build()).run()
+        assert result.converged, result.message
+        last = result.steps[-1]
+        shears = []
+        for r in last.bodies.values():
+            carries = r.friction_status > 0
+            if carries.any():
+                assert np.all(r.friction_status[carries] == expected)
+                shears.append(np.abs(r.contact_shear[carries, 0]))
+                np.testing.assert_allclose(r.contact_traction[carries], p, rtol=1e-8)
+        shear = np.concatenate(shears)
+        np.testing.assert_allclose(shear, tau, rtol=0, atol=1e-8 * mu * p)

@@ -218,7 +218,7 @@ class FrictionalPairedContact(PairedContact):
 
         def correct(it: int, c: Check) -> None:
             pens, dw, platen_ok = c.extra
-            self._correct_frictional(state, pens, dw, it)
+            self._correct_frictional(state, pens, dw, it, platen_ok)
             self.assemble_forces(state)
 
         return iterate(cfg, check, correct, on_iteration)
@@ -276,7 +276,7 @@ class FrictionalPairedContact(PairedContact):
         return out
 
     def _correct_frictional(self, state: FrictionState, pens: list[np.ndarray],
-                            dw: list[np.ndarray], it: int) -> None:
+                            dw: list[np.ndarray], it: int, platen_ok: bool = True) -> None:
         """Release tension, sort the contact nodes into sticking and slipping, then one solve of
         the normal and tangential conditions of every pair together (module docstring)."""
         cfg = self.settings
@@ -292,6 +292,11 @@ class FrictionalPairedContact(PairedContact):
         jump = np.zeros(m_all)  # known changes of the unknowns (cone, release)
         q_cols, s_cols, rows, rhs = [], [], [], []
         slip_tie = []  # (column of q, column of s, -mu sigma) of each slipping node
+        # a platen short of its force with no node touching: hold the nodes touching within
+        # the tolerance there (as without friction, PairedContact._correct)
+        touching = not platen_ok and not any(
+            ((self.tractions(state, k) > 0) | (pens[k] > tol)).any()
+            for k in range(len(self.contact_pairs)))
         for k, pair in enumerate(self.contact_pairs):
             n = len(pair.nodes)
             q, s, p = self.tractions(state, k), self.shear(state, k), pens[k]
@@ -300,7 +305,7 @@ class FrictionalPairedContact(PairedContact):
                 q, tension, state.released[pair.fine][pair.nodes], cfg.release_iterations)
             q += change
             self._torn[k] |= tension
-            contact = ~tension & ((q > 0) | (p > tol))
+            contact = ~tension & ((q > 0) | (p > (-tol if touching else tol)))
             base = offsets[k]
             slip_k = dw[k].copy()
             # A node that comes into contact in the prediction (the first iteration of a step:
