@@ -20,6 +20,7 @@ from vfem.contact.settings import ContactSettings
 from vfem.contact.state import FrictionState
 from vfem.errors import InputError
 from vfem.io.input import loads
+from vfem.io.results import contact_work
 from vfem.solver import Analysis, Model
 
 BLOCKS = """
@@ -124,7 +125,7 @@ def test_a_sliding_block_carries_mu_times_its_normal_force_both_ways():
         assert all(s.invariants.get("force_balance", 0.0) < 1e-12 for s in result.steps)
         # sliding at a constant force, the friction dissipates that force times the shift's
         # increment (0.025 per step), all of it slip
-        work = [sum(r.frictional_work.sum() for r in s.bodies.values()) for s in result.steps]
+        work = contact_work(result.steps)
         np.testing.assert_allclose(work[-3:], abs(last[0]) * 0.025, rtol=1e-9)
 
 
@@ -275,6 +276,47 @@ def test_cattaneo_mindlin_partial_slip_of_similar_cylinders():
     assert abs(abs(last.tangential) / (p.friction * last.normal) - 1) < 1e-4  # sliding
 
 
+def test_mindlin_deresiewicz_unloading_and_the_hysteresis_loop():
+    """The Cattaneo model sheared to Q* (0.67 mu P), back to -Q*, forward to Q* again
+    (``cycle``): while Q falls from Q*, the contact slips back from its edges and sticks over
+    |x| < c' = a sqrt(1 - (Q* - Q)/(2 mu P)) (Mindlin and Deresiewicz 1953), the outermost
+    sticking node within 1.25 facets inside c' (measured: at most 1.15); the loop closes (Q
+    back at Q* where the motion is, to 1e-9) and is symmetric (-Q* at the reversal); the work
+    the contact forces took from the bodies over the cycle is the loop's area, within 2.5 %
+    with 10 steps per branch and 1.0 % with 20 (measured; 0.46 % with 40)."""
+    from vfem.bodies import multiplier
+    from vfem.examples import cattaneo
+
+    errors = {}
+    for steps in (10, 20):
+        p = cattaneo.Parameters(cycle=True, shift=5e-4, shear_steps=steps)
+        result, readings = cattaneo.run(p)
+        assert result.converged, result.message
+        a = cattaneo.theory(p)["a"]
+        x = readings[-1].x
+        h = np.diff(np.sort(x[np.abs(x) < a])).max()
+        at = {round(r.load_factor, 9): r for r in readings}
+        peak = at[1.0].tangential
+        assert 0.6 < peak / (p.friction * p.force) < 0.7
+        assert at[1.5].tangential == pytest.approx(-peak, rel=1e-9)
+        assert at[2.0].tangential == pytest.approx(peak, rel=1e-9)
+        for r in readings:
+            if 1.0 < r.load_factor <= 1.5:
+                c = cattaneo.reverse_stick_half_width(p, peak, r.tangential)
+                last = r.last_sticking(p.friction)
+                assert c - 1.25 * h <= last <= c, (r.load_factor, last, c, h)
+        amplitude = result.model.bodies[0].prescribed[0].amplitude
+        factors = np.array([s.load_factor for s in result.steps])
+        shift = p.shift * np.array([multiplier(amplitude, f) for f in factors])
+        force = np.array([s.bodies["lower"].contact_force.sum(axis=0)[0] for s in result.steps])
+        start = int(np.argmin(np.abs(factors - 1.0)))
+        area = float(np.sum(0.5 * (force[start + 1:] + force[start:-1]) * np.diff(shift[start:])))
+        dissipated = sum(contact_work(result.steps)[start + 1:])
+        assert area > 0 and dissipated > 0
+        errors[steps] = abs(dissipated / area - 1)
+    assert errors[10] < 0.03 and errors[20] < 0.015 and errors[20] < errors[10]
+
+
 # -- output and resuming ------------------------------------------------------------------------
 
 def test_friction_output_and_a_resumed_run_equal_to_an_uninterrupted_one(tmp_path):
@@ -296,7 +338,7 @@ def test_friction_output_and_a_resumed_run_equal_to_an_uninterrupted_one(tmp_pat
     assert {"shear_x", "slip_increment", "accumulated_slip", "friction"} <= set(rows[0])
     assert {r["friction"] for r in rows} >= {"stick", "slip", ""}
     vtu = meshio.read(tmp_path / "whole" / "upper_step0006.vtu")
-    assert {"contact_shear", "friction_status", "frictional_work"} <= set(vtu.point_data)
+    assert {"contact_shear", "friction_status", "accumulated_slip"} <= set(vtu.point_data)
     saved = json.loads((tmp_path / "whole" / "summary.json").read_text())
     assert saved["frictional_work_total"] == pytest.approx(
         sum(x["frictional_work"] for x in saved["steps"]), rel=1e-12)

@@ -60,9 +60,6 @@ class BodyStepResult:
     #: (npoints,) 0 free, 1 sticking, 2 slipping; -1 at the nodes that carry no pair's
     #: compatibility (the other side of a pair reads the traction field its partner defines)
     friction_status: np.ndarray | None = None
-    #: (npoints,) the frictional work dissipated in this step at the node: minus its slip
-    #: increment times its tangential nodal force (>= 0 where it slips, 0 where it sticks)
-    frictional_work: np.ndarray | None = None
 
     def __post_init__(self):
         if self.contact_traction is None:

@@ -251,7 +251,7 @@ class FrictionalPairedContact(PairedContact):
     def fields(self, state: ContactState, result: SolveResult) -> dict:
         """The frictionless fields, and the friction's at each pair's compatibility-side nodes
         (:class:`~vfem.result_types.BodyStepResult`: tangential traction, slip increment,
-        accumulated slip, stick or slip, frictional work)."""
+        accumulated slip, stick or slip)."""
         out = super().fields(state, result)
         increments = getattr(self, "_increments", None) or [
             np.zeros(len(p.nodes)) for p in self.contact_pairs]
@@ -259,7 +259,7 @@ class FrictionalPairedContact(PairedContact):
             r = out[s.body.name]
             n = s.body.npoints
             r.contact_shear, r.slip_increment = np.zeros((n, s.dim)), np.zeros(n)
-            r.accumulated_slip, r.frictional_work = np.zeros(n), np.zeros(n)
+            r.accumulated_slip = np.zeros(n)
             r.friction_status = np.full(n, -1)  # not a compatibility-side node of a pair
         for k, pair in enumerate(self.contact_pairs):
             sf = self.surfaces[pair.fine]
@@ -270,9 +270,6 @@ class FrictionalPairedContact(PairedContact):
             r.slip_increment[points] = increments[k]
             r.accumulated_slip[points] = self.accumulated_slip(state, k)
             r.friction_status[points] = coulomb_status(self.tractions(state, k), shear, self.mu)
-            # the tangential nodal forces of the traction field (N s along t), against the slip
-            nodal = pair.mass[np.ix_(pair.nodes, pair.nodes)] @ shear
-            r.frictional_work[points] = -increments[k] * nodal
         return out
 
     def _correct_frictional(self, state: FrictionState, pens: list[np.ndarray],

@@ -41,6 +41,9 @@ class Parameters:
     poissons_ratio: float = 0.2
     press_steps: int = 5  # load factors 0 to 0.5: P applied
     shear_steps: int = 10  # load factors 0.5 to 1: the shift applied, P held
+    # then (cycle) the shift back to -shift over load factors 1 to 1.5 and forward to +shift
+    # over 1.5 to 2, shear_steps each: Mindlin and Deresiewicz's unloading and the loop
+    cycle: bool = False
 
 
 def theory(p: Parameters) -> dict[str, float]:
@@ -53,6 +56,13 @@ def theory(p: Parameters) -> dict[str, float]:
 def stick_half_width(p: Parameters, tangential: float) -> float:
     """Cattaneo-Mindlin's c for the tangential force ``tangential`` (0 at full slip)."""
     return theory(p)["a"] * math.sqrt(max(0.0, 1 - abs(tangential) / (p.friction * p.force)))
+
+
+def reverse_stick_half_width(p: Parameters, peak: float, tangential: float) -> float:
+    """Mindlin and Deresiewicz's c' of the stick zone while the tangential force falls from
+    ``peak`` (Q*) to ``tangential``: the contact slips back over c' < |x| < a."""
+    drop = abs(peak - tangential)
+    return theory(p)["a"] * math.sqrt(max(0.0, 1 - drop / (2 * p.friction * p.force)))
 
 
 def half_disk(p: Parameters, facets: int, flip: bool) -> MeshTri:
@@ -84,15 +94,16 @@ def build(p: Parameters) -> Model:
     material = LinearElastic(p.youngs_modulus, p.poissons_ratio)
     up, down = half_disk(p, p.facets_upper, False), half_disk(p, p.facets_lower, True)
     top, bottom = up.p[1].max(), down.p[1].min()
-    press = ((0.0, 0.0), (0.5, 1.0), (1.0, 1.0))
-    shear = ((0.0, 0.0), (0.5, 0.0), (1.0, 1.0))
+    press = ((0.0, 0.0), (0.5, 1.0), (2.0, 1.0))
+    shear = ((0.0, 0.0), (0.5, 0.0), (1.0, 1.0)) + (((1.5, -1.0), (2.0, 1.0)) if p.cycle else ())
     upper = Body("upper", up.with_boundaries({"top": lambda x: x[1] > top - 1e-9}), material,
                  prescribed=(PrescribedDisplacement("top", "x", p.shift, amplitude=shear),),
                  platen=Platen("top", "y", -p.force, amplitude=press))
     lower = Body("lower", down.with_boundaries({"bottom": lambda x: x[1] < bottom + 1e-9}),
                  material, supports=(Support("bottom", ("x", "y")),))
+    branches = 3 if p.cycle else 1
     factors = ([0.5 * (k + 1) / p.press_steps for k in range(p.press_steps)]
-               + [0.5 + 0.5 * (k + 1) / p.shear_steps for k in range(p.shear_steps)])
+               + [0.5 + 0.5 * (k + 1) / p.shear_steps for k in range(branches * p.shear_steps)])
     return Model("cattaneo", [upper, lower], ContactSettings(friction=p.friction), factors)
 
 

@@ -20,6 +20,7 @@ from ..solver import AnalysisResult, Model
 from .files import forget_vtus
 from .input import to_data
 from .results import (
+    contact_work,
     finish_summary,
     force_record,
     run_writing,
@@ -65,6 +66,9 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
     steps = []
     for s in result.steps:
         steps.append({**step_record(s), "platen_displacement": s.platen_displacement})
+    if config.contact.friction > 0:  # the work the friction dissipated, per step
+        for x, work in zip(steps, contact_work(result.steps), strict=True):
+            x["frictional_work"] = work
     return {
         "model": config.name,
         "input": source,
