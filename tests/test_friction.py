@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
 from vfem.contact.formulation import formulation_class
 from vfem.contact.friction import FrictionalPairedContact, coulomb_status, tangents
 from vfem.contact.paired import PairedContact
@@ -317,6 +318,53 @@ def test_mindlin_deresiewicz_unloading_and_the_hysteresis_loop():
     assert errors[10] < 0.03 and errors[20] < 0.015 and errors[20] < errors[10]
 
 
+def test_a_step_cut_in_a_frictional_history_starts_again_from_the_same_bits():
+    """A step that fails after its iteration has changed the tractions, anchors and slip (a
+    contact solve that ends in an AnalysisError: here one is made to fail once, on the fourth
+    step, after it ran) is cut, and its halves start from the last converged state exactly:
+    every array of the friction's history bit for bit as it was before the failed attempt;
+    the answer is then bit for bit that of a run scheduled through the same load factors."""
+    from vfem.errors import ContactNotConverged
+
+    def run():
+        model = blocks(0.3, 0.02)
+        model.contact = dataclasses.replace(model.contact, max_step_cuts=3)
+        analysis = Analysis(model)
+        analysis.setup()
+        real = analysis.contact.solve
+        seen = []
+
+        def solve(state, on_iteration=None):
+            seen.append((state.load_factor, {k: v.copy() for k, v in state.unknowns().items()},
+                         [f.copy() for f in state.forces]))
+            result = real(state, on_iteration)
+            if len(seen) == 4:
+                raise ContactNotConverged("made to fail once, after it ran")
+            return result
+
+        analysis.contact.solve = solve
+        return analysis.run(), seen
+
+    result, seen = run()
+    assert result.converged and result.steps[3].cuts == 1
+    (lf_failed, before, forces), (lf_retry, again, forces_again) = seen[3], seen[4]
+    assert lf_retry < lf_failed and before.keys() == again.keys()
+    assert any(name.startswith("anchor_") for name in before)
+    for name in before:
+        np.testing.assert_array_equal(again[name], before[name], err_msg=name)
+    for a, b in zip(forces, forces_again, strict=True):
+        np.testing.assert_array_equal(a, b)
+    # the same answer, bit for bit, as a run scheduled through the load factors it took
+    model = blocks(0.3, 0.02)
+    model.load_factors = [s.load_factor for s in result.steps]
+    clean = Analysis(model).run()
+    assert [s.load_factor for s in clean.steps] == model.load_factors
+    for a, b in zip(result.steps, clean.steps, strict=True):
+        for name in ("lower", "upper"):
+            np.testing.assert_array_equal(a.bodies[name].contact_force,
+                                          b.bodies[name].contact_force)
+
+
 # -- output and resuming ------------------------------------------------------------------------
 
 def test_friction_output_and_a_resumed_run_equal_to_an_uninterrupted_one(tmp_path):
@@ -458,3 +506,61 @@ def test_friction_patch_test_uniform_shear_sticking_and_slipping(n_lower, n_uppe
                 np.testing.assert_allclose(r.contact_traction[carries], p, rtol=1e-8)
         shear = np.concatenate(shears)
         np.testing.assert_allclose(shear, tau, rtol=0, atol=1e-8 * mu * p)
+
+
+# -- the inclined block (NAFEMS) -------------------------------------------------------------------
+
+def inclined(mu: float, push: float) -> Model:
+    """A block 0.5 x 0.25 on a plane inclined at tan(alpha) = 0.1 (both meshes sheared so, their
+    interface non-matching: 9 against 20 facets over the block's width), pressed by a platen
+    with the force G = 10, then pushed uphill (+x) by moving its left side by ``push``."""
+    from skfem import MeshQuad
+
+    from vfem.materials import LinearElastic
+
+    slope = 0.1
+
+    def sheared(x0, x1, y0, y1, nx, ny):
+        m = MeshQuad.init_tensor(np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1))
+        p = m.p.copy()
+        p[1] += slope * p[0]
+        return MeshQuad(p, m.t)
+
+    def level(y):  # the height above the inclined plane through the origin
+        return lambda x: x[1] - slope * x[0] - y
+
+    lower = sheared(-1.0, 1.0, -0.5, 0.0, 80, 10).with_boundaries({
+        "top": lambda x: np.abs(level(0.0)(x)) < 1e-9,
+        "bottom": lambda x: np.abs(level(-0.5)(x)) < 1e-9})
+    upper = sheared(-0.25, 0.25, 0.0, 0.25, 9, 5).with_boundaries({
+        "bottom": lambda x: np.abs(level(0.0)(x)) < 1e-9,
+        "top": lambda x: np.abs(level(0.25)(x)) < 1e-9,
+        "left": lambda x: x[0] < -0.25 + 1e-9})
+    material = LinearElastic(1000.0, 0.3)
+    press = ((0.0, 0.0), (0.5, 1.0), (1.0, 1.0))
+    shove = ((0.0, 0.0), (0.5, 0.0), (1.0, 1.0))
+    bodies = [Body("plane", lower, material, supports=(Support("bottom"),)),
+              Body("block", upper, material,
+                   prescribed=(PrescribedDisplacement("left", "x", push, amplitude=shove),),
+                   platen=Platen("top", "y", -10.0, amplitude=press))]
+    return Model("inclined block", bodies, ContactSettings(friction=mu),
+                 [0.25, 0.5, 0.625, 0.75, 0.875, 1.0])
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.1, 0.2, 0.3])
+def test_an_inclined_block_slides_uphill_at_the_nafems_ratio(mu):
+    """The NAFEMS friction test: pushed far enough, the block slides up the plane when the push
+    F over its weight G reaches (tan(alpha) + mu) / (1 - mu tan(alpha)) (0.412371 for mu = 0.3;
+    by statics, once every node slips); before that the push it takes grows with the motion.
+    Measured: the ratio to 1e-12 of it for every mu."""
+    slope = 0.1
+    result = Analysis(inclined(mu, 0.05)).run()
+    assert result.converged, result.message
+    force = result.steps[-1].bodies["block"].contact_force.sum(axis=0)
+    push = -force[0]  # the side's reaction balances the contact force along x (the platen: y)
+    weight = force[1]
+    assert weight == pytest.approx(10.0, rel=1e-9)
+    assert push / weight == pytest.approx((slope + mu) / (1 - mu * slope), rel=1e-12)
+    if mu > 0:  # every node in contact slips (on whichever body carries compatibility)
+        status = np.concatenate([r.friction_status for r in result.steps[-1].bodies.values()])
+        assert np.all(status[status > 0] == 2)
