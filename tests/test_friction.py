@@ -564,3 +564,100 @@ def test_an_inclined_block_slides_uphill_at_the_nafems_ratio(mu):
     if mu > 0:  # every node in contact slips (on whichever body carries compatibility)
         status = np.concatenate([r.friction_status for r in result.steps[-1].bodies.values()])
         assert np.all(status[status > 0] == 2)
+
+
+# -- friction laws and pairs ---------------------------------------------------------------------
+
+def _patch(n_lower, n_upper, tau, shift, pair="", mu=0.3):
+    """The friction patch test's model with the sides loaded by ``tau`` and ``pair`` (a
+    ``[[contact.pairs]]`` table) before the bodies."""
+    text = PATCH.format(n_lower=n_lower, n_upper=n_upper, mu=mu, shift=shift, pressure=-100.0,
+                        sides=SIDES.format(minus=-tau, plus=tau))
+    return loads(text.replace("[[bodies]]", pair + "[[bodies]]", 1)).build()
+
+
+def _interface_shear(result, expected_status):
+    last = result.steps[-1]
+    shears = []
+    for r in last.bodies.values():
+        carries = r.friction_status > 0
+        if carries.any():
+            assert np.all(r.friction_status[carries] == expected_status)
+            shears.append(np.abs(r.contact_shear[carries, 0]))
+    return np.concatenate(shears)
+
+
+@pytest.mark.parametrize("n_lower, n_upper", [(4, 7), (7, 4), (1, 5)])
+def test_static_and_dynamic_coefficients_on_the_patch(n_lower, n_upper):
+    """mu_s = 0.4, mu_d = 0.3: a uniform shear of 0.35 p (above the dynamic coefficient, below
+    the static one) sticks everywhere, uniform to 1e-8 of p; driven far, the interface slips at
+    0.3 p, uniform."""
+    pair = ('[[contact.pairs]]\nbodies = ["lower", "upper"]\nfriction = 0.3\n'
+            'law = "static_dynamic"\nstatic_friction = 0.4\n')
+    p, G = 100.0, 1.0e6 / 2
+    stick = Analysis(_patch(n_lower, n_upper, 0.35 * p, 2 * 0.35 * p / G, pair)).run()
+    assert stick.converged, stick.message
+    np.testing.assert_allclose(_interface_shear(stick, 1), 0.35 * p, rtol=0, atol=1e-8 * p)
+    slide = Analysis(_patch(n_lower, n_upper, 0.3 * p, 6 * 0.4 * p / G, pair)).run()
+    assert slide.converged, slide.message
+    np.testing.assert_allclose(_interface_shear(slide, 2), 0.3 * p, rtol=0, atol=1e-8 * p)
+
+
+@pytest.mark.parametrize("n_lower, n_upper", [(4, 7), (7, 4), (1, 5)])
+def test_the_elastoplastic_law_adds_its_slip_compliance_in_series(n_lower, n_upper):
+    """The thesis's friction-slippage law (§1.10) with slip stiffness k_t: below the cone the
+    interface slips elastically by tau / k_t, in series with the two blocks' shear
+    compliance H / G each, so moving the top by delta gives the uniform shear
+    delta / (2 / G + 1 / k_t) (to 1e-8 of it); driven far, it slips at mu p."""
+    k_t, p, G, mu = 2.5e5, 100.0, 1.0e6 / 2, 0.3
+    pair = ('[[contact.pairs]]\nbodies = ["lower", "upper"]\nfriction = 0.3\n'
+            f'law = "elastoplastic"\nslip_stiffness = {k_t}\n')
+    delta = 1e-4
+    tau = delta / (2 / G + 1 / k_t)
+    assert tau < mu * p
+    elastic = Analysis(_patch(n_lower, n_upper, tau, delta, pair)).run()
+    assert elastic.converged, elastic.message
+    np.testing.assert_allclose(_interface_shear(elastic, 1), tau, rtol=1e-8)
+    slide = Analysis(_patch(n_lower, n_upper, mu * p, 10 * mu * p * (2 / G + 1 / k_t),
+                            pair)).run()
+    assert slide.converged, slide.message
+    np.testing.assert_allclose(_interface_shear(slide, 2), mu * p, rtol=0, atol=1e-8 * p)
+
+
+def test_a_pair_entry_overrides_the_models_friction():
+    """``[[contact.pairs]]`` sets a pair's friction instead of ``contact.friction``: mu = 0.3
+    for the pair under a model-wide 0.5 slides at 0.3; a frictionless pair entry under a
+    model-wide 0.3 gives the frictionless answer (to 1e-12 of the force)."""
+    entry = '[[contact.pairs]]\nbodies = ["upper", "lower"]\nfriction = {}\n'
+
+    def run(mu, pair_mu=None):
+        text = BLOCKS.format(mu=mu, shift=0.1)
+        if pair_mu is not None:
+            text = text.replace("[[bodies]]", entry.format(pair_mu) + "[[bodies]]", 1)
+        result = Analysis(loads(text).build()).run()
+        assert result.converged, result.message
+        return np.array([s.bodies["lower"].contact_force.sum(axis=0) for s in result.steps])
+
+    forces = run(0.5, 0.3)
+    assert abs(forces[-1, 0] / forces[-1, 1]) == pytest.approx(0.3, rel=1e-12)
+    plain, zero = run(0.0), run(0.3, 0.0)
+    np.testing.assert_allclose(zero, plain, rtol=0, atol=1e-12 * np.abs(plain).max())
+
+
+@pytest.mark.parametrize("entry, words", [
+    ('bodies = ["lower", "upper"]\nlaw = "viscous"', "law must be one of"),
+    ('bodies = ["lower", "upper"]\nfriction = 0.3\nlaw = "static_dynamic"\n'
+     'static_friction = 0.2', "static_friction >= friction"),
+    ('bodies = ["lower", "upper"]\nfriction = 0.3\nlaw = "elastoplastic"',
+     "needs slip_stiffness > 0"),
+    ('bodies = ["lower", "upper"]\nfriction = 0.3\nslip_stiffness = 10.0',
+     "slip_stiffness is for the elastoplastic law"),
+    ('bodies = ["lower", "lower"]\nfriction = 0.3', "two different bodies"),
+    ('bodies = ["lower", "top"]\nfriction = 0.3', "no body named 'top'"),
+])
+def test_a_wrong_pair_entry_is_refused_naming_it(entry, words):
+    text = BLOCKS.format(mu=0.0, shift=0.1).replace(
+        "[[bodies]]", "[[contact.pairs]]\n" + entry + "\n[[bodies]]", 1)
+    with pytest.raises(InputError, match=words):
+        model = loads(text).build()
+        Analysis(model).setup()

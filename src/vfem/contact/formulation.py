@@ -57,7 +57,7 @@ def formulation_class(settings, large: bool) -> type:
 
         return LargeDeformationContact
     if settings.variant == "paired":
-        if settings.friction > 0:
+        if settings.frictional:
             from .friction import FrictionalPairedContact
 
             return FrictionalPairedContact
@@ -86,14 +86,20 @@ def check_capabilities(model) -> None:
     elif large and settings.variant != "paired":
         raise InputError(f"model {model.name!r}: large kinematics needs the paired contact "
                          "variant")
-    if settings.friction > 0 and "coulomb" not in caps.friction:
+    names = {b.name for b in model.bodies}
+    for pair in settings.pairs:
+        unknown = [n for n in pair.bodies if n not in names]
+        if unknown:
+            raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: no "
+                             f"body named {unknown[0]!r} (bodies: {', '.join(sorted(names))})")
+    if settings.frictional and "coulomb" not in caps.friction:
         what = ("large kinematics" if large and settings.method == "vfem" else
                 f"contact.method = {settings.method!r}" if settings.method != "vfem" else
                 f"contact.variant = {settings.variant!r}")
-        raise InputError(f"model {model.name!r}: contact.friction = {settings.friction:g} "
-                         f"(Coulomb friction) is available with the paired variant and small "
-                         f"kinematics only, not yet with {what}; set contact.friction = 0 for "
-                         "frictionless contact")
+        raise InputError(f"model {model.name!r}: friction (contact.friction = "
+                         f"{settings.friction:g}, or a contact.pairs entry) is available with the "
+                         f"paired variant and small kinematics only, not yet with {what}; set "
+                         "it to 0 for frictionless contact")
     for b in model.bodies:
         if b.order not in caps.orders:
             if large:

@@ -93,7 +93,11 @@ class FrictionalPairedContact(PairedContact):
 
     def __init__(self, surfaces, pairs, settings, backend: str | None = None):
         super().__init__(surfaces, pairs, settings, backend)
-        self.mu = float(settings.friction)
+        #: per contact pair, its law's (mu of a slipping node, mu at which a sticking node
+        #: starts to slip, 1 / slip stiffness: 0 where it sticks rigidly)
+        self.laws = [settings.pair_friction(surfaces[p.fine].body.name,
+                                            surfaces[p.coarse].body.name).coefficients
+                     for p in self.contact_pairs]
         self._tangents = [tangents(pair.normal) for pair in self.contact_pairs]
 
     def directions(self, k: int) -> list[np.ndarray]:
@@ -129,6 +133,26 @@ class FrictionalPairedContact(PairedContact):
         """Pair k's slip accumulated over the converged steps (length, per node)."""
         return self._values(state, "slip", k)
 
+    def sliding(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's nodes that slipped in the last correction."""
+        if k not in state.sliding:
+            state.sliding[k] = np.zeros(len(self.contact_pairs[k].nodes), dtype=bool)
+        return state.sliding[k]
+
+    def status(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's nodes: 0 free (no normal traction), 1 sticking, 2 slipping."""
+        on = self.tractions(state, k) > 0
+        return np.where(on, np.where(self.sliding(state, k), 2, 1), 0)
+
+    def free_slips(self, state: FrictionState) -> list[np.ndarray]:
+        """Per pair, each node's slip within the step that its law does not take up
+        elastically: the relative tangential displacement from its anchor, plus its
+        tangential traction over the slip stiffness (the elastoplastic law; nothing for the
+        others). A sticking node holds it at zero; a slipping one moves it against its
+        traction."""
+        return [w - self.anchor(state, k) + self.laws[k][2] * self.shear(state, k)
+                for k, w in enumerate(self.tangential_displacements(state))]
+
     def tangential_displacements(self, state: ContactState) -> list[np.ndarray]:
         """Per pair, each node's relative tangential displacement against its virtual node,
         ``w = t.(u_fine - u_virtual)`` (linear kinematics, as the penetrations)."""
@@ -160,11 +184,11 @@ class FrictionalPairedContact(PairedContact):
         excess of a tangential traction over its cone (relative to the largest mu q), and the
         nodes sticking and slipping."""
         err, excess, stick, slip = 0.0, 0.0, 0, 0
-        scale = max((self.mu * float(self.tractions(state, k).max(initial=0.0))
+        scale = max((self.laws[k][1] * float(self.tractions(state, k).max(initial=0.0))
                      for k in range(len(self.contact_pairs))), default=0.0)
         for k, dw in enumerate(slips):
             q, s = self.tractions(state, k), self.shear(state, k)
-            status = coulomb_status(q, s, self.mu)
+            status = self.status(state, k)
             stick += int((status == 1).sum())
             slip += int((status == 2).sum())
             if (status == 1).any():
@@ -173,7 +197,7 @@ class FrictionalPairedContact(PairedContact):
             if on.any():
                 sigma = -np.sign(s[on])
                 err = max(err, float(np.maximum(-sigma * dw[on], 0.0).max()))
-            outside = np.abs(s) - self.mu * np.maximum(q, 0.0)
+            outside = np.abs(s) - self.laws[k][1] * np.maximum(q, 0.0)
             if len(outside) and scale > 0:
                 excess = max(excess, float(outside.max()) / scale)
             elif np.any(s != 0):
@@ -192,8 +216,7 @@ class FrictionalPairedContact(PairedContact):
 
         def check(it: int) -> Check:
             pens = self.penetrations(state)
-            dw = [w - self.anchor(state, k)
-                  for k, w in enumerate(self.tangential_displacements(state))]
+            dw = self.free_slips(state)
             traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
             self._check_rind(pens)
             errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
@@ -228,7 +251,7 @@ class FrictionalPairedContact(PairedContact):
         out = []
         for k, pair in enumerate(self.contact_pairs):
             sf = self.surfaces[pair.fine]
-            status = coulomb_status(self.tractions(state, k), self.shear(state, k), self.mu)
+            status = self.status(state, k)
             nodes = sf.nodes[pair.nodes]
             out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2),
                     (sf.body.name, nodes, self.shear(state, k) < 0)]
@@ -243,10 +266,12 @@ class FrictionalPairedContact(PairedContact):
         for k, w in enumerate(self.tangential_displacements(state)):
             anchor = self.anchor(state, k)
             on = self.tractions(state, k) > 0
-            increment = np.where(on, w - anchor, 0.0)
+            # where the node is, less its elastic slip (the elastoplastic law's s / k_t)
+            new = w + self.laws[k][2] * self.shear(state, k)
+            increment = np.where(on, new - anchor, 0.0)
             self.accumulated_slip(state, k)[:] += np.abs(increment)
             self._increments.append(increment)
-            anchor[:] = w
+            anchor[:] = new
 
     def fields(self, state: ContactState, result: SolveResult) -> dict:
         """The frictionless fields, and the friction's at each pair's compatibility-side nodes
@@ -269,7 +294,7 @@ class FrictionalPairedContact(PairedContact):
             r.contact_shear[points] = shear[:, None] * self._tangents[k][0]
             r.slip_increment[points] = increments[k]
             r.accumulated_slip[points] = self.accumulated_slip(state, k)
-            r.friction_status[points] = coulomb_status(self.tractions(state, k), shear, self.mu)
+            r.friction_status[points] = self.status(state, k)
         return out
 
     def _correct_frictional(self, state: FrictionState, pens: list[np.ndarray],
@@ -294,9 +319,12 @@ class FrictionalPairedContact(PairedContact):
         touching = not platen_ok and not any(
             ((self.tractions(state, k) > 0) | (pens[k] > tol)).any()
             for k in range(len(self.contact_pairs)))
+        elastic = []  # (row, column of s, 1 / slip stiffness) of each elastic sticking node
         for k, pair in enumerate(self.contact_pairs):
             n = len(pair.nodes)
+            mu, mu_static, compliance = self.laws[k]
             q, s, p = self.tractions(state, k), self.shear(state, k), pens[k]
+            was_sliding = self.sliding(state, k)
             tension = q < 0
             change, state.released[pair.fine][pair.nodes] = release_tension(
                 q, tension, state.released[pair.fine][pair.nodes], cfg.release_iterations)
@@ -327,18 +355,21 @@ class FrictionalPairedContact(PairedContact):
                 tau = np.clip(tau, 0.0, 1.0)
                 self.anchor(state, k)[fresh] += tau * slip_k[fresh]
                 slip_k[fresh] *= 1.0 - tau
-            # a node on the cone keeps slipping unless its slip has turned back
+            # a node on the cone keeps slipping unless its slip has turned back: the static cone
+            # for a node at rest, the dynamic one for a node that slips (the same for Coulomb)
             sigma = -np.sign(s)
-            on_cone = (q > 0) & (np.abs(s) >= (1.0 - CONE_TOLERANCE) * self.mu * q) & (s != 0)
+            reach = np.abs(s) >= (1.0 - CONE_TOLERANCE) * q * np.where(was_sliding, mu, mu_static)
+            on_cone = (q > 0) & reach & (s != 0)
             moving = torn & (np.abs(slip_k) > tol)
             sigma[moving] = np.sign(slip_k[moving])
             slipping = contact & ((on_cone & (sigma * slip_k >= -tol)) | moving)
             # a node whose relative tangential motion the supports hold (a symmetry plane through
             # the contact, both bodies held along it) has no tangential unknown: its tangential
-            # traction is the supports' (zero on a symmetry plane)
-            held = self._held[base + n: base + 2 * n]
+            # traction is the supports' (zero on a symmetry plane); nor has a frictionless pair
+            held = self._held[base + n: base + 2 * n] | (mu_static == 0.0)
             slipping &= ~held
             sticking = contact & ~slipping & ~held
+            was_sliding[:] = slipping | (contact & (mu_static == 0.0))
             jump[base + n + np.flatnonzero(held)] = -s[held]
             jump[base + n + np.flatnonzero(~contact)] = -s[~contact]  # no q, no s
             for i in np.flatnonzero(contact):
@@ -349,8 +380,10 @@ class FrictionalPairedContact(PairedContact):
                 s_cols.append(base + n + i)
                 rows.append(base + n + i)
                 rhs.append(-omega * slip_k[i])  # undo the slip within the step
+                if compliance > 0:  # elastoplastic: the slip s / k_t is elastic
+                    elastic.append((len(rows) - 1, base + n + i, compliance))
             for i in np.flatnonzero(slipping):
-                tie = -self.mu * sigma[i]
+                tie = -mu * sigma[i]
                 jump[base + n + i] = tie * q[i] - s[i]  # onto the cone
                 slip_tie.append((base + i, base + n + i, tie))
         self.assemble_forces(state)  # the releases change the forces the platen sees
@@ -368,6 +401,8 @@ class FrictionalPairedContact(PairedContact):
         position = {c: j for j, c in enumerate(cols)}
         for qc, sc, tie in slip_tie:  # s follows q on the cone
             A[:, position[qc]] += tie * Gr[:, sc]
+        for row, sc, compliance in elastic:
+            A[row, position[sc]] += compliance
         b = np.array(rhs) - Gr @ jump
         bordered = self.platen_body is not None and state.platen_force != 0.0
         if bordered:

@@ -10,6 +10,70 @@ from ..errors import InputError
 CONVERGENCE_CRITERIA = ("stationary", "physical", "thesis")
 VARIANTS = ("thesis", "paired")
 METHODS = ("vfem", "penalty", "lagrange", "augmented")
+#: the friction laws of a contact pair (docs/method.md §11)
+FRICTION_LAWS = ("coulomb", "static_dynamic", "elastoplastic")
+
+
+@dataclass(frozen=True)
+class PairFriction:
+    """The friction of one pair of bodies (``[[contact.pairs]]``), instead of the model's
+    ``contact.friction``.
+
+    Attributes:
+        bodies: the two bodies' names.
+        friction: Coulomb's coefficient mu (with ``static_dynamic``: the dynamic one, of a node
+            that slips). 0: frictionless.
+        law: ``"coulomb"`` — stick while the tangential traction is within mu times the normal
+            one, slip at mu times it; ``"static_dynamic"`` — a node that sticks starts slipping
+            at ``static_friction`` times its normal traction and slips at ``friction`` times
+            it; ``"elastoplastic"`` — the thesis's friction-slippage law (§1.10), a regularised
+            Coulomb law: below the cone the tangential traction is ``slip_stiffness`` times an
+            elastic slip, on it the node slips at mu times its normal traction (it has a
+            parameter to choose: for those who want the regularisation).
+        static_friction: the static coefficient (``static_dynamic``), at least ``friction``.
+        slip_stiffness: the tangential traction per unit elastic slip (``elastoplastic``).
+    """
+
+    bodies: tuple[str, str]
+    friction: float = 0.0
+    law: str = "coulomb"
+    static_friction: float | None = None
+    slip_stiffness: float | None = None
+
+    def validate(self, where: str = "contact.pairs") -> None:
+        if len(self.bodies) != 2 or self.bodies[0] == self.bodies[1]:
+            raise InputError(f"{where}: bodies must name two different bodies, got "
+                             f"{list(self.bodies)!r}")
+        if self.law not in FRICTION_LAWS:
+            raise InputError(f"{where} {list(self.bodies)!r}: law must be one of "
+                             f"{FRICTION_LAWS}, got {self.law!r}")
+        if not (math.isfinite(self.friction) and self.friction >= 0):
+            raise InputError(f"{where} {list(self.bodies)!r}: friction must be a number >= 0, "
+                             f"got {self.friction!r}")
+        static, stiffness = self.static_friction, self.slip_stiffness
+        if self.law == "static_dynamic":
+            if static is None or not (math.isfinite(static) and static >= self.friction):
+                raise InputError(f"{where} {list(self.bodies)!r}: the static_dynamic law needs "
+                                 f"static_friction >= friction ({self.friction:g}), got "
+                                 f"{static!r}")
+        elif static is not None:
+            raise InputError(f"{where} {list(self.bodies)!r}: static_friction is for the "
+                             f"static_dynamic law, not {self.law!r}")
+        if self.law == "elastoplastic":
+            if stiffness is None or not (math.isfinite(stiffness) and stiffness > 0):
+                raise InputError(f"{where} {list(self.bodies)!r}: the elastoplastic law needs "
+                                 f"slip_stiffness > 0, got {stiffness!r}")
+        elif stiffness is not None:
+            raise InputError(f"{where} {list(self.bodies)!r}: slip_stiffness is for the "
+                             f"elastoplastic law, not {self.law!r}")
+
+    @property
+    def coefficients(self) -> tuple[float, float, float]:
+        """(mu of a slipping node, mu at which a sticking one starts to slip, 1 / slip
+        stiffness: 0 for a node that sticks rigidly)."""
+        static = self.static_friction if self.static_friction is not None else self.friction
+        return (float(self.friction), float(static),
+                1.0 / self.slip_stiffness if self.slip_stiffness else 0.0)
 
 
 @dataclass(frozen=True)
@@ -89,6 +153,9 @@ class ContactSettings:
             that traction opposing its slip otherwise (docs/method.md §11). 0 (the default):
             frictionless, the code path of every analysis before friction. The paired variant
             with small kinematics only, for now.
+        pairs: the friction of particular pairs of bodies (``[[contact.pairs]]`` tables:
+            ``bodies``, ``friction``, ``law`` and its parameters), instead of ``friction``;
+            different laws in different contact areas, as the thesis allows (§1.10).
     """
 
     method: str = "vfem"
@@ -112,6 +179,7 @@ class ContactSettings:
     augmented_tolerance: float = 1e-9
     compatibility_side: str | None = None
     friction: float = 0.0
+    pairs: tuple[PairFriction, ...] = ()
 
     def validate(self) -> None:
         for f in fields(self):
@@ -127,6 +195,13 @@ class ContactSettings:
         if self.friction < 0:
             raise InputError(f"contact.friction (Coulomb's coefficient) must be >= 0, got "
                              f"{self.friction!r}")
+        named = set()
+        for pair in self.pairs:
+            pair.validate()
+            key = frozenset(pair.bodies)
+            if key in named:
+                raise InputError(f"contact.pairs: {sorted(pair.bodies)!r} given twice")
+            named.add(key)
         for name in ("penetration_tolerance", "search_distance", "penalty"):
             v = getattr(self, name)
             if v is not None and v <= 0:
@@ -146,6 +221,19 @@ class ContactSettings:
             v = getattr(self, name)
             if int(v) < 0:
                 raise InputError(f"contact.{name} must be >= 0, got {v!r}")
+
+    @property
+    def frictional(self) -> bool:
+        """Whether any pair has friction (``friction`` or a ``pairs`` entry's)."""
+        return self.friction > 0 or any(p.friction > 0 for p in self.pairs)
+
+    def pair_friction(self, a: str, b: str) -> PairFriction:
+        """The friction of the bodies named ``a`` and ``b``: their ``pairs`` entry, else
+        Coulomb's law with ``friction``."""
+        for pair in self.pairs:
+            if set(pair.bodies) == {a, b}:
+                return pair
+        return PairFriction((a, b), self.friction)
 
     @property
     def release_iterations(self) -> int:

@@ -102,16 +102,19 @@ class FrictionState(TractionState):
     virtual node at the last converged step (``anchor``: a node that sticks keeps it within the
     step), the slip accumulated since the start (``slip``) and the penetration at the last
     converged step (``penetration``: where a node that comes into contact within a step first
-    touched). All are path-dependent history: saved in checkpoints and restored exactly when a
-    step is cut."""
+    touched) and which nodes slip (``sliding``). All are path-dependent history: saved in
+    checkpoints and restored exactly when a step is cut."""
 
     shear: dict[int, np.ndarray] = field(default_factory=dict)
     anchor: dict[int, np.ndarray] = field(default_factory=dict)
     slip: dict[int, np.ndarray] = field(default_factory=dict)
     penetration: dict[int, np.ndarray] = field(default_factory=dict)
+    #: per node, whether it slipped in the last correction (a static coefficient holds a node
+    #: at rest until its traction reaches it; a sliding one slips at the dynamic coefficient)
+    sliding: dict[int, np.ndarray] = field(default_factory=dict)
 
     #: the history arrays, by their names in :meth:`unknowns`
-    HISTORY = ("shear", "anchor", "slip", "penetration")
+    HISTORY = ("shear", "anchor", "slip", "penetration", "sliding")
 
     def unknowns(self) -> dict[str, np.ndarray]:
         return {**super().unknowns(),
