@@ -21,23 +21,11 @@ import numpy as np
 from vfem.examples import cattaneo
 
 
-def shear_theory(p: cattaneo.Parameters, x: np.ndarray, tangential: float) -> np.ndarray:
-    """Cattaneo-Mindlin's shear traction magnitude at ``x`` for the tangential force."""
-    th = cattaneo.theory(p)
-    a, mu_p0 = th["a"], p.friction * th["p0"]
-    c = cattaneo.stick_half_width(p, tangential)
-    out = mu_p0 * np.sqrt(np.clip(1 - (x / a) ** 2, 0, None))
-    if c > 0:
-        out -= np.where(np.abs(x) < c,
-                        mu_p0 * (c / a) * np.sqrt(np.clip(1 - (x / c) ** 2, 0, None)), 0.0)
-    return out
-
-
 def main(pairs: list[tuple[int, int]]) -> None:
     for upper, lower in pairs:
         p = cattaneo.Parameters(facets_upper=upper, facets_lower=lower)
         t0 = time.perf_counter()
-        result, readings = cattaneo.run(p)
+        result, readings = cattaneo.solve(p)
         seconds = time.perf_counter() - t0
         th = cattaneo.theory(p)
         a, p0 = th["a"], th["p0"]
@@ -55,7 +43,7 @@ def main(pairs: list[tuple[int, int]]) -> None:
             ratio = abs(r.tangential) / (p.friction * r.normal)
             c = cattaneo.stick_half_width(p, r.tangential)
             last = r.last_sticking(p.friction)
-            err = (np.abs(r.s) - shear_theory(p, r.x, r.tangential)) / (p.friction * p0)
+            err = (np.abs(r.s) - cattaneo.shear_theory(p, r.x, r.tangential)) / (p.friction * p0)
             inner, inside = np.abs(r.x) < 0.8 * a, np.abs(r.x) < a
             print(f"{ratio:9.4f} {c / a:10.4f} {last / a:12.4f} {(c - last) / h:10.2f} "
                   f"{100 * np.abs(err[inner]).max():11.2f} "

@@ -134,6 +134,19 @@ def gasket_results() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_cattaneo() -> str:
+    """docs/examples.md, Cattaneo: the steps of the shear of ``vfem run cattaneo``."""
+    s = _summary("cattaneo")
+    rows = ["| Q/(μP) | c/a, theory | outermost sticking node / a | shear error, largest / RMS "
+            "(% of μp0) |", "|---|---|---|---|"]
+    for r in s["cattaneo"]["steps"]:
+        error = (f"{100 * r['shear_max_error']:.1f} % / {100 * r['shear_rms_error']:.1f} %"
+                 if "shear_max_error" in r else "")
+        rows.append(f"| {r['Q_over_muP']:.3f} | {r['c_over_a']:.3f} | "
+                    f"{r['last_sticking_over_a']:.3f} | {error} |")
+    return "\n".join(rows) + "\n"
+
+
 def gasket_steps() -> str:
     """docs/examples.md, Gasket: the loading steps that carry force (``vfem run gasket``)."""
     steps = _summary("gasket")["steps"]
@@ -281,6 +294,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "baselines-hertz": ("docs/baselines.md", baselines_hertz, True),
     "gasket-results": ("docs/examples.md", gasket_results, True),
     "gasket-steps": ("docs/examples.md", gasket_steps, True),
+    "examples-cattaneo": ("docs/examples.md", examples_cattaneo, True),
 }
 
 _TIME = re.compile(r"\b\d+(\.\d+)? s\b")

@@ -40,6 +40,7 @@ SHAPES = {
     "rectangle": shapes.rectangle,
     "block": shapes.block,
     "graded_quarter_disk": parametric.graded_quarter_disk,
+    "graded_half_disk": parametric.graded_half_disk,
     "graded_layer": parametric.graded_layer,
     "wedge": shapes.wedge,
     "wedge_plate": shapes.wedge_plate,

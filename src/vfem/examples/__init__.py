@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import importlib
 
-EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch")
+EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
+            "cattaneo")
 
 
 def load(name: str):

@@ -1,48 +1,59 @@
 """Cattaneo-Mindlin partial slip: two elastically similar cylinders pressed together by P, then
-sheared by a growing sideways motion with P held (issue 20; the model and its measurement, not
-yet a built-in example of ``vfem run``).
+sheared by a growing sideways motion with P held (issue 20).
 
-Two half disks of radius R = 1 (E = 1e6, nu = 0.2), flat sides out: the upper one's flat side
-carries a force-controlled platen (P, then held) and a prescribed sideways motion (0, then
-growing); the lower one's flat side is fixed. Their meshes are the Hertz example's graded
-cylinder, mirrored into a half disk, with different numbers of contact facets across the
-half-width (12 and 17 by default: non-matching). The bodies are alike and symmetric about the
-contact plane, so the normal and tangential problems uncouple exactly: the normal contact is
-Hertz's for R_eff = R/2, ``a = sqrt(4 P R_eff / (pi E*))``, E* = E / (2 (1 - nu^2)), and under a
-tangential force Q < mu P the contact sticks over ``|x| < c = a sqrt(1 - Q / (mu P))`` and slips
-outside, with the shear traction ``mu p0 (sqrt(1 - x^2/a^2) - (c/a) sqrt(1 - x^2/c^2))`` inside c
-and ``mu p(x)`` outside (Cattaneo 1938, Mindlin 1949).
+Plane strain. Two half disks of radius R = 1 (E = 1e6, nu = 0.2), flat sides out (the
+``graded_half_disk`` shape): the upper one's flat side carries a force-controlled platen (P =
+300, applied over load factors 0 to 0.5, then held) and a prescribed sideways motion (0 until
+0.5, then growing to ``shift`` at 1); the lower one's flat side is fixed. Their meshes are
+graded towards the contact, with ``facets_upper`` and ``facets_lower`` contact facets across the
+half-width a (12 and 17: non-matching). Coulomb friction, mu = 0.3. With ``cycle`` the motion
+then goes back to -``shift`` (load factor 1.5) and forward to ``shift`` again (2): the
+hysteresis loop.
+
+Theory. The bodies are alike and symmetric about the contact plane, so the normal and the
+tangential problems uncouple exactly: the normal contact is Hertz's for R_eff = R/2,
+``a = sqrt(4 P R_eff / (pi E*))``, ``E* = E / (2 (1 - nu^2))``, and under a tangential force
+Q < mu P the contact sticks over ``|x| < c = a sqrt(1 - Q / (mu P))`` and slips outside, with the
+shear traction ``mu p0 (sqrt(1 - x^2/a^2) - (c/a) sqrt(1 - x^2/c^2))`` inside c and ``mu p(x)``
+outside (Cattaneo 1938, Mindlin 1949). While Q falls back from its peak Q*, the contact slips
+back from its edges and sticks over ``|x| < c' = a sqrt(1 - (Q* - Q) / (2 mu P))`` (Mindlin and
+Deresiewicz 1953).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
-from skfem import MeshTri
 
-from ..bodies import Body, Platen, PrescribedDisplacement, Support
+from ..bodies import Platen, PrescribedDisplacement, Support
+from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.friction import tangents
 from ..contact.settings import ContactSettings
-from ..solver import Analysis, Model
+from ..errors import InputError
+from ..io.runner import run_status
+from ..materials import LinearElastic
+from ..solver import Analysis, AnalysisResult, Model
 
 
 @dataclass(frozen=True)
 class Parameters:
-    """The two cylinders, the loads and the schedule."""
+    """Parameters of the Cattaneo example (see the module docstring)."""
 
     force: float = 300.0  # P, per unit thickness
     friction: float = 0.3  # mu
-    shift: float = 1e-3  # the upper flat side's sideways motion at the end
+    shift: float = 1e-3  # the upper flat side's sideways motion at load factor 1
     facets_upper: int = 12  # contact facets across the half-width a
     facets_lower: int = 17
     youngs_modulus: float = 1.0e6
     poissons_ratio: float = 0.2
+    max_element_size: float = 0.05
     press_steps: int = 5  # load factors 0 to 0.5: P applied
     shear_steps: int = 10  # load factors 0.5 to 1: the shift applied, P held
-    # then (cycle) the shift back to -shift over load factors 1 to 1.5 and forward to +shift
-    # over 1.5 to 2, shear_steps each: Mindlin and Deresiewicz's unloading and the loop
+    # then the shift back to -shift over load factors 1 to 1.5 and forward to +shift over 1.5 to
+    # 2, shear_steps each: Mindlin and Deresiewicz's unloading and the hysteresis loop
     cycle: bool = False
 
 
@@ -65,46 +76,78 @@ def reverse_stick_half_width(p: Parameters, peak: float, tangential: float) -> f
     return theory(p)["a"] * math.sqrt(max(0.0, 1 - drop / (2 * p.friction * p.force)))
 
 
-def half_disk(p: Parameters, facets: int, flip: bool) -> MeshTri:
-    """The Hertz example's graded cylinder, sized for this contact, mirrored into a half disk
-    (flat side up; ``flip``: flat side down)."""
-    from .hertz import HertzParameters, build
-
-    hertz = HertzParameters(cylinder_youngs_modulus=p.youngs_modulus,
-                            cylinder_poissons_ratio=p.poissons_ratio,
-                            flat_youngs_modulus=p.youngs_modulus,
-                            flat_poissons_ratio=p.poissons_ratio, force=p.force / 2,
-                            facets_per_half_width=facets)
-    quarter = next(b for b in build(hertz).bodies if b.name == "cylinder").mesh
-    mirror = quarter.p * [[-1.0], [1.0]]
-    pts = np.hstack([quarter.p, mirror])
-    _, first, inverse = np.unique(np.round(pts.T / 1e-12).astype(np.int64), axis=0,
-                                  return_index=True, return_inverse=True)
-    t = quarter.t
-    cells = inverse.ravel()[np.hstack([t, t[[0, 2, 1]] + mirror.shape[1]])]
-    pts = pts[:, first]
-    if flip:
-        pts, cells = pts * [[1.0], [-1.0]], cells[[0, 2, 1]]
-    return MeshTri(pts, cells)
+def shear_theory(p: Parameters, x: np.ndarray, tangential: float) -> np.ndarray:
+    """Cattaneo-Mindlin's shear traction magnitude at ``x`` under the tangential force."""
+    th = theory(p)
+    a, mu_p0 = th["a"], p.friction * th["p0"]
+    c = stick_half_width(p, tangential)
+    out = mu_p0 * np.sqrt(np.clip(1 - (x / a) ** 2, 0, None))
+    if c > 0:
+        out -= np.where(np.abs(x) < c,
+                        mu_p0 * (c / a) * np.sqrt(np.clip(1 - (x / c) ** 2, 0, None)), 0.0)
+    return out
 
 
-def build(p: Parameters) -> Model:
-    from ..materials import LinearElastic
-
-    material = LinearElastic(p.youngs_modulus, p.poissons_ratio)
-    up, down = half_disk(p, p.facets_upper, False), half_disk(p, p.facets_lower, True)
-    top, bottom = up.p[1].max(), down.p[1].min()
-    press = ((0.0, 0.0), (0.5, 1.0), (2.0, 1.0))
-    shear = ((0.0, 0.0), (0.5, 0.0), (1.0, 1.0)) + (((1.5, -1.0), (2.0, 1.0)) if p.cycle else ())
-    upper = Body("upper", up.with_boundaries({"top": lambda x: x[1] > top - 1e-9}), material,
-                 prescribed=(PrescribedDisplacement("top", "x", p.shift, amplitude=shear),),
-                 platen=Platen("top", "y", -p.force, amplitude=press))
-    lower = Body("lower", down.with_boundaries({"bottom": lambda x: x[1] < bottom + 1e-9}),
-                 material, supports=(Support("bottom", ("x", "y")),))
+def load_factors(p: Parameters) -> tuple[float, ...]:
     branches = 3 if p.cycle else 1
-    factors = ([0.5 * (k + 1) / p.press_steps for k in range(p.press_steps)]
-               + [0.5 + 0.5 * (k + 1) / p.shear_steps for k in range(branches * p.shear_steps)])
-    return Model("cattaneo", [upper, lower], ContactSettings(friction=p.friction), factors)
+    return (tuple(0.5 * (k + 1) / p.press_steps for k in range(p.press_steps))
+            + tuple(0.5 + 0.5 * (k + 1) / p.shear_steps
+                    for k in range(branches * p.shear_steps)))
+
+
+def config(p: Parameters | None = None) -> ModelConfig:
+    """The model as data (what ``examples/cattaneo.toml`` holds for the defaults)."""
+    p = p or Parameters()
+    try:
+        a = theory(p)["a"]
+    except (ValueError, ArithmeticError, ZeroDivisionError):
+        a = 0.02  # parameters that make no theory are refused by validate()
+    material = LinearElastic(p.youngs_modulus, p.poissons_ratio)
+    end = 2.0 if p.cycle else 1.0
+    press = ((0.0, 0.0), (0.5, 1.0), (end, 1.0))
+    shear = ((0.0, 0.0), (0.5, 0.0), (1.0, 1.0)) + (((1.5, -1.0), (2.0, 1.0)) if p.cycle else ())
+
+    def disk(facets: int, flat_side: str) -> MeshSpec:
+        return MeshSpec(shape="graded_half_disk", parameters=as_parameters(
+            radius=1.0, h_contact=a / max(facets, 1), h_max=p.max_element_size, growth=0.15,
+            plateau=1.5 * a, flat_side=flat_side))
+
+    upper = BodyConfig("upper", disk(p.facets_upper, "top"), material,
+                       prescribed=(PrescribedDisplacement("flat", "x", p.shift, shear),),
+                       platen=Platen("flat", "y", -p.force, press),
+                       contact_boundaries=("contact",))
+    lower = BodyConfig("lower", disk(p.facets_lower, "bottom"), material,
+                       supports=(Support("flat", ("x", "y")),), contact_boundaries=("contact",))
+    return ModelConfig("cattaneo", (upper, lower), ContactSettings(friction=p.friction),
+                       Steps(load_factors=load_factors(p)))
+
+
+def build(p: Parameters | None = None) -> Model:
+    return config(p).build()
+
+
+def validate(p: Parameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    for name in ("force", "friction", "shift", "youngs_modulus", "poissons_ratio",
+                 "max_element_size"):
+        value = getattr(p, name)
+        if not (isinstance(value, (int, float)) and math.isfinite(value)):
+            raise InputError(f"cattaneo: {name} must be a finite number, got {value!r}")
+    if not p.max_element_size > 0:
+        raise InputError(f"cattaneo: max_element_size must be > 0, got {p.max_element_size!r}")
+    if not (p.force > 0 and p.youngs_modulus > 0 and 0 <= p.poissons_ratio < 0.5):
+        raise InputError("cattaneo: force and youngs_modulus must be > 0 and poissons_ratio in "
+                         "[0, 0.5)")
+    if not p.friction > 0:
+        raise InputError("cattaneo: friction (mu) must be > 0")
+    if p.facets_upper < 1 or p.facets_lower < 1 or p.press_steps < 1 or p.shear_steps < 1:
+        raise InputError("cattaneo: facets_upper, facets_lower, press_steps and shear_steps "
+                         "must be at least 1")
+    if theory(p)["a"] > 0.5:
+        raise InputError(f"cattaneo: the contact half-width a = {theory(p)['a']:.3g} is not "
+                         "small against the radius 1 (Hertz's theory needs a << R): lower the "
+                         "force")
+    build(p).validate()
 
 
 @dataclass
@@ -128,8 +171,9 @@ class Reading:
         return float(np.abs(self.x[stick]).max()) if stick.any() else 0.0
 
 
-def run(p: Parameters) -> tuple[object, list[Reading]]:
-    """Solve the model; the analysis result and a :class:`Reading` per converged step."""
+def solve(p: Parameters) -> tuple[AnalysisResult, list[Reading]]:
+    """Solve the model without writing files; the result and a :class:`Reading` per
+    converged step (the traction values of the contact state)."""
     analysis = Analysis(build(p))
     readings: list[Reading] = []
 
@@ -145,3 +189,142 @@ def run(p: Parameters) -> tuple[object, list[Reading]]:
                                 c.surfaces[pair.fine].body.name))
 
     return analysis.run(on_step), readings
+
+
+# -- a run with files: summary, figures, report -------------------------------------------------
+
+def profile(result: AnalysisResult, step) -> dict[str, list[float]]:
+    """At a converged step, the compatibility side's nodes in contact, from the results files'
+    fields: x, the normal traction (``contact_traction``), the tangential one along x on the
+    lower body and the friction status."""
+    # the body whose nodes carry the pair's compatibility (status >= 0; the other's are -1)
+    fine = next(n for n, r in step.bodies.items() if (r.friction_status >= 0).any())
+    body = next(b for b in result.model.bodies if b.name == fine)
+    r = step.bodies[fine]
+    on = r.friction_status > 0
+    sign = 1.0 if fine == "lower" else -1.0  # the traction on the lower body
+    order = np.argsort(body.points[0][on])
+    return {"body": fine, "x": body.points[0][on][order].tolist(),
+            "normal": r.contact_traction[on][order].tolist(),
+            "shear": (sign * r.contact_shear[on, 0][order]).tolist(),
+            "status": r.friction_status[on][order].tolist()}
+
+
+def evaluate(result: AnalysisResult, p: Parameters) -> dict:
+    """Per step of the shear: Q/(mu P), c of the theory and the outermost sticking node, and
+    the shear profile's largest and RMS errors against the theory (% of mu p0)."""
+    th = theory(p)
+    a, p0 = th["a"], th["p0"]
+    rows = []
+    peak = None
+    for step in result.steps:
+        if step.load_factor <= 0.5 + 1e-12:
+            continue
+        force = step.bodies["lower"].contact_force.sum(axis=0)
+        normal, tangential = -float(force[1]), float(force[0])
+        prof = profile(result, step)
+        x, s = np.asarray(prof["x"]), np.asarray(prof["shear"])
+        status = np.asarray(prof["status"])
+        unloading = p.cycle and 1.0 < step.load_factor <= 1.5 + 1e-12
+        if step.load_factor <= 1.0 + 1e-12:
+            peak = tangential
+        c = (reverse_stick_half_width(p, peak, tangential) if unloading and peak is not None
+             else stick_half_width(p, tangential))
+        row = {"load_factor": step.load_factor, "Q_over_muP": tangential / (p.friction * normal),
+               "c_over_a": c / a, "last_sticking_over_a":
+               float(np.abs(x[status == 1]).max() / a) if (status == 1).any() else 0.0}
+        if not p.cycle or step.load_factor <= 1.0 + 1e-12:
+            err = (np.abs(s) - shear_theory(p, x, tangential)) / (p.friction * p0)
+            row["shear_max_error"] = float(np.abs(err[np.abs(x) < 0.8 * a]).max(initial=0.0))
+            row["shear_rms_error"] = float(np.sqrt(np.mean(err[np.abs(x) < a] ** 2)))
+        rows.append(row)
+    return {"a": a, "p0": p0, "mu_p0": p.friction * p0, "steps": rows}
+
+
+def summarize(result: AnalysisResult, p: Parameters) -> dict:
+    from ..io.results import example_summary
+
+    summary = example_summary("cattaneo", result, p)
+    if result.steps:
+        summary["cattaneo"] = evaluate(result, p)
+    return summary
+
+
+def run(p: Parameters, out, on_step=None, figures: bool = True,
+        resume: bool = False) -> dict:
+    """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
+    from ..io.results import run_example
+
+    return run_example(build(p), out, lambda r: summarize(r, p),
+                       (lambda model, result, summary: _figure_data(result, summary, p))
+                       if figures else None, on_step, resume)
+
+
+def _figure_data(result: AnalysisResult, summary: dict, p: Parameters) -> None:
+    """The shear profiles drawn (the steps of the shear nearest Q/(mu P) = 0.3, 0.6 and 0.9:
+    their VTU step and Q), in ``summary.json``'s ``figure_data``."""
+    shear = [s for s in result.steps if 0.5 + 1e-12 < s.load_factor <= 1.0 + 1e-12]
+    ratio = np.array([s.bodies["lower"].contact_force.sum(axis=0)[0]
+                      / (p.friction * p.force) for s in shear])
+    picks = sorted({int(np.argmin(np.abs(ratio - f))) for f in (0.3, 0.6, 0.9)}) \
+        if shear else []
+    summary["figure_data"] = {"profiles": [
+        {"step": shear[i].step,
+         "tangential": float(shear[i].bodies["lower"].contact_force.sum(axis=0)[0]),
+         "profile": profile(result, shear[i])} for i in picks]}
+
+
+def figures(folder) -> list[Path]:
+    """The figures of a Cattaneo results folder (:class:`vfem.io.replot.Folder`), which the run
+    draws and ``vfem plot`` redraws: ``shear.png``, the shear traction over mu p0 against x/a
+    at three steps of the shear with Cattaneo-Mindlin's; ``loop.png``, Q/(mu P) against the
+    motion (the hysteresis loop with ``cycle``)."""
+    from ..io import plots, replot
+
+    s = folder.summary
+    data = s.get("figure_data")
+    if not folder.has_steps or "cattaneo" not in s or not data:
+        return []
+    p = Parameters(**{k: v for k, v in s["parameters"].items()
+                      if k in Parameters.__dataclass_fields__})
+    a, mu_p0 = s["cattaneo"]["a"], s["cattaneo"]["mu_p0"]
+    method = replot.contact_label(s)
+    out = folder.directory
+    curves = []
+    for d in data["profiles"]:
+        x = np.asarray(d["profile"]["x"])
+        xs = np.linspace(-a, a, 401)
+        curves.append((f"Q/(mu P) = {d['tangential'] / (p.friction * p.force):.2f}",
+                       x / a, np.asarray(d["profile"]["shear"]) / mu_p0,
+                       xs / a, shear_theory(p, xs, d["tangential"]) / mu_p0))
+    plots.profiles(out / "shear.png", curves, "x / a", "shear traction / (mu p0)",
+                   f"Cattaneo-Mindlin: two similar cylinders, mu = {p.friction:g} "
+                   f"(lines: theory)\n{method}")
+    rows = s["cattaneo"]["steps"]
+    plots.history(out / "loop.png", np.asarray([r["load_factor"] for r in rows]),
+                  {"Q / (mu P)": np.asarray([r["Q_over_muP"] for r in rows]),
+                   "c / a, theory": np.asarray([r["c_over_a"] for r in rows]),
+                   "outermost sticking node / a": np.asarray(
+                       [r["last_sticking_over_a"] for r in rows])},
+                  "load factor (0.5 to 1: the motion grows)", "ratio",
+                  f"Cattaneo-Mindlin: tangential force and stick zone\n{method}")
+    return [out / "shear.png", out / "loop.png"]
+
+
+def report(s: dict) -> list[str]:
+    steps = s["steps"]
+    lines = [f"vfem: {run_status(s)} in {len(steps)} "
+             f"step(s), {sum(x['iterations'] for x in steps)} contact iterations, "
+             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+    ev = s.get("cattaneo")
+    if ev and ev["steps"]:
+        lines.append(f"  a = {ev['a']:.5f} (Hertz, R_eff = 1/2), mu p0 = {ev['mu_p0']:.5g}")
+        for r in ev["steps"]:
+            extra = (f", shear error {100 * r['shear_max_error']:.1f} % max, "
+                     f"{100 * r['shear_rms_error']:.1f} % RMS of mu p0"
+                     if "shear_max_error" in r else "")
+            lines.append(f"  load factor {r['load_factor']:.3f}: Q/(mu P) "
+                         f"{r['Q_over_muP']:+.3f}, stick zone c/a {r['c_over_a']:.3f} "
+                         f"(theory), outermost sticking node {r['last_sticking_over_a']:.3f}"
+                         f"{extra}")
+    return lines

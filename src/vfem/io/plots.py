@@ -389,6 +389,28 @@ def history(path: Path, x: np.ndarray, series: dict[str, np.ndarray], xlabel: st
     plt.close(fig)
 
 
+def profiles(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray, np.ndarray,
+                                            np.ndarray]],
+             xlabel: str, ylabel: str, title: str) -> None:
+    """Computed values (markers) against a theory (a line of the same colour), per curve:
+    (label, x, y of the nodes, x, y of the theory)."""
+    plt = require_matplotlib()
+    fig, ax = plt.subplots(figsize=(7.0, 4.4))
+    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    for (label, x, y, xt, yt), c in zip(curves, colors * (len(curves) // 6 + 1)):
+        ax.plot(xt, yt, "-", color=c, lw=1.2)
+        ax.plot(x, y, "o", ms=3.5, mfc="none", color=c, label=label)
+    ax.axhline(0, color="0.7", lw=0.8)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, **OUTSIDE)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.ndarray,
                                                                     np.ndarray]]],
                               title: str, xlabel: str = f"x, undeformed ({LENGTH})",

@@ -5,7 +5,7 @@ Each shape returns its mesh with scikit-fem's facet topology already built, once
 and was repeated for every copy of the mesh.
 """
 
-from .parametric import graded_layer, graded_quarter_disk, march
+from .parametric import graded_half_disk, graded_layer, graded_quarter_disk, march
 from .shapes import (
     block,
     gasket,
@@ -24,6 +24,7 @@ __all__ = [
     "gasket_pair",
     "graded_layer",
     "graded_nodes",
+    "graded_half_disk",
     "graded_quarter_disk",
     "march",
     "rectangle",

@@ -155,6 +155,36 @@ def graded_quarter_disk(radius: float, h_contact: float, h_max: float,
     })
 
 
+def graded_half_disk(radius: float, h_contact: float, h_max: float, growth: float = 0.15,
+                     plateau: float = 0.0, flat_side: str = "top") -> MeshTri:
+    """The lower half of a disc of centre (0, radius), touching the x-axis at the origin
+    (``flat_side`` = "bottom": its mirror image below the axis, the upper half of a disc of
+    centre (0, -radius)): :func:`graded_quarter_disk` and its mirror image about x = 0, merged.
+
+    Named boundaries: ``contact`` (the arc) and ``flat`` (the diametral side).
+    """
+    if flat_side not in ("top", "bottom"):
+        raise ValueError(f"flat_side must be 'top' or 'bottom', got {flat_side!r}")
+    quarter = graded_quarter_disk(radius, h_contact, h_max, growth, plateau)
+    mirror = quarter.p * [[-1.0], [1.0]]
+    pts = np.hstack([quarter.p, mirror])
+    # the quarter's nodes on x = 0 appear twice: one node each (an exact zero, mirrored)
+    _, first, inverse = np.unique(np.round(pts.T / (1e-12 * radius)).astype(np.int64), axis=0,
+                                  return_index=True, return_inverse=True)
+    t = quarter.t
+    cells = inverse.ravel()[np.hstack([t, t[[0, 2, 1]] + mirror.shape[1]])]
+    pts = pts[:, first]
+    if flat_side == "bottom":
+        pts, cells = pts * [[1.0], [-1.0]], cells[[0, 2, 1]]
+    mesh = MeshTri(np.ascontiguousarray(pts), np.ascontiguousarray(cells))
+    tol = 1e-9 * radius
+    flat_y = radius if flat_side == "top" else -radius
+    return named_boundaries(mesh, {
+        "flat": lambda x: np.abs(x[1] - flat_y) < tol,
+        "contact": lambda x: np.abs(x[1] - flat_y) >= tol,
+    })
+
+
 def graded_layer(width: float, thickness: float, h_contact: float, h_max: float,
                  growth: float = 0.15, plateau: float = 0.0, layers: int = 2) -> MeshQuad:
     """A rectangular layer [0, width] x [-thickness, 0] of quadrilaterals graded towards x = 0.
