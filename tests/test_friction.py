@@ -21,7 +21,7 @@ from vfem.contact.settings import ContactSettings
 from vfem.contact.state import FrictionState
 from vfem.errors import InputError
 from vfem.io.input import loads
-from vfem.io.results import contact_work
+from vfem.io.results import frictional_work
 from vfem.solver import Analysis, Model
 
 BLOCKS = """
@@ -126,7 +126,7 @@ def test_a_sliding_block_carries_mu_times_its_normal_force_both_ways():
         assert all(s.invariants.get("force_balance", 0.0) < 1e-12 for s in result.steps)
         # sliding at a constant force, the friction dissipates that force times the shift's
         # increment (0.025 per step), all of it slip
-        work = contact_work(result.steps)
+        work = frictional_work(result.steps)
         np.testing.assert_allclose(work[-3:], abs(last[0]) * 0.025, rtol=1e-9)
 
 
@@ -312,7 +312,7 @@ def test_mindlin_deresiewicz_unloading_and_the_hysteresis_loop():
         force = np.array([s.bodies["lower"].contact_force.sum(axis=0)[0] for s in result.steps])
         start = int(np.argmin(np.abs(factors - 1.0)))
         area = float(np.sum(0.5 * (force[start + 1:] + force[start:-1]) * np.diff(shift[start:])))
-        dissipated = sum(contact_work(result.steps)[start + 1:])
+        dissipated = sum(frictional_work(result.steps)[start + 1:])
         assert area > 0 and dissipated > 0
         errors[steps] = abs(dissipated / area - 1)
     assert errors[10] < 0.03 and errors[20] < 0.015 and errors[20] < errors[10]
@@ -649,7 +649,9 @@ def test_a_pair_entry_overrides_the_models_friction():
     ('bodies = ["lower", "upper"]\nfriction = 0.3\nlaw = "static_dynamic"\n'
      'static_friction = 0.2', "static_friction >= friction"),
     ('bodies = ["lower", "upper"]\nfriction = 0.3\nlaw = "elastoplastic"',
-     "needs slip_stiffness > 0"),
+     "needs slip_stiffness \\(> 0\\)"),
+    ('bodies = ["lower", "upper"]\nfriction = 0.3\nlaw = "elastoplastic"\nslip_stiffness = -1.0',
+     "needs slip_stiffness > 0, got -1.0"),
     ('bodies = ["lower", "upper"]\nfriction = 0.3\nslip_stiffness = 10.0',
      "slip_stiffness is for the elastoplastic law"),
     ('bodies = ["lower", "lower"]\nfriction = 0.3', "two different bodies"),
@@ -680,3 +682,29 @@ def test_cattaneo_does_not_depend_on_the_order_of_its_bodies():
     scale = max(np.abs(f).max() for f in forces[0])
     for a, b in zip(*forces, strict=True):
         np.testing.assert_allclose(b, a, rtol=0, atol=1e-8 * scale)
+
+
+def test_a_model_with_friction_only_in_a_pair_entry_writes_the_friction_output(tmp_path):
+    """``contact.friction`` 0 and one ``[[contact.pairs]]`` entry with friction: the run has
+    friction, so contact.csv gets the friction's columns and summary.json the work it
+    dissipated (before, both were keyed on contact.friction alone). And on the Cattaneo model
+    the press, whose contact grows with (in theory) no slip, dissipates next to nothing: the
+    tangential forces' work only (the normal forces' end-of-step work on closing gaps read as
+    friction before, as much at mu = 1e-3 as at 0.3)."""
+    from vfem.examples import cattaneo
+    from vfem.io import runner
+
+    text = BLOCKS.format(mu=0.0, shift=0.1).replace(
+        "[[bodies]]", '[[contact.pairs]]\nbodies = ["lower", "upper"]\nfriction = 0.2\n'
+        'law = "static_dynamic"\nstatic_friction = 0.3\n[[bodies]]', 1)
+    summary = runner.run(loads(text), tmp_path / "pairs", figures=False)
+    header = (tmp_path / "pairs" / "contact.csv").read_text().splitlines()[0]
+    assert header.endswith("shear_x,shear_y,slip_increment,accumulated_slip,friction")
+    work = [x["frictional_work"] for x in summary["steps"]]
+    assert summary["frictional_work_total"] == pytest.approx(sum(work), rel=1e-12)
+    assert any("static_dynamic mu = 0.2" in line for line in runner.report(summary,
+                                                                           tmp_path / "pairs"))
+    result, _ = cattaneo.solve(cattaneo.Parameters())
+    work = frictional_work(result.steps)
+    pressed = [w for s, w in zip(result.steps, work, strict=True) if s.load_factor <= 0.5]
+    assert max(abs(w) for w in pressed) < 1e-5 * sum(work)

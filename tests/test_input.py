@@ -98,11 +98,12 @@ def test_docs_input_holds_the_generated_key_reference():
 def test_every_key_has_help_text():
     import vfem.bodies as bodies
     import vfem.config as config
-    from vfem.contact.settings import ContactSettings
+    from vfem.contact.settings import ContactSettings, PairFriction
     from vfem.io.input import SECTIONS, help_texts
     from vfem.materials import LinearElastic
 
-    classes = {"ContactSettings": ContactSettings, "LinearElastic": LinearElastic}
+    classes = {"ContactSettings": ContactSettings, "PairFriction": PairFriction,
+               "LinearElastic": LinearElastic}
     for name in SECTIONS:
         cls = classes.get(name) or getattr(config, name, None) or getattr(bodies, name)
         helps = help_texts(cls)

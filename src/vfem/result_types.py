@@ -60,6 +60,9 @@ class BodyStepResult:
     #: (npoints,) 0 free, 1 sticking, 2 slipping; -1 at the nodes that carry no pair's
     #: compatibility (the other side of a pair reads the traction field its partner defines)
     friction_status: np.ndarray | None = None
+    #: (npoints, 2) the part of ``contact_force`` that the tangential traction makes (on both
+    #: sides of a pair): what the friction's work is measured with
+    friction_force: np.ndarray | None = None
 
     def __post_init__(self):
         if self.contact_traction is None:

@@ -92,8 +92,9 @@ def _reject_unknown(data: dict, valid: list[str], where: str, owner: str = "") -
 #: Keys a user reaches for that name something vfem does not do yet: said so, not "did you
 #: mean" a key that happens to be spelled alike.
 NOT_YET = {"friction": "friction is set for a model's contact: contact.friction = mu, Coulomb's "
-                       "coefficient, in an input file (the paired variant, small kinematics; "
-                       "the built-in examples are frictionless)",
+                       "coefficient, or [[contact.pairs]], in an input file (the paired "
+                       "variant, small kinematics; of the built-in examples only cattaneo has "
+                       "friction)",
            "self_contact": "contact of a body with itself is not available yet"}
 
 

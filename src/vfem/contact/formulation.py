@@ -93,11 +93,14 @@ def check_capabilities(model) -> None:
             raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: no "
                              f"body named {unknown[0]!r} (bodies: {', '.join(sorted(names))})")
     if settings.frictional and "coulomb" not in caps.friction:
-        what = ("large kinematics" if large and settings.method == "vfem" else
+        body = next((b.name for b in model.bodies if b.large), None)
+        what = (f"large kinematics (body {body!r})" if large and settings.method == "vfem" else
                 f"contact.method = {settings.method!r}" if settings.method != "vfem" else
                 f"contact.variant = {settings.variant!r}")
-        raise InputError(f"model {model.name!r}: friction (contact.friction = "
-                         f"{settings.friction:g}, or a contact.pairs entry) is available with the "
+        where = (f"contact.friction = {settings.friction:g}" if settings.friction > 0 else
+                 "contact.pairs " + ", ".join(repr(list(p.bodies)) for p in settings.pairs
+                                              if p.friction > 0))
+        raise InputError(f"model {model.name!r}: friction ({where}) is available with the "
                          f"paired variant and small kinematics only, not yet with {what}; set "
                          "it to 0 for frictionless contact")
     for b in model.bodies:

@@ -285,6 +285,7 @@ class FrictionalPairedContact(PairedContact):
             n = s.body.npoints
             r.contact_shear, r.slip_increment = np.zeros((n, s.dim)), np.zeros(n)
             r.accumulated_slip = np.zeros(n)
+            r.friction_force = np.zeros((n, s.dim))
             r.friction_status = np.full(n, -1)  # not a compatibility-side node of a pair
         for k, pair in enumerate(self.contact_pairs):
             sf = self.surfaces[pair.fine]
@@ -295,6 +296,14 @@ class FrictionalPairedContact(PairedContact):
             r.slip_increment[points] = increments[k]
             r.accumulated_slip[points] = self.accumulated_slip(state, k)
             r.friction_status[points] = self.status(state, k)
+            # the nodal forces of the tangential traction alone, on both sides (as
+            # assemble_forces makes them)
+            traction = shear[:, None] * self._tangents[k][0]
+            sc = self.surfaces[pair.coarse]
+            out[sf.body.name].friction_force[sf.nodes[: sf.nc]] += \
+                pair.mass[:, pair.nodes] @ traction
+            out[sc.body.name].friction_force[sc.nodes[: sc.nc]] -= \
+                pair.transfer[:, pair.nodes] @ traction
         return out
 
     def _correct_frictional(self, state: FrictionState, pens: list[np.ndarray],

@@ -52,7 +52,10 @@ class PairFriction:
                              f"got {self.friction!r}")
         static, stiffness = self.static_friction, self.slip_stiffness
         if self.law == "static_dynamic":
-            if static is None or not (math.isfinite(static) and static >= self.friction):
+            if static is None:
+                raise InputError(f"{where} {list(self.bodies)!r}: the static_dynamic law needs "
+                                 f"static_friction (>= friction, {self.friction:g})")
+            if not (math.isfinite(static) and static >= self.friction):
                 raise InputError(f"{where} {list(self.bodies)!r}: the static_dynamic law needs "
                                  f"static_friction >= friction ({self.friction:g}), got "
                                  f"{static!r}")
@@ -60,7 +63,11 @@ class PairFriction:
             raise InputError(f"{where} {list(self.bodies)!r}: static_friction is for the "
                              f"static_dynamic law, not {self.law!r}")
         if self.law == "elastoplastic":
-            if stiffness is None or not (math.isfinite(stiffness) and stiffness > 0):
+            if stiffness is None:
+                raise InputError(f"{where} {list(self.bodies)!r}: the elastoplastic law needs "
+                                 "slip_stiffness (> 0), the tangential traction per unit "
+                                 "elastic slip")
+            if not (math.isfinite(stiffness) and stiffness > 0):
                 raise InputError(f"{where} {list(self.bodies)!r}: the elastoplastic law needs "
                                  f"slip_stiffness > 0, got {stiffness!r}")
         elif stiffness is not None:

@@ -88,6 +88,19 @@ def shear_theory(p: Parameters, x: np.ndarray, tangential: float) -> np.ndarray:
     return out
 
 
+def shear_curve(p: Parameters) -> tuple[tuple[float, float], ...]:
+    """The load curve of the sideways motion: 0 until 0.5, 1 at 1 (with ``cycle``: -1 at 1.5,
+    1 at 2)."""
+    return ((0.0, 0.0), (0.5, 0.0), (1.0, 1.0)) + (((1.5, -1.0), (2.0, 1.0)) if p.cycle else ())
+
+
+def shear_multiplier(p: Parameters, load_factor: float) -> float:
+    """The sideways motion at ``load_factor``, over ``shift``."""
+    from ..bodies import multiplier
+
+    return float(multiplier(shear_curve(p), load_factor))
+
+
 def load_factors(p: Parameters) -> tuple[float, ...]:
     branches = 3 if p.cycle else 1
     return (tuple(0.5 * (k + 1) / p.press_steps for k in range(p.press_steps))
@@ -105,7 +118,7 @@ def config(p: Parameters | None = None) -> ModelConfig:
     material = LinearElastic(p.youngs_modulus, p.poissons_ratio)
     end = 2.0 if p.cycle else 1.0
     press = ((0.0, 0.0), (0.5, 1.0), (end, 1.0))
-    shear = ((0.0, 0.0), (0.5, 0.0), (1.0, 1.0)) + (((1.5, -1.0), (2.0, 1.0)) if p.cycle else ())
+    shear = shear_curve(p)
 
     def disk(facets: int, flat_side: str) -> MeshSpec:
         return MeshSpec(shape="graded_half_disk", parameters=as_parameters(
@@ -225,12 +238,14 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
         prof = profile(result, step)
         x, s = np.asarray(prof["x"]), np.asarray(prof["shear"])
         status = np.asarray(prof["status"])
-        unloading = p.cycle and 1.0 < step.load_factor <= 1.5 + 1e-12
-        if step.load_factor <= 1.0 + 1e-12:
-            peak = tangential
-        c = (reverse_stick_half_width(p, peak, tangential) if unloading and peak is not None
+        # after a reversal of the motion (cycle: back from 1, forward again from 1.5), the
+        # stick zone is Mindlin and Deresiewicz's c', from the force at the reversal
+        c = (reverse_stick_half_width(p, peak, tangential) if peak is not None
              else stick_half_width(p, tangential))
-        row = {"load_factor": step.load_factor, "Q_over_muP": tangential / (p.friction * normal),
+        if p.cycle and any(abs(step.load_factor - turn) < 1e-12 for turn in (1.0, 1.5)):
+            peak = tangential
+        row = {"load_factor": step.load_factor, "motion": shear_multiplier(p, step.load_factor),
+               "Q_over_muP": tangential / (p.friction * normal),
                "c_over_a": c / a, "last_sticking_over_a":
                float(np.abs(x[status == 1]).max() / a) if (status == 1).any() else 0.0}
         if not p.cycle or step.load_factor <= 1.0 + 1e-12:
@@ -277,8 +292,10 @@ def _figure_data(result: AnalysisResult, summary: dict, p: Parameters) -> None:
 def figures(folder) -> list[Path]:
     """The figures of a Cattaneo results folder (:class:`vfem.io.replot.Folder`), which the run
     draws and ``vfem plot`` redraws: ``shear.png``, the shear traction over mu p0 against x/a
-    at three steps of the shear with Cattaneo-Mindlin's; ``loop.png``, Q/(mu P) against the
-    motion (the hysteresis loop with ``cycle``)."""
+    at the steps of the shear nearest Q/(mu P) = 0.3, 0.6 and 0.9, with Cattaneo-Mindlin's;
+    ``loop.png``, Q/(mu P) against the motion (the hysteresis loop with ``cycle``);
+    ``stick.png``, the stick zone's half-width of the theory and the outermost sticking node
+    against the load factor; ``von_mises.png``, the contact at the last step."""
     from ..io import plots, replot
 
     s = folder.summary
@@ -301,14 +318,23 @@ def figures(folder) -> list[Path]:
                    f"Cattaneo-Mindlin: two similar cylinders, mu = {p.friction:g} "
                    f"(lines: theory)\n{method}")
     rows = s["cattaneo"]["steps"]
-    plots.history(out / "loop.png", np.asarray([r["load_factor"] for r in rows]),
-                  {"Q / (mu P)": np.asarray([r["Q_over_muP"] for r in rows]),
-                   "c / a, theory": np.asarray([r["c_over_a"] for r in rows]),
-                   "outermost sticking node / a": np.asarray(
-                       [r["last_sticking_over_a"] for r in rows])},
-                  "load factor (0.5 to 1: the motion grows)", "ratio",
-                  f"Cattaneo-Mindlin: tangential force and stick zone\n{method}")
-    return [out / "shear.png", out / "loop.png"]
+    motion = np.asarray([r["motion"] for r in rows])
+    ratio = np.asarray([r["Q_over_muP"] for r in rows])
+    plots.profiles(out / "loop.png", [("vfem", motion, ratio, motion, ratio)],
+                   f"sideways motion / shift (shift = {p.shift:g})", "Q / (mu P)",
+                   f"Cattaneo-Mindlin: tangential force against the motion\n{method}")
+    factor = np.asarray([r["load_factor"] for r in rows])
+    plots.profiles(out / "stick.png", [
+        ("outermost sticking node (line: theory's c)", factor,
+         np.asarray([r["last_sticking_over_a"] for r in rows]), factor,
+         np.asarray([r["c_over_a"] for r in rows]))],
+        "load factor (the motion from 0.5)", "stick zone half-width / a",
+        f"Cattaneo-Mindlin: the stick zone (Mindlin-Deresiewicz after a reversal)\n{method}")
+    last = folder.steps[-1]
+    vm = replot.von_mises(folder, last, "von_mises.png",
+                          f"Cattaneo-Mindlin: von Mises stress at the contact, load factor "
+                          f"{last.load_factor:g}\n{method}", window=(-3 * a, 3 * a, -2 * a, 2 * a))
+    return [out / "shear.png", out / "loop.png", out / "stick.png", vm]
 
 
 def report(s: dict) -> list[str]:

@@ -41,6 +41,7 @@ from ..schema import (
 SECTIONS = {
     "ModelConfig": "top level",
     "ContactSettings": "[contact]",
+    "PairFriction": "[[contact.pairs]]",
     "Steps": "[steps]",
     "Output": "[output]",
     "BodyConfig": "[[bodies]]",
@@ -357,11 +358,11 @@ def _default_text(f) -> str:
 def reference() -> str:
     """The key reference of ``docs/input.md`` (generated; a test compares the two)."""
     from ..bodies import Platen, PrescribedDisplacement, Support, Traction
-    from ..contact.settings import ContactSettings
+    from ..contact.settings import ContactSettings, PairFriction
     from ..materials import LinearElastic
 
-    classes = [ModelConfig, ContactSettings, Steps, Output, BodyConfig, MeshSpec, Curve,
-               LinearElastic, Support, PrescribedDisplacement, Traction, Platen]
+    classes = [ModelConfig, ContactSettings, PairFriction, Steps, Output, BodyConfig, MeshSpec,
+               Curve, LinearElastic, Support, PrescribedDisplacement, Traction, Platen]
     out = []
     for cls in classes:
         doc = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0].replace("\n", " ")

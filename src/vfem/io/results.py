@@ -110,7 +110,7 @@ class ResultsWriter:
         self.contact_rows: list[list[str]] = []
         self.reaction_rows: list[list[str]] = []
         #: contact.csv's columns: the friction's too when the model has friction
-        self.friction = float(getattr(model.contact, "friction", 0.0)) > 0
+        self.friction = bool(getattr(model.contact, "frictional", False))
 
     def restore(self, steps: list[StepResult]) -> None:
         """Take up the series of an earlier run whose ``steps`` are already on disk (their
@@ -395,20 +395,22 @@ def step_record(step: StepResult) -> dict:
             "invariants": step.invariants, **force_record(step)}
 
 
-def contact_work(steps: list[StepResult]) -> list[float]:
-    """Per step, the work the contact forces took from the bodies: minus the sum, over every
-    node of every body, of the step's final contact force times the node's displacement in
-    the step (from the step before; from zero for the first). With friction it is the work the
-    friction dissipated (the normal forces do none where gaps stay closed: their share is
-    the penetration tolerance's); over a closed loop of loading it is the loop's area (the
-    Cattaneo model's shear cycle: within 2.0 % with 10 steps per branch, 0.34 % with 40,
-    ``tests/test_friction.py``). Computed from the results alone, not from the formulation."""
+def frictional_work(steps: list[StepResult]) -> list[float]:
+    """Per step, the work the friction took from the bodies: minus the sum, over every node of
+    every body, of the step's final tangential contact force (``friction_force``, the part of
+    the contact force the tangential traction makes) times the node's displacement in the step
+    (from the step before; from zero for the first). Over a closed loop of loading it is the
+    loop's area (the Cattaneo model's shear cycle, ``tests/test_friction.py``). The normal
+    forces are left out: where a contact grows (a press), their end-of-step force times the
+    closing of the gaps it made is the step's discretisation, not dissipation (it read as much
+    "frictional work" at mu = 1e-3 as at 0.3). 0 for a step without friction's fields."""
     out, before = [], {}
     for step in steps:
         work = 0.0
         for name, r in step.bodies.items():
-            du = r.displacement - before.get(name, 0.0)
-            work -= float(np.einsum("ij,ij->", r.contact_force, du))
+            if r.friction_force is not None:
+                du = r.displacement - before.get(name, 0.0)
+                work -= float(np.einsum("ij,ij->", r.friction_force, du))
         out.append(work)
         before = {name: r.displacement for name, r in step.bodies.items()}
     return out
@@ -470,7 +472,7 @@ def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
            "parameters": dataclasses.asdict(parameters), "timings": result.timings,
            "linear_solver": result.backend}
     if result.model.contact.frictional:
-        work = contact_work(result.steps)
+        work = frictional_work(result.steps)
         for x, w in zip(out["steps"], work, strict=True):
             x["frictional_work"] = w
         out["frictional_work_total"] = float(sum(work))

@@ -20,9 +20,9 @@ from ..solver import AnalysisResult, Model
 from .files import forget_vtus
 from .input import to_data
 from .results import (
-    contact_work,
     finish_summary,
     force_record,
+    frictional_work,
     run_writing,
     step_record,
     total,
@@ -66,8 +66,8 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
     steps = []
     for s in result.steps:
         steps.append({**step_record(s), "platen_displacement": s.platen_displacement})
-    if config.contact.friction > 0:  # the work the friction dissipated, per step
-        for x, work in zip(steps, contact_work(result.steps), strict=True):
+    if config.contact.frictional:  # the work the friction dissipated, per step
+        for x, work in zip(steps, frictional_work(result.steps), strict=True):
             x["frictional_work"] = work
     return {
         "model": config.name,
@@ -232,9 +232,12 @@ def report(s: dict, out: Path) -> list[str]:
         if line:
             lines.append("  " + line)
     if "frictional_work_total" in s:
-        mu = (s.get("config") or {}).get("contact", {}).get("friction")
-        lines.append(f"  friction: mu = {mu:g}, work dissipated {s['frictional_work_total']:.4g} "
-                     f"over the run (contact_shear, slip and friction status in contact.csv and "
-                     f"the VTU files)")
+        contact = (s.get("config") or {}).get("contact", {})
+        laws = [f"mu = {contact.get('friction', 0.0):g}"] if contact.get("friction") else []
+        laws += [f"{'/'.join(x['bodies'])}: {x.get('law', 'coulomb')} mu = "
+                 f"{x.get('friction', 0.0):g}" for x in contact.get("pairs") or ()]
+        lines.append(f"  friction ({'; '.join(laws)}): work dissipated "
+                     f"{s['frictional_work_total']:.4g} over the run (shear, slip and stick or "
+                     f"slip per node in contact.csv and the VTU files)")
     return lines
 
