@@ -54,6 +54,36 @@ def main(pairs: list[tuple[int, int]]) -> None:
               f"{abs(readings[-1].tangential) / (p.friction * readings[-1].normal) - 1:+.1e}")
 
 
+def cost(pairs: list[tuple[int, int]]) -> None:
+    """The same model with friction and without (contact.friction = 0: the shear then slides
+    freely), alternately, twice, the faster of each: wall time and contact iterations."""
+    import dataclasses
+
+    from vfem.solver import Analysis
+
+    print(f"\n{'facets':>8} {'dofs':>7} {'frictional s':>12} {'iterations':>10} "
+          f"{'frictionless s':>14} {'iterations':>10} {'ratio':>6}")
+    for upper, lower in pairs:
+        p = cattaneo.Parameters(facets_upper=upper, facets_lower=lower)
+        best = {}
+        for _ in range(2):
+            for mu in (p.friction, 0.0):
+                model = cattaneo.build(p)
+                model.contact = dataclasses.replace(model.contact, friction=mu)
+                t0 = time.perf_counter()
+                result = Analysis(model).run()
+                seconds = time.perf_counter() - t0
+                its = sum(s.iterations for s in result.steps)
+                if mu not in best or seconds < best[mu][0]:
+                    best[mu] = (seconds, its, sum(b.ndofs for b in model.bodies))
+        (tf, itf, dofs), (t0_, it0, _) = best[p.friction], best[0.0]
+        print(f"{upper:>3}/{lower:<4} {dofs:>7} {tf:>12.2f} {itf:>10} {t0_:>14.2f} {it0:>10} "
+              f"{tf / t0_:>6.2f}")
+
+
 if __name__ == "__main__":
-    numbers = [int(v) for v in sys.argv[1:]] or [12, 17]
-    main(list(zip(numbers[::2], numbers[1::2])))
+    args = sys.argv[1:]
+    timing = "--cost" in args
+    numbers = [int(v) for v in args if v != "--cost"] or [12, 17]
+    pairs = list(zip(numbers[::2], numbers[1::2]))
+    (cost if timing else main)(pairs)
