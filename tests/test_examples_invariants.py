@@ -23,6 +23,8 @@ collection included: about 10 s; they vary by 2-3x with the machine's load):
 case                            time        invariants
 ==============================  ==========  =============================================
 block.toml                      1 s         hold
+cattaneo.toml                   0.5 s       hold
+friction/pushed_block.toml      0.1 s       hold
 gasket.toml                     0.7-4 s     hold
 hertz.toml                      0.3 s       hold
 hertz_gmsh (needs gmsh)         0.5 s       hold (mesh made by make_mesh.py in tmp first)

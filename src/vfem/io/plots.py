@@ -400,6 +400,11 @@ def profiles(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray, np.ndar
     for (label, x, y, xt, yt), c in zip(curves, colors * (len(curves) // 6 + 1)):
         ax.plot(xt, yt, "-", color=c, lw=1.2)
         ax.plot(x, y, "o", ms=3.5, mfc="none", color=c, label=label)
+    _finish_profiles(plt, fig, ax, path, xlabel, ylabel, title)
+
+
+def _finish_profiles(plt, fig, ax, path: Path, xlabel: str, ylabel: str, title: str) -> None:
+    """A profile figure's zero line, labels, title, grid and legend beside the axes; saved."""
     ax.axhline(0, color="0.7", lw=0.8)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
@@ -409,6 +414,26 @@ def profiles(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray, np.ndar
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+def friction_profiles(path: Path, bodies: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
+                      title: str) -> None:
+    """The tangential traction against x per body: (x, signed traction, status 1 stick or 2
+    slip) of the nodes in contact; sticking nodes filled, slipping ones open."""
+    plt = require_matplotlib()
+    fig, ax = plt.subplots(figsize=(8.0, 4.2))
+    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    for (name, (x, s, status)), c in zip(bodies.items(), colors * (len(bodies) // 6 + 1)):
+        if not len(x):
+            continue
+        order = np.argsort(x, kind="stable")
+        ax.plot(x[order], s[order], "-", color=c, lw=0.8)
+        for code, fill, what in ((1, c, "sticks"), (2, "none", "slips")):
+            pick = status == code
+            if pick.any():
+                ax.plot(x[pick], s[pick], "o", ms=4, mfc=fill, color=c, label=f"{name}: {what}")
+    _finish_profiles(plt, fig, ax, path, f"x, undeformed ({LENGTH})",
+                     f"tangential traction, sign of its x part ({LENGTH})", title)
 
 
 def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.ndarray,

@@ -18,7 +18,9 @@ records no figure set, e.g. one written before figure sets were recorded):
 * ``history.png`` — per step: iterations, final largest penetration and equilibrium error (from
   ``summary.json``'s ``steps``, when there), and the magnitude of the resultant contact force
   on each body (the sum of the VTU's nodal ``contact_force``; per unit thickness);
-* ``von_mises.png`` — the last step's deformed bodies filled by the VTU's element ``von_mises``.
+* ``von_mises.png`` — the last step's deformed bodies filled by the VTU's element ``von_mises``;
+* ``friction.png`` (a run with friction) — the last step's tangential traction against x at the
+  nodes that carry a pair's compatibility, sticking and slipping nodes marked apart.
 
 Without ``contact.csv`` (results written by an older version), the nodes in contact and their
 pressure are taken from the VTU's ``contact_status`` and ``contact_pressure`` point fields.
@@ -419,6 +421,8 @@ def generic(folder: Folder) -> list[Path]:
     written.append(_pressure(folder.directory, steps, folder.contact, folder.contact_source,
                              label))
     written.append(_history(folder.directory, steps, folder.summary or None))
+    if "contact_shear" in steps[-1].bodies[0].point_data:  # a run with friction
+        written.append(_friction(folder.directory, steps[-1], label))
     # the most stressed step (a load that is held and then removed ends unloaded)
     peak = max(steps, key=lambda s: max(float(_cell_field(b, "von_mises").max(initial=0.0))
                                         for b in s.bodies))
@@ -523,6 +527,26 @@ def _pressure(directory: Path, steps: list[Step], contact, source: str, method: 
         + f"\n(nominal: normal force / undeformed length; from {source})\n{method}",
         xlabel=f"{'xy'[axis]}, undeformed ({plots.LENGTH})",
         ylabel=f"nominal contact pressure ({plots.LENGTH})")
+    return path
+
+
+def _friction(directory: Path, step: Step, method: str) -> Path:
+    """``friction.png``: at ``step``, the tangential traction (its size, signed by its x
+    component) against the normal one at the nodes that carry a pair's compatibility and
+    touch, per body, sticking and slipping nodes marked apart (the VTU's ``contact_shear``,
+    ``contact_traction`` and ``friction_status``): a slipping node lies on its line
+    |s| = mu q."""
+    bodies = {}
+    for b in step.bodies:
+        status = np.asarray(b.point_data["friction_status"]).ravel()
+        on = status > 0
+        shear = np.asarray(b.point_data["contact_shear"])[on, :2]
+        signed = np.hypot(shear[:, 0], shear[:, 1]) * np.where(shear[:, 0] < 0, -1.0, 1.0)
+        bodies[b.name] = (b.points[on, 0], signed, status[on])
+    path = directory / "friction.png"
+    plots.friction_profiles(path, bodies,
+                            f"Tangential traction at the nodes in contact, step {step.step} "
+                            f"(load factor {step.load_factor:.6g})\n{method}")
     return path
 
 
