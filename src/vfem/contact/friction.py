@@ -17,7 +17,11 @@ more traction field per contact pair:
   converged step (``FrictionState.anchor``): no slip within the step.
 * **The Coulomb law** (a node that slips): ``|s| = mu q`` with s opposing the slip increment
   ``w - anchor``. A node sticks while ``|s| < mu q``; a node with no normal traction carries
-  no tangential one.
+  no tangential one. Per pair of bodies (``[[contact.pairs]]``,
+  :class:`~vfem.contact.settings.PairFriction`) the law may instead have a static coefficient
+  (a node at rest sticks until ``|s|`` reaches ``mu_s q``, then slips at ``mu q``) or be the
+  thesis's elasto-plastic friction-slippage law (§1.10: below the cone an elastic slip
+  ``s / k_t``, which the sticking rows take up).
 * **The correction.** For given sets (in contact; of those, sticking or slipping, and each
   slipping node's direction σ), the conditions are linear in the traction values: the normal
   rows ask each contact node's penetration to close (as without friction), the tangential rows
