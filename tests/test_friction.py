@@ -491,20 +491,7 @@ def test_friction_patch_test_uniform_shear_sticking_and_slipping(n_lower, n_uppe
     mu, p, E = 0.3, 100.0, 1.0e6
     for tau, shift, expected in ((0.5 * mu * p, 2 * (0.5 * mu * p) / (E / 2), 1),
                                  (mu * p, 3 * 2 * (mu * p) / (E / 2), 2)):
-        sides = SIDES.format(minus=-tau, plus=tau)
-        text = PATCH.format(n_lower=n_lower, n_upper=n_upper, mu=mu, shift=shift,
-                            pressure=-p, sides=sides)
-        result = Analysis(loads(text).build()).run()
-        assert result.converged, result.message
-        last = result.steps[-1]
-        shears = []
-        for r in last.bodies.values():
-            carries = r.friction_status > 0
-            if carries.any():
-                assert np.all(r.friction_status[carries] == expected)
-                shears.append(np.abs(r.contact_shear[carries, 0]))
-                np.testing.assert_allclose(r.contact_traction[carries], p, rtol=1e-8)
-        shear = np.concatenate(shears)
+        shear = _patch_shear(n_lower, n_upper, tau, shift, "", expected)
         np.testing.assert_allclose(shear, tau, rtol=0, atol=1e-8 * mu * p)
 
 
@@ -576,14 +563,20 @@ def _patch(n_lower, n_upper, tau, shift, pair="", mu=0.3):
     return loads(text.replace("[[bodies]]", pair + "[[bodies]]", 1)).build()
 
 
-def _interface_shear(result, expected_status):
-    last = result.steps[-1]
+def _patch_shear(n_lower, n_upper, tau, shift, pair, expected_status):
+    """Solve :func:`_patch`'s model (it must converge) and return the tangential traction at
+    the interface nodes that carry compatibility, all of which must have ``expected_status``
+    (1 stick, 2 slip)."""
+    result = Analysis(_patch(n_lower, n_upper, tau, shift, pair)).run()
+    assert result.converged, result.message
     shears = []
-    for r in last.bodies.values():
+    for r in result.steps[-1].bodies.values():
         carries = r.friction_status > 0
         if carries.any():
             assert np.all(r.friction_status[carries] == expected_status)
             shears.append(np.abs(r.contact_shear[carries, 0]))
+            # the normal traction is the uniform pressure
+            np.testing.assert_allclose(r.contact_traction[carries], 100.0, rtol=1e-8)
     return np.concatenate(shears)
 
 
@@ -595,12 +588,10 @@ def test_static_and_dynamic_coefficients_on_the_patch(n_lower, n_upper):
     pair = ('[[contact.pairs]]\nbodies = ["lower", "upper"]\nfriction = 0.3\n'
             'law = "static_dynamic"\nstatic_friction = 0.4\n')
     p, G = 100.0, 1.0e6 / 2
-    stick = Analysis(_patch(n_lower, n_upper, 0.35 * p, 2 * 0.35 * p / G, pair)).run()
-    assert stick.converged, stick.message
-    np.testing.assert_allclose(_interface_shear(stick, 1), 0.35 * p, rtol=0, atol=1e-8 * p)
-    slide = Analysis(_patch(n_lower, n_upper, 0.3 * p, 6 * 0.4 * p / G, pair)).run()
-    assert slide.converged, slide.message
-    np.testing.assert_allclose(_interface_shear(slide, 2), 0.3 * p, rtol=0, atol=1e-8 * p)
+    stick = _patch_shear(n_lower, n_upper, 0.35 * p, 2 * 0.35 * p / G, pair, 1)
+    np.testing.assert_allclose(stick, 0.35 * p, rtol=0, atol=1e-8 * p)
+    slide = _patch_shear(n_lower, n_upper, 0.3 * p, 6 * 0.4 * p / G, pair, 2)
+    np.testing.assert_allclose(slide, 0.3 * p, rtol=0, atol=1e-8 * p)
 
 
 @pytest.mark.parametrize("n_lower, n_upper", [(4, 7), (7, 4), (1, 5)])
@@ -615,13 +606,10 @@ def test_the_elastoplastic_law_adds_its_slip_compliance_in_series(n_lower, n_upp
     delta = 1e-4
     tau = delta / (2 / G + 1 / k_t)
     assert tau < mu * p
-    elastic = Analysis(_patch(n_lower, n_upper, tau, delta, pair)).run()
-    assert elastic.converged, elastic.message
-    np.testing.assert_allclose(_interface_shear(elastic, 1), tau, rtol=1e-8)
-    slide = Analysis(_patch(n_lower, n_upper, mu * p, 10 * mu * p * (2 / G + 1 / k_t),
-                            pair)).run()
-    assert slide.converged, slide.message
-    np.testing.assert_allclose(_interface_shear(slide, 2), mu * p, rtol=0, atol=1e-8 * p)
+    elastic = _patch_shear(n_lower, n_upper, tau, delta, pair, 1)
+    np.testing.assert_allclose(elastic, tau, rtol=1e-8)
+    slide = _patch_shear(n_lower, n_upper, mu * p, 10 * mu * p * (2 / G + 1 / k_t), pair, 2)
+    np.testing.assert_allclose(slide, mu * p, rtol=0, atol=1e-8 * p)
 
 
 def test_a_pair_entry_overrides_the_models_friction():

@@ -49,7 +49,7 @@ import logging
 
 import numpy as np
 
-from .corrections import relaxation, release_tension
+from .corrections import relaxation
 from .group import bordered_matrix
 from .iteration import Check, iterate
 from .paired import PairedContact
@@ -103,6 +103,10 @@ class FrictionalPairedContact(PairedContact):
                                             surfaces[p.coarse].body.name).coefficients
                      for p in self.contact_pairs]
         self._tangents = [tangents(pair.normal) for pair in self.contact_pairs]
+        #: per pair, the slip increments of the last converged step (for :meth:`fields`) and
+        #: the nodes released from tension in the current solve (:meth:`_correct_frictional`)
+        self._increments = [np.zeros(len(p.nodes)) for p in self.contact_pairs]
+        self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.contact_pairs]
 
     def directions(self, k: int) -> list[np.ndarray]:
         """The normal, then the tangents: the order of each pair's unknowns."""
@@ -119,10 +123,11 @@ class FrictionalPairedContact(PairedContact):
             state.penetration[k] = p.copy()
         return state
 
-    def _values(self, state: FrictionState, name: str, k: int) -> np.ndarray:
+    def _values(self, state: FrictionState, name: str, k: int, dtype=float) -> np.ndarray:
+        """Pair k's array ``name`` of the state's history, zeros until first set."""
         table = getattr(state, name)
         if k not in table:
-            table[k] = np.zeros(len(self.contact_pairs[k].nodes))
+            table[k] = np.zeros(len(self.contact_pairs[k].nodes), dtype=dtype)
         return table[k]
 
     def shear(self, state: FrictionState, k: int) -> np.ndarray:
@@ -139,35 +144,31 @@ class FrictionalPairedContact(PairedContact):
 
     def sliding(self, state: FrictionState, k: int) -> np.ndarray:
         """Pair k's nodes that slipped in the last correction."""
-        if k not in state.sliding:
-            state.sliding[k] = np.zeros(len(self.contact_pairs[k].nodes), dtype=bool)
-        return state.sliding[k]
+        return self._values(state, "sliding", k, bool)
 
     def status(self, state: FrictionState, k: int) -> np.ndarray:
         """Pair k's nodes: 0 free (no normal traction), 1 sticking, 2 slipping."""
         on = self.tractions(state, k) > 0
         return np.where(on, np.where(self.sliding(state, k), 2, 1), 0)
 
-    def free_slips(self, state: FrictionState) -> list[np.ndarray]:
+    def free_slips(self, state: FrictionState, relative: list[np.ndarray] | None = None
+                   ) -> list[np.ndarray]:
         """Per pair, each node's slip within the step that its law does not take up
         elastically: the relative tangential displacement from its anchor, plus its
         tangential traction over the slip stiffness (the elastoplastic law; nothing for the
         others). A sticking node holds it at zero; a slipping one moves it against its
         traction."""
         return [w - self.anchor(state, k) + self.laws[k][2] * self.shear(state, k)
-                for k, w in enumerate(self.tangential_displacements(state))]
+                for k, w in enumerate(self.tangential_displacements(state, relative))]
 
-    def tangential_displacements(self, state: ContactState) -> list[np.ndarray]:
+    def tangential_displacements(self, state: ContactState,
+                                 relative: list[np.ndarray] | None = None) -> list[np.ndarray]:
         """Per pair, each node's relative tangential displacement against its virtual node,
-        ``w = t.(u_fine - u_virtual)`` (linear kinematics, as the penetrations)."""
-        x = self.positions(state)
-        out = []
-        for k, pair in enumerate(self.contact_pairs):
-            sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            uf = x[pair.fine][pair.nodes] - sf.X[pair.nodes]
-            uc = pair.interp @ (x[pair.coarse][: sc.nc] - sc.X[: sc.nc])
-            out.append(np.einsum("ij,ij->i", uf - uc, self._tangents[k][0]))
-        return out
+        ``w = t.(u_fine - u_virtual)`` (linear kinematics, as the penetrations; from
+        ``relative``, :meth:`relative_displacements`, when given)."""
+        relative = self.relative_displacements(state) if relative is None else relative
+        return [np.einsum("ij,ij->i", d, t[0]) for d, t in zip(relative, self._tangents,
+                                                              strict=True)]
 
     def assemble_forces(self, state: ContactState) -> None:
         """Every body's nodal forces from the pairs' normal and tangential tractions."""
@@ -219,8 +220,9 @@ class FrictionalPairedContact(PairedContact):
         self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.contact_pairs]
 
         def check(it: int) -> Check:
-            pens = self.penetrations(state)
-            dw = self.free_slips(state)
+            relative = self.relative_displacements(state)  # one back-substitution for both
+            pens = self.penetrations(state, relative)
+            dw = self.free_slips(state, relative)
             traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
             self._check_rind(pens)
             errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
@@ -265,9 +267,10 @@ class FrictionalPairedContact(PairedContact):
         """A converged step: accumulate each node's slip and anchor it where it now is (the
         step's slip increments are kept for :meth:`fields`)."""
         self._increments = []
-        for k, p in enumerate(self.penetrations(state)):
-            state.penetration[k] = p.copy()
-        for k, w in enumerate(self.tangential_displacements(state)):
+        relative = self.relative_displacements(state)
+        for k, p in enumerate(self.penetrations(state, relative)):
+            state.penetration[k] = p
+        for k, w in enumerate(self.tangential_displacements(state, relative)):
             anchor = self.anchor(state, k)
             on = self.tractions(state, k) > 0
             # where the node is, less its elastic slip (the elastoplastic law's s / k_t)
@@ -282,8 +285,7 @@ class FrictionalPairedContact(PairedContact):
         (:class:`~vfem.result_types.BodyStepResult`: tangential traction, slip increment,
         accumulated slip, stick or slip)."""
         out = super().fields(state, result)
-        increments = getattr(self, "_increments", None) or [
-            np.zeros(len(p.nodes)) for p in self.contact_pairs]
+        increments = self._increments
         for s in self.surfaces:
             r = out[s.body.name]
             n = s.body.npoints
@@ -295,14 +297,13 @@ class FrictionalPairedContact(PairedContact):
             sf = self.surfaces[pair.fine]
             r = out[sf.body.name]
             points = sf.nodes[pair.nodes]
-            shear = self.shear(state, k)
-            r.contact_shear[points] = shear[:, None] * self._tangents[k][0]
+            traction = self.shear(state, k)[:, None] * self._tangents[k][0]
+            r.contact_shear[points] = traction
             r.slip_increment[points] = increments[k]
             r.accumulated_slip[points] = self.accumulated_slip(state, k)
             r.friction_status[points] = self.status(state, k)
             # the nodal forces of the tangential traction alone, on both sides (as
             # assemble_forces makes them)
-            traction = shear[:, None] * self._tangents[k][0]
             sc = self.surfaces[pair.coarse]
             out[sf.body.name].friction_force[sf.nodes[: sf.nc]] += \
                 pair.mass[:, pair.nodes] @ traction
@@ -314,37 +315,27 @@ class FrictionalPairedContact(PairedContact):
                             dw: list[np.ndarray], it: int, platen_ok: bool = True) -> None:
         """Release tension, sort the contact nodes into sticking and slipping, then one solve of
         the normal and tangential conditions of every pair together (module docstring)."""
-        cfg = self.settings
         tol = self.penetration_tolerance
-        omega = relaxation(cfg, it)
+        omega = relaxation(self.settings, it)
         if self._full is None:
             self._full = self._full_flexibility()
             diagonal = np.abs(np.diag(self._full[0]))
             #: the tangential unknowns whose relative tangential displacement no traction moves
             self._held = diagonal <= HELD * diagonal.max(initial=0.0)
         G, dz_dplaten, dR, offsets = self._full
-        m_all = len(G)
-        jump = np.zeros(m_all)  # known changes of the unknowns (cone, release)
-        q_cols, s_cols, rows, rhs = [], [], [], []
-        slip_tie = []  # (column of q, column of s, -mu sigma) of each slipping node
-        # a platen short of its force with no node touching: hold the nodes touching within
-        # the tolerance there (as without friction, PairedContact._correct)
-        touching = not platen_ok and not any(
-            ((self.tractions(state, k) > 0) | (pens[k] > tol)).any()
-            for k in range(len(self.contact_pairs)))
-        elastic = []  # (row, column of s, 1 / slip stiffness) of each elastic sticking node
+        jump = np.zeros(len(G))  # known changes of the unknowns (cone, release)
+        # per pair: the unknowns solved for (normal ones, then tangential), the rows (normal
+        # and tangential conditions, pair by pair), their targets, and the slipping nodes' ties
+        q_cols, s_cols, rows, normal_rows, rhs = [], [], [], [], []
+        tie_q, tie_s, ties, elastic, compliances = [], [], [], [], []
         for k, pair in enumerate(self.contact_pairs):
-            n = len(pair.nodes)
+            n, base = len(pair.nodes), offsets[k]
             mu, mu_static, compliance = self.laws[k]
-            q, s, p = self.tractions(state, k), self.shear(state, k), pens[k]
+            p, s = pens[k], self.shear(state, k)
+            tension, contact = self._release_and_hold(state, k, p, platen_ok)
+            q = self.tractions(state, k)
             was_sliding = self.sliding(state, k)
-            tension = q < 0
-            change, state.released[pair.fine][pair.nodes] = release_tension(
-                q, tension, state.released[pair.fine][pair.nodes], cfg.release_iterations)
-            q += change
             self._torn[k] |= tension
-            contact = ~tension & ((q > 0) | (p > (-tol if touching else tol)))
-            base = offsets[k]
             slip_k = dw[k].copy()
             # A node that comes into contact in the prediction (the first iteration of a step:
             # the new loads with the last contact forces held, linear along the step) touched
@@ -383,51 +374,53 @@ class FrictionalPairedContact(PairedContact):
             slipping &= ~held
             sticking = contact & ~slipping & ~held
             was_sliding[:] = slipping | (contact & (mu_static == 0.0))
-            jump[base + n + np.flatnonzero(held)] = -s[held]
-            jump[base + n + np.flatnonzero(~contact)] = -s[~contact]  # no q, no s
-            for i in np.flatnonzero(contact):
-                q_cols.append(base + i)
-                rows.append(base + i)
-                rhs.append(omega * p[i])  # close the penetration
-            for i in np.flatnonzero(sticking):
-                s_cols.append(base + n + i)
-                rows.append(base + n + i)
-                rhs.append(-omega * slip_k[i])  # undo the slip within the step
-                if compliance > 0:  # elastoplastic: the slip s / k_t is elastic
-                    elastic.append((len(rows) - 1, base + n + i, compliance))
-            for i in np.flatnonzero(slipping):
-                tie = -mu * sigma[i]
-                jump[base + n + i] = tie * q[i] - s[i]  # onto the cone
-                slip_tie.append((base + i, base + n + i, tie))
+            free = held | ~contact  # no tangential traction (and no normal one off contact)
+            jump[base + n + np.flatnonzero(free)] = -s[free]
+            on, stick, slide = (np.flatnonzero(m) for m in (contact, sticking, slipping))
+            q_cols.append(base + on)
+            s_cols.append(base + n + stick)
+            rows += [base + on, base + n + stick]
+            normal_rows += [np.ones(len(on), bool), np.zeros(len(stick), bool)]
+            # close the penetrations; undo the slips within the step
+            rhs += [omega * p[on], -omega * slip_k[stick]]
+            if compliance > 0:  # elastoplastic: the slip s / k_t is elastic
+                elastic.append(base + n + stick)
+                compliances.append(np.full(len(stick), compliance))
+            tie = -mu * sigma[slide]  # s follows q on the cone
+            jump[base + n + slide] = tie * q[slide] - s[slide]
+            tie_q.append(base + slide)
+            tie_s.append(base + n + slide)
+            ties.append(tie)
         self.assemble_forces(state)  # the releases change the forces the platen sees
-        if not q_cols:
+        q_cols, s_cols = np.concatenate(q_cols), np.concatenate(s_cols)
+        if not len(q_cols):
             state.shear.update({k: np.zeros(len(p.nodes))
                                 for k, p in enumerate(self.contact_pairs)})
             self.assemble_forces(state)
             if not self.platen_met(state):
                 self._close_gap(state, pens)
             return
-        cols = np.array(q_cols + s_cols)
-        rows = np.array(rows)
+        cols, rows = np.concatenate([q_cols, s_cols]), np.concatenate(rows)
+        tie_q, tie_s, ties = (np.concatenate(a) for a in (tie_q, tie_s, ties))
+        position = np.full(len(G), -1)  # unknown -> its column in the system
+        position[cols] = np.arange(len(cols))
         Gr = G[rows]
-        A = Gr[:, cols].copy()
-        position = {c: j for j, c in enumerate(cols)}
-        for qc, sc, tie in slip_tie:  # s follows q on the cone
-            A[:, position[qc]] += tie * Gr[:, sc]
-        for row, sc, compliance in elastic:
-            A[row, position[sc]] += compliance
-        b = np.array(rhs) - Gr @ jump
-        bordered = self.platen_body is not None and state.platen_force != 0.0
-        if bordered:
+        A = Gr[:, cols]
+        A[:, position[tie_q]] += Gr[:, tie_s] * ties
+        if elastic:
+            unknowns = np.concatenate(elastic)  # their rows are their own tangential ones
+            at = np.full(len(G), -1)
+            at[rows] = np.arange(len(rows))
+            A[at[unknowns], position[unknowns]] += np.concatenate(compliances)
+        b = np.concatenate(rhs) - Gr @ jump
+        if self.platen_body is not None and state.platen_force != 0.0:
             body = self.surfaces[self.platen_body].body
             row = dR[cols].copy()
-            for qc, sc, tie in slip_tie:
-                row[position[qc]] += tie * dR[sc]
+            row[position[tie_q]] += ties * dR[tie_s]
             extra = state.platen_force - self.platen_reaction(state) - dR @ jump
             # the rows' change per unit platen motion: penetration reduction (normal rows),
             # relative tangential displacement (tangential rows)
-            column = np.where(self._normal_rows(rows, offsets), -dz_dplaten[rows],
-                              dz_dplaten[rows])
+            column = np.where(np.concatenate(normal_rows), -dz_dplaten[rows], dz_dplaten[rows])
             x = np.linalg.solve(bordered_matrix(A, column, row, body.platen_stiffness),
                                 np.concatenate([b, [extra]]))
             x, dplaten = x[:-1], float(x[-1])
@@ -435,19 +428,12 @@ class FrictionalPairedContact(PairedContact):
             x, dplaten = np.linalg.solve(A, b), 0.0
         delta = jump.copy()
         delta[cols] += x
-        for qc, sc, tie in slip_tie:
-            delta[sc] += tie * x[position[qc]]
+        delta[tie_s] += ties * x[position[tie_q]]
         for k, pair in enumerate(self.contact_pairs):
             n, base = len(pair.nodes), offsets[k]
             self.tractions(state, k)[:] += delta[base:base + n]
             self.shear(state, k)[:] += delta[base + n:base + 2 * n]
         state.platen_displacement += dplaten
-
-    def _normal_rows(self, rows: np.ndarray, offsets: np.ndarray) -> np.ndarray:
-        """Which of the unknowns' ``rows`` are normal ones (the first n of each pair's 2n)."""
-        k = np.searchsorted(offsets, rows, side="right") - 1
-        n = (offsets[k + 1] - offsets[k]) // 2
-        return rows - offsets[k] < n
 
 
 __all__ = ["CONE_TOLERANCE", "FrictionalPairedContact", "coulomb_status", "tangents"]

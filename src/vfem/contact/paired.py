@@ -351,16 +351,44 @@ class PairedContact(PairSet):
         self._full = None
         self._factor = ReusedFactor()  # the pair matrix's factors while the active set holds
 
-    def penetrations(self, state: ContactState) -> list[np.ndarray]:
-        """Penetration (> 0 overlap) of every pair's fine nodes, linear kinematics."""
+    def relative_displacements(self, state: ContactState) -> list[np.ndarray]:
+        """Per pair, (nodes, dim) each fine node's displacement less its virtual node's
+        (linear kinematics): along the normal it makes the penetration, along the tangent the
+        friction's slip (:mod:`vfem.contact.friction`)."""
         x = self.positions(state)
         out = []
         for pair in self.contact_pairs:
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
             uf = x[pair.fine][pair.nodes] - sf.X[pair.nodes]
             uc = pair.interp @ (x[pair.coarse][: sc.nc] - sc.X[: sc.nc])
-            out.append(-(pair.gap0 + np.einsum("ij,ij->i", uf - uc, pair.normal)))
+            out.append(uf - uc)
         return out
+
+    def penetrations(self, state: ContactState, relative: list[np.ndarray] | None = None
+                     ) -> list[np.ndarray]:
+        """Penetration (> 0 overlap) of every pair's fine nodes, linear kinematics (from
+        ``relative``, :meth:`relative_displacements`, when given)."""
+        relative = self.relative_displacements(state) if relative is None else relative
+        return [-(pair.gap0 + np.einsum("ij,ij->i", d, pair.normal))
+                for pair, d in zip(self.contact_pairs, relative, strict=True)]
+
+    def _release_and_hold(self, state: ContactState, k: int, p: np.ndarray, platen_ok: bool
+                          ) -> tuple[np.ndarray, np.ndarray]:
+        """Pair k's tension release (thesis §5.6: a node in tension gives up its traction over
+        ``release_iterations``), then the nodes the next correction holds: those carrying
+        traction or penetrating; with a platen short of its force and none of them, those
+        touching within the tolerance. Returns (in tension, held)."""
+        tol = self.penetration_tolerance
+        q = self.tractions(state, k)
+        pair = self.contact_pairs[k]
+        tension = q < 0
+        change, state.released[pair.fine][pair.nodes] = release_tension(
+            q, tension, state.released[pair.fine][pair.nodes], self.settings.release_iterations)
+        q += change
+        held = ~tension & ((q > 0) | (p > tol))
+        if not platen_ok and not held.any():
+            held = ~tension & (p > -tol)  # touching within tolerance: hold them there
+        return tension, held
 
     # -- the iteration ----------------------------------------------------------------------------
 
@@ -398,20 +426,10 @@ class PairedContact(PairSet):
     def _correct(self, state: ContactState, pens: list[np.ndarray], it: int,
                  platen_ok: bool) -> None:
         """Tension release, then the compatibility correction of every pair at once."""
-        cfg = self.settings
-        tol = self.penetration_tolerance
-        omega = relaxation(cfg, it)
+        omega = relaxation(self.settings, it)
         active, targets = [], []
         for k, p in enumerate(pens):
-            q = self.tractions(state, k)
-            pair = self.contact_pairs[k]
-            tension = q < 0  # released over several iterations (thesis §5.6)
-            change, state.released[pair.fine][pair.nodes] = release_tension(
-                q, tension, state.released[pair.fine][pair.nodes], cfg.release_iterations)
-            q += change
-            S = ~tension & ((q > 0) | (p > tol))
-            if not platen_ok and not S.any():
-                S = ~tension & (p > -tol)  # touching within tolerance: hold them there
+            _, S = self._release_and_hold(state, k, p, platen_ok)
             active.append(np.flatnonzero(S))
             targets.append(omega * p[S])
         self.assemble_forces(state)  # the releases change the forces the platen sees

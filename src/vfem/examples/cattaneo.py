@@ -30,7 +30,7 @@ import numpy as np
 
 from ..bodies import Platen, PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.friction import tangents
+from ..contact.friction import coulomb_status, tangents
 from ..contact.settings import ContactSettings
 from ..errors import InputError
 from ..io.runner import run_status
@@ -180,7 +180,7 @@ class Reading:
 
     def last_sticking(self, mu: float) -> float:
         """|x| of the outermost sticking node (0 when none sticks)."""
-        stick = (self.q > 0) & (np.abs(self.s) < (1 - 1e-6) * mu * self.q)
+        stick = coulomb_status(self.q, self.s, mu) == 1
         return float(np.abs(self.x[stick]).max()) if stick.any() else 0.0
 
 

@@ -403,14 +403,15 @@ def profiles(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray, np.ndar
     _finish_profiles(plt, fig, ax, path, xlabel, ylabel, title)
 
 
-def _finish_profiles(plt, fig, ax, path: Path, xlabel: str, ylabel: str, title: str) -> None:
+def _finish_profiles(plt, fig, ax, path: Path, xlabel: str, ylabel: str, title: str,
+                     legend_size: int = 8) -> None:
     """A profile figure's zero line, labels, title, grid and legend beside the axes; saved."""
     ax.axhline(0, color="0.7", lw=0.8)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, **OUTSIDE)
+    ax.legend(fontsize=legend_size, **OUTSIDE)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
@@ -468,15 +469,7 @@ def contact_pressure_profiles(path: Path, bodies: dict[str, list[tuple[str, np.n
         order = np.argsort(x, kind="stable")
         ax.plot(np.asarray(x)[order], np.asarray(p)[order], "-", color=c, lw=1.4,
                 marker=markers[j % len(markers)], ms=4, mfc="none", label=f"{name}: {label}")
-    ax.axhline(0, color="0.7", lw=0.8)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, **OUTSIDE)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    _finish_profiles(plt, fig, ax, path, xlabel, ylabel, title, legend_size=7)
 
 
 def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarray, np.ndarray]],

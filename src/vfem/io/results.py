@@ -110,7 +110,7 @@ class ResultsWriter:
         self.contact_rows: list[list[str]] = []
         self.reaction_rows: list[list[str]] = []
         #: contact.csv's columns: the friction's too when the model has friction
-        self.friction = bool(getattr(model.contact, "frictional", False))
+        self.friction = model.contact.frictional
 
     def restore(self, steps: list[StepResult]) -> None:
         """Take up the series of an earlier run whose ``steps`` are already on disk (their
@@ -471,12 +471,21 @@ def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
            "dofs": int(sum(b.ndofs for b in result.model.bodies)),
            "parameters": dataclasses.asdict(parameters), "timings": result.timings,
            "linear_solver": result.backend}
-    if result.model.contact.frictional:
-        work = frictional_work(result.steps)
-        for x, w in zip(out["steps"], work, strict=True):
-            x["frictional_work"] = w
-        out["frictional_work_total"] = float(sum(work))
+    out.update(friction_summary(result, out["steps"]))
     return out
+
+
+def friction_summary(result: AnalysisResult, records: list[dict]) -> dict:
+    """With friction (the model's ``contact.frictional``): each step's record (``records``,
+    one per ``result.steps``) gets its ``frictional_work`` (:func:`frictional_work`), and the
+    returned keys are ``frictional_work_total``; without friction nothing changes and the
+    keys are none (a frictionless run's summary stays as it was)."""
+    if not result.model.contact.frictional:
+        return {}
+    work = frictional_work(result.steps)
+    for record, w in zip(records, work, strict=True):
+        record["frictional_work"] = w
+    return {"frictional_work_total": float(sum(work))}
 
 
 def _num(x: float) -> str:

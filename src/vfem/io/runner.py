@@ -22,7 +22,7 @@ from .input import to_data
 from .results import (
     finish_summary,
     force_record,
-    frictional_work,
+    friction_summary,
     run_writing,
     step_record,
     total,
@@ -66,9 +66,7 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
     steps = []
     for s in result.steps:
         steps.append({**step_record(s), "platen_displacement": s.platen_displacement})
-    if config.contact.frictional:  # the work the friction dissipated, per step
-        for x, work in zip(steps, frictional_work(result.steps), strict=True):
-            x["frictional_work"] = work
+    friction = friction_summary(result, steps)  # the work the friction dissipated
     return {
         "model": config.name,
         "input": source,
@@ -83,8 +81,7 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
         "config": to_data(config),
         "timings": result.timings,
         "linear_solver": result.backend,
-        **({"frictional_work_total": float(sum(x["frictional_work"] for x in steps))}
-           if steps and "frictional_work" in steps[0] else {}),
+        **friction,
     }
 
 
