@@ -3,6 +3,7 @@
 
     python benchmarks/answers.py save DIR            # run every case, write DIR/<case>.json
     python benchmarks/answers.py compare OLD NEW     # every number alike to 1e-10 relative
+    python benchmarks/answers.py compare OLD NEW --ignore iterations   # all but those keys
     python benchmarks/answers.py save DIR hertz gasket_large   # some cases only
 
 The cases: springs, hertz, hertz with quadratic elements, patch, wedge, block, gasket (small and
@@ -49,6 +50,12 @@ CASES: dict[str, list[str]] = {
     "hertz_penalty": ["hertz", "--set", "contact.method=penalty"],
     "hertz_lagrange": ["hertz", "--set", "contact.method=lagrange"],
     "hertz_augmented": ["hertz", "--set", "contact.method=augmented"],
+    # friction (issue 20): Cattaneo pressed then sheared, the Mindlin-Deresiewicz cycle, a block
+    # pushed over another (run from the repository's root)
+    "cattaneo": ["cattaneo", "--no-figures"],
+    "cattaneo_cycle": ["cattaneo", "--no-figures", "--set", "cycle=true", "--set",
+                       "shift=5e-4"],
+    "pushed_block": ["examples/friction/pushed_block.toml", "--no-figures"],
 }
 
 #: Keys whose values differ from run to run (or name files), dropped wherever they appear.
@@ -135,7 +142,16 @@ def differences(a, b, where: str = "", scale: dict[str, float] | None = None) ->
     return [] if a == b else [f"{where}: {a!r} before, {b!r} after"]
 
 
-def compare(old: Path, new: Path) -> int:
+def drop(value, keys: set[str]):
+    """``value`` without ``keys``, at any depth."""
+    if isinstance(value, dict):
+        return {k: drop(v, keys) for k, v in value.items() if k not in keys}
+    if isinstance(value, list):
+        return [drop(v, keys) for v in value]
+    return value
+
+
+def compare(old: Path, new: Path, ignore: set[str] = frozenset()) -> int:
     status = 0
     for path in sorted(old.glob("*.json")):
         other = new / path.name
@@ -143,7 +159,8 @@ def compare(old: Path, new: Path) -> int:
             print(f"{path.stem}: missing after")
             status = 1
             continue
-        diffs = differences(json.loads(path.read_text()), json.loads(other.read_text()))
+        diffs = differences(drop(json.loads(path.read_text()), ignore),
+                            drop(json.loads(other.read_text()), ignore))
         print(f"{path.stem}: {'the same' if not diffs else f'{len(diffs)} differences'}")
         for d in diffs[:20]:
             print(f"  {d}")
@@ -160,6 +177,10 @@ def main(argv: list[str] | None = None) -> int:
     c = sub.add_parser("compare")
     c.add_argument("old", type=Path)
     c.add_argument("new", type=Path)
+    c.add_argument("--ignore", action="append", default=[], metavar="KEY",
+                   help="leave this key out at any depth (repeatable): a change meant to alter "
+                        "the iteration counts only compares with --ignore iterations --ignore "
+                        "history --ignore iteration_counts")
     args = parser.parse_args(argv)
     if args.command == "save":
         unknown = [c for c in args.cases if c not in CASES]
@@ -167,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
             parser.error(f"unknown cases {unknown}; choose from {', '.join(CASES)}")
         save(args.folder, args.cases or list(CASES))
         return 0
-    return compare(args.old, args.new)
+    return compare(args.old, args.new, set(args.ignore))
 
 
 if __name__ == "__main__":

@@ -285,6 +285,36 @@ def baselines_hertz() -> str:
     return "\n".join(rows) + "\n"
 
 
+def _wedge_ratio(r: float) -> str:
+    return f"{r:g}" if r >= 1 else f"1/{1 / r:g}"
+
+
+def examples_wedge() -> str:
+    """docs/examples.md, Wedge: the five cases of ``vfem run wedge`` (graded mesh)."""
+    rows = ["| case | E_wedge/E_plate | steps | iterations (per step) | thesis | plate share | "
+            "wedge share | contact force | contact to x |", "|---|---|---|---|---|---|---|---|---|"]
+    for c in _summary("wedge", "--set", "figures=false")["cases"]:
+        its = c["iterations"]
+        rows.append(f"| {c['case']} | {_wedge_ratio(c['modulus_ratio'])} | {len(its)} | "
+                    f"{c['total_iterations']} "
+                    + (f"({min(its)} each)" if min(its) == max(its) else f"({min(its)}–{max(its)})")
+                    + f" | {c['thesis_iterations']} "
+                    f"| {_percent(c['plate_share'], 2)} | {_percent(c['wedge_share'], 2)} | "
+                    f"{c['contact_force']:.5g} | {c['contact_extent']:.2f} |")
+    return "\n".join(rows) + "\n"
+
+
+def examples_wedge_coarse() -> str:
+    """docs/examples.md, Wedge: the one-step run on the coarse mesh
+    (``vfem run wedge --set mesh=coarse``)."""
+    rows = ["| case | iterations | thesis | plate share | contact force |",
+            "|---|---|---|---|---|"]
+    for c in _summary("wedge", "--set", "figures=false", "--set", "mesh=coarse")["cases"]:
+        rows.append(f"| {c['case']} | {c['total_iterations']} | {c['thesis_iterations']} | "
+                    f"{_percent(c['plate_share'], 2)} | {c['contact_force']:.5g} |")
+    return "\n".join(rows) + "\n"
+
+
 #: name -> (file, generator, quick: run in the default test suite)
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
@@ -295,6 +325,8 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "gasket-results": ("docs/examples.md", gasket_results, True),
     "gasket-steps": ("docs/examples.md", gasket_steps, True),
     "examples-cattaneo": ("docs/examples.md", examples_cattaneo, True),
+    "examples-wedge": ("docs/examples.md", examples_wedge, True),
+    "examples-wedge-coarse": ("docs/examples.md", examples_wedge_coarse, True),
 }
 
 _TIME = re.compile(r"\b\d+(\.\d+)? s\b")

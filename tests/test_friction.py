@@ -293,6 +293,10 @@ def test_mindlin_deresiewicz_unloading_and_the_hysteresis_loop():
         p = cattaneo.Parameters(cycle=True, shift=5e-4, shear_steps=steps)
         result, readings = cattaneo.solve(p)
         assert result.converged, result.message
+        # the stick, slip and contact sets found on the pair matrix (issue 20, item 6): one
+        # or two corrections of the bodies per step (measured: one in every step with 10 steps
+        # per branch, two in one step with 20)
+        assert max(s.iterations for s in result.steps) <= 2
         a = cattaneo.theory(p)["a"]
         x = readings[-1].x
         h = np.diff(np.sort(x[np.abs(x) < a])).max()

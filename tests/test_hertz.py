@@ -130,7 +130,10 @@ def test_step_cutting_is_bounded_and_reported():
     """A step that cannot converge is cut at most max_step_cuts times below its scheduled
     increment, then the analysis stops with a message (it never creeps up on a load factor)."""
     model = build(HertzParameters())
-    model.contact = dataclasses.replace(model.contact, max_iterations=3, max_step_cuts=3)
+    # relaxed corrections (one correction of the bodies at a time): the contact set by
+    # complementarity would converge in one
+    model.contact = dataclasses.replace(model.contact, max_iterations=3, max_step_cuts=3,
+                                        relaxation=0.3, first_relaxation=0.3)
     result = Analysis(model).run()
     assert not result.converged
     assert "failed with the increment cut 3 times" in result.message
@@ -183,3 +186,23 @@ def test_pointwise_pressure_at_48_facets_and_no_dip_on_the_symmetry_plane():
     full = bench.errors(vfem.solve(bench.mirrored(p)), th["a_theory"], th["p0_theory"])
     for name in half:
         assert half[name][3] == pytest.approx(full[name][3], abs=0.1)  # % of p0
+
+
+def test_the_contact_set_by_complementarity_takes_one_correction_per_step():
+    """Issue 20, item 6: the paired variant finds the contact set on the pair matrix before
+    the bodies see it, so each linear step takes one correction of the bodies; the iteration
+    that releases and adds nodes one correction at a time (reached by releasing tension over
+    two iterations, thesis §5.6) ends in the same state, to round-off, in more corrections."""
+    fast = Analysis(build(HertzParameters())).run()
+    model = build(HertzParameters())
+    model.contact = dataclasses.replace(model.contact, tension_release_iterations=2)
+    slow = Analysis(model).run()
+    assert fast.converged and slow.converged
+    assert [s.iterations for s in fast.steps] == [1] * 5
+    assert sum(s.iterations for s in slow.steps) > 10
+    for a, b in zip(fast.steps, slow.steps):
+        for ra, rb in zip(a.bodies.values(), b.bodies.values()):
+            scale = np.abs(rb.contact_force).max()
+            assert np.abs(ra.contact_force - rb.contact_force).max() <= 1e-10 * scale
+            assert np.abs(ra.displacement - rb.displacement).max() <= 1e-10 * np.abs(
+                rb.displacement).max()

@@ -8,7 +8,7 @@ import pytest
 
 from vfem.errors import InputError
 from vfem.examples import wedge
-from vfem.examples.wedge import Parameters, planned_steps, report, run, validate
+from vfem.examples.wedge import THESIS_ITERATIONS, Parameters, planned_steps, report, run, validate
 
 KEYS = ("plate_share", "wedge_share", "contact_force", "contact_force_plate",
         "plate_support_reaction")
@@ -113,7 +113,10 @@ def test_coarse_mesh_takes_the_motion_in_one_step_like_the_thesis():
     assert s["converged"] and all(len(x["iterations"]) == 1 for x in s["cases"])
     assert c[1]["plate_share"] >= 0.99 and c[5]["wedge_share"] >= 0.99
     assert 0.35 <= c[3]["plate_share"] <= 0.50
-    assert c[1]["total_iterations"] == 3  # the thesis's count for case 1
+    # the contact set by complementarity on the pair matrix (issue 20, item 6): one correction
+    # per case, at or below the thesis's 3, 6, 4, 4, 2
+    assert [c[k]["total_iterations"] for k in range(1, 6)] == [1, 1, 1, 1, 1]
+    assert all(c[k]["total_iterations"] <= t for k, t in zip(range(1, 6), THESIS_ITERATIONS))
     default = by_case(run(Parameters(case=3, figures=False)))[3]
     assert c[3]["plate_share"] == pytest.approx(default["plate_share"], abs=0.01)
 

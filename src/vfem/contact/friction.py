@@ -32,7 +32,10 @@ more traction field per contact pair:
   whose tangential traction leaves the cone slips (in the direction that traction opposes),
   a slipping node whose slip turns back sticks, a node in tension leaves contact (and its
   tangential traction with it). This is a return map onto the Coulomb cone per node, with no
-  penalty and no parameter to tune.
+  penalty and no parameter to tune. The sets are found on the condensed system: after each
+  solve the penetrations and slips it makes are predicted from the pair matrix (exact under
+  small kinematics), so the bodies see only the settled tractions and a step takes one
+  correction of the bodies (:meth:`FrictionalPairedContact._settle`).
 * **History.** When a step converges, every node's anchor becomes its relative tangential
   displacement and the slip is accumulated (``FrictionState.slip``): friction is path
   dependent, and a step that is cut starts again from the last converged state, anchors
@@ -247,10 +250,68 @@ class FrictionalPairedContact(PairedContact):
 
         def correct(it: int, c: Check) -> None:
             pens, dw, platen_ok = c.extra
-            self._correct_frictional(state, pens, dw, it, platen_ok)
+            if self.complementarity(it):
+                self._settle(state, pens, dw, it, platen_ok)
+            else:
+                self._correct_frictional(state, pens, dw, it, platen_ok)
             self.assemble_forces(state)
 
         return iterate(cfg, check, correct, on_iteration)
+
+    def _settle(self, state: FrictionState, pens: list[np.ndarray], dw: list[np.ndarray],
+                it: int, platen_ok: bool) -> None:
+        """The contact, stick and slip sets found on the condensed system (issue 20, item 6):
+        the corrections of :meth:`_correct_frictional`, each followed by the penetrations and
+        slips it makes predicted from the pair matrix instead of measured on the bodies.
+
+        Under small kinematics the prediction is exact (the pair matrix over the normal and
+        tangential unknowns is each body's flexibility seen through the fixed pairs), so the
+        corrections are those the iteration would make one back-substitution at a time, and
+        the sets they settle on are its own; the bodies then see the settled tractions once,
+        and the check measures them. The sets are sought for at most ``max_iterations``
+        corrections, and no longer once one comes back: the check then measures the last and
+        the iteration goes on from there, a correction of the bodies at a time.
+        """
+        tol = self.penetration_tolerance
+        # each node's relative tangential displacement, from its free slip (free_slips)
+        relative = [d + self.anchor(state, k) - self.laws[k][2] * self.shear(state, k)
+                    for k, d in enumerate(dw)]
+        seen = set()
+        for inner in range(self.settings.max_iterations):
+            before = self._unknowns(state)
+            dplaten = self._correct_frictional(state, pens, dw, it + inner, platen_ok)
+            if dplaten is None:  # nothing touches: the platen moved; measure it
+                return
+            self.assemble_forces(state)
+            G, rate, _, offsets = self._full
+            # (the change of every unknown: the correction's, and the tension released before)
+            motion = G @ (self._unknowns(state) - before)  # penetration decrease (normal
+            # rows), slip (tangential rows)
+            n = [len(p) for p in pens]
+            normal = [slice(offsets[k], offsets[k] + n[k]) for k in range(len(n))]
+            tangent = [slice(offsets[k] + n[k], offsets[k] + 2 * n[k]) for k in range(len(n))]
+            pens = [p - motion[r] + rate[r] * dplaten for p, r in zip(pens, normal)]
+            relative = [w + motion[r] + rate[r] * dplaten for w, r in zip(relative, tangent)]
+            dw = [w - self.anchor(state, k) + self.laws[k][2] * self.shear(state, k)
+                  for k, w in enumerate(relative)]
+            traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
+            _, pen_err, _, tension = self.compatibility_errors(pens, traction_values)
+            fric_err, excess, _, _ = self.friction_errors(state, dw)
+            platen_ok = self.platen_met(state)
+            if (pen_err <= tol and fric_err <= tol and excess <= CONE_TOLERANCE
+                    and tension == 0 and platen_ok):
+                log.debug("friction: the sets settled in %d corrections on the pair matrix",
+                          inner + 1)
+                return
+            key = b"".join(m.tobytes() for _, _, m in self._sets(state))
+            if key in seen:
+                return
+            seen.add(key)
+
+    def _unknowns(self, state: FrictionState) -> np.ndarray:
+        """Every pair's normal then tangential traction values, in the pair matrix's order."""
+        return np.concatenate([np.concatenate([self.tractions(state, k), self.shear(state, k)])
+                               for k in range(len(self.contact_pairs))] or [np.zeros(0)])
 
     def _sets(self, state: FrictionState) -> list[tuple[str, np.ndarray, np.ndarray]]:
         """The contact set, the slipping nodes and their directions, for the cycle watch."""
@@ -312,9 +373,12 @@ class FrictionalPairedContact(PairedContact):
         return out
 
     def _correct_frictional(self, state: FrictionState, pens: list[np.ndarray],
-                            dw: list[np.ndarray], it: int, platen_ok: bool = True) -> None:
+                            dw: list[np.ndarray], it: int, platen_ok: bool = True
+                            ) -> float | None:
         """Release tension, sort the contact nodes into sticking and slipping, then one solve of
-        the normal and tangential conditions of every pair together (module docstring)."""
+        the normal and tangential conditions of every pair together (module docstring).
+        Returns the platen's motion, or None where nothing touched (the platen then moved to
+        close the smallest gap)."""
         tol = self.penetration_tolerance
         omega = relaxation(self.settings, it)
         if self._full is None:
@@ -399,7 +463,7 @@ class FrictionalPairedContact(PairedContact):
             self.assemble_forces(state)
             if not self.platen_met(state):
                 self._close_gap(state, pens)
-            return
+            return None
         cols, rows = np.concatenate([q_cols, s_cols]), np.concatenate(rows)
         tie_q, tie_s, ties = (np.concatenate(a) for a in (tie_q, tie_s, ties))
         position = np.full(len(G), -1)  # unknown -> its column in the system
@@ -434,6 +498,7 @@ class FrictionalPairedContact(PairedContact):
             self.tractions(state, k)[:] += delta[base:base + n]
             self.shear(state, k)[:] += delta[base + n:base + 2 * n]
         state.platen_displacement += dplaten
+        return dplaten
 
 
 __all__ = ["CONE_TOLERANCE", "FrictionalPairedContact", "coulomb_status", "tangents"]

@@ -73,7 +73,7 @@ import scipy.sparse as sp
 
 from ..errors import AnalysisError, InputError
 from .capabilities import Capabilities
-from .group import bordered_solve
+from .complementarity import linear_complementarity
 from .iteration import Check, iterate
 from .paired import PairSet
 from .pairing import overlap, virtual_nodes
@@ -109,64 +109,6 @@ def _facet_neighbours(s: ContactSurface) -> list[np.ndarray]:
 def _concatenate(parts: list[np.ndarray]) -> np.ndarray:
     """The parts one after the other; empty where there are none (no contact pair)."""
     return np.concatenate(parts) if parts else np.zeros(0)
-
-
-def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: float,
-                           dp_dplaten: np.ndarray | None = None, dR: np.ndarray | None = None,
-                           stiffness: float = 0.0, need: float = 0.0,
-                           max_pivots: int | None = None) -> tuple[np.ndarray, float]:
-    """The traction values q >= 0 of the linearised contact problem, and the platen motion.
-
-    From traction values ``q0`` with (linearised) penetrations ``p``, the penetrations after the
-    change are ``p - W (q - q0) + dp_dplaten d`` (``d`` the platen motion, solved with the
-    platen's equilibrium ``dR . (q - q0) + stiffness d = need`` when ``dp_dplaten`` is given).
-    Find q with, at every node, q >= 0, penetration <= tol and one of the two zero: the nodes
-    with q > 0 close their gaps exactly.
-
-    Block principal pivoting (every violation swapped at once), which finds the set in a few
-    solves; if a set repeats (it may cycle), one violation at a time, the lowest index first
-    (Murty's rule, finite when W is a P-matrix). A set on which the platen's equilibrium cannot
-    hold (nothing else holds its body) takes the nodes that touch within the tolerance. Without
-    a complementary solution in ``max_pivots`` solves, the last set's solution with its negative
-    values set to zero.
-    """
-    n = len(q0)
-    max_pivots = max_pivots or 10 * n + 10
-    platen = dp_dplaten is not None
-    Wq0 = W @ q0
-
-    def on(active):
-        """q (zero off the set) and d that close the set's gaps exactly; the penetrations."""
-        a = np.flatnonzero(active)
-        q = np.zeros(n)
-        d = 0.0
-        if platen:
-            q[a], d = bordered_solve(W[np.ix_(a, a)], -dp_dplaten[a], dR[a], stiffness,
-                                     p[a] + Wq0[a], need + float(dR @ q0))
-        elif len(a):
-            q[a] = np.linalg.solve(W[np.ix_(a, a)], p[a] + Wq0[a])
-        pen = p - W @ (q - q0) + (d * dp_dplaten if platen else 0.0)
-        return q, d, pen
-
-    active = (q0 > 0) | (p > tol)
-    seen = set()
-    single = False
-    q, d = np.zeros(n), 0.0
-    for _ in range(max_pivots):
-        q, d, pen = on(active)
-        wrong = (active & (q < 0)) | (~active & (pen > tol))
-        if platen and abs(float(dR @ (q - q0)) + stiffness * d - need) > 1e-9 * abs(need):
-            wrong |= ~active & (pen > -tol)  # the platen needs the nodes touching it to push
-        if not wrong.any():
-            return q, d
-        key = active.tobytes()
-        single = single or key in seen
-        seen.add(key)
-        if single:
-            wrong[np.flatnonzero(wrong)[0] + 1:] = False
-        active = active ^ wrong
-    log.debug("linearised contact: no complementary set in %d solves", max_pivots)
-    return np.maximum(q, 0.0), d
 
 
 class LargeDeformationContact(PairSet):

@@ -25,8 +25,10 @@ P is ``K_A K_B / (K_A + K_B) P = (1/K_A + 1/K_B)^-1 P``; here it is ``W^-1 p`` w
 flexibility of the pair seen at the finer side's contact nodes (its own condensed flexibility plus
 the coarser side's, mapped through the virtual nodes and the traction transfer). Each body still
 uses only its own factorization; the corrections are still forces applied at the global level.
-For a fixed set of contact nodes one correction closes every gap exactly, so the iteration spends
-its steps only on finding which nodes touch (and on releasing tension, thesis §5.6).
+For a fixed set of contact nodes one correction closes every gap exactly, so what is left to find
+is which nodes touch: each correction finds that set by complementarity on W over every pair node
+(:mod:`vfem.contact.complementarity`, small dense solves) before the bodies see it, and a linear
+step ends after one correction (docs/method.md §5).
 
 Small-strain analyses pair the surfaces in the undeformed configuration (linear kinematics: the
 virtual nodes, normals and transfer are fixed, the gap is linear in the displacements).
@@ -41,6 +43,7 @@ import scipy.sparse as sp
 
 from ..errors import PlatenUnheld, RindViolation
 from .capabilities import Capabilities
+from .complementarity import linear_complementarity
 from .corrections import relaxation, release_tension
 from .group import ReusedFactor, SurfaceGroup, bordered_matrix, bordered_solve
 from .iteration import Check, iterate
@@ -423,9 +426,21 @@ class PairedContact(PairSet):
 
         return iterate(cfg, check, correct, on_iteration)
 
+    def complementarity(self, it: int) -> bool:
+        """Whether iteration ``it`` finds the contact set on the condensed system
+        (:meth:`_correct_complementarity`): unless the settings relax the corrections or
+        release tension over several iterations (the thesis's §5.6 devices, which then act one
+        correction of the bodies at a time)."""
+        return relaxation(self.settings, it) == 1.0 and self.settings.release_iterations == 1
+
     def _correct(self, state: ContactState, pens: list[np.ndarray], it: int,
                  platen_ok: bool) -> None:
-        """Tension release, then the compatibility correction of every pair at once."""
+        """The compatibility correction of every pair at once: the contact set by
+        complementarity on the pair matrix, or (relaxed settings) tension release, then the
+        correction of the nodes carrying traction or penetrating."""
+        if self.complementarity(it):
+            self._correct_complementarity(state, pens)
+            return
         omega = relaxation(self.settings, it)
         active, targets = [], []
         for k, p in enumerate(pens):
@@ -443,6 +458,42 @@ class PairedContact(PairSet):
         for k, a in enumerate(active):
             self.tractions(state, k)[a] += dq[pos:pos + len(a)]
             pos += len(a)
+        state.platen_displacement += dplaten
+
+    def _correct_complementarity(self, state: ContactState, pens: list[np.ndarray]) -> None:
+        """The traction values of every pair's nodes that close every gap at once: the linear
+        complementarity problem on the pair matrix W over all pair nodes
+        (:func:`~vfem.contact.complementarity.linear_complementarity`; issue 20, item 6).
+
+        Under small kinematics W is exact (the pairs' geometry is fixed and each body linear),
+        so the penetrations after this one correction are those the dense solves predicted: a
+        linear step needs one correction, where releasing and adding nodes one correction of
+        the bodies at a time took several (Hertz 7, 4, 4, 4, 4). Where nothing touches and a
+        platen must find its force, the platen first moves to close the smallest gap.
+        """
+        if self._full is None:
+            self._full = self._full_flexibility()
+        W, rate, dR, _ = self._full
+        tol = self.penetration_tolerance
+        q0 = np.concatenate([self.tractions(state, k) for k in range(len(self.contact_pairs))]
+                            or [np.zeros(0)])
+        p = np.concatenate(pens or [np.zeros(0)])
+        platen = self.platen_body is not None and state.platen_force != 0.0
+        if platen:
+            body = self.surfaces[self.platen_body].body
+            if not ((q0 > 0) | (p > -tol)).any():
+                if not self.platen_met(state):
+                    self._close_gap(state, pens)
+                return
+            q, dplaten = linear_complementarity(
+                W, q0, p, tol, rate, dR, body.platen_stiffness,
+                state.platen_force - self.platen_reaction(state), factor=self._factor)
+        else:
+            q, dplaten = linear_complementarity(W, q0, p, tol, factor=self._factor)
+        pos = 0
+        for k, pair in enumerate(self.contact_pairs):
+            self.tractions(state, k)[:] = q[pos:pos + len(pair.nodes)]
+            pos += len(pair.nodes)
         state.platen_displacement += dplaten
 
     def _solve_pairs(self, state: ContactState, active: list[np.ndarray], rhs: np.ndarray

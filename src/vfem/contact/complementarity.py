@@ -1,0 +1,101 @@
+"""The contact set by complementarity on the condensed system (issue 20, item 6).
+
+Given the pair flexibility W over every contact node (the penetration decrease per unit traction
+value, each body's own factorization behind it: eq. 4.2.4 in matrix form), the traction values
+q >= 0 of the exact contact state solve a linear complementarity problem: at every node
+q >= 0, penetration <= 0 and one of the two zero. The thesis's iteration finds that set one
+correction at a time, each correction a back-substitution through every body (§4.3-4.5; Hertz
+7, 4, 4, 4, 4 corrections per step). Here the set is found on the condensed system alone, by
+small dense solves: under small kinematics W is exact, so one correction of the bodies then
+meets every condition, and under large kinematics (:mod:`vfem.contact.large`) it is the
+linearised problem of one Newton correction.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from .group import ReusedFactor, bordered_matrix, bordered_solve
+
+log = logging.getLogger(__name__)
+
+
+def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: float,
+                           dp_dplaten: np.ndarray | None = None, dR: np.ndarray | None = None,
+                           stiffness: float = 0.0, need: float = 0.0,
+                           max_pivots: int | None = None, factor: ReusedFactor | None = None
+                           ) -> tuple[np.ndarray, float]:
+    """The traction values q >= 0 of the linearised contact problem, and the platen motion.
+
+    From traction values ``q0`` with (linearised) penetrations ``p``, the penetrations after the
+    change are ``p - W (q - q0) + dp_dplaten d`` (``d`` the platen motion, solved with the
+    platen's equilibrium ``dR . (q - q0) + stiffness d = need`` when ``dp_dplaten`` is given).
+    Find q with, at every node, q >= 0, penetration <= tol and one of the two zero: the nodes
+    with q > 0 close their gaps exactly.
+
+    Block principal pivoting (every violation swapped at once), which finds the set in a few
+    solves; if a set repeats (it may cycle), one violation at a time, the lowest index first
+    (Murty's rule, finite when W is a P-matrix). A set on which the platen's equilibrium cannot
+    hold (nothing else holds its body) takes the nodes that touch within the tolerance. Without
+    a complementary solution in ``max_pivots`` solves, the last set's solution with its negative
+    values set to zero.
+
+    ``factor``: keep the LU factors of the last set's matrix (:class:`ReusedFactor`; a step
+    whose set is the last step's solves with the same factors); without it, every set's
+    bordered system is solved by least squares.
+    """
+    n = len(q0)
+    max_pivots = max_pivots or 10 * n + 10
+    platen = dp_dplaten is not None
+    Wq0 = W @ q0
+
+    def on(active):
+        """q (zero off the set) and d that close the set's gaps exactly; the penetrations."""
+        a = np.flatnonzero(active)
+        q = np.zeros(n)
+        d = 0.0
+        rhs = p[a] + Wq0[a]
+        if platen:
+            extra = need + float(dR @ q0)
+            x = None
+            if factor is not None:
+                x = factor.solve((True, a.tobytes()), lambda: bordered_matrix(
+                    W[np.ix_(a, a)], -dp_dplaten[a], dR[a], stiffness),
+                    np.concatenate([rhs, [extra]]))
+            if x is None:  # singular (no node of the platen's body in the set): least squares
+                q[a], d = bordered_solve(W[np.ix_(a, a)], -dp_dplaten[a], dR[a], stiffness,
+                                         rhs, extra)
+            else:
+                q[a], d = x[:-1], float(x[-1])
+        elif len(a):
+            x = None if factor is None else factor.solve(
+                (False, a.tobytes()), lambda: W[np.ix_(a, a)], rhs)
+            q[a] = np.linalg.solve(W[np.ix_(a, a)], rhs) if x is None else x
+        pen = p - W @ (q - q0) + (d * dp_dplaten if platen else 0.0)
+        return q, d, pen
+
+    active = (q0 > 0) | (p > tol)
+    seen = set()
+    single = False
+    q, d = np.zeros(n), 0.0
+    for pivot in range(max_pivots):
+        q, d, pen = on(active)
+        wrong = (active & (q < 0)) | (~active & (pen > tol))
+        if platen and abs(float(dR @ (q - q0)) + stiffness * d - need) > 1e-9 * abs(need):
+            wrong |= ~active & (pen > -tol)  # the platen needs the nodes touching it to push
+        if not wrong.any():
+            log.debug("complementarity: the contact set in %d solves", pivot + 1)
+            return q, d
+        key = active.tobytes()
+        single = single or key in seen
+        seen.add(key)
+        if single:
+            wrong[np.flatnonzero(wrong)[0] + 1:] = False
+        active = active ^ wrong
+    log.debug("linearised contact: no complementary set in %d solves", max_pivots)
+    return np.maximum(q, 0.0), d
+
+
+__all__ = ["linear_complementarity"]
