@@ -26,6 +26,7 @@ import difflib
 import functools
 import io
 import json
+import math
 import os
 import re
 import sys
@@ -315,6 +316,31 @@ def examples_wedge_coarse() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_sliding_friction() -> str:
+    """docs/examples.md, Sliding: the slide with friction (``vfem run sliding --set
+    friction=0.3``)."""
+    s = _summary("sliding", "--no-figures", "--set", "friction=0.3")
+    e = s["sliding"]
+    f = e["friction"]
+    steps = s["steps"]
+    return "\n".join([
+        "| quantity | value |", "|---|---|",
+        f"| steps converged | {sum(x['converged'] for x in steps)} of {len(steps)}, "
+        f"{sum(x['iterations'] for x in steps)} contact iterations, "
+        f"{sum(x['cuts'] for x in steps)} step cuts |",
+        f"| nodes in contact, slid | {f['slipping_nodes']} slipping, {f['sticking_nodes']} "
+        "sticking |",
+        f"| tangential / normal reaction, steady slide ({e['steady_steps']} steps) | "
+        f"{f['reaction_ratio_min']:.5f} to {f['reaction_ratio_max']:.5f} |",
+        f"| tangential tractions' force / normal tractions', slid | "
+        f"{f['friction_over_normal_part']:.5f} |",
+        f"| normal tractions' resultant, leaning against the slide | "
+        f"{f['normal_part_tilt']:.4f} rad |",
+        f"| tan(atan μ − that lean) | {math.tan(math.atan(f['mu']) - f['normal_part_tilt']):.5f} |",
+        f"| frictional work over the run | {s['frictional_work_total']:.4g} |",
+    ]) + "\n"
+
+
 #: name -> (file, generator, quick: run in the default test suite)
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
@@ -327,6 +353,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-cattaneo": ("docs/examples.md", examples_cattaneo, True),
     "examples-wedge": ("docs/examples.md", examples_wedge, True),
     "examples-wedge-coarse": ("docs/examples.md", examples_wedge_coarse, True),
+    "examples-sliding-friction": ("docs/examples.md", examples_sliding_friction, False),
 }
 
 _TIME = re.compile(r"\b\d+(\.\d+)? s\b")

@@ -208,7 +208,7 @@ def test_a_folder_friction_and_one_body_are_told_plainly(tmp_path, capsys):
     for example in ("wedge", "hertz"):
         assert main(["run", example, "--set", "contact.friction=0.3"]) == 2
         err = capsys.readouterr().err
-        assert "only cattaneo has friction" in err and "valid keys" not in err
+        assert "cattaneo and sliding have a friction parameter" in err and "valid keys" not in err
     one = tmp_path / "one.toml"
     one.write_text(text[: text.index('[[bodies]]\nname = "punch"')])
     assert main(["check", str(one)]) == 0

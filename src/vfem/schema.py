@@ -93,8 +93,8 @@ def _reject_unknown(data: dict, valid: list[str], where: str, owner: str = "") -
 #: mean" a key that happens to be spelled alike.
 NOT_YET = {"friction": "friction is set for a model's contact: contact.friction = mu, Coulomb's "
                        "coefficient, or [[contact.pairs]], in an input file (the paired "
-                       "variant, small kinematics; of the built-in examples only cattaneo has "
-                       "friction)",
+                       "variant; of the built-in examples cattaneo and sliding have a friction "
+                       "parameter: --set friction=0.3)",
            "self_contact": "contact of a body with itself is not available yet"}
 
 

@@ -53,6 +53,10 @@ def formulation_class(settings, large: bool) -> type:
 
         return GlobalContact
     if large:
+        if settings.frictional:
+            from .large_friction import FrictionalLargeContact
+
+            return FrictionalLargeContact
         from .large import LargeDeformationContact
 
         return LargeDeformationContact
@@ -93,15 +97,13 @@ def check_capabilities(model) -> None:
             raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: no "
                              f"body named {unknown[0]!r} (bodies: {', '.join(sorted(names))})")
     if settings.frictional and "coulomb" not in caps.friction:
-        body = next((b.name for b in model.bodies if b.large), None)
-        what = (f"large kinematics (body {body!r})" if large and settings.method == "vfem" else
-                f"contact.method = {settings.method!r}" if settings.method != "vfem" else
+        what = (f"contact.method = {settings.method!r}" if settings.method != "vfem" else
                 f"contact.variant = {settings.variant!r}")
         where = (f"contact.friction = {settings.friction:g}" if settings.friction > 0 else
                  "contact.pairs " + ", ".join(repr(list(p.bodies)) for p in settings.pairs
                                               if p.friction > 0))
         raise InputError(f"model {model.name!r}: friction ({where}) is available with the "
-                         f"paired variant and small kinematics only, not yet with {what}; set "
+                         f"paired variant only, not yet with {what}; set "
                          "it to 0 for frictionless contact")
     for b in model.bodies:
         if b.order not in caps.orders:

@@ -41,8 +41,8 @@ more traction field per contact pair:
   dependent, and a step that is cut starts again from the last converged state, anchors
   included (they are part of the state the checkpoints save).
 
-Small kinematics only for now: the pairs, normals and tangents are those of the undeformed
-configuration, as for the frictionless paired variant.
+Small kinematics here (large: :mod:`vfem.contact.large_friction`): the pairs, normals and
+tangents are those of the undeformed configuration, as for the frictionless paired variant.
 """
 
 from __future__ import annotations
@@ -91,40 +91,23 @@ def coulomb_status(q: np.ndarray, s: np.ndarray, mu: float) -> np.ndarray:
     return status
 
 
-class FrictionalPairedContact(PairedContact):
-    """The paired variant with Coulomb friction, small displacements (module docstring)."""
+class FrictionHistory:
+    """What the frictional formulations (small and large kinematics) share: each pair's law,
+    the history in the state (tangential tractions, anchors, accumulated slip, which nodes
+    slide), the friction's errors and its output fields."""
 
-    capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
-                                       friction=("frictionless", "coulomb"))
-    state_type = FrictionState
-
-    def __init__(self, surfaces, pairs, settings, backend: str | None = None):
-        super().__init__(surfaces, pairs, settings, backend)
-        #: per contact pair, its law's (mu of a slipping node, mu at which a sticking node
-        #: starts to slip, 1 / slip stiffness: 0 where it sticks rigidly)
-        self.laws = [settings.pair_friction(surfaces[p.fine].body.name,
-                                            surfaces[p.coarse].body.name).coefficients
+    def _init_friction(self, settings) -> None:
+        """Each pair's law: (mu of a slipping node, mu at which a sticking node starts to slip,
+        1 / slip stiffness: 0 where it sticks rigidly); the last step's slip increments."""
+        self.laws = [settings.pair_friction(self.surfaces[p.fine].body.name,
+                                            self.surfaces[p.coarse].body.name).coefficients
                      for p in self.contact_pairs]
-        self._tangents = [tangents(pair.normal) for pair in self.contact_pairs]
-        #: per pair, the slip increments of the last converged step (for :meth:`fields`) and
-        #: the nodes released from tension in the current solve (:meth:`_correct_frictional`)
+        #: per pair, the slip increments of the last converged step (for :meth:`fields`)
         self._increments = [np.zeros(len(p.nodes)) for p in self.contact_pairs]
-        self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.contact_pairs]
 
-    def directions(self, k: int) -> list[np.ndarray]:
-        """The normal, then the tangents: the order of each pair's unknowns."""
-        return [self.contact_pairs[k].normal] + self._tangents[k]
-
-    # -- state -----------------------------------------------------------------------------------
-
-    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
-                  ) -> ContactState:
-        """No contact force; the penetrations of the unloaded bodies as the last converged ones
-        (where a node that comes into contact in the first step touched)."""
-        state = super().new_state(load_factor, platen_displacement)
-        for k, p in enumerate(self.penetrations(state)):
-            state.penetration[k] = p.copy()
-        return state
+    def tangent(self, k: int) -> np.ndarray:
+        """Pair k's unit tangent at its nodes (2D: the normal turned by +90 degrees)."""
+        return tangents(self.contact_pairs[k].normal)[0]
 
     def _values(self, state: FrictionState, name: str, k: int, dtype=float) -> np.ndarray:
         """Pair k's array ``name`` of the state's history, zeros until first set."""
@@ -153,6 +136,115 @@ class FrictionalPairedContact(PairedContact):
         """Pair k's nodes: 0 free (no normal traction), 1 sticking, 2 slipping."""
         on = self.tractions(state, k) > 0
         return np.where(on, np.where(self.sliding(state, k), 2, 1), 0)
+
+    def friction_errors(self, state: FrictionState, slips: list[np.ndarray]
+                        ) -> tuple[float, float, int, int]:
+        """The largest tangential compatibility error (a sticking node's slip within the step,
+        or a slipping node's slip against the direction its traction opposes), the largest
+        excess of a tangential traction over its cone (relative to the largest mu q), and the
+        nodes sticking and slipping."""
+        err, excess, stick, slip = 0.0, 0.0, 0, 0
+        scale = max((self.laws[k][1] * float(self.tractions(state, k).max(initial=0.0))
+                     for k in range(len(self.contact_pairs))), default=0.0)
+        for k, dw in enumerate(slips):
+            q, s = self.tractions(state, k), self.shear(state, k)
+            status = self.status(state, k)
+            stick += int((status == 1).sum())
+            slip += int((status == 2).sum())
+            if (status == 1).any():
+                err = max(err, float(np.abs(dw[status == 1]).max()))
+            on = status == 2
+            if on.any():
+                sigma = -np.sign(s[on])
+                err = max(err, float(np.maximum(-sigma * dw[on], 0.0).max()))
+            outside = np.abs(s) - self.laws[k][1] * np.maximum(q, 0.0)
+            if len(outside) and scale > 0:
+                excess = max(excess, float(outside.max()) / scale)
+            elif np.any(s != 0):
+                excess = np.inf  # a tangential traction without a normal one
+        return err, excess, stick, slip
+
+    def _unknowns(self, state: FrictionState) -> np.ndarray:
+        """Every pair's normal then tangential traction values, in the pair matrix's order."""
+        return np.concatenate([np.concatenate([self.tractions(state, k), self.shear(state, k)])
+                               for k in range(len(self.contact_pairs))] or [np.zeros(0)])
+
+    def _sets(self, state: FrictionState) -> list[tuple[str, np.ndarray, np.ndarray]]:
+        """The contact set, the slipping nodes and their directions, for the cycle watch."""
+        out = []
+        for k, pair in enumerate(self.contact_pairs):
+            sf = self.surfaces[pair.fine]
+            status = self.status(state, k)
+            nodes = sf.nodes[pair.nodes]
+            out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2),
+                    (sf.body.name, nodes, self.shear(state, k) < 0)]
+        return out
+
+    def fields(self, state: ContactState, result: SolveResult) -> dict:
+        """The frictionless fields, and the friction's at each pair's compatibility-side nodes
+        (:class:`~vfem.result_types.BodyStepResult`: tangential traction, slip increment,
+        accumulated slip, stick or slip)."""
+        out = super().fields(state, result)
+        increments = self._increments
+        for s in self.surfaces:
+            r = out[s.body.name]
+            n = s.body.npoints
+            r.contact_shear, r.slip_increment = np.zeros((n, s.dim)), np.zeros(n)
+            r.accumulated_slip = np.zeros(n)
+            r.friction_force = np.zeros((n, s.dim))
+            r.friction_status = np.full(n, -1)  # not a compatibility-side node of a pair
+        for k, pair in enumerate(self.contact_pairs):
+            sf = self.surfaces[pair.fine]
+            r = out[sf.body.name]
+            points = sf.nodes[pair.nodes]
+            traction = self.shear(state, k)[:, None] * self.tangent(k)
+            r.contact_shear[points] = traction
+            r.slip_increment[points] = increments[k]
+            r.accumulated_slip[points] = self.accumulated_slip(state, k)
+            r.friction_status[points] = self.status(state, k)
+            # the nodal forces of the tangential traction alone, on both sides (as
+            # assemble_forces makes them)
+            sc = self.surfaces[pair.coarse]
+            out[sf.body.name].friction_force[sf.nodes[: sf.nc]] += \
+                pair.mass[:, pair.nodes] @ traction
+            out[sc.body.name].friction_force[sc.nodes[: sc.nc]] -= \
+                pair.transfer[:, pair.nodes] @ traction
+        return out
+
+
+class FrictionalPairedContact(FrictionHistory, PairedContact):
+    """The paired variant with Coulomb friction, small displacements (module docstring)."""
+
+    capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
+                                       friction=("frictionless", "coulomb"))
+    state_type = FrictionState
+
+    def __init__(self, surfaces, pairs, settings, backend: str | None = None):
+        super().__init__(surfaces, pairs, settings, backend)
+        self._init_friction(settings)
+        self._tangents = [tangents(pair.normal) for pair in self.contact_pairs]
+        #: per pair, the nodes released from tension in the current solve
+        #: (:meth:`_correct_frictional`)
+        self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.contact_pairs]
+
+    def directions(self, k: int) -> list[np.ndarray]:
+        """The normal, then the tangents: the order of each pair's unknowns."""
+        return [self.contact_pairs[k].normal] + self._tangents[k]
+
+    def tangent(self, k: int) -> np.ndarray:
+        """Pair k's unit tangent at its nodes (the undeformed one: small kinematics)."""
+        return self._tangents[k][0]
+
+    # -- state -----------------------------------------------------------------------------------
+
+    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
+                  ) -> ContactState:
+        """No contact force; the penetrations of the unloaded bodies as the last converged ones
+        (where a node that comes into contact in the first step touched)."""
+        state = super().new_state(load_factor, platen_displacement)
+        for k, p in enumerate(self.penetrations(state)):
+            state.penetration[k] = p.copy()
+        return state
 
     def free_slips(self, state: FrictionState, relative: list[np.ndarray] | None = None
                    ) -> list[np.ndarray]:
@@ -184,33 +276,6 @@ class FrictionalPairedContact(PairedContact):
             state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ traction
 
     # -- the iteration ---------------------------------------------------------------------------
-
-    def friction_errors(self, state: FrictionState, slips: list[np.ndarray]
-                        ) -> tuple[float, float, int, int]:
-        """The largest tangential compatibility error (a sticking node's slip within the step,
-        or a slipping node's slip against the direction its traction opposes), the largest
-        excess of a tangential traction over its cone (relative to the largest mu q), and the
-        nodes sticking and slipping."""
-        err, excess, stick, slip = 0.0, 0.0, 0, 0
-        scale = max((self.laws[k][1] * float(self.tractions(state, k).max(initial=0.0))
-                     for k in range(len(self.contact_pairs))), default=0.0)
-        for k, dw in enumerate(slips):
-            q, s = self.tractions(state, k), self.shear(state, k)
-            status = self.status(state, k)
-            stick += int((status == 1).sum())
-            slip += int((status == 2).sum())
-            if (status == 1).any():
-                err = max(err, float(np.abs(dw[status == 1]).max()))
-            on = status == 2
-            if on.any():
-                sigma = -np.sign(s[on])
-                err = max(err, float(np.maximum(-sigma * dw[on], 0.0).max()))
-            outside = np.abs(s) - self.laws[k][1] * np.maximum(q, 0.0)
-            if len(outside) and scale > 0:
-                excess = max(excess, float(outside.max()) / scale)
-            elif np.any(s != 0):
-                excess = np.inf  # a tangential traction without a normal one
-        return err, excess, stick, slip
 
     def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
         """Correct the normal and tangential traction values until every pair's normal and
@@ -308,22 +373,6 @@ class FrictionalPairedContact(PairedContact):
                 return
             seen.add(key)
 
-    def _unknowns(self, state: FrictionState) -> np.ndarray:
-        """Every pair's normal then tangential traction values, in the pair matrix's order."""
-        return np.concatenate([np.concatenate([self.tractions(state, k), self.shear(state, k)])
-                               for k in range(len(self.contact_pairs))] or [np.zeros(0)])
-
-    def _sets(self, state: FrictionState) -> list[tuple[str, np.ndarray, np.ndarray]]:
-        """The contact set, the slipping nodes and their directions, for the cycle watch."""
-        out = []
-        for k, pair in enumerate(self.contact_pairs):
-            sf = self.surfaces[pair.fine]
-            status = self.status(state, k)
-            nodes = sf.nodes[pair.nodes]
-            out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2),
-                    (sf.body.name, nodes, self.shear(state, k) < 0)]
-        return out
-
     def _converged(self, state: FrictionState) -> None:
         """A converged step: accumulate each node's slip and anchor it where it now is (the
         step's slip increments are kept for :meth:`fields`)."""
@@ -340,37 +389,6 @@ class FrictionalPairedContact(PairedContact):
             self.accumulated_slip(state, k)[:] += np.abs(increment)
             self._increments.append(increment)
             anchor[:] = new
-
-    def fields(self, state: ContactState, result: SolveResult) -> dict:
-        """The frictionless fields, and the friction's at each pair's compatibility-side nodes
-        (:class:`~vfem.result_types.BodyStepResult`: tangential traction, slip increment,
-        accumulated slip, stick or slip)."""
-        out = super().fields(state, result)
-        increments = self._increments
-        for s in self.surfaces:
-            r = out[s.body.name]
-            n = s.body.npoints
-            r.contact_shear, r.slip_increment = np.zeros((n, s.dim)), np.zeros(n)
-            r.accumulated_slip = np.zeros(n)
-            r.friction_force = np.zeros((n, s.dim))
-            r.friction_status = np.full(n, -1)  # not a compatibility-side node of a pair
-        for k, pair in enumerate(self.contact_pairs):
-            sf = self.surfaces[pair.fine]
-            r = out[sf.body.name]
-            points = sf.nodes[pair.nodes]
-            traction = self.shear(state, k)[:, None] * self._tangents[k][0]
-            r.contact_shear[points] = traction
-            r.slip_increment[points] = increments[k]
-            r.accumulated_slip[points] = self.accumulated_slip(state, k)
-            r.friction_status[points] = self.status(state, k)
-            # the nodal forces of the tangential traction alone, on both sides (as
-            # assemble_forces makes them)
-            sc = self.surfaces[pair.coarse]
-            out[sf.body.name].friction_force[sf.nodes[: sf.nc]] += \
-                pair.mass[:, pair.nodes] @ traction
-            out[sc.body.name].friction_force[sc.nodes[: sc.nc]] -= \
-                pair.transfer[:, pair.nodes] @ traction
-        return out
 
     def _correct_frictional(self, state: FrictionState, pens: list[np.ndarray],
                             dw: list[np.ndarray], it: int, platen_ok: bool = True
@@ -501,4 +519,5 @@ class FrictionalPairedContact(PairedContact):
         return dplaten
 
 
-__all__ = ["CONE_TOLERANCE", "FrictionalPairedContact", "coulomb_status", "tangents"]
+__all__ = ["CONE_TOLERANCE", "FrictionHistory", "FrictionalPairedContact", "coulomb_status",
+           "tangents"]

@@ -208,15 +208,18 @@ class LargeDeformationContact(PairSet):
             need, _, _ = self._platen_terms(state, lins)
             platen_ok = (self.platen_body is None or abs(need) <= cfg.platen_tolerance
                          * max(abs(state.platen_force), 1e-300))
+            other_err, other_ok, other_what = self._further_errors(state)
             return Check(
-                IterationRecord(it, pen_err, body_err, contact, tension, platen_error=-need),
+                IterationRecord(it, max(pen_err, other_err), body_err, contact, tension,
+                                platen_error=-need),
                 (pen_err <= tol and tension == 0 and platen_ok and settled
-                 and body_err <= BODY_TOLERANCE),
-                lambda: self.contact_sets(traction_values), max(pen_err, body_err),
+                 and body_err <= BODY_TOLERANCE and other_ok),
+                lambda: self._iteration_sets(state, traction_values),
+                max(pen_err, body_err, other_err),
                 lambda: self.pairings(state, pens),
                 lambda: (f"no convergence in {cfg.max_iterations} iterations (penetration "
                          f"{pen_err:.3g}{self.worst_node(errs)}, body residual "
-                         f"{body_err:.3g}, {tension} nodes in tension)"),
+                         f"{body_err:.3g}{other_what}, {tension} nodes in tension)"),
                 finish=lambda: self._finish(state), extra=(pens, lins))
 
         def correct(it: int, c: Check) -> None:
@@ -226,6 +229,15 @@ class LargeDeformationContact(PairSet):
             self._correct_all(state, pens, lins)
 
         return iterate(cfg, check, correct, on_iteration)
+
+    def _further_errors(self, state: ContactState) -> tuple[float, bool, str]:
+        """The errors of conditions beside the normal ones (friction's): the largest, whether
+        they hold, and what a message says of them. None here."""
+        return 0.0, True, ""
+
+    def _iteration_sets(self, state: ContactState, traction_values: list[np.ndarray]):
+        """The sets the cycle watch compares between iterations: the contact set."""
+        return self.contact_sets(traction_values)
 
     def _linearize(self, state: ContactState) -> list:
         """Newton's system of every large-kinematics body (None for the others)."""
@@ -281,6 +293,13 @@ class LargeDeformationContact(PairSet):
             out.append((on, normal, seg))
         return out
 
+    def _traction_vectors(self, state: ContactState, k: int, on: np.ndarray,
+                          normal: np.ndarray) -> np.ndarray:
+        """Pair k's traction vectors at its nodes ``on`` with ``normal`` there (linear in it:
+        given a change of the normals, the change of the vectors): q n (friction adds s t,
+        t the normal turned by +90 degrees)."""
+        return self.tractions(state, k)[on, None] * normal
+
     def _forces_at(self, state: ContactState, x: list[np.ndarray]) -> np.ndarray:
         """All bodies' candidate nodal forces (stacked) of the state's traction values with the
         bodies' tracked nodes at ``x``: the traction acts along the opposing surface's normal at
@@ -290,7 +309,7 @@ class LargeDeformationContact(PairSet):
                                                          self._normals_at(state, x))):
             if not len(on):
                 continue
-            qn = self.tractions(state, k)[on, None] * normal
+            qn = self._traction_vectors(state, k, on, normal)
             out[pair.fine] += pair.mass[:, pair.nodes[on]] @ qn
             out[pair.coarse] -= pair.transfer[:, pair.nodes[on]] @ qn
         return np.concatenate([F.ravel() for F in out])
@@ -360,8 +379,8 @@ class LargeDeformationContact(PairSet):
                     if not len(hit):
                         continue
                     on = base_n[k][0][hit]
-                    dqn = (self.tractions(state, k)[on, None]
-                           * (pert_n[k][1][hit] - base_n[k][1][hit]) / h)
+                    dqn = self._traction_vectors(
+                        state, k, on, (pert_n[k][1][hit] - base_n[k][1][hit]) / h)
                     nodes = pair.nodes[on]
                     for side, M, sign in ((pair.fine, pair.mass, 1.0),
                                           (pair.coarse, pair.transfer, -1.0)):
@@ -433,7 +452,10 @@ class LargeDeformationContact(PairSet):
         change of the forces, the forces' turning included (``du = C (A dq + B du)``, solved on
         the coordinates B depends on). The linearised penetrations give the complementarity
         problem for dq; each body then moves by its own correction plus the response of its full
-        mesh to the change of its forces (one more solve with its factorization).
+        mesh to the change of its forces (one more solve with its factorization). With friction
+        the unknowns of a node are its normal and tangential traction values
+        (:meth:`directions_now`), and :meth:`_solve_linearised` finds the stick and slip sets
+        too.
         """
         tol = self.penetration_tolerance
         off = self._offsets
@@ -465,21 +487,24 @@ class LargeDeformationContact(PairSet):
             lin_pens.append(p)
             carrying = self.tractions(state, k) != 0
             sets.append(np.flatnonzero(pair.carries & (carrying | (p > -reach))))
-        m = sum(len(s_) for s_ in sets)
-        # force patterns per unit traction value, stacked candidate dofs x m
+        directions = [self.directions_now(k) for k in range(len(self.contact_pairs))]
+        m = sum(len(s_) * len(dirs) for s_, dirs in zip(sets, directions))
+        # force patterns per unit traction value, stacked candidate dofs x m (per pair, the
+        # set's normal unknowns, then its tangential ones)
         A = np.zeros((nt, m))
         col = 0
         for k, s_ in enumerate(sets):
             pair = self.contact_pairs[k]
-            n = pair.normal[s_]
-            cols = slice(col, col + len(s_))
             dim = self.surfaces[pair.fine].dim
-            for d in range(dim):  # component d of every node's force: every dim-th dof
-                A[off[pair.fine] + d:off[pair.fine + 1]:dim, cols] += (
-                    pair.mass[:, pair.nodes[s_]] * n[:, d])
-                A[off[pair.coarse] + d:off[pair.coarse + 1]:dim, cols] -= (
-                    pair.transfer[:, pair.nodes[s_]] * n[:, d])
-            col += len(s_)
+            for direction in directions[k]:
+                n = direction[s_]
+                cols = slice(col, col + len(s_))
+                for d in range(dim):  # component d of every node's force: every dim-th dof
+                    A[off[pair.fine] + d:off[pair.fine + 1]:dim, cols] += (
+                        pair.mass[:, pair.nodes[s_]] * n[:, d])
+                    A[off[pair.coarse] + d:off[pair.coarse + 1]:dim, cols] -= (
+                        pair.transfer[:, pair.nodes[s_]] * n[:, d])
+                col += len(s_)
         CA = np.zeros((nt, m))
         for b in range(len(self.surfaces)):
             CA[off[b]:off[b + 1]] = C[b] @ A[off[b]:off[b + 1]]
@@ -497,11 +522,18 @@ class LargeDeformationContact(PairSet):
         row = 0
         for k, s_ in enumerate(sets):
             pair = self.contact_pairs[k]
-            rows = slice(row, row + len(s_))
-            W[rows] = self._normal_motion(pair, M, s_)
-            p[rows] = lin_pens[k][s_]
-            q0[rows] = self.tractions(state, k)[s_]
-            row += len(s_)
+            for j, direction in enumerate(directions[k]):
+                rows = slice(row, row + len(s_))
+                if j == 0:  # penetration decrease per unit traction value
+                    W[rows] = self._normal_motion(pair, M, s_)
+                    p[rows] = lin_pens[k][s_]
+                    q0[rows] = self.tractions(state, k)[s_]
+                else:  # the slip along the tangent per unit traction value
+                    W[rows] = self._motion_along(pair, direction, M, s_)
+                    p[rows] = self._slip_now(state, k, s_, direction) + self._motion_along(
+                        pair, direction, a, s_)
+                    q0[rows] = self.shear(state, k)[s_]
+                row += len(s_)
         rate = _concatenate([r[s_] for r, s_ in zip(rates, sets)])
         dR = -motion @ A[off[self.platen_body]:off[self.platen_body + 1]] if platen else None
         if platen and m == 0 and stiffness == 0.0:
@@ -509,8 +541,8 @@ class LargeDeformationContact(PairSet):
             # just far enough to close the smallest gap
             q, dplaten = q0, closing_motion(_concatenate(lin_pens), _concatenate(rates), need)
         else:
-            q, dplaten = linear_complementarity(W, q0, p, tol, rate if platen else None, dR,
-                                                stiffness, need)
+            q, dplaten = self._solve_linearised(state, W, q0, p, tol, sets,
+                                                rate if platen else None, dR, stiffness, need)
         dq = q - q0
         dF = A @ dq + (Bj @ (aJ + MJ @ dq) if len(J) else 0.0)
         moves = []
@@ -525,15 +557,41 @@ class LargeDeformationContact(PairSet):
         self._move(state, sets, dq, dplaten, moves,
                    [dF[off[i]:off[i + 1]].reshape(-1, s.dim) for i, s in enumerate(self.surfaces)])
 
-    def _normal_motion(self, pair, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-        """Penetration decrease n . (u_fine - u_coarse at the virtual node) of the pair's nodes
-        for stacked candidate motions u (vector or columns)."""
+    def directions_now(self, k: int) -> list[np.ndarray]:
+        """The directions of pair k's traction unknowns at its nodes, on the current geometry:
+        the normal alone (friction adds the tangent)."""
+        return [self.contact_pairs[k].normal]
+
+    def _solve_linearised(self, state: ContactState, W: np.ndarray, q0: np.ndarray,
+                          p: np.ndarray, tol: float, sets: list[np.ndarray], rate, dR,
+                          stiffness: float, need: float) -> tuple[np.ndarray, float]:
+        """The traction values of the linearised contact problem (and the platen's motion):
+        complementarity on the normal ones (:func:`linear_complementarity`)."""
+        return linear_complementarity(W, q0, p, tol, rate, dR, stiffness, need)
+
+    def _motion_along(self, pair, direction: np.ndarray, u: np.ndarray, nodes: np.ndarray
+                      ) -> np.ndarray:
+        """``direction . (u_fine - u_coarse at the virtual node)`` of the pair's nodes for
+        stacked candidate motions u (vector or columns)."""
         off = self._offsets
         sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
         uf = u[off[pair.fine]:off[pair.fine + 1]].reshape((sf.nc, sf.dim) + u.shape[1:])
         uc = u[off[pair.coarse]:off[pair.coarse + 1]].reshape((sc.nc, sc.dim) + u.shape[1:])
         rel = uf[pair.nodes[nodes]] - np.tensordot(pair.interp[nodes], uc, axes=(1, 0))
-        return np.einsum("id,id...->i...", pair.normal[nodes], rel)
+        return np.einsum("id,id...->i...", direction[nodes], rel)
+
+    def _add_unknowns(self, state: ContactState, sets: list[np.ndarray], dq: np.ndarray
+                      ) -> None:
+        """Add a correction of the unknowns (the order of :meth:`_correct_all`'s columns)."""
+        pos = 0
+        for k, s_ in enumerate(sets):
+            self.tractions(state, k)[s_] += dq[pos:pos + len(s_)]
+            pos += len(s_)
+
+    def _normal_motion(self, pair, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+        """Penetration decrease n . (u_fine - u_coarse at the virtual node) of the pair's nodes
+        for stacked candidate motions u (vector or columns)."""
+        return self._motion_along(pair, pair.normal, u, nodes)
 
     def _move(self, state: ContactState, sets: list[np.ndarray], dq: np.ndarray,
               dplaten: float, moves: list, dF: list[np.ndarray]) -> None:
@@ -559,10 +617,7 @@ class LargeDeformationContact(PairSet):
                     raise
                 fraction *= 0.5
                 log.info("contact correction halved (%s)", exc)
-        pos = 0
-        for k, s_ in enumerate(sets):
-            self.tractions(state, k)[s_] += fraction * dq[pos:pos + len(s_)]
-            pos += len(s_)
+        self._add_unknowns(state, sets, fraction * dq)
         state.platen_displacement += fraction * dplaten
         for F, d in zip(state.forces, dF):
             F += fraction * d

@@ -158,8 +158,8 @@ class ContactSettings:
             sticks (no relative tangential motion against its virtual node within the step) while
             its tangential traction stays within μ times its normal traction, and slips with
             that traction opposing its slip otherwise (docs/method.md §11). 0 (the default):
-            frictionless, the code path of every analysis before friction. The paired variant
-            with small kinematics only, for now.
+            frictionless, the code path of every analysis before friction. The paired variant,
+            small and large kinematics.
         pairs: the friction of particular pairs of bodies (``[[contact.pairs]]`` tables:
             ``bodies``, ``friction``, ``law`` and its parameters), instead of ``friction``;
             different laws in different contact areas, as the thesis allows (§1.10).

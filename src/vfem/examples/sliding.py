@@ -18,8 +18,13 @@ Plane strain, our dimensions (the thesis has no such example):
 Frictionless sliding over an elastic block stores no energy in the motion, so once the punch is
 away from the block's ends the normal reaction is constant and the tangential one nearly zero:
 any jump when a node of one surface passes a vertex of the other is a defect of the
-discretisation. The checks (``evaluate``): every step converged, the normal reaction's largest
-deviation from its mean over the steady part of the slide, the tangential reaction, and the
+discretisation. With ``friction = mu`` (:mod:`vfem.contact.large_friction`) every node in contact
+slips in steady sliding and the tangential tractions are mu times the normal ones; the
+reactions' ratio is mu less the tilt of the normal tractions' resultant over the curved face
+(:func:`_friction_reading`).
+
+The checks (``evaluate``): every step converged, the normal reaction's largest deviation from its
+mean over the steady part of the slide, the tangential reaction, and the
 penetration of every candidate node of either body into the other, measured on the deformed
 surfaces.
 """
@@ -65,6 +70,7 @@ class Parameters:
     press_steps: int = 4
     slide_steps: int = 20
     steady_after: float = 0.1  # the first part of the slide (fraction) is not steady
+    friction: float = 0.0  # Coulomb's mu between punch and block (0: frictionless)
 
 
 def load_factors(p: Parameters) -> tuple[float, ...]:
@@ -93,7 +99,7 @@ def config(p: Parameters | None = None) -> ModelConfig:
         prescribed=(PrescribedDisplacement("top", "y", -p.depth, ((0.0, 0.0), (1.0, 1.0))),
                     PrescribedDisplacement("top", "x", p.slide, ((1.0, 0.0), (2.0, 1.0)))),
         contact_boundaries=("face",), kinematics=p.kinematics, law=p.law)
-    return ModelConfig("sliding", (block, punch), ContactSettings(),
+    return ModelConfig("sliding", (block, punch), ContactSettings(friction=p.friction),
                        Steps(load_factors=load_factors(p)))
 
 
@@ -111,6 +117,8 @@ def validate(p: Parameters) -> None:
                          "its ends (start, slide, block_length, punch_width)")
     if p.kinematics == "small":
         raise InputError("sliding: needs large kinematics ('total' or 'updated')")
+    if not p.friction >= 0:
+        raise InputError(f"sliding: friction must be >= 0 (got {p.friction})")
     build(p).validate()
 
 
@@ -150,6 +158,8 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
         out["normal_reaction_mean"] = mean
         out["normal_reaction_max_deviation"] = float(np.abs(normal[steady] / mean - 1).max())
         out["tangential_reaction_max"] = float(np.abs(tangential[steady]).max())
+        if p.friction > 0:
+            out["friction"] = _friction_reading(result, p, steady, normal, tangential)
     worst = 0.0
     for step in result.steps:
         both = largest_penetrations(result, step)
@@ -160,6 +170,36 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
     out["penetration_tolerance"] = result.penetration_tolerance
     out["reactions"] = rows
     return out
+
+
+def _friction_reading(result: AnalysisResult, p: Parameters, steady: np.ndarray,
+                      normal: np.ndarray, tangential: np.ndarray) -> dict:
+    """Steady sliding with friction: the punch's tangential over normal reaction, and the
+    block's contact force split into the tangential tractions' part (``friction_force``) and
+    the normal tractions' part.
+
+    Where every node in contact slips, the first is mu times the second in magnitude, whatever
+    the pressure (one traction field, s = mu q at each node). The reactions' ratio is mu only
+    if the normal part is normal to the slide: over the punch's curved face a pressure that is
+    not symmetric about its lowest point tilts it, by ``normal_part_tilt`` (radians, positive
+    when it leans against the slide), and the reactions' ratio is then tan(atan mu - tilt).
+    """
+    ratio = np.abs(tangential[steady]) / normal[steady]
+    last = result.steps[-1].bodies["block"]
+    total = last.contact_force.sum(axis=0)
+    friction = last.friction_force.sum(axis=0)
+    normal_part = total - friction
+    status = last.friction_status
+    return {"mu": p.friction,
+            "reaction_ratio_mean": float(ratio.mean()),
+            "reaction_ratio_min": float(ratio.min()),
+            "reaction_ratio_max": float(ratio.max()),
+            "friction_over_normal_part": float(np.linalg.norm(friction)
+                                               / np.linalg.norm(normal_part)),
+            "normal_part_tilt": float(np.arctan2(-normal_part[0], -normal_part[1])
+                                      * np.sign(p.slide)),
+            "slipping_nodes": int((status == 2).sum()),
+            "sticking_nodes": int((status == 1).sum())}
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
@@ -257,6 +297,15 @@ def report(s: dict) -> list[str]:
                          f"over {e['steady_steps']} steady steps "
                          f"{100 * e['normal_reaction_max_deviation']:.3f} %; tangential "
                          f"reaction at most {e['tangential_reaction_max']:.3g}")
+        if "friction" in e:
+            f = e["friction"]
+            lines.append(f"  friction mu = {f['mu']:g}: tangential / normal reaction "
+                         f"{f['reaction_ratio_min']:.5f} to {f['reaction_ratio_max']:.5f} over "
+                         f"the steady steps; slid, the tangential tractions' force is "
+                         f"{f['friction_over_normal_part']:.5f} times the normal tractions', "
+                         f"which lean {f['normal_part_tilt']:.4f} rad against the slide "
+                         f"({f['slipping_nodes']} nodes slipping, {f['sticking_nodes']} "
+                         "sticking)")
         residual = max((x["max_penetration"] for x in steps), default=0.0)
         lines.append(f"  residual penetration {residual:.2e} (tolerance "
                      f"{e['penetration_tolerance']:.1e}); any node of either body into the "
