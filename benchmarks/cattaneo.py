@@ -2,6 +2,8 @@
 
     python benchmarks/cattaneo.py                 # 12 and 17 contact facets across a
     python benchmarks/cattaneo.py 24 34 48 68     # and finer pairs (upper, lower)
+    python benchmarks/cattaneo.py --cost 12 17    # with friction against without
+    python benchmarks/cattaneo.py --baseline 16 23 40 57   # against the Lagrange baseline
 
 Two elastically similar cylinders (``vfem.examples.cattaneo``) pressed by P, then sheared with
 P held. Per step of the shear: Q/(mu P); the stick zone's half-width c of the theory
@@ -73,9 +75,60 @@ def cost(pairs: list[tuple[int, int]]) -> None:
               f"{tf / t0_:>6.2f}")
 
 
+def baseline(pairs: list[tuple[int, int]]) -> None:
+    """vfem against the classical Lagrange-multiplier baseline with Coulomb friction
+    (``contact.method = "lagrange"``: node-to-segment, one global saddle point refactorized
+    whenever the contact or stick/slip set changes) on the same model and meshes: per shear
+    step the stick zone (the theory's c and each method's outermost sticking node, in facets
+    from c) and the shear's largest error over |x| < 0.8 a (% of mu p0); then each method's
+    iterations (linear solves), factorizations and wall time (the faster of two runs)."""
+    import dataclasses
+
+    from vfem.solver import Analysis
+
+    for upper, lower in pairs:
+        p = cattaneo.Parameters(facets_upper=upper, facets_lower=lower)
+        th = cattaneo.theory(p)
+        runs = {}
+        for method in ("vfem", "lagrange"):
+            for _ in range(2):
+                model = cattaneo.build(p)
+                model.contact = dataclasses.replace(model.contact, method=method)
+                analysis = Analysis(model)
+                t0 = time.perf_counter()
+                result = analysis.run()
+                seconds = time.perf_counter() - t0
+                if method not in runs or seconds < runs[method][1]:
+                    runs[method] = (result, seconds, analysis)
+        dofs = sum(b.ndofs for b in runs["vfem"][0].model.bodies)
+        x = cattaneo.profile(runs["vfem"][0], runs["vfem"][0].steps[-1])["x"]
+        h = float(np.diff(np.sort(np.asarray(x)[np.abs(x) < th["a"]])).max())
+        print(f"\n{upper} / {lower} contact facets across a, {dofs} dofs")
+        print(f"{'Q/(mu P)':>9} {'c/a':>7} {'(c - stick)/h vfem':>19} {'lagrange':>9} "
+              f"{'shear max % vfem':>17} {'lagrange':>9}")
+        # (the steps each converged: a run that stopped is compared up to where it stopped)
+        rows = {m: cattaneo.evaluate(r[0], p)["steps"] for m, r in runs.items()}
+        for rv, rl in zip(rows["vfem"], rows["lagrange"]):
+            if rv["c_over_a"] <= 0:
+                continue
+            gap = [(r["c_over_a"] - r["last_sticking_over_a"]) * th["a"] / h for r in (rv, rl)]
+            print(f"{rv['Q_over_muP']:9.3f} {rv['c_over_a']:7.4f} {gap[0]:19.2f} {gap[1]:9.2f} "
+                  f"{100 * rv['shear_max_error']:17.2f} {100 * rl['shear_max_error']:9.2f}")
+        for method, (result, seconds, analysis) in runs.items():
+            if not result.converged:
+                print(f"  {method} stopped after {len(result.steps)} of "
+                      f"{len(result.model.load_factors)} steps: {result.message}")
+            its = sum(st.iterations for st in result.steps)
+            factorizations = (analysis.contact.factorizations if method == "lagrange"
+                              else len(result.model.bodies))
+            print(f"  {method:>8}: {its} iterations, {factorizations} factorizations, "
+                  f"{seconds:.2f} s")
+        print(f"  lagrange / vfem time: {runs['lagrange'][1] / runs['vfem'][1]:.1f}")
+
+
 if __name__ == "__main__":
     args = sys.argv[1:]
-    timing = "--cost" in args
-    numbers = [int(v) for v in args if v != "--cost"] or [12, 17]
+    mode = next((a for a in args if a.startswith("--")), None)
+    numbers = [int(v) for v in args if not v.startswith("--")] or [12, 17]
     pairs = list(zip(numbers[::2], numbers[1::2]))
-    (cost if timing else main)(pairs)
+    {"--cost": cost, "--baseline": baseline, None: main}[mode](pairs)

@@ -67,7 +67,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..bodies import COMPONENTS, curve_key, superpose
-from ..errors import ActiveSetNotSettled, AnalysisError, SingularSystem
+from ..errors import ActiveSetNotSettled, AnalysisError, InputError, SingularSystem
 from ..linalg import factorize
 from ..memory import memory_guard
 from .capabilities import Capabilities
@@ -139,16 +139,26 @@ class NodeToSegment:
     penalty: np.ndarray
     B_slave: sp.csr_matrix
     B_master: sp.csr_matrix
+    #: the relative tangential displacement's rows (the master's tangent, its normal turned by
+    #: +90 degrees, in place of the normal): Coulomb friction's (lagrange)
+    T_slave: sp.csr_matrix | None = None
+    T_master: sp.csr_matrix | None = None
 
     @property
     def B(self) -> sp.csr_matrix:
         return (self.B_slave + self.B_master).tocsr()
 
+    @property
+    def Bt(self) -> sp.csr_matrix:
+        return (self.T_slave + self.T_master).tocsr()
+
     def subset(self, keep: np.ndarray) -> NodeToSegment:
         return NodeToSegment(self.slave[keep], self.master[keep], self.node[keep],
                              self.segment[keep], self.t[keep], self.normal[keep], self.g0[keep],
                              self.weight[keep], self.penalty[keep], self.B_slave[keep],
-                             self.B_master[keep])
+                             self.B_master[keep],
+                             None if self.T_slave is None else self.T_slave[keep],
+                             None if self.T_master is None else self.T_master[keep])
 
 
 def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
@@ -183,7 +193,7 @@ def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
     if not parts:
         empty = sp.csr_matrix((0, ndofs))
         return NodeToSegment(*(np.zeros(0, dtype=int),) * 4, np.zeros(0), np.zeros((0, 2)),
-                             np.zeros(0), np.zeros(0), np.zeros(0), empty, empty)
+                             np.zeros(0), np.zeros(0), np.zeros(0), empty, empty, empty, empty)
 
     def cat(key: str) -> np.ndarray:
         return np.concatenate([p[key] for p in parts])
@@ -197,14 +207,23 @@ def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
     dof_b = np.concatenate([p["master_offset"] + 2 * p["b_points"] for p in parts])
     r2 = np.repeat(rows, 2)
     comp = np.tile([0, 1], m)
-    B_slave = sp.csr_matrix((n.ravel(), (r2, np.repeat(dof_s, 2) + comp)), shape=(m, ndofs))
     master_cols = np.concatenate([np.repeat(dof_a, 2) + comp, np.repeat(dof_b, 2) + comp])
-    master_vals = np.concatenate([(-(1 - t)[:, None] * n).ravel(), (-t[:, None] * n).ravel()])
-    B_master = sp.csr_matrix((master_vals, (np.tile(r2, 2), master_cols)), shape=(m, ndofs))
-    B_slave.eliminate_zeros()  # t = 0 or 1: no entry on the far node (a row of held dofs
-    B_master.eliminate_zeros()  # only is then recognised as no constraint)
+
+    def rows_along(d):
+        """The slave part and the master part of d . (u_slave - u_master at the projection)."""
+        slave_part = sp.csr_matrix((d.ravel(), (r2, np.repeat(dof_s, 2) + comp)),
+                                   shape=(m, ndofs))
+        vals = np.concatenate([(-(1 - t)[:, None] * d).ravel(), (-t[:, None] * d).ravel()])
+        master_part = sp.csr_matrix((vals, (np.tile(r2, 2), master_cols)), shape=(m, ndofs))
+        slave_part.eliminate_zeros()  # t = 0 or 1: no entry on the far node (a row of held
+        master_part.eliminate_zeros()  # dofs only is then recognised as no constraint)
+        return slave_part, master_part
+
+    B_slave, B_master = rows_along(n)
+    T_slave, T_master = rows_along(np.column_stack([-n[:, 1], n[:, 0]]))
     c = NodeToSegment(cat("slave"), cat("master"), cat("node"), cat("segment"), t, n,
-                      cat("g0"), cat("weight"), cat("penalty"), B_slave, B_master)
+                      cat("g0"), cat("weight"), cat("penalty"), B_slave, B_master, T_slave,
+                      T_master)
     longest = max(float(s.lengths.max()) for s in surfaces if len(s.lengths))
     on = ~cat("off")
     keep = np.zeros(m, dtype=bool)
@@ -276,7 +295,10 @@ class GlobalContact:
 
     capabilities = Capabilities(
         name="classical", orders=(1,), kinematics=("small",), dimensions=(2,),
-        friction=("frictionless",), invariants="compared", cuts_steps=False)
+        friction=("frictionless", "coulomb"), invariants="compared", cuts_steps=False)
+
+    #: the methods that solve Coulomb friction (the Lagrange multipliers' saddle point)
+    FRICTIONAL_METHODS = ("lagrange",)
 
     def __init__(self, model, backend: str | None = None):
         self.model = model
@@ -336,6 +358,9 @@ class GlobalContact:
         self.c = c.subset(live)
         self.Br = Br[live]
         self.g_prescribed = [self.c.B @ U for U in self.U_prescribed]  # per unit multiplier
+        self.frictional = settings.frictional
+        if self.frictional:
+            self._setup_friction(settings)
         t3 = time.perf_counter()
         slave_lengths = [s.lengths.min() for i, s in enumerate(self.surfaces)
                          if len(s.lengths) and np.any(self.c.slave == i)]
@@ -350,6 +375,26 @@ class GlobalContact:
                         "factorize_s": 0.0, "solve_s": 0.0}
         log.info("%s: global system of %d unknowns, %d node-to-segment constraints",
                  self.method, self.nq, len(self.c.node))
+
+    def _setup_friction(self, settings) -> None:
+        """Coulomb friction on the node-to-segment rows (``lagrange``): each row's law (the
+        pair of its slave and master bodies), its relative tangential displacement's rows on
+        the free dofs and their prescribed part. A row whose tangential motion no free dof
+        moves (a symmetry plane through the contact), or of a frictionless pair, has no
+        tangential unknown."""
+        names = [b.name for b in self.model.bodies]
+        laws = [settings.pair_friction(names[a], names[b]).coefficients
+                for a, b in zip(self.c.slave, self.c.master)]
+        self.mu = np.array([law[0] for law in laws])
+        self.mu_static = np.array([law[1] for law in laws])
+        if any(law[2] > 0 for law in laws):
+            raise InputError("the elastoplastic friction law is available with contact.method "
+                             "= 'vfem' only; use law = 'coulomb' or 'static_dynamic'")
+        Bt = (self.c.Bt @ self.T).tocsr()
+        Bt.eliminate_zeros()
+        self.Btr = Bt
+        self.t_live = (np.diff(abs(Bt).tocsr().indptr) > 0) & (self.mu_static > 0)
+        self.w_prescribed = [self.c.Bt @ U for U in self.U_prescribed]
 
     @property
     def penetration_tolerance(self) -> float:
@@ -506,6 +551,115 @@ class GlobalContact:
             f"the {self.method} method's active set did not settle in {settings.max_iterations} "
             f"linear solves (contact.max_iterations); largest penetration {penetration:.3g}")
 
+    def _factorized_frictional(self, active: np.ndarray, stick: np.ndarray, slide: np.ndarray,
+                               sigma: np.ndarray):
+        """The saddle point of Lagrange multipliers with Coulomb friction for these sets:
+
+            [ K      B_A^T + C   T_S^T ] [q  ]   [f              ]
+            [ B_A    0           0     ] [y_n] = [-g_A           ]
+            [ T_S    0           0     ] [y_t]   [w_anchor - w_p ]
+
+        ``B_A`` the gaps of the nodes in contact, ``T_S`` the relative tangential
+        displacements of the sticking ones (held at their anchors), and ``C`` the slipping
+        nodes' tangential forces tied to their normal ones (``-mu sigma T_L^T`` in their
+        columns): not symmetric, factorized by LU. Refactorized when a set changes."""
+        key = ("coulomb", active.tobytes(), stick.tobytes(), slide.tobytes(),
+               (sigma[slide] > 0).tobytes())
+        if key == self._factor_key:
+            return self._factor
+        A, S, L = np.flatnonzero(active), np.flatnonzero(stick), np.flatnonzero(slide)
+        Bn = self.Br[A]
+        column = Bn.T.tocsr()
+        if len(L):
+            where = np.searchsorted(A, L)  # each slipping row's column among the contact ones
+            pick = sp.csr_matrix((np.ones(len(L)), (np.arange(len(L)), where)),
+                                 shape=(len(L), len(A)))
+            column = column + self.Btr[L].T @ sp.diags(-self.mu[L] * sigma[L]) @ pick
+        Bt = self.Btr[S]
+        M = sp.bmat([[self.K, column, Bt.T], [Bn, None, None], [Bt, None, None]],
+                    format="csc")
+        t0 = time.perf_counter()
+        try:
+            with memory_guard("factorizing the global system (lagrange, friction)"):
+                self._factor = _Refined(M, factorize(
+                    M, self.backend, spd=False, what="the lagrange global system with friction"))
+        except RuntimeError as exc:
+            if isinstance(exc, AnalysisError):
+                raise SingularSystem(str(exc)) from None
+            raise SingularSystem(
+                f"the global matrix of the lagrange method with friction is singular with "
+                f"{len(A)} nodes in contact, {len(S)} sticking ({exc})") from None
+        self.timings["factorize_s"] += time.perf_counter() - t0
+        self.factorizations += 1
+        self._factor_key = key
+        return self._factor
+
+    def solve_frictional(self, load_factor: float, state: BaselineState):
+        """One step of Lagrange multipliers with Coulomb friction (node-to-segment, small
+        displacements): the contact, stick and slip sets iterated until none changes, each set
+        one factorization of :meth:`_factorized_frictional`, the classical active-set strategy.
+        A node in contact sticks (its relative tangential displacement held at its anchor,
+        the value at the last converged step) until its tangential force exceeds mu_s times
+        its normal one; it then slips with the force mu times the normal one opposing the
+        slip, until its slip turns back. Returns (q, Lambda_n, Lambda_t, g, w, active,
+        sliding, sigma, history)."""
+        settings = self.model.contact
+        f = self.at(load_factor, self.f1)
+        gp = self.c.g0 + self.at(load_factor, self.g_prescribed)
+        wp = self.at(load_factor, self.w_prescribed)
+        live = self.t_live
+        anchor = state.anchor
+        active = self._seeded(state.active, gp)
+        sliding = state.sliding & active & live
+        sigma = np.where(state.shear != 0, -np.sign(state.shear), 1.0)
+        seen = set()
+        history: list[IterationRecord] = []
+        nq = self.nq
+        for it in range(1, settings.max_iterations + 1):
+            stick, slide = active & live & ~sliding, active & live & sliding
+            A, S, L = np.flatnonzero(active), np.flatnonzero(stick), np.flatnonzero(slide)
+            factor = self._factorized_frictional(active, stick, slide, sigma)
+            t0 = time.perf_counter()
+            sol = factor.solve(np.r_[f, -gp[A], anchor[S] - wp[S]])
+            self.timings["solve_s"] += time.perf_counter() - t0
+            q = sol[:nq]
+            if not np.all(np.isfinite(q)):
+                raise SingularSystem("the lagrange method's linear solve with friction gave "
+                                     "non-finite displacements: the global matrix is singular")
+            Lam, Lt = np.zeros(len(gp)), np.zeros(len(gp))
+            Lam[A] = -sol[nq:nq + len(A)]
+            Lt[S] = -sol[nq + len(A):]
+            Lt[L] = -self.mu[L] * sigma[L] * Lam[L]
+            g = gp + self.Br @ q
+            w = wp + self.Btr @ q
+            dw = w - anchor
+            scale = float(np.abs(Lam).max(initial=0.0))
+            leave = active & (Lam < -FORCE_ROUNDOFF * scale)
+            new_active = self._seeded((active & ~leave) | (~active & (g < -self.gap_tolerance)),
+                                      gp)
+            over = stick & (np.abs(Lt) > self.mu_static * Lam + FORCE_ROUNDOFF * scale)
+            back = slide & (sigma * dw < -self.gap_tolerance)
+            new_sigma = np.where(over, -np.sign(Lt), sigma)
+            new_sliding = (sliding | over) & ~back & new_active
+            penetration = float(np.maximum(-g, 0.0).max(initial=0.0))
+            history.append(IterationRecord(it, penetration, 0.0, int((Lam > 0).sum()),
+                                           int(leave.sum())))
+            if (np.array_equal(new_active, active) and np.array_equal(new_sliding, sliding)
+                    and np.array_equal(new_sigma[new_sliding], sigma[new_sliding])):
+                return q, Lam, Lt, g, w, active, sliding & active, sigma, history
+            key = (new_active.tobytes(), new_sliding.tobytes(), (new_sigma > 0).tobytes())
+            if key in seen:
+                changed = np.flatnonzero((new_active != active) | (new_sliding != sliding))
+                raise ActiveSetNotSettled(
+                    "the lagrange method's contact and stick/slip sets cycle: they came back to "
+                    f"sets they had left after {it} linear solves (nodes switching now: "
+                    f"{self._name_rows(changed)})")
+            seen.add(key)
+            active, sliding, sigma = new_active, new_sliding, new_sigma
+        raise ActiveSetNotSettled(
+            f"the lagrange method's contact and stick/slip sets did not settle in "
+            f"{settings.max_iterations} linear solves (contact.max_iterations)")
+
     def _name_rows(self, rows: np.ndarray, limit: int = 8) -> str:
         """'cylinder 12, 13' for constraint rows (slave body, point number)."""
         names = [f"{self.model.bodies[self.c.slave[r]].name} "
@@ -515,14 +669,22 @@ class GlobalContact:
 
     # -- results ----------------------------------------------------------------------------------
 
-    def fields_of(self, load_factor: float, q: np.ndarray, Lam: np.ndarray, g: np.ndarray):
+    def fields_of(self, load_factor: float, q: np.ndarray, Lam: np.ndarray, g: np.ndarray,
+                  friction: dict | None = None):
         """Per body: the :class:`~vfem.result_types.BodyStepResult` and the contact forces on its
-        candidate nodes (nc, 2)."""
+        candidate nodes (nc, 2). ``friction`` (frictional lagrange): per row the tangential
+        force ``shear``, the step's slip ``increment``, the ``accumulated`` slip and the
+        ``status`` (0 free, 1 stick, 2 slip), which add the friction's fields."""
         from ..result_types import BodyStepResult, add_reactions
 
         U = self.T @ q + self.at(load_factor, self.U_prescribed)
         f_slave = self.c.B_slave.T @ Lam
         f_master = self.c.B_master.T @ Lam
+        if friction is not None:
+            f_tangential = (self.c.T_slave.T @ friction["shear"]
+                            + self.c.T_master.T @ friction["shear"])
+            f_slave = f_slave + self.c.T_slave.T @ friction["shear"]
+            f_master = f_master + self.c.T_master.T @ friction["shear"]
         out, forces = {}, []
         for i, (s, off) in enumerate(zip(self.surfaces, self.offsets)):
             b = s.body
@@ -549,11 +711,34 @@ class GlobalContact:
                 depth = np.full(s.nc, -np.inf)
                 np.maximum.at(depth, self.c.node[mine], -g[mine])
                 pen[cand] = np.where(np.isfinite(depth), depth, 0.0)
-            out[b.name] = add_reactions(
-                b, BodyStepResult(U[part].reshape(-1, s.dim), force, pressure, status, pen),
-                load_factor)
+            r = BodyStepResult(U[part].reshape(-1, s.dim), force, pressure, status, pen)
+            if friction is not None:
+                self._friction_fields(r, i, s, mine, friction, f_tangential[part])
+            out[b.name] = add_reactions(b, r, load_factor)
             forces.append(force[cand])
         return out, forces
+
+    def _friction_fields(self, r, i: int, s: ContactSurface, mine: np.ndarray, friction: dict,
+                         f_tangential: np.ndarray) -> None:
+        """The friction's fields of body i (its slave rows ``mine``): the tangential traction
+        on it (force over tributary length, along the master's tangent), slip increment,
+        accumulated slip and status at its slave nodes (-1 elsewhere), and the nodal forces
+        of the tangential multipliers on every node."""
+        nv = s.body.npoints
+        r.contact_shear, r.slip_increment = np.zeros((nv, s.dim)), np.zeros(nv)
+        r.accumulated_slip, r.friction_status = np.zeros(nv), np.full(nv, -1)
+        r.friction_force = f_tangential.reshape(-1, s.dim).copy()
+        if not mine.any():
+            return
+        rows = np.flatnonzero(mine)
+        points = s.nodes[self.c.node[rows]]
+        n = self.c.normal[rows]
+        tangent = np.column_stack([-n[:, 1], n[:, 0]])
+        r.contact_shear[points] = ((friction["shear"][rows] / s.tributary[self.c.node[rows]])
+                                   [:, None] * tangent)
+        r.slip_increment[points] = friction["increment"][rows]
+        r.accumulated_slip[points] = friction["accumulated"][rows]
+        r.friction_status[points] = friction["status"][rows]
 
     # -- the steps --------------------------------------------------------------------------------
 
@@ -573,8 +758,23 @@ class GlobalContact:
             state.pressures, state.active = np.zeros(m), np.zeros(m, dtype=bool)
         lf = state.load_factor
         before = self.factorizations
-        q, Lam, g, active, lam, history = self.solve_step(lf, state.active, state.pressures)
-        fields, forces = self.fields_of(lf, q, Lam, g)
+        if self.frictional:
+            if len(state.anchor) != m:
+                state.anchor, state.shear = np.zeros(m), np.zeros(m)
+                state.slip, state.sliding = np.zeros(m), np.zeros(m, dtype=bool)
+            q, Lam, Lt, g, w, active, sliding, _, history = self.solve_frictional(lf, state)
+            increment = np.where(active, w - state.anchor, 0.0)
+            state.slip = state.slip + np.abs(increment)
+            state.anchor, state.shear, state.sliding = w, Lt, sliding
+            status = np.where(active & (Lam > 0), np.where(sliding, 2, 1), 0)
+            fields, forces = self.fields_of(lf, q, Lam, g, {
+                "shear": Lt, "increment": increment, "accumulated": state.slip,
+                "status": status})
+            lam = Lam / self.c.weight
+        else:
+            q, Lam, g, active, lam, history = self.solve_step(lf, state.active,
+                                                              state.pressures)
+            fields, forces = self.fields_of(lf, q, Lam, g)
         state.platen_displacement = float(q[-1]) if self.platen_body is not None else 0.0
         state.forces[:] = forces
         state.pressures, state.active = lam, active.copy()

@@ -78,7 +78,8 @@ def check_capabilities(model) -> None:
     order, kinematics or dimension), naming the body and what to choose instead."""
     settings = model.contact
     large = any(b.large for b in model.bodies)
-    caps = formulation_class(settings, large).capabilities
+    cls = formulation_class(settings, large)
+    caps = cls.capabilities
     if settings.method != "vfem":
         for b in model.bodies:
             if ("large" if b.large else "small") not in caps.kinematics \
@@ -96,15 +97,17 @@ def check_capabilities(model) -> None:
         if unknown:
             raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: no "
                              f"body named {unknown[0]!r} (bodies: {', '.join(sorted(names))})")
-    if settings.frictional and "coulomb" not in caps.friction:
+    if settings.frictional and ("coulomb" not in caps.friction or (
+            settings.method != "vfem"
+            and settings.method not in getattr(cls, "FRICTIONAL_METHODS", ()))):
         what = (f"contact.method = {settings.method!r}" if settings.method != "vfem" else
                 f"contact.variant = {settings.variant!r}")
         where = (f"contact.friction = {settings.friction:g}" if settings.friction > 0 else
                  "contact.pairs " + ", ".join(repr(list(p.bodies)) for p in settings.pairs
                                               if p.friction > 0))
         raise InputError(f"model {model.name!r}: friction ({where}) is available with the "
-                         f"paired variant only, not yet with {what}; set "
-                         "it to 0 for frictionless contact")
+                         f"paired variant and the lagrange baseline only, not yet with {what}; "
+                         "set it to 0 for frictionless contact")
     for b in model.bodies:
         if b.order not in caps.orders:
             if large:

@@ -136,13 +136,28 @@ class BaselineState(ContactState):
 
     pressures: np.ndarray = field(default_factory=lambda: np.zeros(0))
     active: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    #: Coulomb friction (lagrange): per row the tangential force, the relative tangential
+    #: displacement at the last converged step (a sticking node keeps it), the accumulated
+    #: slip and whether the node slides; empty without friction
+    shear: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    anchor: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    slip: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    sliding: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+
+    FRICTION = ("shear", "anchor", "slip", "sliding")
 
     def unknowns(self) -> dict[str, np.ndarray]:
-        return {"pressures": self.pressures, "active": self.active}
+        out = {"pressures": self.pressures, "active": self.active}
+        out.update({name: getattr(self, name) for name in self.FRICTION
+                    if len(getattr(self, name))})
+        return out
 
     def with_unknowns(self, arrays: dict[str, np.ndarray]) -> BaselineState:
         self.pressures = arrays.get("pressures", np.zeros(0))
         self.active = np.asarray(arrays.get("active", np.zeros(0)), dtype=bool)
+        for name in self.FRICTION:
+            value = np.asarray(arrays.get(name, np.zeros(0)))
+            setattr(self, name, value.astype(bool) if name == "sliding" else value)
         return self
 
 
