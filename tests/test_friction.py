@@ -757,3 +757,24 @@ def test_the_lagrange_baseline_reads_cattaneo_with_its_stick_zone_near_c():
     for r in rows:
         assert abs(r["c_over_a"] - r["last_sticking_over_a"]) * th["a"] <= 1.0 * h, r
     assert analysis.contact.factorizations > 10
+
+
+@pytest.mark.parametrize("name, status, shear", [("patch_stick", "stick", 15.0),
+                                                  ("patch_slip", "slip", 30.0)])
+def test_the_friction_patch_test_input_files(tmp_path, name, status, shear):
+    """``examples/friction/patch_stick.toml`` and ``patch_slip.toml`` (the 4 / 7 case of the
+    patch test above, as files a user runs): every interface node sticks with the shear 15
+    (half of mu p) or slips at mu p = 30, uniform to 1e-8 of mu p, in contact.csv."""
+    import csv
+
+    from vfem.io import runner
+    from vfem.io.input import load
+
+    root = Path(__file__).parent.parent
+    runner.run(load(root / "examples" / "friction" / f"{name}.toml"), tmp_path, figures=False)
+    with open(tmp_path / "contact.csv", newline="") as f:
+        rows = [r for r in csv.DictReader(f) if r["step"] == "2" and r["friction"]]
+    on = [r for r in rows if r["friction"] != "free"]
+    assert len(on) >= 5 and {r["friction"] for r in on} == {status}
+    np.testing.assert_allclose([abs(float(r["shear_x"])) for r in on], shear, rtol=0,
+                               atol=1e-8 * 30.0)
