@@ -42,7 +42,7 @@ import logging
 import numpy as np
 
 from ..errors import InputError
-from .friction import CONE_TOLERANCE, FrictionHistory, tangents
+from .friction import CONE_TOLERANCE, HELD, FrictionHistory, tangents
 from .large import LargeDeformationContact
 from .pairing import virtual_nodes
 from .state import ContactState, FrictionState
@@ -212,7 +212,12 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         slipping = contact & (q > 0) & (np.abs(s) >= (1.0 - CONE_TOLERANCE) * mu_now * q) \
             & (s != 0) & (mu_static > 0)
         sigma = np.where(s != 0, -np.sign(s), np.sign(p[tng]))
-        frictionless = mu_static == 0.0
+        # a node whose relative tangential motion no traction moves (a symmetry plane through
+        # the contact, both bodies held along it) has no tangential unknown, as under small
+        # kinematics (HELD); nor has a frictionless pair's
+        diagonal = np.abs(np.diag(W))
+        held = diagonal[tng] <= HELD * diagonal.max(initial=0.0)
+        frictionless = (mu_static == 0.0) | held
         # a node that comes into contact and has moved along the other surface since the last
         # converged step slips the way it moved, until its traction says it sticks
         entering = contact & (q <= 0) & (np.abs(p[tng]) > tol) & ~frictionless
@@ -239,7 +244,10 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             normal_row = np.isin(rows, nrm)
             b = W[rows] @ q0 + np.where(normal_row, p[rows], -p[rows])
             if len(cols):
-                x[cols] = np.linalg.solve(A, b)
+                try:
+                    x[cols] = np.linalg.solve(A, b)
+                except np.linalg.LinAlgError:  # dependent rows: the least-squares solution
+                    x[cols] = np.linalg.lstsq(A, b, rcond=None)[0]
                 x[tied_s] = tie * x[tied_q]
             dx = x - q0
             pen = p[nrm] - W[nrm] @ dx
