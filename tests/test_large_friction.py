@@ -157,12 +157,27 @@ def test_a_small_push_sticks_as_under_small_kinematics():
     assert force1 < 0.15 * force0 and push1 < 0.3 * push0
 
 
-def test_what_large_kinematics_friction_does_not_solve_yet_is_refused():
+def test_what_large_kinematics_friction_does_not_solve_yet_is_refused_by_validation():
+    """Refused by the model's validation (``vfem check`` as well as ``vfem run``), naming the
+    pair or the body and what to do: the elasto-plastic law under large kinematics or with the
+    lagrange baseline, a force-controlled platen with friction under large kinematics."""
+    from vfem.bodies import Platen
+
     model = slide()
     model.contact = dataclasses.replace(model.contact, pairs=(PairFriction(
         ("base", "block"), 0.3, "elastoplastic", slip_stiffness=1e4),))
-    with pytest.raises(InputError, match="elastoplastic friction law is available with small"):
-        Analysis(model).setup()
+    with pytest.raises(InputError, match=r"contact.pairs \['base', 'block'\]: the elastoplastic "
+                                         "friction law .* not yet with large kinematics"):
+        model.validate()
+    small = slide(kinematics="small")
+    small.contact = dataclasses.replace(model.contact, method="lagrange")
+    with pytest.raises(InputError, match="not yet with contact.method = 'lagrange'"):
+        small.validate()
+    model = slide()
+    block = model.bodies[1]
+    block.platen = Platen("top", "y", -1.0)
+    with pytest.raises(InputError, match="body 'block': a force-controlled platen with friction"):
+        model.validate()
 
 
 def test_the_sliding_example_with_friction_slips_at_mu_in_the_contact_frame():

@@ -226,8 +226,11 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
     if isinstance(exc, InvariantViolation):
         remedy = ("the contact iteration met its own stopping rule but the state it reached "
                   "breaks an invariant checked from the full-mesh results; take smaller steps "
-                  "([steps] count) or refine the mesh where the nodes named are, and if it "
-                  "persists report it with the input (a contact formulation error)")
+                  "([steps] count) or refine the mesh where the nodes named are; where the "
+                  "bodies slide or turn by more than a facet, analyse them with large "
+                  "kinematics (kinematics = \"total\": small kinematics pairs the surfaces "
+                  "once, undeformed); if it persists report it with the input (a contact "
+                  "formulation error)")
     elif isinstance(exc, RindViolation):
         remedy = ("take smaller steps ([steps] count), or give the bodies deeper surface "
                   "elements so a step's overlap stays inside them")

@@ -67,7 +67,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..bodies import COMPONENTS, curve_key, superpose
-from ..errors import ActiveSetNotSettled, AnalysisError, InputError, SingularSystem
+from ..errors import ActiveSetNotSettled, AnalysisError, SingularSystem
 from ..linalg import factorize
 from ..memory import memory_guard
 from .capabilities import Capabilities
@@ -387,9 +387,7 @@ class GlobalContact:
                 for a, b in zip(self.c.slave, self.c.master)]
         self.mu = np.array([law[0] for law in laws])
         self.mu_static = np.array([law[1] for law in laws])
-        if any(law[2] > 0 for law in laws):
-            raise InputError("the elastoplastic friction law is available with contact.method "
-                             "= 'vfem' only; use law = 'coulomb' or 'static_dynamic'")
+        # (the elasto-plastic law is refused before: check_capabilities)
         Bt = (self.c.Bt @ self.T).tocsr()
         Bt.eliminate_zeros()
         self.Btr = Bt
@@ -581,8 +579,11 @@ class GlobalContact:
         t0 = time.perf_counter()
         try:
             with memory_guard("factorizing the global system (lagrange, friction)"):
+                # not symmetric: LU (PARDISO's saddle-point mode reads one triangle of a
+                # symmetric matrix: with slipping nodes its solves were off by 1e-3)
                 self._factor = _Refined(M, factorize(
-                    M, self.backend, spd=False, what="the lagrange global system with friction"))
+                    M, self.backend, spd=False, symmetric=False,
+                    what="the lagrange global system with friction"))
         except RuntimeError as exc:
             if isinstance(exc, AnalysisError):
                 raise SingularSystem(str(exc)) from None

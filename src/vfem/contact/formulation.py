@@ -108,6 +108,21 @@ def check_capabilities(model) -> None:
         raise InputError(f"model {model.name!r}: friction ({where}) is available with the "
                          f"paired variant and the lagrange baseline only, not yet with {what}; "
                          "set it to 0 for frictionless contact")
+    if settings.frictional and (large or settings.method != "vfem"):
+        # what the frictional large-kinematics variant and the lagrange baseline do not solve
+        what = "large kinematics" if large else f"contact.method = {settings.method!r}"
+        for pair in settings.pairs:
+            if pair.law == "elastoplastic" and pair.friction > 0:
+                raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: "
+                                 "the elastoplastic friction law is available with the paired "
+                                 f"variant and small kinematics only, not yet with {what}; use "
+                                 "law = 'coulomb' or 'static_dynamic'")
+        platen = next((b for b in model.bodies if b.platen is not None), None)
+        if large and platen is not None:
+            raise InputError(f"model {model.name!r}, body {platen.name!r}: a force-controlled "
+                             "platen with friction is available with small kinematics only, not "
+                             "yet with large kinematics; prescribe the body's motion instead "
+                             "([[bodies.prescribed]]), or use small kinematics")
     for b in model.bodies:
         if b.order not in caps.orders:
             if large:

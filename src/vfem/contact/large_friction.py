@@ -41,7 +41,6 @@ import logging
 
 import numpy as np
 
-from ..errors import InputError
 from .friction import CONE_TOLERANCE, HELD, FrictionHistory, tangents
 from .large import LargeDeformationContact
 from .pairing import virtual_nodes
@@ -61,16 +60,8 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
     def __init__(self, surfaces, pairs, settings, backend: str | None = None):
         super().__init__(surfaces, pairs, settings, backend)
         self._init_friction(settings)
-        for k, pair in enumerate(self.contact_pairs):
-            names = (self.surfaces[pair.fine].body.name, self.surfaces[pair.coarse].body.name)
-            if self.laws[k][2] > 0:
-                raise InputError(f"contact.pairs {list(names)!r}: the elastoplastic friction "
-                                 "law is available with small kinematics only, not yet with "
-                                 "large kinematics; use law = 'coulomb' or 'static_dynamic'")
-        if self.platen_body is not None and self.laws and max(m[1] for m in self.laws) > 0:
-            raise InputError(f"body {self.surfaces[self.platen_body].body.name!r}: a "
-                             "force-controlled platen with friction is available with small "
-                             "kinematics only, not yet with large kinematics")
+        # (the elasto-plastic law and a force-controlled platen are refused before, by
+        # vfem.contact.formulation.check_capabilities)
 
     # -- the traction field ----------------------------------------------------------------------
 

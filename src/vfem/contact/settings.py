@@ -159,7 +159,7 @@ class ContactSettings:
             its tangential traction stays within μ times its normal traction, and slips with
             that traction opposing its slip otherwise (docs/method.md §11). 0 (the default):
             frictionless, the code path of every analysis before friction. The paired variant,
-            small and large kinematics.
+            small and large kinematics, and the lagrange baseline (docs/baselines.md).
         pairs: the friction of particular pairs of bodies (``[[contact.pairs]]`` tables:
             ``bodies``, ``friction``, ``law`` and its parameters), instead of ``friction``;
             different laws in different contact areas, as the thesis allows (§1.10).

@@ -152,7 +152,9 @@ def validate(p: Parameters) -> None:
         raise InputError("cattaneo: force and youngs_modulus must be > 0 and poissons_ratio in "
                          "[0, 0.5)")
     if not p.friction > 0:
-        raise InputError("cattaneo: friction (mu) must be > 0")
+        raise InputError(f"cattaneo: friction (mu) must be > 0, got {p.friction!r} (the "
+                         "example is about stick and slip; frictionless contact is vfem run "
+                         "hertz)")
     if p.facets_upper < 1 or p.facets_lower < 1 or p.press_steps < 1 or p.shear_steps < 1:
         raise InputError("cattaneo: facets_upper, facets_lower, press_steps and shear_steps "
                          "must be at least 1")
@@ -329,7 +331,8 @@ def figures(folder) -> list[Path]:
          np.asarray([r["last_sticking_over_a"] for r in rows]), factor,
          np.asarray([r["c_over_a"] for r in rows]))],
         "load factor (the motion from 0.5)", "stick zone half-width / a",
-        f"Cattaneo-Mindlin: the stick zone (Mindlin-Deresiewicz after a reversal)\n{method}")
+        "Cattaneo-Mindlin: the stick zone"
+        + (" (Mindlin-Deresiewicz after a reversal)" if p.cycle else "") + f"\n{method}")
     last = folder.steps[-1]
     vm = replot.von_mises(folder, last, "von_mises.png",
                           f"Cattaneo-Mindlin: von Mises stress at the contact, load factor "

@@ -118,7 +118,7 @@ def validate(p: Parameters) -> None:
     if p.kinematics == "small":
         raise InputError("sliding: needs large kinematics ('total' or 'updated')")
     if not p.friction >= 0:
-        raise InputError(f"sliding: friction must be >= 0 (got {p.friction})")
+        raise InputError(f"sliding: friction (mu) must be >= 0, got {p.friction!r}")
     build(p).validate()
 
 

@@ -94,7 +94,7 @@ def use(name: str) -> str:
 
 def factorize(A: sp.spmatrix, backend: str | None = None, trailing: np.ndarray | None = None,
               groups: np.ndarray | None = None, spd: bool = True, what: str = "a matrix",
-              analysis=None):
+              analysis=None, symmetric: bool = True):
     """Factorize the sparse matrix ``A`` with the named backend (see the module docstring).
 
     ``spd=False``: ``A`` is symmetric but indefinite (a saddle-point system of Lagrange
@@ -107,7 +107,11 @@ def factorize(A: sp.spmatrix, backend: str | None = None, trailing: np.ndarray |
     ``analysis``: an earlier factorization by the same backend of a matrix with the same
     sparsity (and ``trailing``), e.g. a large body's tangent of the last iteration; a backend
     that can (PARDISO) takes over its ordering and symbolic analysis, and the earlier one can no
-    longer solve. Others ignore it."""
+    longer solve. Others ignore it.
+
+    ``symmetric=False`` (with ``spd=False``): ``A`` is not symmetric (the Lagrange baseline's
+    saddle point with Coulomb friction's ties); PARDISO factorizes it by LU, MUMPS and SuperLU
+    always do, and CHOLMOD hands it to SuperLU."""
     from ..errors import AnalysisError
 
     name = resolve(backend)
@@ -116,10 +120,12 @@ def factorize(A: sp.spmatrix, backend: str | None = None, trailing: np.ndarray |
         name = "superlu"
     module, cls = BACKENDS[name]
     factory = getattr(importlib.import_module(f".{module}", __name__), cls)
+    extra = {} if symmetric or name != "pardiso" else {"symmetric": False}
     try:
         if analysis is not None and getattr(factory, "reuses_analysis", False):
-            return factory(A, trailing=trailing, groups=groups, spd=spd, analysis=analysis)
-        return factory(A, trailing=trailing, groups=groups, spd=spd)
+            return factory(A, trailing=trailing, groups=groups, spd=spd, analysis=analysis,
+                           **extra)
+        return factory(A, trailing=trailing, groups=groups, spd=spd, **extra)
     except (np.linalg.LinAlgError, RuntimeError, ValueError) as exc:
         raise AnalysisError(f"{what}: factorizing its stiffness ({A.shape[0]} dofs) with {name} "
                             f"failed: {exc}; check that it is held against every rigid-body "

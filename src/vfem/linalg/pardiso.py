@@ -131,16 +131,18 @@ class PardisoFactorization:
 
     def __init__(self, A: sp.spmatrix, trailing: np.ndarray | None = None,
                  groups: np.ndarray | None = None, spd: bool = True,
-                 analysis: PardisoFactorization | None = None):
+                 analysis: PardisoFactorization | None = None, symmetric: bool = True):
         self.shape = A.shape
-        U = sp.triu(A, format="csr")
+        # symmetric matrices: the upper triangle; an unsymmetric one (``symmetric=False``, a
+        # saddle point with friction's ties) whole, factorized by LU (PARDISO's mtype 11)
+        U = sp.triu(A, format="csr") if symmetric else sp.csr_matrix(A)
         U.sort_indices()
         self.n = U.shape[0]
         self._a = np.ascontiguousarray(U.data, dtype=float)
         self._ia = U.indptr.astype(np.int32)
         self._ja = U.indices.astype(np.int32)
         self._pt = np.zeros(64, dtype=np.int64)
-        self._mtype = 2 if spd else -2
+        self._mtype = (2 if spd else -2) if symmetric else 11
         iparm = np.zeros(64, dtype=np.int32)
         iparm[0] = 1  # these values, not the defaults
         iparm[1] = 2  # METIS nested dissection
