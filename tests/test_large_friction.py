@@ -231,3 +231,27 @@ def test_a_resumed_large_frictional_run_equals_an_uninterrupted_one(tmp_path):
         assert a["frictional_work"] == b["frictional_work"]
     assert (tmp_path / "resumed" / "contact.csv").read_text() == \
         (tmp_path / "whole" / "contact.csv").read_text()
+
+
+def test_the_sliding_reactions_tend_to_mu_as_the_indentation_shrinks():
+    """The reactions' ratio differs from mu by the tilt of the normal tractions' resultant,
+    which shrinks with the indentation (the pressure's asymmetry over the punch's curved face
+    is a property of the model, not of the discretisation): on the example's meshes, slid 0.5
+    with mu = 0.3, measured tilts 0.0071 / 0.0032 / 0.0009 rad and ratios 0.2922 / 0.2965 /
+    0.2990 at depths 0.05 / 0.025 / 0.0125 (2026-11-27). At a quarter of the example's depth
+    the ratio is within 1 % of mu, as the issue asks of steady sliding."""
+    from vfem.examples import sliding
+
+    tilts = {}
+    for depth in (0.05, 0.0125):
+        p = sliding.Parameters(slide=0.5, slide_steps=4, friction=0.3, depth=depth)
+        result = run(sliding.build(p))
+        assert all(s.invariants["passed"] for s in result.steps)
+        f = sliding.evaluate(result, p)["friction"]
+        assert f["sticking_nodes"] == 0
+        tilts[depth] = f["normal_part_tilt"]
+        rows = sliding.reactions(result)
+        ratio = abs(rows["tangential"][-1]) / abs(rows["normal"][-1])
+        assert ratio == pytest.approx(math.tan(math.atan(0.3) - tilts[depth]), rel=1e-6)
+    assert 0 < tilts[0.0125] < tilts[0.05] / 4
+    assert abs(ratio / 0.3 - 1) < 0.01
