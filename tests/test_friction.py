@@ -695,8 +695,8 @@ def test_a_model_with_friction_only_in_a_pair_entry_writes_the_friction_output(t
     assert header.endswith("shear_x,shear_y,slip_increment,accumulated_slip,friction")
     work = [x["frictional_work"] for x in summary["steps"]]
     assert summary["frictional_work_total"] == pytest.approx(sum(work), rel=1e-12)
-    assert any("static_dynamic mu = 0.2" in line for line in runner.report(summary,
-                                                                           tmp_path / "pairs"))
+    assert any("lower/upper: static mu = 0.3, dynamic mu = 0.2" in line  # both coefficients
+               for line in runner.report(summary, tmp_path / "pairs"))
     result, _ = cattaneo.solve(cattaneo.Parameters())
     work = frictional_work(result.steps)
     pressed = [w for s, w in zip(result.steps, work, strict=True) if s.load_factor <= 0.5]

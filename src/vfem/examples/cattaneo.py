@@ -33,7 +33,7 @@ from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.friction import coulomb_status, tangents
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import run_status
+from ..io.runner import friction_line, run_status
 from ..materials import LinearElastic
 from ..solver import Analysis, AnalysisResult, Model
 
@@ -356,4 +356,7 @@ def report(s: dict) -> list[str]:
                          f"{r['Q_over_muP']:+.3f}, stick zone c/a {r['c_over_a']:.3f} "
                          f"(theory), outermost sticking node {r['last_sticking_over_a']:.3f}"
                          f"{extra}")
+    if friction_line(s):
+        lines.append("  " + friction_line(s, "the shear per node in contact.csv and the VTU "
+                                             "files"))
     return lines

@@ -41,7 +41,7 @@ from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.check import largest_penetrations
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import run_status
+from ..io.runner import friction_line, run_status
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -306,6 +306,8 @@ def report(s: dict) -> list[str]:
                          f"which lean {f['normal_part_tilt']:.4f} rad against the slide "
                          f"({f['slipping_nodes']} nodes slipping, {f['sticking_nodes']} "
                          "sticking)")
+        if friction_line(s):  # with friction, whether or not the slide reached steady steps
+            lines.append("  " + friction_line(s))
         residual = max((x["max_penetration"] for x in steps), default=0.0)
         lines.append(f"  residual penetration {residual:.2e} (tolerance "
                      f"{e['penetration_tolerance']:.1e}); any node of either body into the "

@@ -329,6 +329,61 @@ def contact_label(summary: dict) -> str:
     return f"contact: vfem, {variant} variant" if method == "vfem" else f"contact: {method}"
 
 
+def contact_settings(model) -> dict:
+    """``summary.json``'s ``contact_settings``: the contact ``method`` and ``variant`` of
+    ``model`` and, with friction (``contact.frictional``), ``friction``: the law that ran and
+    its coefficients (:func:`friction_law`: ``law`` and ``mu``, or ``mu_static`` and
+    ``mu_dynamic``, ...) where every pair of bodies ran the same one, else ``law`` ``"per
+    pair"``; then ``pairs``, each pair of bodies that may touch with its own law."""
+    out = {"variant": model.contact.variant, "method": model.contact.method}
+    if model.contact.frictional:
+        names = [b.name for b in model.bodies]
+        pairs = [friction_law(model.contact.pair_friction(a, b)) for a, b in (
+            model.contact_pairs if model.contact_pairs is not None
+            else [(a, b) for i, a in enumerate(names) for b in names[i + 1:]])]
+        laws = [{k: v for k, v in p.items() if k != "bodies"} for p in pairs]
+        common = laws[0] if laws and all(law == laws[0] for law in laws) else {"law": "per pair"}
+        out["friction"] = {**common, "pairs": pairs}
+    return out
+
+
+def friction_law(pair) -> dict:
+    """One pair's friction (:class:`vfem.contact.settings.PairFriction`) as data: ``bodies``,
+    ``law`` and its coefficients by name — ``coulomb``: ``mu``; ``static_dynamic``:
+    ``mu_static`` (a sticking node starts to slip) and ``mu_dynamic`` (a slipping one);
+    ``elastoplastic``: ``mu`` and ``slip_stiffness``; ``frictionless`` where the pair has no
+    friction."""
+    out: dict = {"bodies": list(pair.bodies)}
+    mu, static, _ = pair.coefficients
+    if mu == 0 and static == 0:
+        return {**out, "law": "frictionless"}
+    if pair.law == "static_dynamic":
+        return {**out, "law": pair.law, "mu_static": static, "mu_dynamic": mu}
+    if pair.law == "elastoplastic":
+        return {**out, "law": pair.law, "mu": mu, "slip_stiffness": float(pair.slip_stiffness)}
+    return {**out, "law": pair.law, "mu": mu}
+
+
+def friction_laws_text(settings: dict | None) -> str:
+    """The friction laws of ``contact_settings`` (:func:`contact_settings`) in words, for the
+    closing screen and the figures: "upper/lower: Coulomb, mu = 0.3" or "base/block: static
+    mu = 0.3, dynamic mu = 0.2" (pairs joined by "; "); "" without friction."""
+    friction = (settings or {}).get("friction") or {}
+    texts = []
+    for p in friction.get("pairs") or ():
+        law, who = p.get("law"), "/".join(p.get("bodies") or ())
+        if law == "static_dynamic":
+            texts.append(f"{who}: static mu = {p['mu_static']:g}, dynamic mu = {p['mu_dynamic']:g}")
+        elif law == "elastoplastic":
+            texts.append(f"{who}: elasto-plastic, mu = {p['mu']:g}, slip stiffness "
+                         f"{p['slip_stiffness']:g}")
+        elif law == "frictionless":
+            texts.append(f"{who}: frictionless")
+        else:
+            texts.append(f"{who}: Coulomb, mu = {p.get('mu', 0.0):g}")
+    return "; ".join(texts)
+
+
 #: set by :func:`defer`: runs write their results and leave the figures to ``vfem plot``
 _deferred = False
 
@@ -357,8 +412,7 @@ def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> lis
     out = Path(out)
     summary["figure_set"] = figure_set
     if model is not None:
-        summary["contact_settings"] = {"variant": model.contact.variant,
-                                       "method": model.contact.method}
+        summary["contact_settings"] = contact_settings(model)
     summary.pop("figures_not_drawn", None)
     missing = (f"--no-figures (vfem plot {out} draws them)" if _deferred
                else plots.matplotlib_missing())

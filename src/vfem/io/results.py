@@ -416,6 +416,31 @@ def frictional_work(steps: list[StepResult]) -> list[float]:
     return out
 
 
+def external_work(result: AnalysisResult) -> list[float]:
+    """Per step, the work done on the bodies from outside them: the supports, prescribed
+    displacements and platen (each body's nodal ``reaction``) and the applied loads (its
+    tractions at the step's load factor), times each node's displacement in the step, by the
+    trapezoidal rule (the mean of the forces at the step's start and end: exact for a force
+    linear in the displacement over the step). The measure against which the frictional work
+    is told from round-off (:func:`vfem.io.runner.dissipated`). A body whose reactions were
+    not computed (a step read back from an older checkpoint) counts its applied loads only."""
+    bodies = {b.name: b for b in result.model.bodies}
+    out: list[float] = []
+    before: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for step in result.steps:
+        work = 0.0
+        for name, r in step.bodies.items():
+            u = np.asarray(r.displacement, dtype=float)
+            force = bodies[name].applied_load(step.load_factor).reshape(u.shape)
+            if r.reaction is not None:
+                force = force + r.reaction
+            u0, f0 = before.get(name, (np.zeros_like(u), np.zeros_like(u)))
+            work += 0.5 * float(np.einsum("ij,ij->", force + f0, u - u0))
+            before[name] = (u, force)
+        out.append(work)
+    return out
+
+
 def total(force: np.ndarray) -> list[float]:
     """The resultant (x, y) of nodal forces (n, 2), summed per component (the same digits
     wherever a total is reported)."""
@@ -464,28 +489,37 @@ def force_record(step: StepResult) -> dict:
 
 
 def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
-    """The keys every example's ``summary.json`` starts with (its own evaluation follows); with
-    friction, per step the work it dissipated and ``frictional_work_total``."""
+    """The keys every example's ``summary.json`` starts with (its own evaluation follows): the
+    contact settings that ran (:func:`vfem.io.replot.contact_settings`: with friction, its
+    laws); with friction, per step the work it dissipated and ``frictional_work_total``
+    (:func:`friction_summary`)."""
+    from .replot import contact_settings
+
     out = {"example": name, "converged": result.converged, "message": result.message,
            "steps": [step_record(s) for s in result.steps],
            "dofs": int(sum(b.ndofs for b in result.model.bodies)),
            "parameters": dataclasses.asdict(parameters), "timings": result.timings,
-           "linear_solver": result.backend}
+           "linear_solver": result.backend, "contact_settings": contact_settings(result.model)}
     out.update(friction_summary(result, out["steps"]))
     return out
 
 
 def friction_summary(result: AnalysisResult, records: list[dict]) -> dict:
     """With friction (the model's ``contact.frictional``): each step's record (``records``,
-    one per ``result.steps``) gets its ``frictional_work`` (:func:`frictional_work`), and the
-    returned keys are ``frictional_work_total``; without friction nothing changes and the
-    keys are none (a frictionless run's summary stays as it was)."""
+    one per ``result.steps``) gets its ``frictional_work`` (:func:`frictional_work`) and its
+    ``external_work`` (:func:`external_work`, the scale that tells the former from
+    round-off), and the returned keys are ``frictional_work_total`` and
+    ``external_work_total``; without friction nothing changes and the keys are none (a
+    frictionless run's summary stays as it was)."""
     if not result.model.contact.frictional:
         return {}
     work = frictional_work(result.steps)
-    for record, w in zip(records, work, strict=True):
+    outside = external_work(result)
+    for record, w, e in zip(records, work, outside, strict=True):
         record["frictional_work"] = w
-    return {"frictional_work_total": float(sum(work))}
+        record["external_work"] = e
+    return {"frictional_work_total": float(sum(work)),
+            "external_work_total": float(sum(outside))}
 
 
 def _num(x: float) -> str:

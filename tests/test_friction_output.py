@@ -1,0 +1,136 @@
+"""What a run with friction tells its reader (issue 20, a new user's trial): the work the
+friction dissipated on every closing screen that reads friction (0, never a negative
+round-off, where nothing slipped), the laws that ran in ``summary.json``'s
+``contact_settings`` and on the screen (both coefficients of the static/dynamic law)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from vfem.cli import main
+from vfem.io.runner import ROUND_OFF, dissipated, friction_line
+
+ROOT = Path(__file__).resolve().parents[1]
+FRICTION = ROOT / "examples" / "friction"
+
+#: the sliding example at settings that run in a few seconds (as tests/test_replot.py)
+SLIDING = ["block_columns=60", "block_rows=6", "punch_columns=16", "punch_rows=3",
+           "press_steps=2", "slide_steps=4", "slide=0.5"]
+#: the Cattaneo example, shorter
+CATTANEO = ["press_steps=2", "shear_steps=4"]
+
+
+def _run(capsys, *args) -> tuple[str, dict]:
+    """``vfem run ...`` (exit status 0): what it printed and its summary.json."""
+    out = Path(args[args.index("--out") + 1])
+    assert main(["run", *args]) == 0
+    printed = capsys.readouterr().out
+    return printed, json.loads((out / "summary.json").read_text())
+
+
+def _sets(settings: list[str]) -> list[str]:
+    return [a for s in settings for a in ("--set", s)]
+
+
+# -- the work dissipated -------------------------------------------------------------------------
+
+def test_round_off_is_shown_as_zero_and_real_work_as_it_is():
+    steps = [{"external_work": 0.01}, {"external_work": 0.0005}]
+    stick = {"frictional_work_total": -2.3e-17, "steps": steps}
+    assert dissipated(stick) == 0.0
+    assert "work dissipated 0 over the run, to round-off" in friction_line(stick)
+    assert "-2.3e-17" not in friction_line(stick)
+    # just above the threshold, and a real (even negative) reading, are shown as they are
+    above = 2 * ROUND_OFF * 0.0105
+    assert dissipated({"frictional_work_total": above, "steps": steps}) == above
+    assert dissipated({"frictional_work_total": -1e-3, "steps": steps}) == -1e-3
+    assert dissipated({"frictional_work_total": 0.0072, "steps": steps}) == 0.0072
+    assert dissipated({"steps": steps}) is None and friction_line({"steps": steps}) == ""
+
+
+def test_a_run_that_only_sticks_prints_zero_work_not_a_negative_round_off(tmp_path, capsys):
+    printed, summary = _run(capsys, str(FRICTION / "patch_stick.toml"), "--out",
+                            str(tmp_path), "--no-figures")
+    assert abs(summary["frictional_work_total"]) < 1e-12  # round-off (-2.8e-17 here)
+    assert summary["external_work_total"] == pytest.approx(0.01045, rel=1e-9)
+    assert len(summary["steps"]) == 2
+    assert all("external_work" in x and "frictional_work" in x for x in summary["steps"])
+    line = next(x for x in printed.splitlines() if "work dissipated" in x)
+    assert "work dissipated 0 over the run, to round-off" in line, line
+    assert "work dissipated -" not in printed
+
+
+def test_the_cattaneo_and_sliding_screens_give_the_total_work(tmp_path, capsys):
+    printed, summary = _run(capsys, "cattaneo", *_sets(CATTANEO), "--out", str(tmp_path / "c"),
+                            "--no-figures")
+    total = summary["frictional_work_total"]
+    assert total > 0
+    lines = printed.splitlines()
+    line = next(x for x in lines if "work dissipated" in x)
+    assert f"work dissipated {total:.4g} over the run" in line
+    assert "upper/lower: Coulomb, mu = 0.3" in line
+    # beside the other friction readings: after the steps of the shear, before the forces
+    assert lines.index(line) == 1 + max(k for k, x in enumerate(lines) if "Q/(mu P)" in x)
+    printed, summary = _run(capsys, "sliding", *_sets(SLIDING + ["friction=0.3"]), "--out",
+                            str(tmp_path / "s"), "--no-figures")
+    total = summary["frictional_work_total"]
+    assert total > 0
+    lines = printed.splitlines()
+    line = next(x for x in lines if "work dissipated" in x)
+    assert f"work dissipated {total:.4g} over the run" in line
+    assert lines.index(line) == 1 + next(k for k, x in enumerate(lines)
+                                         if x.startswith("  friction mu = 0.3"))
+    printed, summary = _run(capsys, "sliding", *_sets(SLIDING), "--out", str(tmp_path / "f"),
+                            "--no-figures")
+    assert "work dissipated" not in printed and "frictional_work_total" not in summary
+
+
+# -- the laws that ran ---------------------------------------------------------------------------
+
+def test_contact_settings_record_the_law_and_the_screen_gives_both_coefficients(tmp_path,
+                                                                              capsys):
+    printed, summary = _run(capsys, str(FRICTION / "pushed_block.toml"), "--out",
+                            str(tmp_path / "p"), "--no-figures")
+    pair = {"bodies": ["base", "block"], "law": "static_dynamic", "mu_static": 0.3,
+            "mu_dynamic": 0.2}
+    assert summary["contact_settings"] == {
+        "variant": "paired", "method": "vfem",
+        "friction": {"law": "static_dynamic", "mu_static": 0.3, "mu_dynamic": 0.2,
+                     "pairs": [pair]}}
+    line = next(x for x in printed.splitlines() if "work dissipated" in x)
+    assert "friction (base/block: static mu = 0.3, dynamic mu = 0.2)" in line, line
+    # an example's summary, figures drawn or not: Coulomb's law and its mu
+    _, summary = _run(capsys, "cattaneo", *_sets(CATTANEO), "--out", str(tmp_path / "c"),
+                      "--no-figures")
+    assert summary["contact_settings"]["friction"] == {
+        "law": "coulomb", "mu": 0.3,
+        "pairs": [{"bodies": ["upper", "lower"], "law": "coulomb", "mu": 0.3}]}
+    # frictionless: no friction recorded
+    _, summary = _run(capsys, str(ROOT / "examples" / "hertz.toml"), "--out",
+                      str(tmp_path / "h"), "--no-figures")
+    assert summary["contact_settings"] == {"variant": "paired", "method": "vfem"}
+
+
+def test_different_laws_in_different_pairs_are_recorded_per_pair():
+    from vfem.contact.settings import ContactSettings, PairFriction
+    from vfem.io.replot import contact_settings, friction_laws_text
+    from vfem.solver import Model
+
+    class Named:
+        def __init__(self, name):
+            self.name = name
+
+    contact = ContactSettings(friction=0.25, pairs=(
+        PairFriction(("a", "b"), 0.2, "static_dynamic", static_friction=0.4),
+        PairFriction(("b", "c"), 0.3, "elastoplastic", slip_stiffness=1e4)))
+    model = Model("three", [Named("a"), Named("b"), Named("c")], contact=contact)
+    settings = contact_settings(model)
+    assert settings["friction"]["law"] == "per pair"
+    assert [p["law"] for p in settings["friction"]["pairs"]] == [
+        "static_dynamic", "coulomb", "elastoplastic"]  # a/b, a/c (contact.friction), b/c
+    assert friction_laws_text(settings) == (
+        "a/b: static mu = 0.4, dynamic mu = 0.2; a/c: Coulomb, mu = 0.25; b/c: "
+        "elasto-plastic, mu = 0.3, slip stiffness 10000")
