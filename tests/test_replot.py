@@ -256,3 +256,41 @@ def test_progress_prefixes_the_case_and_counts_its_steps_anew():
     first, second = stream.getvalue().splitlines()
     assert first.startswith("  case 1: [##########..........]")
     assert second.startswith("  case 2: [##########..........]")
+
+
+@pytest.fixture
+def legends(monkeypatch):
+    """Per figure saved: each legend's box and its axes' box, in pixels, as drawn, and the
+    figure's box."""
+    seen = {}
+    save = matplotlib.figure.Figure.savefig
+
+    def record(fig, path, *args, **kw):
+        out = save(fig, path, *args, **kw)  # drawn: the boxes are final
+        renderer = fig.canvas.get_renderer()
+        seen[Path(path).name] = {
+            "figure": fig.bbox,
+            "boxes": [(ax.get_legend().get_window_extent(renderer),
+                       ax.get_window_extent(renderer)) for ax in fig.axes if ax.get_legend()]}
+        return out
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", record)
+    return seen
+
+
+@pytest.mark.parametrize("model, figure", [
+    (["sliding", *(a for s in SMALL["sliding"] + ["friction=0.3"] for a in ("--set", s))],
+     "reactions.png"),
+    ([str(ROOT / "examples" / "friction" / "pushed_block.toml")], "history.png")])
+def test_the_legends_of_the_step_histories_stand_beside_the_curves(model, figure, tmp_path,
+                                                                  legends):
+    """reactions.png (sliding) and history.png (an input file's run): each panel's legend
+    outside its axes, where it covers no curve (inside, at "upper right", it covered the last
+    points of the tangential reaction and of a held contact force), and whole in the figure."""
+    assert main(["-q", "run", *model, "--out", str(tmp_path)]) == 0
+    boxes = legends[figure]["boxes"]
+    assert boxes, figure
+    for legend, axes in boxes:
+        assert not legend.overlaps(axes), (figure, legend, axes)
+        assert legends[figure]["figure"].contains(legend.x0, legend.y0)
+        assert legends[figure]["figure"].contains(legend.x1, legend.y1)

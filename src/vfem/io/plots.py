@@ -478,12 +478,15 @@ def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarra
     """Several quantities against the step, one panel each, stacked with a shared x axis.
 
     ``panels``: (ylabel, series name -> (x, y), logarithmic y axis). On a logarithmic axis,
-    values <= 0 are left out (a panel with none left stays linear).
+    values <= 0 are left out (a panel with none left stays linear). Each panel's legend
+    stands beside it (:data:`OUTSIDE`), never over its curves (inside, at "upper right", it
+    covered the last points of a curve that ends high: the tangential reaction of a slide,
+    the contact force of a held load).
     """
     plt = require_matplotlib()
     from matplotlib.ticker import MaxNLocator
 
-    fig, axes = plt.subplots(len(panels), 1, figsize=(6.4, 2.4 * len(panels) + 0.8),
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8.6, 2.4 * len(panels) + 0.8),
                              sharex=True, squeeze=False)
     for ax, (ylabel, series, log) in zip(axes[:, 0], panels):
         positive = False
@@ -503,7 +506,7 @@ def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarra
         ax.set_ylabel(ylabel, fontsize=8)
         ax.grid(alpha=0.3, which="both")
         if series:
-            ax.legend(fontsize=7, loc="upper right")
+            ax.legend(fontsize=7, **OUTSIDE)
     axes[-1, 0].set_xlabel(xlabel)
     axes[-1, 0].xaxis.set_major_locator(MaxNLocator(integer=True))
     fig.suptitle(title, fontsize=10)
