@@ -134,3 +134,63 @@ def test_different_laws_in_different_pairs_are_recorded_per_pair():
     assert friction_laws_text(settings) == (
         "a/b: static mu = 0.4, dynamic mu = 0.2; a/c: Coulomb, mu = 0.25; b/c: "
         "elasto-plastic, mu = 0.3, slip stiffness 10000")
+
+
+# -- friction.png: the Coulomb limit beside the traction -----------------------------------------
+
+@pytest.fixture
+def lines(monkeypatch):
+    """Per figure saved: its lines by label ("_" labels: the lines the legend does not name,
+    under their own key as a list)."""
+    import matplotlib.figure
+
+    seen = {}
+    save = matplotlib.figure.Figure.savefig
+
+    def record(fig, path, *args, **kw):
+        named, other = {}, []
+        for ax in fig.axes:
+            for line in ax.get_lines():
+                if line.get_label().startswith("_"):
+                    other.append(line)
+                else:
+                    named[line.get_label()] = line
+        seen[Path(path).name] = {**named, "_": other}
+        return save(fig, path, *args, **kw)
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", record)
+    return seen
+
+
+@pytest.mark.parametrize("model, body, bounds", [
+    ("patch_stick", "upper", {"upper: ±mu q = 0.3 q, Coulomb limit": 0.3}),
+    ("pushed_block", "block", {"block: ±mu_s q = 0.3 q, stick limit": 0.3,
+                               "block: ±mu_d q = 0.2 q, slip": 0.2})])
+def test_friction_png_draws_the_coulomb_limit_beside_the_traction(model, body, bounds, tmp_path,
+                                                                 lines):
+    """friction.png: the lines +mu q and -mu q, q the normal traction at the nodes in contact
+    (both coefficients of the static/dynamic law), so a reader sees a slipping node on its
+    limit and a sticking one within it; a redraw from the folder draws the same."""
+    import meshio
+    import numpy as np
+
+    assert main(["-q", "run", str(FRICTION / f"{model}.toml"), "--out", str(tmp_path)]) == 0
+    last = sorted(tmp_path.glob(f"{body}_step*.vtu"))[-1]
+    fields = meshio.read(last).point_data
+    status = np.asarray(fields["friction_status"]).ravel()
+    on = status > 0
+    q = np.asarray(fields["contact_traction"]).ravel()[on]
+    shear = np.hypot(*np.asarray(fields["contact_shear"])[on, :2].T)
+    drawn = lines["friction.png"]
+    for label, mu in bounds.items():
+        upper = np.sort(drawn[label].get_ydata())
+        assert upper == pytest.approx(np.sort(mu * q), rel=1e-12), label
+        assert any(np.allclose(np.sort(line.get_ydata()), np.sort(-mu * q), rtol=1e-12)
+                   for line in drawn["_"]), f"-{label}"
+    slips, sticks = status[on] == 2, status[on] == 1
+    mu = min(bounds.values())  # a slipping node carries the (dynamic) coefficient
+    assert shear[slips] == pytest.approx(mu * q[slips], rel=1e-9)
+    assert np.all(shear[sticks] <= max(bounds.values()) * q[sticks] * (1 + 1e-9))
+    assert (model == "patch_stick") == (sticks.all() and not slips.any())
+    assert main(["-q", "plot", str(tmp_path)]) == 0
+    assert set(lines["friction.png"]) - {"_"} >= set(bounds)

@@ -418,16 +418,27 @@ def _finish_profiles(plt, fig, ax, path: Path, xlabel: str, ylabel: str, title: 
 
 
 def friction_profiles(path: Path, bodies: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
-                      title: str) -> None:
+                      title: str,
+                      limits: dict[str, tuple[np.ndarray, list[tuple[str, float]]]] | None = None
+                      ) -> None:
     """The tangential traction against x per body: (x, signed traction, status 1 stick or 2
-    slip) of the nodes in contact; sticking nodes filled, slipping ones open."""
+    slip) of the nodes in contact; sticking nodes filled, slipping ones open. ``limits``: per
+    body, the normal traction q at those nodes and the coefficients of its law, each (what it
+    is, mu): drawn as the lines +mu q and -mu q beside the traction (the Coulomb limit: a
+    slipping node lies on it, a sticking one within)."""
     plt = require_matplotlib()
-    fig, ax = plt.subplots(figsize=(8.0, 4.2))
+    fig, ax = plt.subplots(figsize=(9.0, 4.4))
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
     for (name, (x, s, status)), c in zip(bodies.items(), colors * (len(bodies) // 6 + 1)):
         if not len(x):
             continue
         order = np.argsort(x, kind="stable")
+        q, coefficients = (limits or {}).get(name, (None, []))
+        for (what, mu), ls in zip(coefficients, ("--", ":", "-.")):
+            bound = mu * np.asarray(q, dtype=float)[order]
+            ax.plot(x[order], bound, ls, color=c, lw=1.0, alpha=0.8,
+                    label=f"{name}: ±{what.replace(' q', f' q = {mu:g} q', 1)}")
+            ax.plot(x[order], -bound, ls, color=c, lw=1.0, alpha=0.8)
         ax.plot(x[order], s[order], "-", color=c, lw=0.8)
         for code, fill, what in ((1, c, "sticks"), (2, "none", "slips")):
             pick = status == code

@@ -20,7 +20,9 @@ records no figure set, e.g. one written before figure sets were recorded):
   on each body (the sum of the VTU's nodal ``contact_force``; per unit thickness);
 * ``von_mises.png`` — the last step's deformed bodies filled by the VTU's element ``von_mises``;
 * ``friction.png`` (a run with friction) — the last step's tangential traction against x at the
-  nodes that carry a pair's compatibility, sticking and slipping nodes marked apart.
+  nodes that carry a pair's compatibility, sticking and slipping nodes marked apart, between
+  the Coulomb limit ±mu q (q the normal traction there; both of the static/dynamic law's
+  coefficients): a slipping node lies on it, a sticking one within.
 
 Without ``contact.csv`` (results written by an older version), the nodes in contact and their
 pressure are taken from the VTU's ``contact_status`` and ``contact_pressure`` point fields.
@@ -476,7 +478,7 @@ def generic(folder: Folder) -> list[Path]:
                              label))
     written.append(_history(folder.directory, steps, folder.summary or None))
     if "contact_shear" in steps[-1].bodies[0].point_data:  # a run with friction
-        written.append(_friction(folder.directory, steps[-1], label))
+        written.append(_friction(folder.directory, steps[-1], label, folder.summary))
     # the most stressed step (a load that is held and then removed ends unloaded)
     peak = max(steps, key=lambda s: max(float(_cell_field(b, "von_mises").max(initial=0.0))
                                         for b in s.bodies))
@@ -584,24 +586,60 @@ def _pressure(directory: Path, steps: list[Step], contact, source: str, method: 
     return path
 
 
-def _friction(directory: Path, step: Step, method: str) -> Path:
+def _friction(directory: Path, step: Step, method: str, summary: dict | None = None) -> Path:
     """``friction.png``: at ``step``, the tangential traction (its size, signed by its x
-    component) against the normal one at the nodes that carry a pair's compatibility and
-    touch, per body, sticking and slipping nodes marked apart (the VTU's ``contact_shear``,
-    ``contact_traction`` and ``friction_status``): a slipping node lies on its line
-    |s| = mu q."""
-    bodies = {}
+    component) against x at the nodes that carry a pair's compatibility and touch, per body,
+    sticking and slipping nodes marked apart (the VTU's ``contact_shear`` and
+    ``friction_status``), between the Coulomb limit ±mu q, q the normal traction there (the
+    VTU's ``contact_traction``; mu of the body's pairs, :func:`body_friction_limits`): a
+    slipping node lies on its line, a sticking one within."""
+    bodies, limits = {}, {}
     for b in step.bodies:
         status = np.asarray(b.point_data["friction_status"]).ravel()
         on = status > 0
         shear = np.asarray(b.point_data["contact_shear"])[on, :2]
         signed = np.hypot(shear[:, 0], shear[:, 1]) * np.where(shear[:, 0] < 0, -1.0, 1.0)
         bodies[b.name] = (b.points[on, 0], signed, status[on])
+        coefficients = body_friction_limits(summary or {}, b.name)
+        if coefficients and "contact_traction" in b.point_data:
+            normal = np.asarray(b.point_data["contact_traction"], dtype=float).ravel()[on]
+            limits[b.name] = (normal, coefficients)
     path = directory / "friction.png"
     plots.friction_profiles(path, bodies,
                             f"Tangential traction at the nodes in contact, step {step.step} "
-                            f"(load factor {step.load_factor:.6g})\n{method}")
+                            f"(load factor {step.load_factor:.6g})\n{method}", limits)
     return path
+
+
+def body_friction_limits(summary: dict, body: str) -> list[tuple[str, float]]:
+    """The bounds of the tangential traction over the normal one at ``body``'s nodes, each
+    (what it is, its coefficient), from the laws of the pairs ``body`` belongs to
+    (``contact_settings.friction.pairs``, :func:`contact_settings`; for a folder written
+    before those were recorded, its input file's ``config.contact``): Coulomb's (and the
+    elasto-plastic law's) mu, where a node slips; the static/dynamic law's mu_s, which a
+    sticking node reaches before it slips, and mu_d, which a slipping node carries. [] when
+    none is known or the body has no friction."""
+    pairs = ((summary.get("contact_settings") or {}).get("friction") or {}).get("pairs")
+    if pairs is None:  # older results: the input file's keys
+        contact = (summary.get("config") or {}).get("contact") or {}
+        own = [p for p in contact.get("pairs") or () if body in (p.get("bodies") or ())]
+        pairs = [{"law": p.get("law", "coulomb"), "mu": p.get("friction", 0.0),
+                  "mu_dynamic": p.get("friction", 0.0),
+                  "mu_static": p.get("static_friction") or p.get("friction", 0.0)}
+                 for p in own] or [{"law": "coulomb", "mu": contact.get("friction", 0.0)}]
+    else:
+        pairs = [p for p in pairs if body in (p.get("bodies") or ())]
+    out: list[tuple[str, float]] = []
+    for p in pairs:
+        if p.get("law") == "static_dynamic":
+            found = [("mu_s q, stick limit", float(p["mu_static"])),
+                     ("mu_d q, slip", float(p["mu_dynamic"]))]
+        elif p.get("law") in ("coulomb", "elastoplastic") and p.get("mu"):
+            found = [("mu q, Coulomb limit", float(p["mu"]))]
+        else:
+            found = []
+        out += [x for x in found if x[1] > 0 and x not in out]
+    return out
 
 
 def _history(directory: Path, steps: list[Step], summary: dict | None) -> Path:
