@@ -151,6 +151,30 @@ def test_export_refuses_springs_and_needs_a_folder_for_several_models(capsys, tm
     assert loads(capsys.readouterr().out) == hertz.config(hertz.HertzParameters(order=2))
 
 
+def test_the_export_header_is_plain_text_naming_the_whole_command(capsys, tmp_path):
+    """The comment lines ``vfem export`` writes: no Markdown backticks (which read as part of
+    the command, and closed before its --set options), the command with every --set and the
+    run that solves the same model, the example's title whole (Cattaneo's spans two lines)."""
+    assert main(["export", "sliding", "--set", "friction=0.3", "--set", "slide=1.5"]) == 0
+    text = capsys.readouterr().out
+    header = [x for x in text.splitlines() if x.startswith("#")]
+    assert "`" not in "".join(header)
+    assert "# Written by: vfem export sliding --set friction=0.3 --set slide=1.5" in header
+    assert ("# vfem run <this file> solves the same model as: vfem run sliding --set "
+            "friction=0.3 --set slide=1.5") in header
+    assert loads(text) == sliding.config(sliding.Parameters(friction=0.3, slide=1.5))
+    assert main(["export", "cattaneo"]) == 0
+    header = " ".join(x[2:] for x in capsys.readouterr().out.splitlines() if x.startswith("#"))
+    assert "then sheared by a growing sideways motion with P held (issue 20)." in header
+    assert main(["-q", "export", "wedge", "--out", str(tmp_path)]) == 0
+    for path in tmp_path.glob("*.toml"):
+        assert "`" not in path.read_text(), path.name
+    # the files in examples/ that vfem export wrote say the same
+    for path, _ in example_files():
+        written = [x for x in path.read_text().splitlines() if "vfem export" in x]
+        assert written and not any("`" in x for x in written), path
+
+
 def test_plot_redraws_the_figures_of_a_results_folder(tmp_path, capsys):
     assert main(["-q", "run", str(EXAMPLES / "patch" / "2x10_nu0.toml"), "--out",
                  str(tmp_path)]) == 0

@@ -17,6 +17,7 @@ import shlex
 import shutil
 import signal
 import sys
+import textwrap
 from pathlib import Path
 
 from . import linalg, threads
@@ -376,17 +377,26 @@ def example_configs(name: str, assignments: list[str]) -> dict:
                      "model of bodies: it has no input file")
 
 
+def export_header(example: str, assignments: list[str]) -> str:
+    """The comment lines at the top of a file ``vfem export`` writes: the example, its title
+    (the first paragraph of its module's docstring, whole), the command that wrote it and the
+    one that solves it. Plain text, as a TOML comment is read: no Markdown (the backticks
+    around the commands read as part of them, and ended before the ``--set`` options)."""
+    doc = (load(example).__doc__ or example).strip()
+    title = " ".join(doc.split("\n\n")[0].split()).replace("``", "")
+    sets = "".join(f" --set {shlex.quote(a)}" for a in assignments)
+    return "\n".join([f"vfem input file: the built-in example '{example}'.",
+                      *textwrap.wrap(title, 96),
+                      f"Written by: vfem export {example}{sets}",
+                      f"vfem run <this file> solves the same model as: vfem run {example}{sets}",
+                      "Keys: docs/input.md."])
+
+
 def cmd_export(args) -> int:
     from .io.input import dumps
 
     configs = example_configs(args.example, args.set or [])
-    example = load(args.example)
-    title = (example.__doc__ or args.example).strip().splitlines()[0]
-    header = (f"vfem input file: the built-in example '{args.example}'.\n{title}\n"
-              f"Written by `vfem export {args.example}`"
-              + (" --set " + " --set ".join(args.set) if args.set else "")
-              + f"; `vfem run <this file>` solves the same model as `vfem run {args.example}`.\n"
-              "Keys: docs/input.md.")
+    header = export_header(args.example, args.set or [])
     if len(configs) == 1 and not args.out:
         print(dumps(next(iter(configs.values())), header), end="")
         return 0
