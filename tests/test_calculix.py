@@ -154,3 +154,63 @@ def test_bench_rows():
     assert row["ccx_iterations_total"] > row["ccx_iterations"] > 0
     assert abs(row["ccx_p_max_error_nodal"]) < 5e-3 and abs(row["vfem_p_max_error"]) < 5e-3
     assert len(lines) == 2 and lines[1].split()[:2] == ["0", str(dofs)]
+
+
+@pytest.fixture(scope="module")
+def cattaneo_deck(tmp_path_factory):
+    from vfem.examples import cattaneo
+
+    p = cattaneo.Parameters(facets_upper=6, facets_lower=8, press_steps=2, shear_steps=4)
+    model = cattaneo.build(p)
+    deck = write_deck(model, tmp_path_factory.mktemp("ccx") / "cattaneo.inp", steps="curves",
+                      friction=p.friction, stick_slope=1e10)
+    return p, model, deck
+
+
+def test_frictional_deck_follows_the_load_curves(cattaneo_deck):
+    """Cattaneo's press then shear: Coulomb friction in the surface interaction; the platen's
+    approach, then one ccx step per stretch of linear loading (the press to P with the flat
+    sides held, then the shift with P held), increments no longer than the model's steps."""
+    p, model, deck = cattaneo_deck
+    cards = blocks(deck.path.read_text())
+    friction = [data for key, data in cards if key == "*FRICTION"]
+    assert friction == [["0.3, 10000000000.0"]]
+    assert deck.steps == [0.5, 1.0] and deck.increments == [[0.25, 0.5], [0.625, 0.75, 0.875,
+                                                                          1.0]]
+    statics = [data[0].split(", ") for key, data in cards if key == "*STATIC"]
+    assert [float(s[3]) for s in statics] == [1.0, 0.25, 0.125]  # the largest increments
+    loads = [data for key, data in cards if key == "*CLOAD"]
+    assert [float(d[0].split(",")[2]) for d in loads] == [-p.force, -p.force]
+    body, shift = next((b, pd) for b in model.bodies for pd in b.prescribed)
+    name = f"B_{body.name.upper()}_{shift.boundary.upper()}"
+    moved = [float(d.split(",")[3]) for key, data in cards if key.startswith("*BOUNDARY")
+             for d in data if d.split(",")[0] == name]
+    assert moved == [0.0, 0.0, pytest.approx(shift.at(1.0))]  # held, held, shifted
+    assert "*TIME POINTS" not in deck.path.read_text()
+
+
+@needs_ccx
+@pytest.mark.slow
+def test_ccx_cattaneo_with_friction(cattaneo_deck):
+    """ccx's penalty friction on the coarse Cattaneo model (about 25 s): every load factor of
+    the model has an increment; the press carries P; the shear's reaction rises to mu P at
+    full slip (measured 0.9938 mu P: ccx's stick slope) and not beyond, with the stick zone
+    shrinking."""
+    from vfem.tools.calculix import sticking
+
+    p, model, deck = cattaneo_deck
+    r = run(deck)
+    history = {round(h["load_factor"], 9): h for h in r["history"]}
+    assert set(model.load_factors) <= set(history)
+    q = [abs(history[f]["reactions"]["B_LOWER_FLAT"][0]) for f in model.load_factors]
+    for f in model.load_factors:
+        h = history[f]
+        assert h["reactions"]["B_LOWER_FLAT"][1] == pytest.approx(p.force * min(1, 2 * f),
+                                                                 rel=1e-6)
+        # (ccx's nodal CSHEAR is extrapolated from integration points: at the contact's edge
+        # it reads far above mu CPRESS, measured 1765 against 0.3 x 54; the forces do not)
+        assert abs(h["reactions"]["B_LOWER_FLAT"][0]) <= p.friction * p.force * (1 + 1e-6)
+    assert q[1] < 1e-6 * p.force  # pressed, not sheared: alike bodies carry no shear force
+    assert np.all(np.diff(q[1:]) > 0) and q[-1] == pytest.approx(p.friction * p.force, rel=0.01)
+    stick = [int(sticking(history[f], p.friction).sum()) for f in model.load_factors[1:]]
+    assert stick[0] > 0 and stick[-1] == 0 and all(np.diff(stick) <= 0)

@@ -10,12 +10,20 @@ CalculiX*):
   body; supports and prescribed displacements as ``*BOUNDARY``; a force-controlled platen as
   ``*EQUATION`` ties of its nodes' platen component to one reference node that carries the
   ``*CLOAD``; frictionless surface-to-surface penalty contact (``*CONTACT PAIR, TYPE=SURFACE TO
-  SURFACE``) between the bodies' contact candidate facets, the softer body the slave.
+  SURFACE``) between the bodies' contact candidate facets, the softer body the slave. With
+  ``friction``, Coulomb friction (``*FRICTION``: mu and ccx's stick slope); with
+  ``steps="curves"``, loads on load curves (prescribed displacements and a platen force with
+  amplitudes: the Cattaneo example's press, then shear) as one ccx step per stretch of linear
+  loading, its increments at the model's load factors.
 * :func:`run` runs ``ccx`` in a temporary folder, times it, and reads the results: ccx's own
   nodal contact pressure on the slave surface (CPRESS of ``*CONTACT FILE, CSTR``: "raw"), the
   total contact force ccx reports, and the slave body's nodal contact forces recomputed as
   ``K u`` (its stiffness, the same elements as ccx's, times ccx's displacements) per undeformed
-  tributary length, the reading :func:`vfem.examples.hertz.evaluate` makes of vfem's results.
+  tributary length, the reading :func:`vfem.examples.hertz.evaluate` makes of vfem's results;
+  and per increment (``history``) the slave nodes' contact stresses and slips (CPRESS, CSHEAR1,
+  CSHEAR2, COPEN, CSLIP1, CSLIP2), their ``K u`` forces, the reactions of the held boundaries
+  and ccx's total contact force: what benchmarks/cattaneo_calculix.py compares with vfem's
+  friction.
 
 The core never imports this module.
 """
@@ -71,6 +79,12 @@ class Deck:
     tension: float
     approach: float | None  # the platen's displacement in the first, contact-making step
     steps: list[float] = field(default_factory=list)  # load factor at the end of each load step
+    friction: float | None = None  # Coulomb's mu of *FRICTION (None: frictionless)
+    stick_slope: float | None = None  # *FRICTION's tangential stiffness
+    # steps="curves": per load step, the model's load factors it ends its increments at
+    increments: list[list[float]] = field(default_factory=list)
+    # boundary node sets whose total reaction is printed per increment: set -> (body, boundary)
+    reaction_sets: dict[str, tuple[str, str]] = field(default_factory=dict)
 
     def body(self, name: str) -> BodyDeck:
         return next(b for b in self.bodies if b.name == name)
@@ -79,8 +93,9 @@ class Deck:
 # -- writing -------------------------------------------------------------------------------------
 
 
-def _check_supported(model) -> None:
-    """Refuse what the deck writer cannot express (one message per kind of problem)."""
+def _check_supported(model, curves: bool = False) -> None:
+    """Refuse what the deck writer cannot express (one message per kind of problem); load curves
+    (amplitudes) only with ``curves`` (``steps="curves"``)."""
     model.validate()
     if len(model.bodies) != 2:
         raise InputError(f"CalculiX deck: the writer handles two bodies in contact, model "
@@ -93,6 +108,8 @@ def _check_supported(model) -> None:
         if b.tractions:
             raise InputError(f"CalculiX deck: body {b.name!r} has tractions, which the writer "
                              "does not translate")
+        if curves:
+            continue
         if any(pd.amplitude is not None for pd in b.prescribed):
             raise InputError(f"CalculiX deck: body {b.name!r} has a prescribed displacement "
                              "with an amplitude, which the writer does not translate")
@@ -157,13 +174,14 @@ def _initial_gap(s, m) -> float:
 
 def write_deck(model, path, *, slave: str | None = None, penalty: float | None = 1e11,
                tension: float = 0.0, steps: str = "one", approach: float | None = None,
-               max_increments: int = 1000) -> Deck:
+               max_increments: int = 1000, friction: float | None = None,
+               stick_slope: float | None = None) -> Deck:
     """Write ``model`` as a CalculiX input deck at ``path`` (see the module docstring).
 
     Args:
         model: a two-body :class:`~vfem.solver.Model` with linear elements, small kinematics,
-            supports, prescribed displacements (no amplitude) and at most one platen (no
-            amplitude).
+            supports, prescribed displacements and at most one platen (with amplitudes, i.e.
+            load curves, only with ``steps="curves"``).
         path: the ``.inp`` file to write.
         slave: the slave body's name; default the one with the smaller Young's modulus.
         penalty: the contact stiffness (pressure per unit overclosure) of ccx's linear
@@ -178,16 +196,38 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
             results with 0, 1 and 1.4e5).
         steps: ``"one"``: one ccx step to the last load factor, ccx's automatic increments
             starting with the first load factor (load factors that do not rise steadily get one
-            step each); ``"model"``: one ccx step per model step.
+            step each); ``"model"``: one ccx step per model step; ``"curves"``: for loads on
+            load curves (press, then shear), one ccx step per stretch of the model's load
+            factors over which every load changes linearly (a new step where a load's rate
+            changes or the load factor turns back: the Cattaneo example's press and shear), its
+            increments the model's steps (ccx's automatic increments, at most a model step
+            long, so that they end at the model's load factors unless ccx cuts one back), the
+            loads at each step's end from their curves, so that ccx follows the path vfem does; the
+            prescribed displacements are held at their load factor 0 values during the
+            platen's approach; the total reaction of every held boundary (``*NODE PRINT,
+            TOTALS=ONLY``, RF) and the contact displacements (``CDIS``) are written at every
+            increment besides what the other choices write.
         approach: with a platen, a first ccx step pushes the platen this far (towards its
             force) under displacement control, so that contact holds the body when force
             control starts (ccx starts with no contact elements, and a body that only contact
             holds is singular then); default the initial gap plus 1e-6 times the model's size.
         max_increments: ccx's limit on the increments of a step.
+        friction: Coulomb's coefficient mu: ``*FRICTION`` in the surface interaction (ccx's
+            penalty friction: a node sticks elastically, its tangential traction the stick
+            slope times its relative tangential displacement, until that reaches mu times its
+            pressure); ``None``: frictionless, as before.
+        stick_slope: *FRICTION's stick slope lambda (shear traction per unit relative
+            tangential displacement); default the normal ``penalty`` (on the Cattaneo example
+            the stick zone is then within a contact facet of Cattaneo-Mindlin's and no longer
+            moves with the slope: benchmarks/cattaneo_calculix.py measures it). The elastic slip
+            of a sticking node is its shear over lambda, which must be small against the slips
+            of the slip zone near its edge, else the stick zone shrinks.
     """
-    _check_supported(model)
-    if steps not in ("one", "model"):
-        raise InputError(f"CalculiX deck: steps must be 'one' or 'model', got {steps!r}")
+    curves = steps == "curves"
+    _check_supported(model, curves)
+    if steps not in ("one", "model", "curves"):
+        raise InputError(f"CalculiX deck: steps must be 'one' or 'model', got {steps!r} (or "
+                         "'curves' for loads on load curves)")
     names = [b.name for b in model.bodies]
     if slave is None:
         slave = min(model.bodies, key=lambda b: b.material.youngs_modulus).name
@@ -238,7 +278,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
 
     def prescribed(factor: float) -> list[str]:
         return [f"B_{tags[b.name]}_{_tag(pd.boundary)}, {DOF[pd.component]}, "
-                f"{DOF[pd.component]}, {_num(factor * pd.value)}"
+                f"{DOF[pd.component]}, {_num(pd.at(factor))}"
                 for b in model.bodies for pd in b.prescribed]
 
     ref = None
@@ -262,9 +302,15 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     else:
         out += ["*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
                 f"{_num(penalty)}, {_num(tension)}"]
+    if friction is not None:
+        if stick_slope is None:
+            stick_slope = penalty if penalty is not None else 1e11
+        out += ["*FRICTION", f"{_num(friction)}, {_num(stick_slope)}"]
     out += ["*CONTACT PAIR, INTERACTION=CONTACT, TYPE=SURFACE TO SURFACE",
             f"S_{tags[slave]}, S_{tags[master]}"]
 
+    factors = [float(f) for f in model.load_factors]
+    stretches = _stretches(model) if curves else []
     if ref is not None:
         if approach is None:
             gap = _initial_gap(surfaces[i_slave], surfaces[1 - i_slave])
@@ -272,34 +318,86 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
         towards = float(np.sign(pl.force)) or 1.0
         out += ["** step 1: the platen pushed under displacement control until contact holds "
                 "the body", "*STEP, INC=100", "*STATIC", "1., 1., 1e-5, 1.", "*BOUNDARY",
-                f"{ref}, {dof}, {dof}, {_num(towards * approach)}", "*END STEP"]
-    factors = [float(f) for f in model.load_factors]
+                f"{ref}, {dof}, {dof}, {_num(towards * approach)}",
+                *(prescribed(0.0) if curves else []), "*END STEP"]
     rising = all(np.diff(np.r_[0.0, factors]) > 0)
-    if steps == "one" and rising:
+    if curves:
+        plan = [(stretch[0], stretch[-1]) for stretch in stretches]
+    elif steps == "one" and rising:
         plan = [(factors[0], factors[-1])]
     else:
         plan = [(f, f) for f in factors]
-    output = [f"*NODE PRINT, NSET=N_{tags[slave]}", "U", f"*NODE PRINT, NSET=N_{tags[master]}",
-              "U", f"*CONTACT PRINT, SLAVE=S_{tags[slave]}, MASTER=S_{tags[master]}", "CF",
-              "*CONTACT FILE", "CSTR"]
+    reaction_sets = {}
+    if curves:
+        for b in model.bodies:
+            for x in (*b.supports, *b.prescribed):
+                reaction_sets[f"B_{tags[b.name]}_{_tag(x.boundary)}"] = (b.name, x.boundary)
+
+    def output(k: int) -> list[str]:
+        if not curves:
+            return [f"*NODE PRINT, NSET=N_{tags[slave]}", "U",
+                    f"*NODE PRINT, NSET=N_{tags[master]}", "U",
+                    f"*CONTACT PRINT, SLAVE=S_{tags[slave]}, MASTER=S_{tags[master]}", "CF",
+                    "*CONTACT FILE", "CSTR"]
+        # every increment (ccx's default frequency): *TIME POINTS would pin the increments to
+        # the load factors, but ccx 2.20 then stalls on an increment of length 0 after landing
+        # on one (measured on the Cattaneo example); the increments are the model's steps
+        # unless ccx cuts one back, and the readers match increments to load factors by time
+        return [f"*NODE PRINT, NSET=N_{tags[slave]}", "U",
+                f"*NODE PRINT, NSET=N_{tags[master]}", "U",
+                *(line for name in reaction_sets
+                  for line in (f"*NODE PRINT, NSET={name}, TOTALS=ONLY", "RF")),
+                f"*CONTACT PRINT, SLAVE=S_{tags[slave]}, MASTER=S_{tags[master]}", "CF",
+                "*CONTACT FILE", "CSTR, CDIS"]
+
     previous = 0.0
-    for first, factor in plan:
+    for k, (first, factor) in enumerate(plan):
         span = abs(factor - previous)
+        initial, largest = min(abs(first - previous), span), span
+        if curves:  # increments no longer than the model's steps (rounded: 0.05, not 0.05 +
+            # 4e-17): ccx lands on each of them
+            largest = round(float(np.abs(np.diff([previous, *stretches[k]])).max()), 12)
+            initial, span = round(initial, 12), round(span, 12)
         out += [f"*STEP, INC={max_increments}", "*STATIC",
-                f"{_num(min(abs(first - previous), span))}, {_num(span)}, {_num(1e-5 * span)}, "
-                f"{_num(span)}"]
+                f"{_num(initial)}, {_num(span)}, {_num(1e-5 * span)}, {_num(largest)}"]
         if ref is not None:
             # OP=NEW releases the platen's reference node: force control from here on
             out += ["*BOUNDARY, OP=NEW", *supports, *prescribed(factor),
-                    "*CLOAD", f"{ref}, {dof}, {_num(factor * pl.force)}"]
+                    "*CLOAD", f"{ref}, {dof}, {_num(pl.force_at(factor))}"]
         elif prescribed(factor):
             out += ["*BOUNDARY", *prescribed(factor)]
-        out += [*output, "*END STEP"]
+        out += [*output(k), "*END STEP"]
         previous = factor
     path = Path(path)
     path.write_text("\n".join(out) + "\n", encoding="ascii")
     return Deck(path, model, decks, slave, master, ref, penalty, tension, approach,
-                [f for _, f in plan])
+                [f for _, f in plan], friction, stick_slope if friction is not None else None,
+                [list(s) for s in stretches], reaction_sets)
+
+
+def _stretches(model) -> list[list[float]]:
+    """The model's load factors in stretches over which every prescribed displacement and
+    platen force changes linearly with the load factor and the load factor runs one way: a new
+    stretch where a load's rate changes (a load curve's corner at a load factor) or the load
+    factor turns back. vfem applies the loads at the load factors only, so between two of them
+    they change linearly, as in a ccx step."""
+    factors = np.r_[0.0, np.asarray(model.load_factors, dtype=float)]
+    loads = [pd.at for b in model.bodies for pd in b.prescribed]
+    loads += [b.platen.force_at for b in model.bodies if b.platen is not None]
+    values = np.array([[load(f) for load in loads] for f in factors]).reshape(len(factors), -1)
+    scale = np.abs(values).max(axis=0) + 1e-300
+    out: list[list[float]] = [[]]
+    for k in range(1, len(factors)):
+        out[-1].append(float(factors[k]))
+        if k + 1 == len(factors):
+            break
+        d0, d1 = factors[k] - factors[k - 1], factors[k + 1] - factors[k]
+        straight = d0 * d1 > 0 and np.all(np.abs(
+            values[k] + (values[k] - values[k - 1]) * (d1 / d0) - values[k + 1])
+            <= 1e-9 * scale)
+        if not straight:
+            out.append([])
+    return out
 
 
 # -- running and reading -------------------------------------------------------------------------
@@ -310,6 +408,12 @@ _FLOAT = r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?"
 
 def _dat_blocks(text: str, title: str) -> list[np.ndarray]:
     """Every table of the ``.dat`` file whose heading starts with ``title``: rows of numbers."""
+    return [rows for _, rows in _dat_timed_blocks(text, title)]
+
+
+def _dat_timed_blocks(text: str, title: str) -> list[tuple[float, np.ndarray]]:
+    """Every table of the ``.dat`` file whose heading starts with ``title``, with the total time
+    its heading ends with (``... and time  0.1100000E+01``; nan if none)."""
     blocks = []
     lines = text.splitlines()
     for i, line in enumerate(lines):
@@ -321,8 +425,13 @@ def _dat_blocks(text: str, title: str) -> list[np.ndarray]:
             while j < len(lines) and lines[j].strip():
                 rows.append([float(v) for v in lines[j].split()])
                 j += 1
-            blocks.append(np.array(rows))
+            blocks.append((_heading_time(line), np.array(rows)))
     return blocks
+
+
+def _heading_time(line: str) -> float:
+    m = re.search(r"and time\s+(" + _FLOAT + ")", line)
+    return float(m.group(1)) if m else float("nan")
 
 
 def _contact_statistics(text: str) -> dict:
@@ -330,7 +439,18 @@ def _contact_statistics(text: str) -> dict:
     start = text.rfind("statistics for slave set")
     if start < 0:
         return {}
-    body = text[start:].splitlines()
+    return _statistics_block(text[start:].splitlines())
+
+
+def _contact_statistics_by_time(text: str) -> list[tuple[float, dict]]:
+    """Every "statistics for slave set" block of the ``.dat`` file, with its total time."""
+    pieces = text.split(" statistics for slave set")[1:]
+    return [(_heading_time(p.splitlines()[0]), _statistics_block(p.splitlines()))
+            for p in pieces]
+
+
+def _statistics_block(body: list[str]) -> dict:
+    """Total force, contact area, normal and shear force of a statistics block's lines."""
     out = {}
     for i, line in enumerate(body):
         nums = None
@@ -347,22 +467,40 @@ def _contact_statistics(text: str) -> dict:
 
 
 def _frd_contact_pressure(path: Path) -> dict[int, float]:
-    """CPRESS per node of the last CONTACT block of the ``.frd`` file (``*CONTACT FILE, CSTR``).
+    """CPRESS per node of the last CONTACT block of the ``.frd`` file (``*CONTACT FILE, CSTR``)."""
+    blocks = _frd_contact(path)
+    return {n: float(v[3]) for n, v in blocks[-1][1].items()} if blocks else {}
 
-    Fixed columns: ``-1``, the node in 10 characters, then 12 characters per value (COPEN,
-    CSLIP1, CSLIP2, CPRESS, CSHEAR1, CSHEAR2)."""
+
+def _frd_contact(path: Path) -> list[tuple[float, dict[int, np.ndarray]]]:
+    """Every CONTACT block of the ``.frd`` file (``*CONTACT FILE, CSTR`` and/or ``CDIS``): its
+    total time and, per node with a value that is not zero, (COPEN, CSLIP1, CSLIP2, CPRESS,
+    CSHEAR1, CSHEAR2).
+
+    Fixed columns: ``-1``, the node in 10 characters, then 12 characters per value (6 significant
+    digits: ratios of two values, such as shear over pressure, are known to about 1e-5). The
+    time is the third field of the ``100CL`` line that heads the block."""
+    blocks = []
     lines = path.read_text(errors="replace").splitlines()
-    start = max((i for i, line in enumerate(lines) if line.startswith(" -4  CONTACT")),
-                default=-1)
-    out: dict[int, float] = {}
-    if start < 0:
-        return out
-    for line in lines[start + 1:]:
-        if line.startswith(" -3"):
-            break
-        if line.startswith(" -1"):
-            out[int(line[3:13])] = float(line[13 + 3 * 12: 13 + 4 * 12])
-    return out
+    for i, line in enumerate(lines):
+        if not line.startswith(" -4  CONTACT"):
+            continue
+        head = next((lines[k] for k in range(i - 1, -1, -1)
+                     if lines[k].lstrip().startswith("100C")), "")
+        fields = head.split()
+        time = float(fields[2]) if len(fields) > 2 else float("nan")
+        values: dict[int, np.ndarray] = {}
+        for row in lines[i + 1:]:
+            if row.startswith(" -3"):
+                break
+            if row.startswith(" -1"):
+                v = np.zeros(6)
+                for k in range(min(6, (len(row.rstrip()) - 13) // 12)):
+                    v[k] = float(row[13 + 12 * k: 25 + 12 * k])
+                if v.any():
+                    values[int(row[3:13])] = v
+        blocks.append((time, values))
+    return blocks
 
 
 def _sta(text: str) -> list[dict]:
@@ -396,7 +534,7 @@ def _constrained(body) -> np.ndarray:
     return np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, dtype=int)
 
 
-def nodal_reading(body, facets: np.ndarray, u: np.ndarray) -> dict:
+def nodal_reading(body, facets: np.ndarray, u: np.ndarray, stiffness=None) -> dict:
     """The body's nodal contact forces ``K u`` on the nodes of ``facets`` and the nominal pressure.
 
     ``u``: (npoints, 2) displacements. On a contact node the only forces besides contact are the
@@ -405,8 +543,9 @@ def nodal_reading(body, facets: np.ndarray, u: np.ndarray) -> dict:
     :func:`vfem.examples.hertz.evaluate` reads vfem's. ``residual`` is the largest ``|K u|`` on a
     free dof off the contact surface (zero in exact arithmetic: the check that the elements and
     the displacements read back are ccx's), relative to the largest nodal contact force.
+    ``stiffness``: the body's, if already assembled (:func:`_stiffness`).
     """
-    K = _stiffness(body)
+    K = _stiffness(body) if stiffness is None else stiffness
     f = (K @ np.asarray(u, dtype=float).ravel()).reshape(-1, 2)
     held = np.zeros(2 * body.npoints, dtype=bool)
     held[_constrained(body)] = True
@@ -428,9 +567,92 @@ def nodal_reading(body, facets: np.ndarray, u: np.ndarray) -> dict:
             "residual": float(np.abs(free_off).max(initial=0.0)) / scale}
 
 
+def _load_factor(deck: Deck, total: float) -> float:
+    """The model's load factor at ccx's total time ``total``: a step's time is the change of the
+    load factor over it, after the platen's approach step (time 1) if there is one."""
+    start = 1.0 if deck.reference_node is not None else 0.0
+    ends = np.asarray(deck.steps, dtype=float)
+    times = start + np.cumsum(np.abs(np.diff(np.r_[0.0, ends])))
+    return float(np.interp(total, np.r_[start, times], np.r_[0.0, ends]))
+
+
+def _at(blocks: list[tuple[float, np.ndarray]], total: float) -> np.ndarray | None:
+    """The block of ``blocks`` (``(time, rows)``, :func:`_dat_timed_blocks`) written at
+    total time ``total`` (the .dat file prints times to 7 digits, the .frd file to 10)."""
+    return next((rows for t, rows in blocks if abs(t - total) <= 1e-6 * max(1.0, abs(total))),
+                None)
+
+
+def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
+    """Per increment with contact output (each CONTACT block of the .frd file), on the slave
+    body's contact candidate nodes (sorted by x): ``time`` (ccx's total time),
+    ``load_factor``, ``x`` (undeformed coordinates), ccx's nodal ``cpress``, ``cshear``
+    (CSHEAR1, CSHEAR2: along the master surface's tangent nearest to global x, and along z),
+    ``copen`` and ``cslip`` (CSLIP1, CSLIP2; the total relative tangential displacement,
+    written with friction only), ``force_nodal`` (the contact forces ``K u`` of
+    :func:`nodal_reading`, where the .dat file has the slave's displacements at that time) and
+    ``tributary`` (each node's undeformed tributary length), ``reactions`` (set -> the total
+    (fx, fy) of ``*NODE PRINT, TOTALS=ONLY``, ``steps="curves"``) and ``contact_force`` (ccx's
+    total surface force (fx, fy) on the slave), ``contact_normal_force`` and
+    ``contact_shear_force`` (its size) from ``*CONTACT PRINT, CF``."""
+    body = next(b for b in deck.model.bodies if b.name == deck.slave)
+    bd = deck.body(deck.slave)
+    nodes = np.unique(body.mesh.facets[:, bd.contact_facets])
+    nodes = nodes[np.argsort(body.mesh.p[0, nodes], kind="stable")]
+    ids = nodes + bd.node_offset + 1
+    reactions = {name: _dat_timed_blocks(dat, f"total force (fx,fy,fz) for set {name}")
+                 for name in deck.reaction_sets}
+    statistics = _contact_statistics_by_time(dat)
+    displacements = _dat_timed_blocks(dat, f"displacements (vx,vy,vz) for set "
+                                           f"N_{_tag(deck.slave)}")
+    stiffness = _stiffness(body) if displacements else None
+    out = []
+    for total, values in contact:
+        v = np.array([values.get(int(i), np.zeros(6)) for i in ids]).reshape(-1, 6)
+        row = {"time": total, "load_factor": _load_factor(deck, total),
+               "x": body.mesh.p[:, nodes].T.copy(), "copen": v[:, 0], "cslip": v[:, 1:3],
+               "cpress": v[:, 3], "cshear": v[:, 4:6]}
+        rows = _at(displacements, total)
+        if rows is not None:
+            u = np.zeros((body.npoints, 2))
+            u[rows[:, 0].astype(int) - bd.node_offset - 1] = rows[:, 1:3]
+            reading = nodal_reading(body, bd.contact_facets, u, stiffness)
+            where = {int(n): k for k, n in enumerate(reading["nodes"])}
+            order = [where[int(n)] for n in nodes]
+            row["force_nodal"] = reading["force"][order]
+            row["tributary"] = reading["tributary"][order]
+        row["reactions"] = {}
+        for name, blocks in reactions.items():
+            r = _at(blocks, total)
+            if r is not None:
+                row["reactions"][name] = r[0, :2].copy()
+        stats = next((st for t, st in statistics
+                      if abs(t - total) <= 1e-6 * max(1.0, abs(total))), {})
+        if stats:
+            row["contact_force"] = np.asarray(stats.get("force", [np.nan] * 3)[:2])
+            row["contact_normal_force"] = abs(stats.get("normal_force", np.nan))
+            row["contact_shear_force"] = stats.get("shear_force", np.nan)
+        out.append(row)
+    return out
+
+
+def sticking(row: dict, friction: float, tolerance: float = 1e-4) -> np.ndarray:
+    """Which slave nodes of a ``history`` row (:func:`run`) stick: in contact (CPRESS > 0) with
+    a shear below the Coulomb bound, ``|(CSHEAR1, CSHEAR2)| < mu CPRESS (1 - tolerance)``.
+
+    ccx writes no stick/slip status; at a slipping node its extrapolated shear is mu times its
+    pressure to the 6 digits the .frd file keeps (hence the default tolerance 1e-4, not 1e-6;
+    next to the stick zone's edge, where its integration points differ, it can exceed the
+    bound by a few % and counts as slipping)."""
+    shear = np.linalg.norm(row["cshear"], axis=1)
+    return (row["cpress"] > 0) & (shear < friction * row["cpress"] * (1 - tolerance))
+
+
 def _solver(log: str) -> str:
-    m = re.search(r"Factoring the system of equations using the (.+?) solver", log)
-    return m.group(1).strip() if m else "unknown"
+    """The equation solver ccx names last (with friction its matrix is unsymmetric: the first,
+    contact-free iteration still factors a symmetric one)."""
+    found = re.findall(r"Factoring the system of equations using the (.+?) solver", log)
+    return found[-1].strip() if found else "unknown"
 
 
 def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
@@ -454,7 +676,9 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
     :func:`nodal_reading`), ``p_max_master_nodal`` (the same reading on the master body),
     ``total_contact_force`` (ccx's, on the slave), ``total_contact_force_nodal``,
     ``nodal_residual``, ccx's own ``final_residual_force`` against its ``final_average_force``
-    (its last iteration) and per-node arrays under ``slave``.
+    (its last iteration), per-node arrays under ``slave``, ``step_iterations`` (ccx step ->
+    its iterations, the .sta file's) and ``history``, what ccx wrote at each increment
+    (:func:`_history`: the contact stresses and slips, reactions, contact forces).
     """
     exe = shutil.which(ccx)
     if exe is None:
@@ -490,7 +714,8 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
                             f"the end of its output:\n{tail}")
         dat = (work / "job.dat").read_text(errors="replace")
         sta = _sta((work / "job.sta").read_text(errors="replace"))
-        cpress = _frd_contact_pressure(work / "job.frd")
+        contact = _frd_contact(work / "job.frd")
+    cpress = {n: float(v[3]) for n, v in contact[-1][1].items()} if contact else {}
 
     total = re.search(r"Total CalculiX Time:\s*(" + _FLOAT + ")", log)
     residual = re.findall(r"largest residual force=\s*(" + _FLOAT + ")", log)
@@ -527,6 +752,8 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
         "iterations": int(sum(r["iterations"] for r in load_steps)),
         "cutbacks": int(sum(r["attempts"] - 1 for r in load_steps)),
         "contact_step_iterations": int(sum(r["iterations"] for r in first)),
+        "step_iterations": {k: int(sum(r["iterations"] for r in sta if r["step"] == k))
+                            for k in sorted({r["step"] for r in sta})},
         "final_residual_force": float(residual[-1]) if residual else float("nan"),
         "final_average_force": float(average[-1]) if average else float("nan"),
         "penalty": deck.penalty,
@@ -539,6 +766,7 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
         "nodal_residual": s["residual"],
         "slave": {"x": body.mesh.p[:, s["nodes"]].T, "pressure_raw": raw,
                   "pressure_nodal": s["pressure"], "force": s["force"]},
+        "history": _history(deck, dat, contact),
     }
     if p0:
         out["p0"] = p0
