@@ -194,3 +194,41 @@ def test_friction_png_draws_the_coulomb_limit_beside_the_traction(model, body, b
     assert (model == "patch_stick") == (sticks.all() and not slips.any())
     assert main(["-q", "plot", str(tmp_path)]) == 0
     assert set(lines["friction.png"]) - {"_"} >= set(bounds)
+
+
+# -- a resume of another model names what differs ------------------------------------------------
+
+def test_a_resume_with_other_settings_names_each_setting_stored_and_now(tmp_path, capsys):
+    out = tmp_path / "c"
+    assert main(["-q", "run", "cattaneo", *_sets(CATTANEO), "--out", str(out),
+                 "--no-figures"]) == 0
+    checkpoints = sorted((out / "checkpoint").glob("*.npz"))
+    before = [p.read_bytes() for p in checkpoints]
+    assert main(["-q", "run", "cattaneo", *_sets(CATTANEO + ["friction=0.2"]), "--resume",
+                 str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"vfem: error: {out}: its results were written by a different model "
+                          "(contact.friction: stored 0.3, now 0.2); give the same model")
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert [p.read_bytes() for p in checkpoints] == before  # nothing changed
+    # several settings: each named, the meshes made from them after the settings themselves
+    assert main(["-q", "run", "cattaneo", *_sets(CATTANEO + ["facets_upper=8", "force=250"]),
+                 "--resume", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "bodies.upper.platen.force: stored -300.0, now -250.0; " in err
+    assert err.index("platen.force") < err.index("bodies.upper.mesh: stored ")
+    assert err.count("\n") == 1
+
+
+def test_the_differences_are_named_briefly():
+    from vfem.io.checkpoint import differences
+
+    stored = {f"k{i}": str(i) for i in range(6)} | {"long": "x" * 100}
+    now = {f"k{i}": str(i + 1) for i in range(6)} | {"long": "y" * 100, "new": "1"}
+    text = differences(stored, now)
+    assert text.startswith("k0: stored 0, now 1; k1: stored 1, now 2; ")
+    assert text.endswith("; and 4 more")  # k4, k5, long, new
+    assert differences({"a": "1"}, {"a": "1"}) == ""
+    assert differences({"a": "1"}, {}) == "a: stored 1, now (none)"
+    text = differences({"long": "x" * 100}, {"long": "y" * 100})
+    assert "x" * 57 + "..." in text and "x" * 58 not in text

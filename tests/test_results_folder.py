@@ -151,7 +151,10 @@ def test_a_refused_resume_changes_nothing_and_a_resume_keeps_the_description(tmp
     summary = (out / "summary.json").read_text()
     assert main(["-q", "run", str(HERTZ), "--resume", str(out), "--set",
                  "contact.variant=thesis"]) == 2
-    assert "different model" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "different model" in err
+    assert "(contact.variant: stored 'paired', now 'thesis')" in err  # which setting, both values
+    assert err.count("\n") == 1 and "Traceback" not in err
     assert (out / RECORD).read_text() == record and (out / "summary.json").read_text() == summary
     assert main(["-q", "run", str(HERTZ), "--resume", str(out)]) == 0
     run = json.loads((out / "summary.json").read_text())["run"]

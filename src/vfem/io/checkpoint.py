@@ -9,7 +9,9 @@ back — NumPy arrays and one JSON text, never pickles — and continues from th
 same answer as a run that was never interrupted.
 
 A fingerprint of the model (meshes, materials, boundary conditions, contact settings, load
-schedule) is stored in every file; resuming a different model is refused.
+schedule) is stored in every file; resuming a different model is refused. With it goes the
+same model setting by setting (:func:`describe`), so the refusal names the settings that
+differ, each as stored and as now.
 """
 
 from __future__ import annotations
@@ -54,9 +56,89 @@ def fingerprint(model: Model) -> str:
     return h.hexdigest()
 
 
-def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: str) -> Path:
+#: The most characters of a setting's value a refusal quotes (a long load schedule is cut).
+_VALUE_CHARS = 60
+#: The most differing settings a refusal names (then how many more).
+_NAMED = 4
+
+
+def describe(model: Model) -> dict[str, str]:
+    """What :func:`fingerprint` covers, setting by setting, each value in words: keys as the
+    input file names them where it does (``contact.friction``,
+    ``bodies.<name>.material.youngs_modulus``, ``bodies.<name>.supports[0].components``,
+    ``steps.load_factors``), a body's mesh by its size and a hash of its nodes, elements and
+    boundaries. Stored beside the fingerprint, so a resume of another model names what
+    differs (:func:`differences`)."""
+    out: dict[str, str] = {"steps.load_factors": _text(model.load_factors),
+                           "contact_pairs": _text(model.contact_pairs),
+                           "bodies": _text([b.name for b in model.bodies])}
+    _flatten("contact", model.contact, out)
+    for b in model.bodies:
+        key = f"bodies.{b.name}"
+        h = hashlib.sha256()
+        for a in (b.mesh.p, b.mesh.t):
+            h.update(np.ascontiguousarray(a).tobytes())
+        for name in sorted(b.mesh.boundaries or {}):
+            h.update(name.encode() + np.asarray(b.mesh.boundaries[name]).tobytes())
+        out[f"{key}.mesh"] = (f"{b.mesh.p.shape[1]} nodes and {b.mesh.t.shape[1]} elements "
+                              f"(hash {h.hexdigest()[:8]})")
+        for name in ("material", "supports", "prescribed", "tractions", "platen",
+                     "contact_boundaries", "order", "kinematics", "law"):
+            _flatten(f"{key}.{name}", getattr(b, name), out)
+    return out
+
+
+def _flatten(key: str, value, out: dict[str, str]) -> None:
+    """``value`` under ``key`` in ``out``: a dataclass field by field, a sequence of them item
+    by item (``key[0]``, with its length), anything else as text."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        for f in dataclasses.fields(value):
+            _flatten(f"{key}.{f.name}", getattr(value, f.name), out)
+    elif isinstance(value, (tuple, list)) and value and all(
+            dataclasses.is_dataclass(v) and not isinstance(v, type) for v in value):
+        out[f"{key} (count)"] = str(len(value))
+        for i, v in enumerate(value):
+            _flatten(f"{key}[{i}]", v, out)
+    else:
+        out[key] = _text(value)
+
+
+def _text(value) -> str:
+    """A setting's value as a short text (numbers as Python writes them, arrays as lists)."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    elif isinstance(value, (np.floating, np.integer)):
+        value = value.item()
+    elif isinstance(value, (tuple, list)):
+        value = [v.item() if isinstance(v, (np.floating, np.integer)) else v for v in value]
+    return repr(value)
+
+
+def differences(stored: dict[str, str], now: dict[str, str]) -> str:
+    """The settings that differ between two :func:`describe` texts, in words:
+    "contact.friction: stored 0.3, now 0.2; ..." (at most :data:`_NAMED`, then how many more;
+    the meshes last, which often differ only because a setting they are made from does);
+    "" when none."""
+    keys = [k for k in dict.fromkeys([*stored, *now]) if stored.get(k) != now.get(k)]
+    keys.sort(key=lambda k: k.endswith(".mesh"))  # stable: otherwise in the model's order
+
+    def value(text: str | None) -> str:
+        if text is None:
+            return "(none)"
+        return text if len(text) <= _VALUE_CHARS else text[:_VALUE_CHARS - 3] + "..."
+
+    named = [f"{k}: stored {value(stored.get(k))}, now {value(now.get(k))}"
+             for k in keys[:_NAMED]]
+    if len(keys) > _NAMED:
+        named.append(f"and {len(keys) - _NAMED} more")
+    return "; ".join(named)
+
+
+def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: str,
+          description: dict[str, str] | None = None) -> Path:
     """Save the last step of ``checkpoint`` (its results and the state after it);
-    ``model_fingerprint``: :func:`fingerprint` of ``model``, computed once per run."""
+    ``model_fingerprint``: :func:`fingerprint` of ``model``, and ``description``, its
+    :func:`describe` (None: made here), computed once per run."""
     step = checkpoint.steps[-1]
     state = checkpoint.state
     arrays: dict[str, np.ndarray] = {}
@@ -73,6 +155,7 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
         arrays[f"unknown_{name}"] = value
     meta = {
         "fingerprint": model_fingerprint,
+        "model": describe(model) if description is None else description,
         "step": {"step": step.step, "load_factor": step.load_factor,
                  "iterations": step.iterations, "converged": step.converged,
                  "platen_displacement": step.platen_displacement, "cuts": step.cuts,
@@ -119,10 +202,14 @@ def read(out: Path, model: Model) -> Checkpoint | None:
         except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
             raise InputError(f"{path}: not a readable vfem checkpoint ({exc})") from None
         if meta.get("fingerprint") != expected:
-            raise InputError(f"{out}: its results were written by a different model (meshes, "
-                             "materials, loads or settings differ); give the same model and "
-                             "options as the run that wrote them, or run afresh without "
-                             "--resume")
+            # which settings differ, where the checkpoint recorded them (written since
+            # 2026-11-27); else what may differ
+            what = (differences(meta["model"], describe(model)) if isinstance(
+                meta.get("model"), dict) else "")
+            raise InputError(f"{out}: its results were written by a different model ("
+                             + (what or "meshes, materials, loads or settings differ")
+                             + "); give the same model and options as the run that wrote "
+                             "them, or run afresh without --resume")
         steps.append(_step(meta["step"], arrays, model, meta.get("reactions", {})))
     state = _state(meta["state"], arrays, model)
     bodies = {b.name: {key: arrays[f"body_{i}_{key}"] for key in meta["bodies"][b.name]}

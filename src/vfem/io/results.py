@@ -292,6 +292,7 @@ def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = Fal
     start = None
     if writer is not None:
         model_fingerprint = checkpoint.fingerprint(model)
+        model_description = checkpoint.describe(model)
         if resume:
             start = checkpoint.read(out, model)
             if start is not None:
@@ -311,7 +312,7 @@ def run_writing(model: Model, out: Path | None, on_step=None, resume: bool = Fal
 
             def job() -> None:
                 writer.write_step(step)
-                checkpoint.write(out, model, saved, model_fingerprint)
+                checkpoint.write(out, model, saved, model_fingerprint, model_description)
                 write_summary(out, progress_summary(model, steps, "running"))
 
             background.submit(job)
