@@ -53,6 +53,9 @@ _WRAPPERS_AS_WRITTEN = {
     ("cli.py", 'f"{path}{changes}: {exc}"'):
         "vfem check/run prefix the input file's path (and its --set changes) to a model error "
         "(catalogued at its source)",
+    ("cli.py", 'f"vfem: {why}"'):
+        "vfem plot: the line vfem.io.replot.unfinished_example makes on an example's unfinished "
+        "run (catalogued under 'Results directories and vfem plot')",
     ("config.py", 'f"body {self.name!r}: {exc}"'):
         "names the body in front of a mesh error (mesh shape, mesh file, mesh.curve)",
     ("io/input.py", 'f"{source}: {exc}"'):

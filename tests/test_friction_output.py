@@ -232,3 +232,51 @@ def test_the_differences_are_named_briefly():
     assert differences({"a": "1"}, {}) == "a: stored 1, now (none)"
     text = differences({"long": "x" * 100}, {"long": "y" * 100})
     assert "x" * 57 + "..." in text and "x" * 58 not in text
+
+
+# -- vfem plot on an unfinished example run ------------------------------------------------------
+
+def test_plotting_an_unfinished_example_run_says_why_its_own_figures_are_not_drawn(
+        tmp_path, capsys, monkeypatch):
+    """A sliding run interrupted after step 3: ``vfem plot`` says in one line which example,
+    how far it came and why its own figures (reactions.png, ...: the evaluation of the
+    finished run) are not drawn, draws the generic figures of the steps done, and names the
+    command that finishes it; once resumed, its own figures and no such line."""
+    from vfem import cli
+
+    out = tmp_path / "s"
+    sets = _sets(SLIDING + ["friction=0.3"])
+    progress = cli.Progress.__call__
+
+    def stop_after_3(self, step):
+        progress(self, step)
+        if step.step == 3:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli.Progress, "__call__", stop_after_3)
+    assert main(["-q", "run", "sliding", *sets, "--out", str(out)]) == 130
+    monkeypatch.setattr(cli.Progress, "__call__", progress)
+    capsys.readouterr()
+    assert main(["plot", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert captured.err.count("\n") == 1, captured.err
+    assert captured.err.startswith(
+        f"vfem: {out}: an unfinished run of the sliding example (3 steps done: interrupted, or "
+        "still running); its own figures need the finished run's evaluation, so the generic "
+        "figures of the steps done are drawn instead; to finish it: vfem run sliding "
+        "--set block_columns=60")
+    assert captured.err.rstrip().endswith(f"--set friction=0.3 --resume {out}")
+    assert {"history.png", "friction.png"} <= {p.name for p in out.glob("*.png")}
+    assert "reactions.png" not in captured.out
+    # the command it names finishes the run: the example's own figures, and no such line
+    assert main(["-q", "run", "sliding", *sets, "--resume", str(out)]) == 0
+    assert main(["plot", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert captured.err == "" and "reactions.png" in captured.out
+    # an input file's unfinished run gets the generic figures, which are its own: no line
+    stopped = tmp_path / "p"
+    monkeypatch.setattr(cli.Progress, "__call__", stop_after_3)
+    assert main(["-q", "run", str(FRICTION / "pushed_block.toml"), "--out", str(stopped)]) == 130
+    capsys.readouterr()
+    assert main(["plot", str(stopped)]) == 0
+    assert capsys.readouterr().err == ""

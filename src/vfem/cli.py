@@ -429,8 +429,11 @@ def cmd_reference(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    from .io.replot import plot_results
+    from .io.replot import plot_results, unfinished_example
 
+    why = unfinished_example(Path(args.results))  # an example's own figures cannot be drawn
+    if why and not args.quiet:
+        print(f"vfem: {why}", file=sys.stderr)
     written = plot_results(Path(args.results))
     if not args.quiet:
         print(f"vfem: wrote {', '.join(str(p) for p in written)}" if written else

@@ -34,6 +34,7 @@ import csv
 import json
 import logging
 import re
+import shlex
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -441,7 +442,8 @@ def plot_results(directory: Path | str) -> list[Path]:
     (results written before figure sets were recorded) the generic figures of an input-file run
     (none for the examples that draw none, springs and patch):
     ``deformed.png`` (and maybe ``deformed_overall.png``), ``contact_pressure.png``,
-    ``history.png`` and ``von_mises.png``. A run draws its figures by calling this after
+    ``history.png`` and ``von_mises.png``; the same for an example's run that did not finish,
+    whose own figures need its finished run's evaluation (:func:`unfinished_example` says so). A run draws its figures by calling this after
     writing its files, so ``vfem plot`` redraws the same figures from the same data.
 
     Raises :class:`~vfem.errors.InputError` naming the path when the directory, its
@@ -456,6 +458,8 @@ def plot_results(directory: Path | str) -> list[Path]:
     example = folder.summary.get("example")
     if name is None and example in EXAMPLES and not hasattr(load(example), "figures"):
         name = example  # an example that draws no figure (springs, patch: no results files)
+    if name is None and (why := unfinished_example(folder.directory)):
+        log.info("%s", why)  # vfem plot says so (cli.cmd_plot)
     if name not in (None, "input"):
         if name not in EXAMPLES:
             raise InputError(f"{folder.directory}/summary.json: figure_set {name!r} is not a "
@@ -467,6 +471,39 @@ def plot_results(directory: Path | str) -> list[Path]:
     for p in written:
         log.info("wrote %s", p)
     return written
+
+
+def unfinished_example(directory: Path | str) -> str | None:
+    """Why ``vfem plot`` draws the generic figures of a folder that a built-in example's run
+    wrote: the run did not finish (interrupted, or still running: ``summary.json`` is the
+    summary of the steps so far, :func:`vfem.io.results.progress_summary`), and the example's
+    own figures are drawn from its finished run's evaluation (Hertz's theory, the shear
+    profiles, the reactions over the slide), which its ``summary.json`` does not hold yet. One
+    line: which example, how far it came, why, and how to finish it; None where the folder's
+    figures are its own (a finished run, an input file's run, not a results folder)."""
+    from ..examples import EXAMPLES, load
+    from .folders import read_record
+
+    directory = Path(directory)
+    if not directory.is_dir():
+        return None
+    try:
+        summary = read_summary(directory)
+    except InputError:
+        return None
+    if summary.get("figure_set") is not None or "example" in summary:
+        return None  # the run finished: its summary says whose figures
+    run = read_record(directory) or summary.get("run") or {}
+    name = run.get("target")
+    if name not in EXAMPLES or getattr(load(name), "figures", None) is None:
+        return None
+    done = len(summary.get("steps") or []) or len(list(directory.glob("checkpoint/step*.npz")))
+    sets = "".join(f" --set {shlex.quote(str(a))}" for a in run.get("settings") or ())
+    return (f"{directory}: an unfinished run of the {name} example ({done} step"
+            f"{'' if done == 1 else 's'} done: interrupted, or still running); its own figures "
+            "need the finished run's evaluation, so the generic figures of the steps done are "
+            f"drawn instead; to finish it: vfem run {name}{sets} --resume "
+            f"{shlex.quote(str(directory))}")
 
 
 def generic(folder: Folder) -> list[Path]:
