@@ -443,8 +443,9 @@ def plot_results(directory: Path | str) -> list[Path]:
     (none for the examples that draw none, springs and patch):
     ``deformed.png`` (and maybe ``deformed_overall.png``), ``contact_pressure.png``,
     ``history.png`` and ``von_mises.png``; the same for an example's run that did not finish,
-    whose own figures need its finished run's evaluation (:func:`unfinished_example` says so). A run draws its figures by calling this after
-    writing its files, so ``vfem plot`` redraws the same figures from the same data.
+    whose own figures need its finished run's evaluation (:func:`unfinished_example` says
+    so). A run draws its figures by calling this after writing its files, so ``vfem plot``
+    redraws the same figures from the same data.
 
     Raises :class:`~vfem.errors.InputError` naming the path when the directory, its
     ``results.pvd`` or a VTU file it lists is missing or unreadable, and naming the fix when
