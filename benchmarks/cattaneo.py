@@ -127,8 +127,18 @@ def baseline(pairs: list[tuple[int, int]]) -> None:
 
 
 if __name__ == "__main__":
-    args = sys.argv[1:]
-    mode = next((a for a in args if a.startswith("--")), None)
-    numbers = [int(v) for v in args if not v.startswith("--")] or [12, 17]
-    pairs = list(zip(numbers[::2], numbers[1::2]))
-    {"--cost": cost, "--baseline": baseline, None: main}[mode](pairs)
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=__doc__.split("\n", 1)[1])
+    ap.add_argument("facets", type=int, nargs="*", default=[12, 17],
+                    help="pairs of contact facets across a, upper and lower (default 12 17)")
+    mode = ap.add_mutually_exclusive_group()
+    mode.add_argument("--cost", action="store_true", help="with friction against without")
+    mode.add_argument("--baseline", action="store_true", help="against the Lagrange baseline")
+    args = ap.parse_args()
+    if len(args.facets) % 2:
+        ap.error("facet counts come in pairs: UPPER LOWER ...")
+    pairs = list(zip(args.facets[::2], args.facets[1::2]))
+    (cost if args.cost else baseline if args.baseline else main)(pairs)
