@@ -4,6 +4,7 @@
     python benchmarks/cattaneo.py 24 34 48 68     # and finer pairs (upper, lower)
     python benchmarks/cattaneo.py --cost 12 17    # with friction against without
     python benchmarks/cattaneo.py --baseline 16 23 40 57   # against the Lagrange baseline
+    python benchmarks/cattaneo.py --cycle 12 17 24 34 48 68  # Mindlin-Deresiewicz's c'
 
 Two elastically similar cylinders (``vfem.examples.cattaneo``) pressed by P, then sheared with
 P held. Per step of the shear: Q/(mu P); the stick zone's half-width c of the theory
@@ -14,7 +15,6 @@ mu p0. Then the Hertz peak of the normal traction and the full slide's Q/(mu P).
 
 from __future__ import annotations
 
-import sys
 import time
 
 import numpy as np
@@ -73,6 +73,33 @@ def cost(pairs: list[tuple[int, int]]) -> None:
         (tf, itf, dofs), (t0_, it0, _) = best[p.friction], best[0.0]
         print(f"{upper:>3}/{lower:<4} {dofs:>7} {tf:>12.2f} {itf:>10} {t0_:>14.2f} {it0:>10} "
               f"{tf / t0_:>6.2f}")
+
+
+def cycle(pairs: list[tuple[int, int]]) -> None:
+    """Mindlin and Deresiewicz's unloading (``vfem run cattaneo --set cycle=true --set
+    shift=5e-4``, 10 steps per branch): per unloading step, the outermost sticking node's
+    distance inside c' = a sqrt(1 - (Q* - Q)/(2 mu P)), in contact facets (negative:
+    outside), and how many steps have it within one facet."""
+    for upper, lower in pairs:
+        p = cattaneo.Parameters(cycle=True, shift=5e-4, facets_upper=upper, facets_lower=lower)
+        result, readings = cattaneo.solve(p)
+        if not result.converged:
+            print(f"{upper}/{lower}: stopped: {result.message}")
+            continue
+        a = cattaneo.theory(p)["a"]
+        x = readings[-1].x
+        h = float(np.diff(np.sort(x[np.abs(x) < a])).max())
+        peak = next(r.tangential for r in readings if abs(r.load_factor - 1.0) < 1e-9)
+        gaps = []
+        for r in readings:
+            if 1.0 < r.load_factor <= 1.5:
+                c = cattaneo.reverse_stick_half_width(p, peak, r.tangential)
+                if c > 0:
+                    gaps.append((c - r.last_sticking(p.friction)) / h)
+        within = sum(abs(g) <= 1.0 for g in gaps)
+        print(f"{upper:>3}/{lower:<4} Q*/(mu P) = {peak / (p.friction * p.force):.3f}; c' - "
+              f"stick, facets: {' '.join(f'{g:.2f}' for g in gaps)}; within one facet: "
+              f"{within} of {len(gaps)}")
 
 
 def baseline(pairs: list[tuple[int, int]]) -> None:
@@ -137,8 +164,10 @@ if __name__ == "__main__":
     mode = ap.add_mutually_exclusive_group()
     mode.add_argument("--cost", action="store_true", help="with friction against without")
     mode.add_argument("--baseline", action="store_true", help="against the Lagrange baseline")
+    mode.add_argument("--cycle", action="store_true",
+                      help="Mindlin-Deresiewicz's c' over the unloading branch")
     args = ap.parse_args()
     if len(args.facets) % 2:
         ap.error("facet counts come in pairs: UPPER LOWER ...")
     pairs = list(zip(args.facets[::2], args.facets[1::2]))
-    (cost if args.cost else baseline if args.baseline else main)(pairs)
+    (cost if args.cost else baseline if args.baseline else cycle if args.cycle else main)(pairs)
