@@ -1,4 +1,5 @@
-"""Built-in parametric meshes for the examples.
+"""Built-in parametric meshes for the examples (2D: :mod:`.shapes`, :mod:`.parametric`; 3D:
+:mod:`.solids`).
 
 Each shape returns its mesh with scikit-fem's facet topology already built, once
 (:mod:`vfem.mesh.topology`): at a million elements, scikit-fem's own lazy build took seconds
@@ -17,9 +18,11 @@ from .shapes import (
     wedge_plate,
     wedge_plate_grid,
 )
+from .solids import box
 
 __all__ = [
     "block",
+    "box",
     "gasket",
     "gasket_pair",
     "graded_layer",
