@@ -25,8 +25,8 @@ if TYPE_CHECKING:
 class BodyStepResult:
     """The state of one body at the end of a converged step (full mesh fields)."""
 
-    displacement: np.ndarray  # (npoints, 2), at the body's points (Body.points)
-    contact_force: np.ndarray  # (npoints, 2) nodal force applied by the other bodies
+    displacement: np.ndarray  # (npoints, dim), at the body's points (Body.points)
+    contact_force: np.ndarray  # (npoints, dim) nodal force applied by the other bodies
     #: (npoints,) nominal normal pressure: normal nodal contact force / undeformed tributary
     #: length, i.e. the traction averaged with the node's shape function (int phi q / int phi)
     contact_pressure: np.ndarray
@@ -36,16 +36,17 @@ class BodyStepResult:
     #: unknowns q on the compatibility side, that field read at the other side's nodes); where a
     #: formulation has none, the nodal reading ``contact_pressure``
     contact_traction: np.ndarray | None = None
-    #: (npoints, 2) nodal force the supports, prescribed displacements and platen apply to the
+    #: (npoints, dim) nodal force the supports, prescribed displacements and platen apply to the
     #: body (:meth:`Body.nodal_reaction`): zero on unconstrained dofs. With the contact force and
     #: the applied loads it balances the body (:func:`add_reactions`)
     reaction: np.ndarray | None = None
     #: per boundary carrying a support, a prescribed displacement or the platen, the total (x, y)
-    #: of ``reaction`` over the dofs that boundary's own conditions constrain
+    #: (3D: (x, y, z)) of ``reaction`` over the dofs that boundary's own conditions constrain
     #: (:meth:`Body.boundary_reactions`: a shared corner dof counts in each boundary constraining
     #: it; the body's total, ``reaction.sum(axis=0)``, counts it once)
-    reactions: dict[str, tuple[float, float]] = field(default_factory=dict)
-    #: (2,) resultant (x, y) of the body's applied loads (its tractions) at the step's load factor
+    reactions: dict[str, tuple[float, ...]] = field(default_factory=dict)
+    #: (dim,) resultant (x, y[, z]) of the body's applied loads (its tractions) at the step's
+    #: load factor
     applied_load: np.ndarray | None = None
     # -- with friction (vfem.contact.friction; None without): at the nodes that carry a contact
     # pair's compatibility (where its traction values live), zero at the others
@@ -70,9 +71,12 @@ class BodyStepResult:
 
     @property
     def reaction_total(self) -> np.ndarray:
-        """(2,) the body's total support reaction (x, y): ``reaction`` summed over the nodes,
-        each constrained dof once; zeros where reactions were not computed."""
-        return np.zeros(2) if self.reaction is None else self.reaction.sum(axis=0)
+        """(dim,) the body's total support reaction (x, y[, z]): ``reaction`` summed over the
+        nodes, each constrained dof once; zeros where reactions were not computed."""
+        if self.reaction is None:
+            shape = np.shape(self.displacement)
+            return np.zeros(shape[1] if len(shape) == 2 else 2)
+        return self.reaction.sum(axis=0)
 
 
 def add_reactions(body: Body, r: BodyStepResult, load_factor: float) -> BodyStepResult:

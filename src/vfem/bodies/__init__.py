@@ -27,17 +27,24 @@ from functools import cached_property
 import numpy as np
 from skfem import (
     Basis,
+    ElementHex1,
+    ElementHex2,
     ElementQuad1,
     ElementQuad2,
+    ElementTetP1,
+    ElementTetP2,
     ElementTriP1,
     ElementTriP2,
     ElementVector,
     FacetBasis,
     LinearForm,
+    MeshHex,
     MeshQuad,
+    MeshTet,
     MeshTri,
     asm,
 )
+from skfem.io.meshio import HEX_MAPPING
 from skfem.mesh.mesh_2d_2 import Mesh2D2
 from skfem.models.elasticity import linear_elasticity
 
@@ -55,7 +62,40 @@ from .mechanics import (
 
 log = logging.getLogger(__name__)
 
-COMPONENTS = {"x": 0, "y": 1}
+#: The displacement components by name; a body has the first ``dim`` of them (``Body.dim``).
+COMPONENTS = {"x": 0, "y": 1, "z": 2}
+AXES = tuple(COMPONENTS)
+
+#: The meshes a body accepts (scikit-fem's classes by name): 2D triangles and quadrilaterals,
+#: 3D tetrahedra and hexahedra, each with straight (1) or curved (2: quadratic geometry) sides.
+MESHES = ("MeshTri1", "MeshQuad1", "MeshTri2", "MeshQuad2",
+          "MeshTet1", "MeshHex1", "MeshTet2", "MeshHex2")
+#: The meshes whose own nodes are the quadratic element's points (curved geometry).
+_QUADRATIC_GEOMETRY = ("MeshTet2", "MeshHex2")
+
+#: Node permutations that mirror a VTK cell (turn a negative volume positive): a tetrahedron's
+#: nodes 1 and 2 swapped, a hexahedron's bottom and top faces swapped, with their edge and face
+#: nodes.
+_VTK_MIRROR = {
+    "tetra": [0, 2, 1, 3],
+    "tetra10": [0, 2, 1, 3, 6, 5, 4, 7, 9, 8],
+    "hexahedron": [4, 5, 6, 7, 0, 1, 2, 3],
+    "hexahedron27": [4, 5, 6, 7, 0, 1, 2, 3, 12, 13, 14, 15, 8, 9, 10, 11, 16, 17, 18, 19,
+                     20, 21, 22, 23, 25, 24, 26],
+}
+
+
+class AllComponents(tuple):
+    """The default of :attr:`Support.components`: every displacement component of the body it
+    holds (x and y in 2D, x, y and z in 3D). It is the tuple ``("x", "y")`` itself, so that
+    whatever reads a support's components without knowing the body's dimension reads the 2D
+    default as before; :meth:`Body.support_components` gives the body's own."""
+
+    __slots__ = ()
+
+
+#: Every component of the body (:class:`AllComponents`).
+ALL_COMPONENTS = AllComponents(("x", "y"))
 
 #: A load curve: ``((load_factor, multiplier), ...)`` points, load factors strictly increasing.
 Amplitude = tuple[tuple[float, float], ...]
@@ -146,11 +186,12 @@ class Support:
 
     Attributes:
         boundary: the boundary's name.
-        components: the fixed components, ``"x"`` and/or ``"y"``.
+        components: the fixed components, ``"x"``, ``"y"`` (and ``"z"`` in 3D); by default
+            all of the body's.
     """
 
     boundary: str
-    components: tuple[str, ...] = ("x", "y")
+    components: tuple[str, ...] = ALL_COMPONENTS
 
 
 @dataclass(frozen=True)
@@ -184,7 +225,8 @@ class Traction:
 
     Attributes:
         boundary: the boundary's name.
-        value: the traction (tx, ty), force per unit undeformed length, at load factor 1.
+        value: the traction (tx, ty), force per unit undeformed length, at load factor 1;
+            (tx, ty, tz), force per unit undeformed area, on a 3D body.
         amplitude: a load curve, ``[[load_factor, multiplier], ...]`` points (load factors
             strictly increasing): the traction is ``value`` times the multiplier interpolated
             linearly at the load factor (constant beyond the ends), instead of ``value`` times
@@ -192,7 +234,7 @@ class Traction:
     """
 
     boundary: str
-    value: tuple[float, float]
+    value: tuple[float, ...]
     amplitude: tuple[tuple[float, float], ...] | None = None
 
 
@@ -226,6 +268,21 @@ class Platen:
         return self.force * multiplier(self.amplitude, load_factor)
 
 
+def _named_first(null: np.ndarray) -> np.ndarray:
+    """The rows of ``null`` (an orthonormal basis of free rigid-body motions, as coefficients
+    of the named modes) rewritten as the named modes that are free by themselves (unit rows),
+    then an orthonormal basis of the rest: a roller-supported box is free to "translate in x"
+    and "rotate about z", not in combinations of them."""
+    n = null.shape[1]
+    pure = [i for i in range(n) if np.linalg.norm(null[:, i]) > 1 - 1e-8]
+    named = np.eye(n)[pure]
+    if len(pure) == len(null):
+        return named
+    rest = null - (null @ named.T) @ named  # the part orthogonal to the named modes
+    _, _, vt = np.linalg.svd(rest)
+    return np.vstack([named, vt[: len(null) - len(pure)]])
+
+
 @dataclass
 class Body:
     """One deformable body of a contact model.
@@ -234,14 +291,17 @@ class Body:
         name: unique name, used in messages and output files.
         mesh: a scikit-fem ``MeshTri`` or ``MeshQuad`` with named boundaries; ``MeshTri2`` or
             ``MeshQuad2`` for curved (quadratic) facets, e.g. a cylinder's arc
-            (:func:`vfem.mesh.quadratic.curved`).
+            (:func:`vfem.mesh.quadratic.curved`). In 3D a ``MeshTet`` or ``MeshHex``
+            (``MeshTet2``, ``MeshHex2`` curved), e.g. :func:`vfem.mesh.solids.box`: linear
+            elasticity under small kinematics.
         material: its material.
         supports, prescribed, tractions: boundary conditions on named boundaries.
         platen: an optional force-controlled rigid platen.
         contact_boundaries: boundaries that may touch other bodies; default: every exterior facet
             on which no displacement is prescribed (symmetry planes and supports cannot touch).
-        order: 1 for linear elements (3-node triangles, 4-node quadrilaterals), 2 for quadratic
-            ones (6-node triangles, 9-node quadrilaterals) on the same mesh.
+        order: 1 for linear elements (3-node triangles, 4-node quadrilaterals; 4-node
+            tetrahedra, 8-node hexahedra), 2 for quadratic ones (6-node triangles, 9-node
+            quadrilaterals; 10-node tetrahedra, 27-node hexahedra) on the same mesh.
         kinematics: ``"small"`` (default: small displacements and strains, linear elasticity)
             or large displacements and strains, by the ``"total"`` or ``"updated"`` Lagrangian
             formulation (thesis Chapters 2-3; plane strain, linear elements).
@@ -251,11 +311,13 @@ class Body:
     Points: the nodes of the elements. For linear elements they are the mesh vertices; quadratic
     elements add one point at the middle of each facet (numbered after the vertices, in facet
     order) and, for quadrilaterals, one at each element's centre. Point k carries dofs 2k (x) and
-    2k + 1 (y), as scikit-fem numbers them.
+    2k + 1 (y), as scikit-fem numbers them. In 3D, quadratic elements add the middle of each
+    edge (in ``mesh.edges`` order) and, for hexahedra, each facet's centre (``mesh.facets``
+    order) and each element's; point k carries dofs 3k (x), 3k + 1 (y) and 3k + 2 (z).
     """
 
     name: str
-    mesh: MeshTri | MeshQuad
+    mesh: MeshTri | MeshQuad | MeshTet | MeshHex
     material: LinearElastic
     supports: tuple[Support, ...] = ()
     prescribed: tuple[PrescribedDisplacement, ...] = ()
@@ -265,6 +327,23 @@ class Body:
     order: int = 1
     kinematics: str = "small"
     law: str = "saint-venant-kirchhoff"
+
+    @property
+    def dim(self) -> int:
+        """The body's dimension, 2 or 3: its mesh's number of coordinates."""
+        return int(self.mesh.p.shape[0])
+
+    @property
+    def components(self) -> tuple[str, ...]:
+        """The body's displacement components: ``("x", "y")``, or ``("x", "y", "z")`` in 3D."""
+        return AXES[: self.dim]
+
+    def support_components(self, support: Support) -> tuple[str, ...]:
+        """The components ``support`` fixes on this body: its own, or by default
+        (:class:`AllComponents`) all of the body's."""
+        if isinstance(support.components, AllComponents):
+            return self.components
+        return tuple(support.components)
 
     @property
     def large(self) -> bool:
@@ -324,7 +403,7 @@ class Body:
             trailing = pos[free]
         t2 = time.perf_counter()
         self.factor = factorize(self.K_ff, backend, trailing=trailing,
-                                groups=self.free_dofs // 2, what=f"body {self.name!r}")
+                                groups=self.free_dofs // self.dim, what=f"body {self.name!r}")
         t3 = time.perf_counter()
         self.condensed_flexibility = None
         if condensed_dofs is not None:
@@ -361,7 +440,7 @@ class Body:
         self.mechanics = LargeMechanics(self, fixed) if self.large else LinearMechanics(self)
         self.timings.update(constraints_s=self.timings["constraints_s"] + t2 - t1,
                             factorize_s=t3 - t2, load_cases_s=time.perf_counter() - t3)
-        log.info("body %s: %d points, %d dofs (%d fixed)", self.name, self.ndofs // 2,
+        log.info("body %s: %d points, %d dofs (%d fixed)", self.name, self.ndofs // self.dim,
                  self.ndofs, len(self.fixed_dofs))
 
     # -- the body's mechanics (vfem.bodies.mechanics) ---------------------------------------
@@ -430,7 +509,7 @@ class Body:
         prescribed value at load factor 1 of every supported or prescribed dof."""
         fixed: dict[int, float] = {}  # dof -> prescribed value at factor 1
         for s in self.supports:
-            for c in s.components:
+            for c in self.support_components(s):
                 fixed.update(dict.fromkeys(self._boundary_dofs(s.boundary, c).tolist(), 0.0))
         for pd in self.prescribed:
             fixed.update(dict.fromkeys(self._boundary_dofs(pd.boundary, pd.component).tolist(),
@@ -488,6 +567,10 @@ class Body:
 
     def element(self):
         """The scalar scikit-fem element of each displacement component."""
+        if isinstance(self.mesh, MeshTet):
+            return ElementTetP2() if self.order == 2 else ElementTetP1()
+        if isinstance(self.mesh, MeshHex):
+            return ElementHex2() if self.order == 2 else ElementHex1()
         tri = isinstance(self.mesh, MeshTri)
         if self.order == 2:
             return ElementTriP2() if tri else ElementQuad2()
@@ -495,12 +578,17 @@ class Body:
 
     @cached_property
     def points(self) -> np.ndarray:
-        """(2, npoints) coordinates of the element nodes (see the class docstring)."""
+        """(dim, npoints) coordinates of the element nodes (see the class docstring)."""
         mesh = self.mesh
         if self.order == 1:
             return mesh.p[:, : mesh.nvertices]
-        if isinstance(mesh, Mesh2D2):  # curved (quadratic) geometry: its nodes are the points
-            return mesh.doflocs
+        if isinstance(mesh, Mesh2D2) or type(mesh).__name__ in _QUADRATIC_GEOMETRY:
+            return mesh.doflocs  # curved (quadratic) geometry: its nodes are the points
+        if self.dim == 3:  # scikit-fem's dofs: vertices, edges, (hexahedra) facets, elements
+            parts = [mesh.p, mesh.p[:, mesh.edges].mean(axis=1)]
+            if isinstance(mesh, MeshHex):
+                parts += [mesh.p[:, mesh.facets].mean(axis=1), mesh.p[:, mesh.t].mean(axis=1)]
+            return np.hstack(parts)
         parts = [mesh.p, mesh.p[:, mesh.facets].mean(axis=1)]
         if not isinstance(mesh, MeshTri):
             parts.append(mesh.p[:, mesh.t].mean(axis=1))
@@ -511,9 +599,19 @@ class Body:
         return self.points.shape[1]
 
     def facet_points(self, facets: np.ndarray) -> np.ndarray:
-        """(nf, 2 or 3) points of the given facets: the two vertices, then the midpoint."""
-        fp = self.mesh.facets[:, facets].T
+        """(nf, k) points of the given facets: the two vertices, then (order 2) the midpoint.
+        In 3D the facet's 3 or 4 vertices (``mesh.facets``), then (order 2) its edges' middles
+        (in the order of ``mesh.f2e``: the facet's edges 0-1, 1-2, then 0-2 of a triangle,
+        2-3 and 0-3 of a quadrilateral) and a quadrilateral's centre."""
+        mesh = self.mesh
+        fp = mesh.facets[:, facets].T
         if self.order == 2:
+            if self.dim == 3:
+                facets = np.asarray(facets)
+                cols = [fp, mesh.nvertices + mesh.f2e[:, facets].T]
+                if isinstance(mesh, MeshHex):
+                    cols.append(mesh.nvertices + mesh.edges.shape[1] + facets)
+                return np.column_stack(cols)
             fp = np.column_stack([fp, self.mesh.nvertices + np.asarray(facets)])
         return fp
 
@@ -523,7 +621,12 @@ class Body:
 
     def cells(self) -> tuple[str, np.ndarray]:
         """VTK cell type and (nelements, k) point connectivity, in VTK's node order (after
-        :meth:`setup`)."""
+        :meth:`setup`). In 3D: ``tetra``, ``hexahedron``, ``tetra10`` or ``hexahedron27``
+        (scikit-fem's hexahedron nodes reordered by ``skfem.io.meshio.HEX_MAPPING``), each cell
+        with a positive volume in VTK's convention (a mirrored element's nodes listed
+        mirrored)."""
+        if self.dim == 3:
+            return self._cells_3d()
         tri = isinstance(self.mesh, MeshTri)
         if self.order == 1:
             return ("triangle" if tri else "quad"), self.mesh.t.T
@@ -532,14 +635,37 @@ class Body:
         conn = self.basis.element_dofs[::2].T // 2
         return ("triangle6" if tri else "quad9"), conn
 
+    def _cells_3d(self) -> tuple[str, np.ndarray]:
+        """:meth:`cells` of a 3D body."""
+        mesh, tet = self.mesh, isinstance(self.mesh, MeshTet)
+        if self.order == 1:
+            kind = "tetra" if tet else "hexahedron"
+            conn = mesh.t if tet else mesh.t[HEX_MAPPING[:8]]
+        else:  # scikit-fem's element dofs (x of point k is dof 3k): vertices, edges, ...
+            kind = "tetra10" if tet else "hexahedron27"
+            conn = self.basis.element_dofs[::3] // 3
+            conn = conn if tet else conn[HEX_MAPPING]
+        conn = np.ascontiguousarray(conn.T)
+        x = self.points[:, conn[:, :8 if not tet else 4]]  # (3, ne, corners)
+        if tet:
+            a, b, c = x[:, :, 1] - x[:, :, 0], x[:, :, 2] - x[:, :, 0], x[:, :, 3] - x[:, :, 0]
+        else:  # the trilinear map's Jacobian at the centre, VTK's corner order
+            a = (x[:, :, [1, 2, 5, 6]] - x[:, :, [0, 3, 4, 7]]).sum(axis=2)
+            b = (x[:, :, [2, 3, 6, 7]] - x[:, :, [1, 0, 5, 4]]).sum(axis=2)
+            c = (x[:, :, [4, 5, 6, 7]] - x[:, :, [0, 1, 2, 3]]).sum(axis=2)
+        volume = np.einsum("ie,ie->e", np.cross(a, b, axis=0), c)
+        mirrored = volume < 0
+        if mirrored.any():
+            conn[mirrored] = conn[mirrored][:, _VTK_MIRROR[kind]]
+        return kind, conn
+
     def validate(self) -> None:
         """Raise :class:`InputError` naming the body if its definition cannot be analysed."""
         where = f"body {self.name!r}"
-        if not isinstance(self.mesh, (MeshTri, MeshQuad)) or type(self.mesh).__name__ not in (
-            "MeshTri1", "MeshQuad1", "MeshTri2", "MeshQuad2"
-        ):
-            raise InputError(f"{where}: mesh must be triangles or quadrilaterals, "
-                             f"got {type(self.mesh).__name__}")
+        if not isinstance(self.mesh, (MeshTri, MeshQuad, MeshTet, MeshHex)) or (
+                type(self.mesh).__name__ not in MESHES):
+            raise InputError(f"{where}: mesh must be triangles or quadrilaterals (2D), "
+                             f"tetrahedra or hexahedra (3D), got {type(self.mesh).__name__}")
         # validate runs before every use of the body; the mesh is checked once
         if getattr(self, "_checked_mesh", None) is not self.mesh:
             check_mesh(self.mesh, where)
@@ -554,6 +680,13 @@ class Body:
         if self.law not in ("saint-venant-kirchhoff", "neo-hookean"):
             raise InputError(f"{where}: law must be 'saint-venant-kirchhoff' or 'neo-hookean', "
                              f"got {self.law!r}")
+        if self.dim == 3 and self.material.plane != "strain":
+            raise InputError(f"{where}: plane = {self.material.plane!r} is an assumption of 2D "
+                             "bodies; a 3D body (tetrahedra or hexahedra) has none: leave "
+                             "the material's plane out")
+        if self.dim == 3 and self.large:
+            raise InputError(f"{where}: large kinematics ({self.kinematics!r}) is not "
+                             "available for 3D bodies yet; use kinematics = 'small'")
         if self.large and (self.order != 1 or self.material.plane != "strain"):
             raise InputError(f"{where}: large kinematics ({self.kinematics!r}) needs linear "
                              "elements (order 1) and plane strain")
@@ -568,12 +701,25 @@ class Body:
                 raise InputError(f"{where}: boundary {name!r} holds no facet of the mesh's "
                                  "outline; check how it is defined (a shape's parameters, or "
                                  "the mesh file's group)")
-        comps = [c for s in self.supports for c in s.components]
-        comps += [pd.component for pd in self.prescribed]
-        comps += [self.platen.component] if self.platen else []
-        for c in comps:
-            if c not in COMPONENTS:
-                raise InputError(f"{where}: component must be 'x' or 'y', got {c!r}")
+        comps = [("support", s.boundary, c) for s in self.supports
+                 for c in self.support_components(s)]
+        comps += [("prescribed displacement", pd.boundary, pd.component)
+                  for pd in self.prescribed]
+        comps += [("platen", self.platen.boundary, self.platen.component)] if self.platen else []
+        allowed = self.components
+        for kind, boundary, c in comps:
+            if c not in allowed:
+                names = " or ".join((", ".join(repr(a) for a in allowed[:-1]),
+                                     repr(allowed[-1])))
+                raise InputError(f"{where}: {kind} on {boundary!r}: component must be {names}"
+                                 + ("" if c not in COMPONENTS else
+                                    f" (the body's mesh is {self.dim}D)") + f", got {c!r}")
+        for tr in self.tractions:
+            if not isinstance(tr.value, (tuple, list)) or len(tr.value) != self.dim:
+                raise InputError(
+                    f"{where}: traction on {tr.boundary!r}: value must have {self.dim} "
+                    f"components ({', '.join('t' + a for a in allowed)}) on a {self.dim}D "
+                    f"body, got {_shown(tr.value)}")
         for kind, loads in (("prescribed displacement", self.prescribed),
                             ("traction", self.tractions),
                             ("platen", (self.platen,) if self.platen else ())):
@@ -589,21 +735,45 @@ class Body:
         facets = self.mesh.boundaries[boundary]
         return self.basis.get_dofs(facets).all(f"u^{COMPONENTS[component] + 1}")
 
+    def _rigid_modes(self) -> dict[str, np.ndarray]:
+        """The body's rigid-body motions by name, each (npoints, dim): in 2D the translations
+        in x and y and the rotation; in 3D the translations in x, y and z and the rotations
+        about the axes x, y and z through the points' centroid."""
+        if self.dim == 2:
+            x, y = self.points
+            return {"translation in x": np.column_stack([np.ones_like(x), 0 * y]),
+                    "translation in y": np.column_stack([0 * x, np.ones_like(y)]),
+                    "rotation": np.column_stack([-(y - y.mean()), x - x.mean()])}
+        X = self.points - self.points.mean(axis=1, keepdims=True)
+        zero, one = np.zeros(X.shape[1]), np.ones(X.shape[1])
+        x, y, z = X
+        return {"translation in x": np.column_stack([one, zero, zero]),
+                "translation in y": np.column_stack([zero, one, zero]),
+                "translation in z": np.column_stack([zero, zero, one]),
+                "rotation about x": np.column_stack([zero, -z, y]),
+                "rotation about y": np.column_stack([z, zero, -x]),
+                "rotation about z": np.column_stack([-y, x, zero])}
+
     def _check_supported(self) -> None:
-        """Refuse a body that can move as a rigid body: its stiffness would be singular."""
-        x, y = self.points
-        modes = {"translation in x": np.column_stack([np.ones_like(x), 0 * y]),
-                 "translation in y": np.column_stack([0 * x, np.ones_like(y)]),
-                 "rotation": np.column_stack([-(y - y.mean()), x - x.mean()])}
+        """Refuse a body that can move as a rigid body: its stiffness would be singular. The
+        message names the free motions (2D: the translations in x and y, the rotation; 3D:
+        the translations in x, y and z, the rotations about x, y and z)."""
+        modes = self._rigid_modes()
         R = np.column_stack([m.ravel() for m in modes.values()])  # interleaved dofs
         Rc = R[self.fixed_dofs]
         names = list(modes)
-        _, sv, vt = np.linalg.svd(Rc if len(Rc) else np.zeros((1, 3)))
+        n = len(names)
+        # (rows of zeros up to n: vt is then n x n without the full, fixed dofs squared, U)
+        A = Rc if len(Rc) >= n else np.vstack([Rc, np.zeros((n - len(Rc), n))])
+        _, sv, vt = np.linalg.svd(A, full_matrices=False)
         tol = 1e-10 * max(1.0, float(np.abs(R).max())) * max(1, len(Rc))
         rank = int((sv > tol).sum())
-        if rank < 3:
+        if rank < n:
+            null = vt[rank:]  # the free motions' coefficients, an orthonormal basis
+            if self.dim == 3:
+                null = _named_first(null)
             free = []
-            for v in vt[rank:]:
+            for v in null:
                 parts = [names[i] for i in np.flatnonzero(np.abs(v) > 1e-6 * np.abs(v).max())]
                 free.append(parts[0] if len(parts) == 1
                             else "a combination of " + " and ".join(parts))
@@ -618,7 +788,10 @@ class Body:
 
         @LinearForm
         def load(v, w):
-            return t[0] * v[0] + t[1] * v[1]
+            out = t[0] * v[0] + t[1] * v[1]
+            for d in range(2, len(t)):  # 3D: + t[2] * v[2]
+                out = out + t[d] * v[d]
+            return out
 
         return asm(load, fb)
 
@@ -689,7 +862,7 @@ class Body:
         boundaries (a corner) is in both where both constrain the same component."""
         parts: dict[str, list[np.ndarray]] = {}
         for s in self.supports:
-            for c in s.components:
+            for c in self.support_components(s):
                 parts.setdefault(s.boundary, []).append(self._boundary_dofs(s.boundary, c))
         for pd in self.prescribed:
             parts.setdefault(pd.boundary, []).append(self._boundary_dofs(pd.boundary,
@@ -698,15 +871,17 @@ class Body:
             parts.setdefault(self.platen.boundary, []).append(self.platen_dofs)
         return {name: np.unique(np.concatenate(d)) for name, d in parts.items()}
 
-    def boundary_reactions(self, nodal_reaction: np.ndarray) -> dict[str, tuple[float, float]]:
-        """Per constrained boundary (:meth:`reaction_dofs`), the total (x, y) of
+    def boundary_reactions(self, nodal_reaction: np.ndarray) -> dict[str, tuple[float, ...]]:
+        """Per constrained boundary (:meth:`reaction_dofs`), the total (x, y), or (x, y, z) in
+        3D, of
         ``nodal_reaction`` (ndofs, from :meth:`nodal_reaction`) over the dofs it constrains.
         A shared corner dof counts in each boundary that constrains it, so the boundaries'
         totals add up to the body's total only where no dof is shared."""
         r = np.asarray(nodal_reaction, dtype=float).ravel()
         out = {}
         for name, dofs in self.reaction_dofs().items():
-            out[name] = (float(r[dofs[dofs % 2 == 0]].sum()), float(r[dofs[dofs % 2 == 1]].sum()))
+            dim = self.dim
+            out[name] = tuple(float(r[dofs[dofs % dim == c]].sum()) for c in range(dim))
         return out
 
     def reaction(self, u: np.ndarray, boundary: str, component: str, load_factor: float = 1.0,

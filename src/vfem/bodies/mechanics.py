@@ -173,7 +173,7 @@ class LargeMechanics:
             # body)
             pos = np.searchsorted(free, condensed_dofs)
             held = free[np.minimum(pos, len(free) - 1)] == condensed_dofs
-            factor, step = _tangent_factorization(K_ff, pos[held], free // 2,
+            factor, step = _tangent_factorization(K_ff, pos[held], free // self.body.dim,
                                                   -R[free] - K[free] @ pending, backend,
                                                   self.body.name, self._tangent_analysis)
             self._tangent_analysis = factor if factor.trailing_inverse is not None else None

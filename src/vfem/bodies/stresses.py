@@ -1,9 +1,10 @@
 """Stresses and strains of a body's displacement: output fields, not part of the body.
 
-:func:`small_strain_stress` (linear elasticity, plane strain or stress) and
+:func:`small_strain_stress` (linear elasticity, plane strain or stress, or 3D) and
 :func:`cauchy_stress` (large kinematics, deformed configuration) give element averages with the
-von Mises stress; each body's mechanics (:mod:`vfem.bodies.mechanics`) picks one, and
-:func:`stress` asks it. :func:`max_strain` is the small-strain measure the solver's warning reads
+von Mises stress (in 3D: the six components sxx, syy, szz, syz, sxz, sxy); each body's
+mechanics (:mod:`vfem.bodies.mechanics`) picks one, and :func:`stress` asks it.
+:func:`max_strain` is the small-strain measure the solver's warning reads
 (:data:`vfem.solver.SMALL_STRAIN_LIMIT`), whatever the kinematics.
 """
 
@@ -15,7 +16,7 @@ import numpy as np
 def stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
     """Element-average stresses of ``body`` at displacement ``u`` (ndofs): sxx, syy, sxy, szz
     and von Mises (per element); Cauchy stresses in the deformed configuration under large
-    kinematics."""
+    kinematics. A 3D body's: sxx, syy, szz, syz, sxz, sxy and von Mises."""
     return body.mechanics.stress(u)
 
 
@@ -33,6 +34,13 @@ def small_strain_stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
     lam, mu = body.material.lame()
     nel = body.basis.nelems
     e = average_strain_operator(body) @ np.asarray(u, dtype=float)
+    if body.mesh.p.shape[0] == 3:
+        exx, eyy, ezz, eyz, exz, exy = e.reshape(6, nel)
+        tr = exx + eyy + ezz
+        avg = {"sxx": 2 * mu * exx + lam * tr, "syy": 2 * mu * eyy + lam * tr,
+               "szz": 2 * mu * ezz + lam * tr, "syz": 2 * mu * eyz, "sxz": 2 * mu * exz,
+               "sxy": 2 * mu * exy}
+        return _with_von_mises(avg)
     exx, eyy, exy = e[:nel], e[nel:2 * nel], e[2 * nel:]
     tr = exx + eyy
     avg = {"sxx": 2 * mu * exx + lam * tr, "syy": 2 * mu * eyy + lam * tr, "sxy": 2 * mu * exy}
@@ -47,7 +55,8 @@ def average_strain_operator(body):
     small strain (exx, eyy, exy stacked), built once per body from its basis's shape-function
     gradients and quadrature weights (each vector shape function moves one component, i % 2).
     Stresses of every step and body are then one sparse product (issue 19: recomputing them
-    by interpolation took 0.6 s per step of a 462k-dof body)."""
+    by interpolation took 0.6 s per step of a 462k-dof body). A 3D body's is 6 nelems x ndofs:
+    exx, eyy, ezz, eyz, exz, exy (tensor shear strains, half the engineering ones)."""
     cached = body.__dict__.get("_average_strain")
     if cached is not None and cached[0] is body.basis:
         return cached[1]
@@ -59,6 +68,24 @@ def average_strain_operator(body):
     nel = basis.nelems
     rows, cols, vals = [], [], []
     elements = np.arange(nel)
+    if body.mesh.p.shape[0] == 3:
+        for i in range(basis.Nbfun):
+            c = i % 3  # ElementVector: shape function i moves component i % 3
+            g = basis.basis[i][0].grad[c]  # (derivative, element, quadrature point)
+            avg = (g * w[None]).sum(axis=2) / total[None]  # (derivative, element)
+            dofs = basis.element_dofs[i]
+            rows.append(c * nel + elements)  # exx, eyy, ezz from d/dx, d/dy, d/dz of u_c
+            cols.append(dofs)
+            vals.append(avg[c])
+            for d in range(3):  # the shears: half of d(u_c)/dd + d(u_d)/dc
+                if d != c:
+                    rows.append(_SHEAR[frozenset((c, d))] * nel + elements)
+                    cols.append(dofs)
+                    vals.append(0.5 * avg[d])
+        op = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                           shape=(6 * nel, basis.N))
+        body.__dict__["_average_strain"] = (basis, op)
+        return op
     for i in range(basis.Nbfun):
         c = i % 2  # ElementVector: shape function i moves component i % 2
         g = basis.basis[i][0].grad[c]  # (derivative, element, quadrature point)
@@ -83,8 +110,19 @@ def max_strain(body, u: np.ndarray) -> tuple[float, int]:
     gradient is summed from the basis's own shape-function gradients, each vector shape
     function's one nonzero component only (4 times faster than ``basis.interpolate``:
     0.05 s for 160k dofs; after :meth:`~vfem.bodies.Body.assemble`); for linear triangles,
-    whose strain is constant in each element, from :func:`average_strain_operator`."""
+    whose strain is constant in each element, from :func:`average_strain_operator`. In 3D the
+    largest absolute eigenvalue of the 3 x 3 strain tensor (:func:`_largest_eigenvalue`)."""
     basis = body.basis
+    if body.mesh.p.shape[0] == 3:
+        if body.order == 1 and body.mesh.t.shape[0] == 4:  # linear tetrahedra: constant
+            nel = basis.nelems
+            e = (average_strain_operator(body) @ np.asarray(u, dtype=float)).reshape(6, nel)
+            per_element = _largest_eigenvalue(*e)
+            if not per_element.size:
+                return 0.0, 0
+            element = int(np.argmax(per_element))
+            return float(per_element[element]), element
+        return _max_strain_at_quadrature(body, u)
     if body.order == 1 and body.mesh.t.shape[0] == 3:
         # linear triangles: the strain is constant in each element, its average (one sparse
         # product, :func:`average_strain_operator`) is its value at every quadrature point
@@ -103,23 +141,56 @@ def max_strain(body, u: np.ndarray) -> tuple[float, int]:
 def _max_strain_at_quadrature(body, u: np.ndarray) -> tuple[float, int]:
     """:func:`max_strain` over every quadrature point (any element)."""
     basis = body.basis
+    dim = body.mesh.p.shape[0]
     ue = np.asarray(u, dtype=float)[basis.element_dofs]  # (shape functions, elements)
     grad = None  # (component, derivative, element, quadrature point)
     for i in range(basis.Nbfun):
-        c = i % 2  # ElementVector: shape function i moves component i % 2
+        c = i % dim  # ElementVector: shape function i moves component i % dim
         g = basis.basis[i][0].grad[c]  # (derivative, element, quadrature point)
         if grad is None:
-            grad = np.zeros((2,) + g.shape)
+            grad = np.zeros((dim,) + g.shape)
         grad[c] += ue[i][:, None] * g
-    exx, eyy, exy = grad[0, 0], grad[1, 1], 0.5 * (grad[0, 1] + grad[1, 0])
-    principal = np.abs(0.5 * (exx + eyy)) + np.sqrt((0.5 * (exx - eyy)) ** 2 + exy**2)
+    if dim == 3:
+        principal = _largest_eigenvalue(
+            grad[0, 0], grad[1, 1], grad[2, 2], 0.5 * (grad[1, 2] + grad[2, 1]),
+            0.5 * (grad[0, 2] + grad[2, 0]), 0.5 * (grad[0, 1] + grad[1, 0]))
+    else:
+        exx, eyy, exy = grad[0, 0], grad[1, 1], 0.5 * (grad[0, 1] + grad[1, 0])
+        principal = np.abs(0.5 * (exx + eyy)) + np.sqrt((0.5 * (exx - eyy)) ** 2 + exy**2)
     per_element = principal.max(axis=1) if principal.size else np.zeros(1)
     element = int(np.argmax(per_element))
     return float(per_element[element]), element
 
 
+def _largest_eigenvalue(xx, yy, zz, yz, xz, xy) -> np.ndarray:
+    """The largest absolute eigenvalue of symmetric 3 x 3 tensors given by their six
+    components (arrays of one shape), in closed form (the trigonometric solution of the
+    characteristic cubic): no loop and no 3 x 3 arrays per point."""
+    q = (xx + yy + zz) / 3.0
+    a, b, c = xx - q, yy - q, zz - q
+    p2 = (a * a + b * b + c * c + 2.0 * (xy * xy + xz * xz + yz * yz)) / 6.0
+    p = np.sqrt(p2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        det = (a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz))
+        r = np.clip(np.where(p > 0, det / (2.0 * np.where(p > 0, p, 1.0) ** 3), 0.0), -1, 1)
+    phi = np.arccos(r) / 3.0
+    largest = q + 2.0 * p * np.cos(phi)
+    smallest = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
+    return np.maximum(np.abs(largest), np.abs(smallest))
+
+
+#: The row block of each shear strain in a 3D :func:`average_strain_operator` (components'
+#: pairs: yz, xz, xy).
+_SHEAR = {frozenset((1, 2)): 3, frozenset((0, 2)): 4, frozenset((0, 1)): 5}
+
+
 def _with_von_mises(avg: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     sxx, syy, sxy, szz = avg["sxx"], avg["syy"], avg["sxy"], avg["szz"]
+    if "syz" in avg:  # 3D: the three shears
+        avg["von_mises"] = np.sqrt(
+            0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
+            + 3 * (sxy**2 + avg["syz"] ** 2 + avg["sxz"] ** 2))
+        return avg
     avg["von_mises"] = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
                                + 3 * sxy**2)
     return avg
