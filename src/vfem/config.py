@@ -30,7 +30,7 @@ from .bodies import Body, Platen, PrescribedDisplacement, Support, Traction
 from .contact.settings import ContactSettings
 from .errors import InputError
 from .materials import LinearElastic
-from .mesh import parametric, shapes
+from .mesh import parametric, shapes, solids
 from .schema import check_parameters
 from .solver import Model
 
@@ -49,7 +49,10 @@ SHAPES = {
     "gasket": shapes.gasket,
     "rounded_punch": shapes.rounded_punch,
     "filleted_punch": shapes.filleted_punch,
+    "box": solids.box,
 }
+#: The shapes of :data:`SHAPES` that make 3D meshes (tetrahedra, hexahedra).
+SOLID_SHAPES = ("box",)
 
 
 @dataclass(frozen=True)

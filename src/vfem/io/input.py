@@ -24,7 +24,16 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ..config import SHAPES, BodyConfig, Curve, MeshSpec, ModelConfig, Output, Steps
+from ..config import (
+    SHAPES,
+    SOLID_SHAPES,
+    BodyConfig,
+    Curve,
+    MeshSpec,
+    ModelConfig,
+    Output,
+    Steps,
+)
 from ..errors import InputError
 from ..schema import (
     _join,
@@ -267,7 +276,27 @@ def to_data(obj) -> dict:
             out[f.name] = [to_data(x) for x in v]
         else:
             out[f.name] = _listify(v)
+    if isinstance(obj, BodyConfig) and _solid(obj.mesh):
+        _exact_components(obj, out)
     return out
+
+
+def _solid(mesh: MeshSpec) -> bool:
+    """Whether a body's mesh is 3D: a solid shape (:data:`vfem.config.SOLID_SHAPES`). A mesh
+    file is 2D: the import refuses 3D (:mod:`vfem.mesh.imports`; 3D import, issue 21's C17,
+    must make this read the file's dimension)."""
+    return mesh.shape in SOLID_SHAPES
+
+
+def _exact_components(body: BodyConfig, out: dict) -> None:
+    """A 3D body's supports with their components written where they are given, even as
+    ``["x", "y"]``: left out, they read back as every component of the body (x, y and z,
+    :class:`vfem.bodies.AllComponents`), which ``["x", "y"]`` compares equal to."""
+    from ..bodies import AllComponents
+
+    for support, data in zip(body.supports, out.get("supports", ())):
+        if not isinstance(support.components, AllComponents):
+            data["components"] = _listify(support.components)
 
 
 def dumps(config: ModelConfig, header: str = "") -> str:

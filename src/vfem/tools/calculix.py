@@ -273,7 +273,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
         elem_off += t.shape[1]
 
     supports = [f"B_{tags[b.name]}_{_tag(sup.boundary)}, {DOF[c]}, {DOF[c]}"
-                for b in model.bodies for sup in b.supports for c in sup.components]
+                for b in model.bodies for sup in b.supports for c in b.support_components(sup)]
     out += ["*BOUNDARY", *supports]
 
     def prescribed(factor: float) -> list[str]:
@@ -524,7 +524,7 @@ def _stiffness(body):
 def _constrained(body) -> np.ndarray:
     """Dofs held by supports, prescribed displacements and the platen (not contact's)."""
     dofs = []
-    comps = [(s.boundary, c) for s in body.supports for c in s.components]
+    comps = [(s.boundary, c) for s in body.supports for c in body.support_components(s)]
     comps += [(pd.boundary, pd.component) for pd in body.prescribed]
     if body.platen is not None:
         comps.append((body.platen.boundary, body.platen.component))
