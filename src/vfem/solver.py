@@ -113,6 +113,10 @@ class Model:
                     raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
         for b in self.bodies:
             b.validate()
+        dims = {b.name: b.dim for b in self.bodies}
+        if len(set(dims.values())) > 1:
+            raise InputError(f"model {self.name!r}: its bodies must all be 2D or all 3D, got "
+                             + ", ".join(f"{n!r} {d}D" for n, d in dims.items()))
         check_capabilities(self)  # what the formulation supports, as it declares it
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
@@ -388,11 +392,12 @@ class Analysis:
             strain, element = max_strain(b, step.bodies[b.name].displacement.ravel())
             if strain > SMALL_STRAIN_LIMIT:
                 self.strain_warned.add(b.name)
-                x, y = b.mesh.p[:, b.mesh.t[:, element]].mean(axis=1)
+                where = ", ".join(f"{c:.4g}" for c in
+                                  b.mesh.p[:, b.mesh.t[:, element]].mean(axis=1))
                 log.warning("body %r: strain %.3g %% at step %d (load factor %.6g), element %d "
-                            "at (%.4g, %.4g), beyond the %g %% small kinematics is meant for: "
+                            "at (%s), beyond the %g %% small kinematics is meant for: "
                             "its answer may be far off; analyse it with kinematics = \"total\"",
-                            b.name, 100 * strain, step.step, step.load_factor, element, x, y,
+                            b.name, 100 * strain, step.step, step.load_factor, element, where,
                             100 * SMALL_STRAIN_LIMIT)
 
     def solve_step(self, start: ContactState, load_factor: float, history_out: list

@@ -123,6 +123,7 @@ def check_capabilities(model) -> None:
                              "platen with friction is available with small kinematics only, not "
                              "yet with large kinematics; prescribe the body's motion instead "
                              "([[bodies.prescribed]]), or use small kinematics")
+    touching = bodies_that_may_touch(model)
     for b in model.bodies:
         if b.order not in caps.orders:
             if large:
@@ -132,10 +133,21 @@ def check_capabilities(model) -> None:
                              f"supports {_orders(caps).replace(' (', ' only (', 1)}; use the "
                              "paired variant for quadratic elements")
         dim = b.mesh.p.shape[0]
-        if dim not in caps.dimensions:
+        if dim not in caps.dimensions and b.name in touching:
             raise InputError(f"model {model.name!r}, body {b.name!r}: {caps.name} contact "
                              f"supports {' and '.join(f'{d}D' for d in caps.dimensions)} "
                              f"bodies, this one is {dim}D")
+
+
+def bodies_that_may_touch(model) -> set[str]:
+    """The names of the bodies in a pair that may touch (``contact_pairs``, by default every
+    pair of the model's bodies). A body in none (a model of one body, or one its
+    ``contact_pairs`` leave out) is analysed without contact: its dimension is not the contact
+    formulation's to refuse (a 3D body alone runs before 3D contact does, issue 21)."""
+    names = [b.name for b in model.bodies]
+    if model.contact_pairs is None:
+        return set(names) if len(names) > 1 else set()
+    return {n for pair in model.contact_pairs for n in pair}
 
 
 def _orders(caps: Capabilities) -> str:
@@ -145,4 +157,5 @@ def _orders(caps: Capabilities) -> str:
             f"(order {' or '.join(str(o) for o in caps.orders)})")
 
 
-__all__ = ["Capabilities", "ContactFormulation", "check_capabilities", "formulation_class"]
+__all__ = ["Capabilities", "ContactFormulation", "bodies_that_may_touch", "check_capabilities",
+           "formulation_class"]

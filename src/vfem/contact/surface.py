@@ -98,6 +98,8 @@ class ContactSurface:
     def build(cls, body: Body, facet_ids: np.ndarray) -> ContactSurface:
         mesh = body.mesh
         fn = body.facet_points(facet_ids).copy()  # (nf, 2 or 3) point numbers
+        if body.dim == 3:
+            return cls._untouched(body, fn)
         # Orient each facet so that (t_y, -t_x) points away from its element.
         elem = mesh.f2t[0, facet_ids]
         centroid = mesh.p[:, mesh.t[:, elem]].mean(axis=1).T
@@ -124,6 +126,19 @@ class ContactSurface:
             ones = np.ones(len(facets))
             surface.tributary = np.asarray(surface.mass_matrix(ones).sum(axis=1)).ravel()
         return surface
+
+    @classmethod
+    def _untouched(cls, body: Body, fn: np.ndarray) -> ContactSurface:
+        """The surface of a 3D body that touches nothing (in no pair that may touch,
+        :func:`~vfem.contact.formulation.bodies_that_may_touch`): no candidate, no rind. 3D
+        contact surfaces (triangle and quadrilateral facets) are issue 21's to come."""
+        if len(fn):
+            raise NotImplementedError(f"body {body.name!r}: contact surfaces of 3D bodies are "
+                                      "not implemented yet")
+        none = np.zeros(0, dtype=np.int64)
+        return cls(body=body, facet_ids=none, facets=fn.astype(np.int64), nodes=none, nc=0,
+                   X=np.zeros((0, 3)), lengths=np.zeros(0), tributary=np.zeros(0),
+                   rind=np.zeros((0, 3), dtype=np.int64))
 
     @property
     def order(self) -> int:
