@@ -232,7 +232,7 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
                                  "contact_candidate_nodes": int(s.nc)}
                    for s in result.surfaces},
         "dofs": int(sum(s.body.ndofs for s in result.surfaces)),
-        "contact_dofs": int(sum(2 * s.nc for s in result.surfaces)),
+        "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces)),
         "pressure_measure": "nominal: nodal contact force / undeformed tributary length",
         "parameters": asdict(p),
         "timings": result.timings,

@@ -51,21 +51,31 @@ log = logging.getLogger(__name__)
 # boundary polygon of each VTK cell type (corners and edge midpoints in order around the cell)
 _POLYGONS = {"triangle": [0, 1, 2], "triangle6": [0, 3, 1, 4, 2, 5], "quad": [0, 1, 2, 3],
              "quad8": [0, 4, 1, 5, 2, 6, 3, 7], "quad9": [0, 4, 1, 5, 2, 6, 3, 7]}
+#: The 3D cell types vfem writes (:meth:`vfem.bodies.Body.cells`): a frame keeps their nodes
+_SOLIDS = ("tetra", "hexahedron", "tetra10", "hexahedron27")
 _STEP_IN_NAME = re.compile(r"^(?P<stem>.*)_step(?P<step>\d+)\.vtu$")
 
 
 @dataclass
 class BodyFrame:
-    """One body at one step, as read from its VTU file."""
+    """One body at one step, as read from its VTU file. A 3D body's (tetrahedra, hexahedra:
+    ``dim`` 3) has its three coordinates and displacement components, and in ``polygons`` its
+    cells' nodes in VTK's order (``cell_type`` says which cells)."""
 
     part: int
     name: str
     path: Path
-    points: np.ndarray  # (n, 2) undeformed
-    polygons: np.ndarray  # (m, k) point numbers around each cell
-    displacement: np.ndarray  # (n, 2)
+    points: np.ndarray  # (n, 2) undeformed; (n, 3) in 3D
+    polygons: np.ndarray  # (m, k) point numbers around each cell; 3D: the cells' nodes
+    displacement: np.ndarray  # (n, 2); (n, 3) in 3D
     point_data: dict[str, np.ndarray]
     cell_data: dict[str, np.ndarray] = field(default_factory=dict)  # one value per cell
+    cell_type: str = ""  # VTK's name of the cells (meshio's: triangle, ..., tetra, hexahedron)
+
+    @property
+    def dim(self) -> int:
+        """2, or 3 for a 3D body."""
+        return int(self.points.shape[1])
 
 
 class Step:
@@ -151,16 +161,20 @@ def read_vtu(path: Path, part: int, name: str) -> BodyFrame:
     if len(m.cells) != 1:
         raise InputError(f"{path}: expected one block of cells, found {len(m.cells)}")
     block = m.cells[0]
-    if block.type not in _POLYGONS:
+    if block.type not in _POLYGONS and block.type not in _SOLIDS:
         raise InputError(f"{path}: cell type {block.type!r} is not one vfem writes "
-                         f"({', '.join(_POLYGONS)})")
+                         f"({', '.join([*_POLYGONS, *_SOLIDS])})")
     if "displacement" not in m.point_data:
         raise InputError(f"{path}: no 'displacement' point field")
     u = np.asarray(m.point_data["displacement"], dtype=float)
-    return BodyFrame(part=part, name=name, path=path, points=np.asarray(m.points)[:, :2],
-                     polygons=np.asarray(block.data)[:, _POLYGONS[block.type]],
-                     displacement=u[:, :2], point_data=dict(m.point_data),
-                     cell_data={k: np.asarray(v[0]).ravel() for k, v in m.cell_data.items()})
+    if block.type in _SOLIDS:  # a 3D body: every coordinate, the cells as they are
+        dim, cells = 3, np.asarray(block.data)
+    else:
+        dim, cells = 2, np.asarray(block.data)[:, _POLYGONS[block.type]]
+    return BodyFrame(part=part, name=name, path=path, points=np.asarray(m.points)[:, :dim],
+                     polygons=cells, displacement=u[:, :dim], point_data=dict(m.point_data),
+                     cell_data={k: np.asarray(v[0]).ravel() for k, v in m.cell_data.items()},
+                     cell_type=block.type)
 
 
 def read_steps(directory: Path) -> list[Step]:
@@ -175,28 +189,34 @@ def read_steps(directory: Path) -> list[Step]:
 
 
 def read_contact_csv(path: Path) -> dict[tuple[int, str], ContactNodes]:
-    """``contact.csv`` by (step, body name)."""
+    """``contact.csv`` by (step, body name); a 3D model's (columns ``z`` and ``uz``) with the
+    three coordinates and displacement components."""
     rows: dict[tuple[int, str], list[list]] = {}
     try:
         with open(path, newline="", encoding="utf-8") as f:
             reader = csv.DictReader(f)
-            missing = {"step", "body", "node", "x", "y", "ux", "uy", "pressure", "status"} - set(
-                reader.fieldnames or ())
+            names = set(reader.fieldnames or ())
+            axes = "xyz" if {"z", "uz"} <= names else "xy"
+            missing = {"step", "body", "node", "x", "y", "ux", "uy", "pressure", "status"} - names
             if missing:
                 raise InputError(f"{path}: missing column(s) {', '.join(sorted(missing))}")
             for r in reader:
                 rows.setdefault((int(r["step"]), r["body"]), []).append(
-                    [int(r["node"]), float(r["x"]), float(r["y"]), float(r["ux"]),
-                     float(r["uy"]), float(r["pressure"]), r["status"] == "contact"])
+                    [int(r["node"]), *(float(r[a]) for a in axes),
+                     *(float(r[f"u{a}"]) for a in axes), float(r["pressure"]),
+                     r["status"] == "contact"])
     except (ValueError, KeyError, TypeError) as exc:
         if isinstance(exc, InputError):
             raise
         raise InputError(f"{path}: malformed row ({exc})") from None
     out = {}
+    dim = len(axes)
     for key, rs in rows.items():
-        node, x, y, ux, uy, p, on = (np.array(c) for c in zip(*rs))
-        out[key] = ContactNodes(node.astype(int), np.column_stack([x, y]),
-                                np.column_stack([ux, uy]), p.astype(float), on.astype(bool))
+        columns = [np.array(c) for c in zip(*rs)]
+        node, p, on = columns[0], columns[-2], columns[-1]
+        out[key] = ContactNodes(node.astype(int), np.column_stack(columns[1:1 + dim]),
+                                np.column_stack(columns[1 + dim:1 + 2 * dim]), p.astype(float),
+                                on.astype(bool))
     return out
 
 
@@ -306,11 +326,16 @@ def write_frames(out: Path, label: str, model, displacements: dict[str, np.ndarr
     files = {}
     for body in model.bodies:
         cell_type, conn = body.cells()
-        u = np.asarray(displacements[body.name], dtype=float).reshape(-1, 2)
+        dim = body.dim
+        u = np.asarray(displacements[body.name], dtype=float).reshape(-1, dim)
         name = f"{_safe(body.name)}_{label}.vtu"
-        m = meshio.Mesh(points=np.column_stack([body.points.T, np.zeros(body.npoints)]),
-                        cells=[(cell_type, conn)],
-                        point_data={"displacement": np.column_stack([u, np.zeros(len(u))])})
+        if dim == 3:  # a 3D body's points and vectors as they are
+            points, displacement = body.points.T, u
+        else:  # z = 0
+            points = np.column_stack([body.points.T, np.zeros(body.npoints)])
+            displacement = np.column_stack([u, np.zeros(len(u))])
+        m = meshio.Mesh(points=points, cells=[(cell_type, conn)],
+                        point_data={"displacement": displacement})
         meshio.write(Path(out) / name, m, file_format="vtu")
         files[body.name] = name
     return files
@@ -508,9 +533,15 @@ def unfinished_example(directory: Path | str) -> str | None:
 
 
 def generic(folder: Folder) -> list[Path]:
-    """The figures of an input file's run (see :func:`plot_results`)."""
+    """The figures of an input file's run (see :func:`plot_results`). Of a 3D model's, only
+    ``history.png`` for now: its deformed shape, pressure map and sections are issue 21's
+    figures to come."""
     steps = folder.steps
     label = contact_label(folder.summary)
+    if any(b.dim == 3 for b in steps[-1].bodies):
+        log.info("%s: a 3D model: only history.png is drawn (3D figures are not implemented "
+                 "yet)", folder.directory)
+        return [_history(folder.directory, steps, folder.summary or None)]
     written = _deformed(folder.directory, steps, folder.contact, label)
     written.append(_pressure(folder.directory, steps, folder.contact, folder.contact_source,
                              label))
@@ -706,7 +737,7 @@ def _history(directory: Path, steps: list[Step], summary: dict | None) -> Path:
         for s in steps:
             for b in s.bodies:
                 if b.name == name and "contact_force" in b.point_data:
-                    f = np.asarray(b.point_data["contact_force"], dtype=float)[:, :2]
+                    f = np.asarray(b.point_data["contact_force"], dtype=float)[:, :b.dim]
                     xs.append(s.step)
                     ys.append(float(np.linalg.norm(f.sum(axis=0))))
         if xs:

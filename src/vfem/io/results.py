@@ -19,6 +19,16 @@ no pair's compatibility; :mod:`vfem.contact.friction`). Cell fields:
 Quadratic elements are written as VTK's 6-node triangles and 9-node quadrilaterals, with the
 fields at every node.
 
+A 3D body (tetrahedra, hexahedra: :attr:`vfem.bodies.Body.dim` 3) is written with its own
+coordinates and its vectors' three components (nothing padded), as VTK's ``tetra`` and
+``hexahedron`` cells, quadratic ones as ``tetra10`` and ``hexahedron27``
+(:meth:`vfem.bodies.Body.cells`: every cell's VTK volume positive), and the six stresses
+``stress_xx``, ``stress_yy``, ``stress_zz``, ``stress_yz``, ``stress_xz``, ``stress_xy`` with
+``von_mises``. Its CSV files gain the z columns: ``contact.csv`` ``z`` after ``y``, ``uz`` after
+``uy`` and ``shear_z`` after ``shear_y`` (:func:`contact_columns`), ``reactions.csv`` ``Rz``
+(:func:`reaction_columns`); ``summary.json``'s forces have three components. A 2D model's files
+are as they were.
+
 ``contact.csv`` (when the writer is given the contact surfaces, as :func:`run_writing` does): one
 row per converged step, body and contact candidate node, columns ``step, load_factor, body, node,
 x, y, ux, uy, pressure, gap, status``: ``node`` the point number in the body (the VTU's point
@@ -75,16 +85,49 @@ from .files import (  # noqa: F401 (write_summary: importers)
 
 log = logging.getLogger(__name__)
 
-# vfem.bodies.stresses.stress keys -> the VTU's cell field names
-_CELL_FIELD = {"sxx": "stress_xx", "syy": "stress_yy", "sxy": "stress_xy", "szz": "stress_zz"}
+# vfem.bodies.stresses.stress keys -> the VTU's cell field names (3D: also the shears yz, xz)
+_CELL_FIELD = {"sxx": "stress_xx", "syy": "stress_yy", "sxy": "stress_xy", "szz": "stress_zz",
+               "syz": "stress_yz", "sxz": "stress_xz"}
+#: contact.csv's columns of a 2D model (:func:`contact_columns`: a 3D one's add z and uz)
 CONTACT_COLUMNS = ("step", "load_factor", "body", "node", "x", "y", "ux", "uy", "pressure",
                    "gap", "status")
-#: contact.csv's further columns under friction (``contact.friction`` > 0)
+#: contact.csv's further columns under friction (``contact.friction`` > 0), 2D (3D: shear_z)
 FRICTION_COLUMNS = ("shear_x", "shear_y", "slip_increment", "accumulated_slip", "friction")
 #: contact.csv's ``friction`` column: BodyStepResult.friction_status by name (empty where -1:
 #: a node that carries no pair's compatibility)
 FRICTION_STATUS = ("free", "stick", "slip")
+#: reactions.csv's columns of a 2D model (:func:`reaction_columns`: a 3D one's add Rz)
 REACTION_COLUMNS = ("step", "load_factor", "body", "boundary", "Rx", "Ry")
+
+
+def contact_columns(dim: int = 2, friction: bool = False) -> tuple[str, ...]:
+    """contact.csv's columns for a model of dimension ``dim``: :data:`CONTACT_COLUMNS` in 2D;
+    in 3D ``z`` after ``y`` and ``uz`` after ``uy``; then, with ``friction``,
+    :data:`FRICTION_COLUMNS` (3D: ``shear_z`` after ``shear_y``)."""
+    if dim == 2:
+        return CONTACT_COLUMNS + (FRICTION_COLUMNS if friction else ())
+    axes = "xyz"[:dim]
+    out = (*CONTACT_COLUMNS[:4], *axes, *(f"u{a}" for a in axes), *CONTACT_COLUMNS[8:])
+    if friction:
+        out += (*(f"shear_{a}" for a in axes), *FRICTION_COLUMNS[2:])
+    return out
+
+
+def reaction_columns(dim: int = 2) -> tuple[str, ...]:
+    """reactions.csv's columns for a model of dimension ``dim``: :data:`REACTION_COLUMNS` in
+    2D, with ``Rz`` in 3D."""
+    return REACTION_COLUMNS[:4] + tuple(f"R{a}" for a in "xyz"[:dim])
+
+
+def _padded(v: np.ndarray) -> np.ndarray:
+    """A 2D body's (n, 2) vectors with z = 0 appended (VTK's points and vectors have 3)."""
+    v = np.asarray(v)
+    return np.column_stack([v, np.zeros(len(v))])
+
+
+def _vector(v: np.ndarray) -> np.ndarray:
+    """A 3D body's (n, 3) vectors, as they are."""
+    return np.asarray(v)
 
 
 class ResultsWriter:
@@ -111,6 +154,8 @@ class ResultsWriter:
         self.reaction_rows: list[list[str]] = []
         #: contact.csv's columns: the friction's too when the model has friction
         self.friction = model.contact.frictional
+        #: the model's dimension (every body's, :meth:`Model.validate`): the CSV files' columns
+        self.dim = model.bodies[0].dim if model.bodies else 2
 
     def restore(self, steps: list[StepResult]) -> None:
         """Take up the series of an earlier run whose ``steps`` are already on disk (their
@@ -134,25 +179,24 @@ class ResultsWriter:
             npts = body.npoints
             if npts < 2**31:  # 32-bit connectivity, as VTK's own: 8 % less to compress at 1M
                 conn = np.asarray(conn, dtype=np.int32)
-            u = np.column_stack([r.displacement, np.zeros(len(r.displacement))])
+            pad = _vector if body.dim == 3 else _padded  # 2D: z = 0 appended
             stress = body_stress(body, r.displacement.ravel())
             name = self._vtu_name(body, step)
             m = meshio.Mesh(
-                points=np.column_stack([body.points.T, np.zeros(npts)]),
+                points=pad(body.points.T),
                 cells=[(cell_type, conn)],
-                point_data={"displacement": u,
-                            "contact_force": np.column_stack([r.contact_force,
-                                                              np.zeros(npts)]),
+                point_data={"displacement": pad(r.displacement),
+                            "contact_force": pad(r.contact_force),
                             "contact_pressure": r.contact_pressure,
                             "contact_traction": r.contact_traction,
                             "contact_status": r.contact_status.astype(np.int32),
                             "penetration": r.penetration,
-                            "reaction": np.column_stack([reaction, np.zeros(npts)])},
+                            "reaction": pad(reaction)},
                 cell_data={_CELL_FIELD.get(k, k): [v] for k, v in stress.items()},
             )
             if r.contact_shear is not None:  # friction's fields (vfem.contact.friction)
                 m.point_data.update({
-                    "contact_shear": np.column_stack([r.contact_shear, np.zeros(npts)]),
+                    "contact_shear": pad(r.contact_shear),
                     "slip_increment": r.slip_increment,
                     "accumulated_slip": r.accumulated_slip,
                     "friction_status": np.asarray(r.friction_status, dtype=np.int32)})
@@ -177,21 +221,23 @@ class ResultsWriter:
             X = body.points[:, nodes].T
             u = r.displacement[nodes]
             gap = 0.0 - r.penetration[nodes]  # 0.0 - x: no "-0" for an unmeasured gap
+            dim = body.dim
             for k, n in enumerate(nodes):
                 self.contact_rows.append(
                     [str(step.step), _num(step.load_factor), body.name, str(int(n)),
-                     _num(X[k, 0]), _num(X[k, 1]), _num(u[k, 0]), _num(u[k, 1]),
+                     *(_num(X[k, c]) for c in range(dim)), *(_num(u[k, c]) for c in range(dim)),
                      _num(r.contact_pressure[n]), _num(gap[k]),
                      "contact" if r.contact_status[n] > 0 else "free"]
-                    + (self._friction_row(r, n) if self.friction else []))
+                    + (self._friction_row(r, n, dim) if self.friction else []))
 
     @staticmethod
-    def _friction_row(r: BodyStepResult, n: int) -> list[str]:
-        """A contact.csv row's friction columns (:data:`FRICTION_COLUMNS`) for point ``n``."""
+    def _friction_row(r: BodyStepResult, n: int, dim: int = 2) -> list[str]:
+        """A contact.csv row's friction columns (:data:`FRICTION_COLUMNS`, with shear_z in
+        3D) for point ``n``."""
         if r.contact_shear is None:  # a step written without them (an older checkpoint)
-            return ["", "", "", "", ""]
+            return [""] * (dim + 3)
         status = int(r.friction_status[n])
-        return [_num(r.contact_shear[n, 0]), _num(r.contact_shear[n, 1]),
+        return [*(_num(r.contact_shear[n, c]) for c in range(dim)),
                 _num(r.slip_increment[n]), _num(r.accumulated_slip[n]),
                 FRICTION_STATUS[status] if status >= 0 else ""]
 
@@ -199,21 +245,20 @@ class ResultsWriter:
         """Keep the rows of ``step``'s per-boundary support reactions for ``reactions.csv``."""
         for body in self.model.bodies:
             r = step.bodies[body.name]
-            for boundary, (rx, ry) in r.reactions.items():
+            for boundary, components in r.reactions.items():
                 self.reaction_rows.append([str(step.step), _num(step.load_factor), body.name,
-                                           boundary, _num(rx), _num(ry)])
+                                           boundary, *map(_num, components)])
             if r.reactions:  # the body's total: each constrained dof once
-                rx, ry = total(r.reaction)  # as summary.json's total, to the last digit
+                # as summary.json's total, to the last digit
                 self.reaction_rows.append([str(step.step), _num(step.load_factor), body.name,
-                                           TOTAL_ROW, _num(rx), _num(ry)])
+                                           TOTAL_ROW, *map(_num, total(r.reaction))])
 
     def write_contact_csv(self) -> None:
-        _write_csv(self.out / "contact.csv",
-                   CONTACT_COLUMNS + (FRICTION_COLUMNS if self.friction else ()),
+        _write_csv(self.out / "contact.csv", contact_columns(self.dim, self.friction),
                    self.contact_rows)
 
     def write_reactions_csv(self) -> None:
-        _write_csv(self.out / "reactions.csv", REACTION_COLUMNS, self.reaction_rows)
+        _write_csv(self.out / "reactions.csv", reaction_columns(self.dim), self.reaction_rows)
 
     def write_pvd(self) -> None:
         lines = ['<?xml version="1.0"?>',
@@ -443,10 +488,10 @@ def external_work(result: AnalysisResult) -> list[float]:
 
 
 def total(force: np.ndarray) -> list[float]:
-    """The resultant (x, y) of nodal forces (n, 2), summed per component (the same digits
-    wherever a total is reported)."""
+    """The resultant (x, y), or (x, y, z) in 3D, of nodal forces (n, 2 or 3), summed per
+    component (the same digits wherever a total is reported)."""
     force = np.asarray(force, dtype=float)
-    return [float(force[:, 0].sum()), float(force[:, 1].sum())]
+    return [float(force[:, c].sum()) for c in range(force.shape[1])]
 
 
 def imbalance(contact: list[float], reaction: list[float], applied: list[float]) -> float:
@@ -480,7 +525,7 @@ def force_record(step: StepResult) -> dict:
             continue
         contact, reaction = out["contact_force"][name], total(r.reaction)
         applied = [float(v) for v in (r.applied_load if r.applied_load is not None
-                                      else np.zeros(2))]
+                                      else np.zeros(len(reaction)))]
         out["reactions"][name] = {"total": reaction,
                                   "boundaries": {k: [float(v) for v in xy]
                                                  for k, xy in r.reactions.items()}}

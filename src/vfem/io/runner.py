@@ -76,7 +76,7 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
         "steps": steps,
         "bodies": body_summary(result),
         "dofs": int(sum(s.body.ndofs for s in result.surfaces)),
-        "contact_dofs": int(sum(2 * s.nc for s in result.surfaces)),
+        "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces)),
         "penetration_tolerance": result.penetration_tolerance,
         "pressure_measure": "nominal: nodal contact force / undeformed tributary length",
         "config": to_data(config),
@@ -150,7 +150,8 @@ def invariants_line(steps: list[dict]) -> str:
 
 
 def _xy(v) -> str:
-    return f"({v[0]:.6g}, {v[1]:.6g})"
+    """A vector's components, "(x, y)" or in 3D "(x, y, z)"."""
+    return "(" + ", ".join(f"{c:.6g}" for c in v) + ")"
 
 
 def balance_line(steps: list[dict]) -> str:
@@ -163,9 +164,10 @@ def balance_line(steps: list[dict]) -> str:
     rows = []
     for x in steps:
         for name, r in (x.get("reactions") or {}).items():
-            c = np.asarray((x.get("contact_force") or {}).get(name, (0.0, 0.0)), dtype=float)
-            a = np.asarray((x.get("applied_load") or {}).get(name, (0.0, 0.0)), dtype=float)
             t = np.asarray(r["total"], dtype=float)
+            none = (0.0,) * len(t)  # (x, y), or (x, y, z) in 3D
+            c = np.asarray((x.get("contact_force") or {}).get(name, none), dtype=float)
+            a = np.asarray((x.get("applied_load") or {}).get(name, none), dtype=float)
             scale[name] = max(scale.get(name, 0.0), *(float(np.linalg.norm(v)) for v in (c, t, a)))
             rows.append((float(np.linalg.norm(c + t + a)), name, x["step"]))
     if not rows:
