@@ -1,0 +1,864 @@
+"""Closest points on the facets of a 3D contact surface (issue 21, commit C5 of the 3D plan).
+
+The 3D counterpart of :func:`vfem.contact.search.project_points`: for each query point, the
+nearest of a set of surface facets, the local coordinates and position of the closest point on
+it, the distance, the facet's unit outward normal there and the unclamped local coordinates that
+tell whether the point lies beyond the facet. Nothing in the 2D code calls it yet (C6 builds the
+3D ``ContactSurface`` on it).
+
+**Facets.** One kind per call, told by the number of nodes per facet (``facets.shape[1]``):
+
+====  =========================  ==========================  ==============================
+k     kind                       reference domain            node order (scikit-fem's)
+====  =========================  ==========================  ==============================
+3     linear triangle (T3)       ξ, η ≥ 0, ξ + η ≤ 1          ``ElementTriP1``: (0,0) (1,0) (0,1)
+4     bilinear quadrilateral     [0, 1]²                      ``ElementQuad1``: (0,0) (1,0)
+      (Q4), possibly warped                                   (1,1) (0,1)
+6     quadratic triangle (T6)    as T3                        ``ElementTriP2``: the corners,
+                                                              then the midpoints of the edges
+                                                              0-1, 1-2, 0-2
+9     quadratic quadrilateral    [0, 1]²                      ``ElementQuad2``: the corners,
+      (Q9)                                                    the midpoints of 0-1, 1-2, 2-3,
+                                                              0-3, the centre
+====  =========================  ==========================  ==============================
+
+The reference domains are scikit-fem's (``RefTri``, ``RefQuad`` = [0, 1]², not [-1, 1]²), so
+``xi`` can be handed to scikit-fem's elements as it is. A facet is *oriented* when its corners
+run counter-clockwise seen from outside the body: its outward normal is then
+``x_ξ × x_η / |x_ξ × x_η|`` (a T3's ``(b − a) × (c − a)``), the 3D form of 2D's ``(t_y, −t_x)``.
+
+**The closest point.**
+
+* Linear triangles: Ericson's region classification (*Real-Time Collision Detection*, 5.1.5)
+  as masked array expressions: vertex, edge or face region, then the exact closest point of that
+  region. No iteration and no tolerance: a point whose closest point is a vertex gets that
+  vertex's coordinates exactly, one over an edge a coordinate exactly 0 (or ξ + η = 1).
+* Bilinear and quadratic facets: the distance to the facet's chord triangles (a quadrilateral's
+  corners split along the diagonal 0-2, a T6's corners) differs from the distance to the facet
+  by at most a bound of the facet's warp and curvature (:func:`chord_deviation`), so a
+  candidate whose lower bound exceeds the point's best distance so far cannot be nearest and is
+  dropped, before each stage: (a) projected Newton on the facet's map ``x(ξ)`` (Hessian
+  ``JᵀJ + (x − p)·∂²x``, Gauss-Newton where that is not positive definite; on a bound the
+  gradient pushes against, the 1D step along it; steps halved until the distance falls;
+  iterates clamped to the reference domain), from the chord triangles' closest point, first
+  for each point's nearest chord triangles, whose distance then cuts the other candidates;
+  (b) the same Newton from every basin a 7 x 7 lattice over the facet shows (its points no
+  farther than their neighbours: a wavy facet can hold two local minima); (c) the facet's
+  edges: straight ones (Q4) by the exact segment formula, curved ones (T6, Q9) by a
+  safeguarded 1D Newton from both ends and the chord's closest point, only where the chord
+  less its bulge comes near enough. The nearest of these is the closest point; the edges win
+  ties to round-off, so a point whose closest point lies on an edge or at a corner gets the
+  clamped coordinate exactly. Limit: a local minimum whose basin is narrower than a lattice
+  cell (1/6 of the facet) and lower than the others could be missed; no mesh of a smooth
+  surface has such facets, and the tests' wavy facets (midside nodes 0.3-0.4 of the facet off
+  the chord) do not.
+
+**Unclamped coordinates.** ``xi_free = xi + (JᵀJ)⁻¹ Jᵀ (p − x(xi))``, one Gauss-Newton step from
+the closest point without clamping: for a flat (affine) facet it is the exact position of the
+point's orthogonal projection on the facet's plane, in the facet's coordinates (as 2D's
+``t_free`` along the chord); over the facet it equals ``xi`` to round-off, and past an edge it
+lies beyond that edge (:func:`outside`), so "beyond the patch" can be judged later.
+
+**Ties** (a point as near, to 1e-9 of the largest facet, to two facets as to its nearest, e.g.
+outside a box's edge, equidistant from its two faces): with ``point_normals`` (the outward
+normal of the surface the point lies on) the facet whose outward normal at the closest point
+is most opposed to it wins (dot product rounded to 9 digits), so a point pairs with the face
+that faces it, as in 2D; then the facet the point lies over (``xi_free`` inside its reference
+domain, 1e-9); then the lowest facet number. Unlike 2D's fixed distance bins the tie is judged
+against each point's own nearest distance, so two equal distances never fall into different
+bins.
+
+**Candidates.** Given as (point, facet) index pairs, or every pair (``pairs="all"``), or found
+here (``pairs=None``): every facet whose bounding sphere (centred at a point *on* the facet)
+reaches as near as the point's nearest such centre. Up to :data:`DIRECT_PAIRS` point-facet
+pairs they are found from all distances at once, above it with a KD-tree on the centres; both
+give the same candidates, so the same answer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+#: up to this many point-facet pairs the candidates come from all centre distances at once,
+#: above it from a KD-tree on the facets' centres (as :data:`vfem.contact.search.DIRECT_PAIRS`)
+DIRECT_PAIRS = 8192
+
+#: two distances within this fraction of the largest facet are a tie
+TIE = 1e-9
+
+#: unclamped coordinates this far outside the reference domain put a point beyond an edge
+OUTSIDE = 1e-9
+
+#: a facet is degenerate where a corner's two edges span less than this fraction of the square
+#: of the facet's longest corner-to-corner distance (zero area)
+DEGENERATE = 1e-12
+
+_NEWTON_STEPS = 40  # 2D projected Newton iterations (quadratic convergence: 4-8 are used)
+_EDGE_STEPS = 30  # 1D Newton iterations on a curved edge
+_HALVINGS = 30  # step halvings before a Newton iteration gives up
+CHUNK = 65536  # point-facet pairs handled at once (bounds the memory of the kernels)
+FEW_PAIRS = 4096  # up to this many pairs the Newton stages on curved facets run as one
+
+
+@dataclass(frozen=True)
+class FacetKind:
+    """A kind of 3D surface facet: its nodes, reference domain and edges.
+
+    Attributes:
+        name: "T3", "Q4", "T6" or "Q9".
+        nodes: nodes per facet.
+        corners: 3 (triangles) or 4 (quadrilaterals).
+        order: 1 or 2.
+        edges: per reference edge (in scikit-fem's order, ``RefTri.facets`` /
+            ``RefQuad.facets``) its two corner nodes and its midside node (-1 on linear facets).
+        centre: reference coordinates of the facet's centre (a point on the facet).
+    """
+
+    name: str
+    nodes: int
+    corners: int
+    order: int
+    edges: tuple[tuple[int, int, int], ...]
+    centre: tuple[float, float]
+
+    @property
+    def simplex(self) -> bool:
+        return self.corners == 3
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(corners, 2) reference coordinates of the corners."""
+        if self.simplex:
+            return np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+        return np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+
+
+_TRI_EDGES = ((0, 1), (1, 2), (0, 2))
+_QUAD_EDGES = ((0, 1), (1, 2), (2, 3), (0, 3))
+
+T3 = FacetKind("T3", 3, 3, 1, tuple((a, b, -1) for a, b in _TRI_EDGES), (1 / 3, 1 / 3))
+Q4 = FacetKind("Q4", 4, 4, 1, tuple((a, b, -1) for a, b in _QUAD_EDGES), (0.5, 0.5))
+T6 = FacetKind("T6", 6, 3, 2, tuple((a, b, 3 + i) for i, (a, b) in enumerate(_TRI_EDGES)),
+               (1 / 3, 1 / 3))
+Q9 = FacetKind("Q9", 9, 4, 2, tuple((a, b, 4 + i) for i, (a, b) in enumerate(_QUAD_EDGES)),
+               (0.5, 0.5))
+
+#: the facet kinds by nodes per facet
+KINDS = {3: T3, 4: Q4, 6: T6, 9: Q9}
+
+
+def facet_kind(facets: np.ndarray) -> FacetKind:
+    """The kind of (nf, k) facets, from k."""
+    k = np.shape(facets)[1] if np.ndim(facets) == 2 else None
+    if k not in KINDS:
+        raise ValueError(f"3D facets must have 3, 4, 6 or 9 nodes each (T3, Q4, T6, Q9), "
+                         f"got an array of shape {np.shape(facets)}")
+    return KINDS[k]
+
+
+class FacetProjection(NamedTuple):
+    """Per query point: the nearest facet and the closest point on it.
+
+    Attributes:
+        facet: (m,) index of the facet (into the ``facets`` given), -1 for a point with no
+            candidate facet (then ``distance`` is inf and the float fields NaN).
+        xi: (m, 2) local coordinates of the closest point (in the reference domain).
+        point: (m, 3) the closest point, ``x(xi)``.
+        distance: (m,) distance from the point to it.
+        normal: (m, 3) unit outward normal of the facet at ``xi``.
+        xi_free: (m, 2) unclamped local coordinates (module docstring; :func:`outside`).
+    """
+
+    facet: np.ndarray
+    xi: np.ndarray
+    point: np.ndarray
+    distance: np.ndarray
+    normal: np.ndarray
+    xi_free: np.ndarray
+
+
+# ---------------------------------------------------------------------------------------------
+# shape functions
+
+
+def _line(order: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """1D Lagrange functions on [0, 1] at nodes 0, 1 (and 1/2): values, first and second
+    derivatives, each (n, order + 1)."""
+    if order == 1:
+        one = np.ones_like(s)
+        return (np.column_stack([1 - s, s]), np.column_stack([-one, one]),
+                np.zeros((len(s), 2)))
+    one = np.ones_like(s)
+    return (np.column_stack([(1 - s) * (1 - 2 * s), s * (2 * s - 1), 4 * s * (1 - s)]),
+            np.column_stack([4 * s - 3, 4 * s - 1, 4 - 8 * s]),
+            np.column_stack([4 * one, 4 * one, -8 * one]))
+
+
+#: a quadrilateral's nodes as (index of the 1D function in ξ, in η)
+_TENSOR = {4: ((0, 0), (1, 0), (1, 1), (0, 1)),
+           9: ((0, 0), (1, 0), (1, 1), (0, 1), (2, 0), (1, 2), (2, 1), (0, 2), (2, 2))}
+
+
+def shape_functions(kind: FacetKind, xi: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Shape functions of ``kind`` at (n, 2) local coordinates: values (n, k), first
+    derivatives (n, k, 2) (d/dξ, d/dη) and second derivatives (n, k, 3) (ξξ, ξη, ηη).
+    Equal to scikit-fem's ``ElementTriP1/ElementQuad1/ElementTriP2/ElementQuad2`` bases."""
+    xi = np.asarray(xi, dtype=float).reshape(-1, 2)
+    x, y = xi[:, 0], xi[:, 1]
+    n = len(xi)
+    if kind.simplex:
+        if kind.order == 1:
+            N = np.column_stack([1 - x - y, x, y])
+            dN = np.broadcast_to(np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]), (n, 3, 2))
+            return N, dN.copy(), np.zeros((n, 3, 3))
+        L = 1 - x - y
+        N = np.column_stack([L * (2 * L - 1), x * (2 * x - 1), y * (2 * y - 1),
+                             4 * L * x, 4 * x * y, 4 * L * y])
+        zero = np.zeros(n)
+        dx = np.column_stack([1 - 4 * L, 4 * x - 1, zero, 4 * (L - x), 4 * y, -4 * y])
+        dy = np.column_stack([1 - 4 * L, zero, 4 * y - 1, -4 * x, 4 * x, 4 * (L - y)])
+        second = np.array([[4.0, 4.0, 4.0], [4.0, 0.0, 0.0], [0.0, 0.0, 4.0],
+                           [-8.0, -4.0, 0.0], [0.0, 4.0, 0.0], [0.0, -4.0, -8.0]])
+        return N, np.stack([dx, dy], axis=2), np.broadcast_to(second, (n, 6, 3)).copy()
+    fx, dfx, ddfx = _line(kind.order, x)
+    fy, dfy, ddfy = _line(kind.order, y)
+    i, j = np.array(_TENSOR[kind.nodes]).T
+    N = fx[:, i] * fy[:, j]
+    dN = np.stack([dfx[:, i] * fy[:, j], fx[:, i] * dfy[:, j]], axis=2)
+    d2N = np.stack([ddfx[:, i] * fy[:, j], dfx[:, i] * dfy[:, j], fx[:, i] * ddfy[:, j]],
+                   axis=2)
+    return N, dN, d2N
+
+
+def _evaluate(kind: FacetKind, X: np.ndarray, xi: np.ndarray):
+    """Position (n, 3), Jacobian (n, 3, 2) and second derivatives (n, 3, 3) (ξξ, ξη, ηη) of
+    facets with node coordinates X (n, k, 3) at xi (n, 2)."""
+    N, dN, d2N = shape_functions(kind, xi)
+    return ((N[:, None, :] @ X)[:, 0], np.swapaxes(np.swapaxes(dN, 1, 2) @ X, 1, 2),
+            np.swapaxes(np.swapaxes(d2N, 1, 2) @ X, 1, 2))
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.maximum(np.sqrt(_dot(v, v)), 1e-300)[..., None]
+
+
+def facet_map(x: np.ndarray, facets: np.ndarray, facet: np.ndarray, xi: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (n, 3) and Jacobians (n, 3, 2) (columns x_ξ, x_η) of ``facets[facet]`` (node
+    coordinates ``x``) at local coordinates ``xi`` (n, 2)."""
+    kind = facet_kind(facets)
+    pos, J, _ = _evaluate(kind, np.asarray(x, dtype=float)[np.asarray(facets)[facet]], xi)
+    return pos, J
+
+
+def facet_normals(x: np.ndarray, facets: np.ndarray, facet: np.ndarray, xi: np.ndarray
+                  ) -> np.ndarray:
+    """Unit outward normals ``x_ξ × x_η / |x_ξ × x_η|`` (n, 3) of oriented facets (corners
+    counter-clockwise seen from outside) at local coordinates ``xi``."""
+    _, J = facet_map(x, facets, facet, xi)
+    return _unit(np.cross(J[:, :, 0], J[:, :, 1]))
+
+
+def outside(kind: FacetKind, xi_free: np.ndarray, eps: float = OUTSIDE) -> np.ndarray:
+    """(n, edges) whether each point lies past each reference edge of its facet (edges in
+    ``kind.edges``' order): a triangle's edge 0-1 is η = 0, 1-2 is ξ + η = 1, 0-2 is ξ = 0; a
+    quadrilateral's 0-1 is η = 0, 1-2 is ξ = 1, 2-3 is η = 1, 0-3 is ξ = 0."""
+    u, v = xi_free[:, 0], xi_free[:, 1]
+    if kind.simplex:
+        return np.column_stack([v < -eps, u + v > 1 + eps, u < -eps])
+    return np.column_stack([v < -eps, u > 1 + eps, v > 1 + eps, u < -eps])
+
+
+# ---------------------------------------------------------------------------------------------
+# facet checks and bounds
+
+
+def check_facets(x: np.ndarray, facets: np.ndarray) -> None:
+    """Refuse facets the closest point is not defined on: non-finite coordinates, corners that
+    coincide or lie in a line (zero area), a quadrilateral folded over its diagonal (bow-tie).
+
+    Raises:
+        ValueError: naming how many, the first facet, its nodes and corners.
+    """
+    kind = facet_kind(facets)
+    facets = np.asarray(facets)
+    if len(facets) == 0:
+        return
+    C = np.asarray(x, dtype=float)[facets[:, :kind.corners]]
+    bad = ~np.isfinite(C).all(axis=(1, 2))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{int(bad.sum())} facet(s) with a coordinate that is not a finite "
+                         f"number (the first: facet {i}, nodes {facets[i].tolist()}, corners at "
+                         f"{_corners(C[i])})")
+    nxt, prv = np.roll(np.arange(kind.corners), -1), np.roll(np.arange(kind.corners), 1)
+    at = np.cross(C[:, nxt] - C, C[:, prv] - C)  # (nf, corners, 3) normal at each corner
+    diff = C[:, :, None] - C[:, None]
+    size2 = _dot(diff, diff).max(axis=(1, 2))
+    zero = (np.sqrt(_dot(at, at)) <= DEGENERATE * size2[:, None]).any(axis=1)
+    if zero.any():
+        i = int(np.flatnonzero(zero)[0])
+        raise ValueError(f"{int(zero.sum())} degenerate facet(s) of zero area (the first: facet "
+                         f"{i}, nodes {facets[i].tolist()}, corners at {_corners(C[i])}): "
+                         "corners that coincide or lie in a line have no closest point or "
+                         "normal; fix the mesh")
+    folded = (_dot(at, at.sum(axis=1)[:, None]) <= 0).any(axis=1)
+    if folded.any():
+        i = int(np.flatnonzero(folded)[0])
+        raise ValueError(f"{int(folded.sum())} folded quadrilateral facet(s) (the first: facet "
+                         f"{i}, nodes {facets[i].tolist()}, corners at {_corners(C[i])}): a "
+                         "corner lies past the diagonal of the others (a bow-tie), so the "
+                         "normal flips inside the facet; fix the mesh")
+
+
+def _corners(c: np.ndarray) -> str:
+    return "[" + ", ".join("(" + ", ".join(f"{v:.6g}" for v in row) + ")" for row in c) + "]"
+
+
+def chord_deviation(kind: FacetKind, X: np.ndarray) -> np.ndarray:
+    """(n,) an upper bound of |x(ξ) − x_c(ξ)| over the facet, x_c the piecewise linear map on
+    its chord triangles (corners 0-1-2 and 0-2-3 of a quadrilateral, the corners of a
+    triangle): the distance from any point to the facet and to its chord triangles differ by
+    at most this. X: (n, k, 3) node coordinates.
+
+    A bilinear map differs from the chord triangles' by −η(1 − ξ) q (ξ ≥ η) or −ξ(1 − η) q,
+    q = x0 − x1 + x2 − x3: at most |q|/4. A quadratic facet adds its hierarchical bubbles,
+    the edges' δ = x_mid − (x_a + x_b)/2 times 4λ_aλ_b (T6: Σ ≤ 4/3, each ≤ 1) or
+    4s(1 − s) times the linear function across (Q9: opposite edges' sum ≤ 1), and a Q9's
+    centre's x8 − mean(corners) − Σδ/2 times 16ξ(1 − ξ)η(1 − η) ≤ 1."""
+    dev = np.zeros(len(X))
+    if kind.corners == 4:
+        dev += 0.25 * np.linalg.norm(X[:, 0] - X[:, 1] + X[:, 2] - X[:, 3], axis=1)
+    if kind.order == 2:
+        delta = np.stack([X[:, m] - 0.5 * (X[:, a] + X[:, b]) for a, b, m in kind.edges], 1)
+        size = np.linalg.norm(delta, axis=2)
+        if kind.corners == 3:
+            dev += np.minimum(size.sum(axis=1), 4 / 3 * size.max(axis=1))
+        else:
+            dev += np.maximum(size[:, 0], size[:, 2]) + np.maximum(size[:, 1], size[:, 3])
+            centre = X[:, 8] - X[:, :4].mean(axis=1) - 0.5 * delta.sum(axis=1)
+            dev += np.linalg.norm(centre, axis=1)
+    return dev
+
+
+def bounding_spheres(x: np.ndarray, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(nf, 3) centres (a point on each facet: ``x`` at ``kind.centre``) and (nf,) radii of
+    spheres that hold the facets: the farthest corner (a bilinear facet lies in its corners'
+    convex hull) plus, on a quadratic facet, its :func:`chord_deviation`."""
+    kind = facet_kind(facets)
+    X = np.asarray(x, dtype=float)[np.asarray(facets)]
+    N, _, _ = shape_functions(kind, np.array([kind.centre]))
+    centre = (N[0] @ X) if len(X) else np.zeros((0, 3))
+    C = X[:, :kind.corners] - centre[:, None]
+    radius = np.sqrt(_dot(C, C)).max(axis=1, initial=0.0)
+    if kind.order == 2:
+        radius += chord_deviation(kind, X)
+    return centre, radius
+
+
+# ---------------------------------------------------------------------------------------------
+# candidates
+
+
+def _distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """|a − b| along the last axis, the same arithmetic however the arrays are shaped."""
+    d0, d1, d2 = a[..., 0] - b[..., 0], a[..., 1] - b[..., 1], a[..., 2] - b[..., 2]
+    return np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
+def candidate_pairs(points: np.ndarray, x: np.ndarray, facets: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """(point, facet) index pairs that may be nearest: every facet whose bounding sphere
+    (:func:`bounding_spheres`) comes as near to the point as the nearest facet centre (a point
+    on that facet, so no farther than it). All pairs' centre distances at once up to
+    :data:`DIRECT_PAIRS` pairs, a KD-tree on the centres above; the same pairs either way,
+    sorted by point."""
+    points = np.asarray(points, dtype=float)
+    m, nf = len(points), len(facets)
+    if m == 0 or nf == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    centre, radius = bounding_spheres(x, facets)
+    rmax = radius.max()
+    slack = TIE * rmax + 1e-300
+    if m * nf <= DIRECT_PAIRS:
+        dc = _distance(points[:, None], centre[None])
+        d0 = dc.min(axis=1)
+        pt, fc = np.nonzero(dc - radius[None] <= (d0 + slack)[:, None])
+        return pt.astype(np.int64), fc.astype(np.int64)
+    # the tree's k nearest centres, k doubled for the points whose k-th is still within reach
+    tree = cKDTree(centre)
+    pts, fcs = [], []
+    todo = np.arange(m)
+    k = min(nf, 16)
+    d0 = None
+    while len(todo):
+        d, j = tree.query(points[todo], k=k, workers=-1)
+        if d0 is None:
+            d0 = _distance(points, centre[j[:, 0]])
+        reach = (d0[todo] + rmax + slack) * (1 + 1e-12) + 1e-300
+        done = (d[:, -1] > reach) | (k == nf)
+        rows, cols = np.nonzero(d[done] <= reach[done, None])
+        pts.append(todo[done][rows])
+        fcs.append(j[done][rows, cols])
+        todo = todo[~done]
+        k = min(2 * k, nf)
+    pt, fc = np.concatenate(pts), np.concatenate(fcs).astype(np.int64)
+    keep = _distance(points[pt], centre[fc]) - radius[fc] <= d0[pt] + slack
+    pt, fc = pt[keep], fc[keep]
+    order = np.lexsort((fc, pt))
+    return pt[order], fc[order]
+
+
+# ---------------------------------------------------------------------------------------------
+# kernels
+
+
+def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray
+                         ) -> np.ndarray:
+    """(n, 2) local coordinates (ξ, η) (weights of ``b`` and ``c``) of the closest point on
+    each triangle (a, b, c) to each point ``p`` (all (n, 3)): Ericson's region classification,
+    exact at edges and vertices. The triangles must have non-zero area."""
+    ab, ac = b - a, c - a
+    d1, d2 = _dot(ab, p - a), _dot(ac, p - a)
+    d3, d4 = _dot(ab, p - b), _dot(ac, p - b)
+    d5, d6 = _dot(ab, p - c), _dot(ac, p - c)
+    va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2
+    # the regions in Ericson's order: the first that holds is the point's
+    regions = [(d1 <= 0) & (d2 <= 0),  # vertex a
+               (d3 >= 0) & (d4 <= d3),  # vertex b
+               (vc <= 0) & (d1 >= 0) & (d3 <= 0),  # edge ab
+               (d6 >= 0) & (d5 <= d6),  # vertex c
+               (vb <= 0) & (d2 >= 0) & (d6 <= 0),  # edge ac
+               (va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0)]  # edge bc
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_ab = d1 / (d1 - d3)  # denominators |ab|², |ac|², |bc|², |ab × ac|²
+        w_ac = d2 / (d2 - d6)
+        w_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        den = va + vb + vc
+        v, w = vb / den, vc / den
+    zero, one = np.zeros(len(p)), np.ones(len(p))
+    s = np.select(regions, [zero, one, v_ab, zero, zero, 1 - w_bc], v)
+    t = np.select(regions, [zero, zero, zero, one, w_ac, w_bc], w)
+    return np.column_stack([s, t])
+
+
+def _to_domain(kind: FacetKind, xi: np.ndarray) -> np.ndarray:
+    """Clamp local coordinates into the reference domain."""
+    xi = np.clip(xi, 0.0, 1.0)
+    if kind.simplex:
+        over = xi.sum(axis=1) > 1
+        u = np.clip(0.5 * (xi[over, 0] - xi[over, 1] + 1), 0.0, 1.0)
+        xi[over] = np.column_stack([u, 1 - u])
+    return xi
+
+
+def _reduced_step(kind: FacetKind, xi: np.ndarray, g: np.ndarray, H: np.ndarray,
+                  G: np.ndarray) -> np.ndarray:
+    """Newton step at ``xi`` restricted to the bounds that are not active: a bound is active
+    where ``xi`` lies on it and the gradient ``g`` pushes out of the domain there.
+
+    No active bound: −H⁻¹g with the Hessian H (n, 3) (ξξ, ξη, ηη) where it is positive
+    definite, else with JᵀJ = G (Gauss-Newton). One: the 1D Newton step along it, with H's
+    curvature along it where positive, else a step across the whole edge downhill (the line
+    search halves it). Two (a corner): no step."""
+    u, v = xi[:, 0], xi[:, 1]
+    if kind.simplex:
+        fix_u = (u <= 0) & (g[:, 0] > 0)
+        fix_v = (v <= 0) & (g[:, 1] > 0)
+        slant = (u + v >= 1) & (g[:, 0] + g[:, 1] < 0)
+    else:
+        fix_u = ((u <= 0) & (g[:, 0] > 0)) | ((u >= 1) & (g[:, 0] < 0))
+        fix_v = ((v <= 0) & (g[:, 1] > 0)) | ((v >= 1) & (g[:, 1] < 0))
+        slant = np.zeros(len(u), dtype=bool)
+    det = H[:, 0] * H[:, 2] - H[:, 1] ** 2
+    convex = (H[:, 0] > 0) & (det > 1e-12 * H[:, 0] * H[:, 2])
+    M = np.where(convex[:, None], H, G)
+    det = M[:, 0] * M[:, 2] - M[:, 1] ** 2
+    step = -np.column_stack([M[:, 2] * g[:, 0] - M[:, 1] * g[:, 1],
+                             M[:, 0] * g[:, 1] - M[:, 1] * g[:, 0]]) / det[:, None]
+
+    def along(gt, ct):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(ct > 0, -gt / ct, -np.sign(gt))
+
+    zero = np.zeros(len(u))
+    du = along(g[:, 0], H[:, 0])
+    dv = along(g[:, 1], H[:, 2])
+    ds = along(g[:, 0] - g[:, 1], H[:, 0] - 2 * H[:, 1] + H[:, 2])
+    corner = (fix_u.astype(int) + fix_v + slant) >= 2
+    return np.select(
+        [corner[:, None], fix_u[:, None], fix_v[:, None], slant[:, None]],
+        [np.zeros_like(step), np.column_stack([zero, dv]), np.column_stack([du, zero]),
+         np.column_stack([ds, -ds])], step)
+
+
+def _newton(kind: FacetKind, X: np.ndarray, p: np.ndarray, xi: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Projected Newton for min f = ½|x(ξ) − p|² over the reference domain, from ``xi``
+    (:func:`_reduced_step` on the active bounds). Every iterate is in the domain and no
+    farther from ``p`` than the one before (a step that is not is halved, up to
+    :data:`_HALVINGS` times), but for the last step (:func:`_last`), taken as it is.
+    Returns (xi, f)."""
+    xi = _to_domain(kind, xi)
+    pos, J, S = _evaluate(kind, X, xi)
+    r = pos - p
+    f = 0.5 * _dot(r, r)
+    step = np.zeros_like(xi)
+    alpha = np.ones(len(p))
+    last = np.zeros(len(p), dtype=bool)
+    fresh = np.ones(len(p), dtype=bool)  # the step is to be (re)computed at xi
+    act = np.arange(len(p))
+    for _ in range(_NEWTON_STEPS + _HALVINGS):
+        if not len(act):
+            break
+        new = act[fresh[act]]
+        if len(new):
+            Jn, rn = J[new], r[new]
+            g = (rn[:, None, :] @ Jn)[:, 0]
+            G = (np.swapaxes(Jn, 1, 2) @ Jn).reshape(-1, 4)[:, [0, 1, 3]]
+            H = G + (rn[:, None, :] @ S[new])[:, 0]
+            step[new] = _reduced_step(kind, xi[new], g, H, G)
+            alpha[new] = 1.0
+            last[new] = _last(step[new], -_dot2(g, step[new]), f[new], p[new])
+        trial = _to_domain(kind, xi[act] + alpha[act, None] * step[act])
+        move = np.abs(trial - xi[act]).max(axis=1)
+        pt_, Jt, St = _evaluate(kind, X[act], trial)
+        rt = pt_ - p[act]
+        ft = 0.5 * _dot(rt, rt)
+        ok = (ft <= f[act]) | last[act]
+        acc = act[ok]
+        xi[acc], pos[acc], J[acc], S[acc], r[acc], f[acc] = (
+            trial[ok], pt_[ok], Jt[ok], St[ok], rt[ok], ft[ok])
+        fresh[act] = ok
+        alpha[act[~ok]] *= 0.5
+        act = act[~last[act] & (move > 0) & (alpha[act] > 0.5 ** _HALVINGS)]
+    return xi, f
+
+
+def _last(step: np.ndarray, decrease: np.ndarray, f: np.ndarray, p: np.ndarray
+          ) -> np.ndarray:
+    """Whether a Newton step is the last: |step| ≤ 1e-9 in local coordinates (Newton's
+    quadratic convergence leaves ~1e-18 after it), or its predicted decrease of
+    f = ½|x − p|² within f's round-off (x − p is rounded to ~1e-16 of |p| and |x − p|). It
+    is taken without the line search, which could not tell its effect from round-off."""
+    size = np.abs(step).reshape(len(step), -1).max(axis=1)
+    dist = np.sqrt(2 * f)
+    noise = 1e-15 * dist * (np.abs(p).max(axis=1) + dist) + 1e-300
+    return (size <= 1e-9) | (decrease <= noise)
+
+
+def _dot2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
+
+
+def _curved_edges(A: np.ndarray, B: np.ndarray, M: np.ndarray, p: np.ndarray, t: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Nearest point to p on quadratic edges from A (s = 0) to B (s = 1) through M (s = 1/2),
+    all (n, 3): (s, f) with f = ½|x(s) − p|². x(s) = c0 + c1 s + c2 s²; safeguarded 1D
+    Newton (a step that does not come nearer is halved; where f is concave, a step across the
+    edge downhill) from both ends and from ``t`` (n,), the chord's closest point (f is a
+    quartic: at most two minima in [0, 1])."""
+    n, ns = len(p), 3
+    c0 = np.repeat(A, ns, axis=0)
+    c1 = np.repeat(-3 * A + 4 * M - B, ns, axis=0)
+    c2 = np.repeat(2 * A - 4 * M + 2 * B, ns, axis=0)
+    q = np.repeat(p, ns, axis=0)
+    s = np.column_stack([np.zeros(n), t, np.ones(n)]).ravel()
+
+    def residual(i, s):
+        return c0[i] + s[:, None] * c1[i] + (s * s)[:, None] * c2[i] - q[i]
+
+    r = residual(slice(None), s)
+    f = 0.5 * _dot(r, r)
+    step = np.zeros(len(s))
+    alpha = np.ones(len(s))
+    last = np.zeros(len(s), dtype=bool)
+    fresh = np.ones(len(s), dtype=bool)
+    act = np.arange(len(s))
+    for _ in range(_EDGE_STEPS + _HALVINGS):
+        if not len(act):
+            break
+        new = act[fresh[act]]
+        if len(new):
+            d1 = c1[new] + 2 * s[new, None] * c2[new]
+            g = _dot(r[new], d1)
+            h = _dot(d1, d1) + 2 * _dot(r[new], c2[new])
+            step[new] = np.where(h > 0, -g / np.where(h > 0, h, 1.0), -np.sign(g))
+            alpha[new] = 1.0
+            last[new] = _last(step[new], -g * step[new], f[new], q[new])
+        trial = np.clip(s[act] + alpha[act] * step[act], 0.0, 1.0)
+        move = np.abs(trial - s[act])
+        rt = residual(act, trial)
+        ft = 0.5 * _dot(rt, rt)
+        ok = (ft <= f[act]) | last[act]
+        acc = act[ok]
+        s[acc], r[acc], f[acc] = trial[ok], rt[ok], ft[ok]
+        fresh[act] = ok
+        alpha[act[~ok]] *= 0.5
+        act = act[~last[act] & (move > 0) & (alpha[act] > 0.5 ** _HALVINGS)]
+    f = f.reshape(n, ns)
+    j = f.argmin(axis=1)
+    rows = np.arange(n)
+    return s.reshape(n, ns)[rows, j], f[rows, j]
+
+
+def _chord_start(kind: FacetKind, X: np.ndarray, p: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Distance to the chord triangles and the facet coordinates of its closest point."""
+    C = X[:, :kind.corners]
+    if kind.simplex:
+        xi = closest_on_triangles(p, C[:, 0], C[:, 1], C[:, 2])
+        r = C[:, 0] + xi[:, :1] * (C[:, 1] - C[:, 0]) + xi[:, 1:] * (C[:, 2] - C[:, 0]) - p
+        return np.sqrt(_dot(r, r)), xi
+    # triangles 0-1-2 (ξ = s + t, η = t) and 0-2-3 (ξ = s, η = s + t)
+    st1 = closest_on_triangles(p, C[:, 0], C[:, 1], C[:, 2])
+    st2 = closest_on_triangles(p, C[:, 0], C[:, 2], C[:, 3])
+    r1 = C[:, 0] + st1[:, :1] * (C[:, 1] - C[:, 0]) + st1[:, 1:] * (C[:, 2] - C[:, 0]) - p
+    r2 = C[:, 0] + st2[:, :1] * (C[:, 2] - C[:, 0]) + st2[:, 1:] * (C[:, 3] - C[:, 0]) - p
+    d1, d2 = np.sqrt(_dot(r1, r1)), np.sqrt(_dot(r2, r2))
+    xi1 = np.column_stack([st1[:, 0] + st1[:, 1], st1[:, 1]])
+    xi2 = np.column_stack([st2[:, 0], st2[:, 0] + st2[:, 1]])
+    second = d2 < d1
+    return np.where(second, d2, d1), np.where(second[:, None], xi2, xi1)
+
+
+def _chunks(n: int, size: int = CHUNK) -> list[slice]:
+    return [slice(i, i + size) for i in range(0, n, size)]
+
+
+def _lattice(kind: FacetKind, n: int = 6) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A lattice of local coordinates over the reference domain (n intervals a side), its
+    neighbour table (each point's lattice neighbours, padded with itself) and its shape
+    functions."""
+    ij = [(i, j) for i in range(n + 1) for j in range(n + 1)
+          if not kind.simplex or i + j <= n]
+    index = {v: k for k, v in enumerate(ij)}
+    steps = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, -1), (-1, 1)]
+    if not kind.simplex:
+        steps += [(1, 1), (-1, -1)]
+    nbr = np.array([[index.get((i + di, j + dj), index[i, j]) for di, dj in steps]
+                    for i, j in ij])
+    xi = np.array(ij, dtype=float) / n
+    return xi, nbr, shape_functions(kind, xi)[0]
+
+
+_LATTICES: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+
+
+def _lattice_starts(kind: FacetKind, X: np.ndarray, p: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Newton starts that catch every basin of the distance on a facet: the points of a
+    lattice over the facet (7 x 7, or 28 on a triangle) no farther from p than their lattice
+    neighbours. Returns (rows into X and p, starts)."""
+    if kind.name not in _LATTICES:
+        _LATTICES[kind.name] = _lattice(kind)
+    xi, nbr, N = _LATTICES[kind.name]
+    rows, starts = [], []
+    for c in _chunks(len(p), CHUNK // 16):
+        P = N[None] @ X[c]  # (n, samples, 3)
+        D = _dot(P - p[c][:, None], P - p[c][:, None])
+        r, j = np.nonzero((D[:, :, None] <= D[:, nbr]).all(axis=2))
+        rows.append(r + c.start)
+        starts.append(xi[j])
+    return np.concatenate(rows), np.concatenate(starts).reshape(-1, 2)
+
+
+def _best_per_row(rows: np.ndarray, n: int, xi: np.ndarray, f: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """For each of n rows the (xi, f) of its entry with the least f (rows without one: f =
+    inf)."""
+    order = np.lexsort((f, rows))
+    first = order[np.r_[0, np.flatnonzero(np.diff(rows[order])) + 1]] if len(rows) else order
+    out_xi, out_f = np.zeros((n, 2)), np.full(n, np.inf)
+    out_xi[rows[first]], out_f[rows[first]] = xi[first], f[first]
+    return out_xi, out_f
+
+
+def _project_curved(kind: FacetKind, x: np.ndarray, facets: np.ndarray, points: np.ndarray,
+                    pt: np.ndarray, fc: np.ndarray, tol: float):
+    """Closest points of the candidate pairs (pt, fc) on bilinear or quadratic facets, less
+    the pairs that cannot be nearest: (pt, fc, xi).
+
+    In stages, each dropping the pairs whose lower bound (chord-triangle distance less
+    :func:`chord_deviation`) exceeds the point's best distance so far (+ ``tol``): the chord
+    triangles (their distance plus the deviation bounds the facet's); Newton from the chord
+    triangles' closest point (first on each point's nearest chord triangles, whose distance
+    cuts the others); Newton from every basin a lattice over the facet shows
+    (:func:`_lattice_starts`: a wavy facet can hold two local minima); then the edges
+    (straight: exact; curved: 1D Newton, only on edges whose chord comes near enough)."""
+    m = len(points)
+    corners = kind.corners
+    dev = chord_deviation(kind, x[facets])
+
+    def cut(upper_of_pair, lower_of_pair):
+        upper = np.full(m, np.inf)
+        np.minimum.at(upper, pt, upper_of_pair)
+        return lower_of_pair <= upper[pt] + tol
+
+    parts = [_chord_start(kind, x[facets[fc[c], :corners]], points[pt[c]])
+             for c in _chunks(len(pt))]
+    d_chord = np.concatenate([d for d, _ in parts])
+    xi = np.concatenate([v for _, v in parts])
+    lower = d_chord - dev[fc]
+    keep = cut(d_chord + dev[fc], lower)
+    pt, fc, xi, lower, d_chord = pt[keep], fc[keep], xi[keep], lower[keep], d_chord[keep]
+
+    def newton(sel, start):
+        parts = [_newton(kind, x[facets[fc[sel[c]]]], points[pt[sel[c]]], start[c])
+                 for c in _chunks(len(sel))]
+        return (np.concatenate([v for v, _ in parts]).reshape(-1, 2),
+                np.concatenate([v for _, v in parts]))
+
+    if len(pt) <= FEW_PAIRS:
+        # few pairs: every start of every pair in one Newton call (fewer numpy calls)
+        rows, starts = _lattice_starts(kind, x[facets[fc]], points[pt])
+        rows = np.r_[np.arange(len(pt)), rows]
+        xi_s, f_s = newton(rows, np.vstack([xi, starts]))
+        xi, f = _best_per_row(rows, len(pt), xi_s, f_s)
+    else:
+        order = np.lexsort((d_chord, pt))
+        first = order[np.r_[0, np.flatnonzero(np.diff(pt[order])) + 1]]
+        f = np.full(len(pt), np.inf)
+        xi[first], f[first] = newton(first, xi[first])
+        keep = cut(np.sqrt(2 * f), lower)
+        keep[first] = True
+        pt, fc, xi, f, lower = pt[keep], fc[keep], xi[keep], f[keep], lower[keep]
+        rest = np.flatnonzero(np.isinf(f))
+        xi[rest], f[rest] = newton(rest, xi[rest])
+        keep = cut(np.sqrt(2 * f), lower)
+        pt, fc, xi, f = pt[keep], fc[keep], xi[keep], f[keep]
+        rows, starts = _lattice_starts(kind, x[facets[fc]], points[pt])
+        xi_s, f_s = newton(rows, starts)
+        xi2, f2 = _best_per_row(rows, len(pt), xi_s, f_s)
+        better = f2 < f
+        xi[better], f[better] = xi2[better], f2[better]
+
+    # the edges: a clamped coordinate there is exact (they win ties)
+    V = kind.vertices
+    for a, b, mid in kind.edges:
+        A, B = x[facets[fc, a]], x[facets[fc, b]]
+        p = points[pt]
+        d = B - A
+        t = np.clip(_dot(p - A, d) / _dot(d, d), 0.0, 1.0)
+        rc = A + t[:, None] * d - p
+        if mid < 0:
+            s_e, f_e, e = t, 0.5 * _dot(rc, rc), np.arange(len(pt))
+        else:
+            # x(s) − chord(s) = 4 s (1 − s) δ: the edge is no nearer than its chord less |δ|
+            M = x[facets[fc, mid]]
+            bulge = np.sqrt(_dot(M - 0.5 * (A + B), M - 0.5 * (A + B)))
+            e = np.flatnonzero(np.sqrt(_dot(rc, rc)) - bulge <= np.sqrt(2 * f) + tol)
+            s_e, f_e = _curved_edges(A[e], B[e], M[e], p[e], t[e])
+        # the edge wins a tie to f's round-off: its clamped coordinate is exact
+        dist = np.sqrt(2 * f[e])
+        win = f_e <= f[e] + 1e-15 * dist * (np.abs(p[e]).max(axis=1) + dist)
+        w = e[win]
+        xi[w] = V[a] + s_e[win, None] * (V[b] - V[a])
+        f[w] = f_e[win]
+    return pt, fc, xi
+
+
+# ---------------------------------------------------------------------------------------------
+# the projection
+
+
+def closest_on_facets(points: np.ndarray, x: np.ndarray, facets: np.ndarray,
+                      point_normals: np.ndarray | None = None,
+                      pairs: tuple[np.ndarray, np.ndarray] | str | None = None
+                      ) -> FacetProjection:
+    """Closest point on a set of 3D facets for each point (module docstring).
+
+    Args:
+        points: (m, 3) query points.
+        x: (npts, 3) node coordinates.
+        facets: (nf, k) node indices of the facets, k = 3, 4, 6 or 9 (T3, Q4, T6, Q9), each
+            oriented (corners counter-clockwise seen from outside).
+        point_normals: (m, 3) unit outward normals of the surface each point lies on, to break
+            ties (optional).
+        pairs: the candidates: (point indices, facet indices), two equal-length arrays; or
+            ``"all"`` (every point against every facet); or None (found here,
+            :func:`candidate_pairs`).
+
+    Returns:
+        :class:`FacetProjection` (facet, xi, point, distance, normal, xi_free).
+
+    Raises:
+        ValueError: facets of another node count, or degenerate (:func:`check_facets`).
+    """
+    kind = facet_kind(facets)
+    facets = np.asarray(facets, dtype=np.int64)
+    x = np.asarray(x, dtype=float)
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    m, nf = len(points), len(facets)
+    check_facets(x, facets)
+    if isinstance(pairs, str):
+        if pairs != "all":
+            raise ValueError(f"pairs must be (points, facets), 'all' or None, got {pairs!r}")
+        pt = np.repeat(np.arange(m, dtype=np.int64), nf)
+        fc = np.tile(np.arange(nf, dtype=np.int64), m)
+    elif pairs is None:
+        pt, fc = candidate_pairs(points, x, facets)
+    else:
+        pt, fc = (np.asarray(a, dtype=np.int64).ravel() for a in pairs)
+    out = FacetProjection(np.full(m, -1, dtype=np.int64), np.full((m, 2), np.nan),
+                          np.full((m, 3), np.nan), np.full(m, np.inf), np.full((m, 3), np.nan),
+                          np.full((m, 2), np.nan))
+    if len(pt) == 0:
+        return out
+    C = x[facets[:, :kind.corners]]
+    diff = C[:, :, None] - C[:, None]
+    tol = TIE * np.sqrt(_dot(diff, diff).max()) + 1e-300
+    chunks = _chunks(len(pt))
+
+    if kind.name == "T3":
+        xi = np.concatenate([closest_on_triangles(points[pt[c]], *np.moveaxis(
+            x[facets[fc[c]]], 1, 0)) for c in chunks])
+    else:
+        pt, fc, xi = _project_curved(kind, x, facets, points, pt, fc, tol)
+        chunks = _chunks(len(pt))
+    dist = np.concatenate([_distance(points[pt[c]],
+                                     _evaluate(kind, x[facets[fc[c]]], xi[c])[0])
+                           for c in chunks])
+    nearest = np.full(m, np.inf)
+    np.minimum.at(nearest, pt, dist)
+    tied = np.flatnonzero(dist <= nearest[pt] + tol)
+
+    # the tie rules, among the tied candidates: facing, then over the facet, then facet number
+    pt, fc, xi, dist = pt[tied], fc[tied], xi[tied], dist[tied]
+    p = points[pt]
+    pos, J, _ = _evaluate(kind, x[facets[fc]], xi)
+    normal = _unit(np.cross(J[:, :, 0], J[:, :, 1]))
+    xi_free = xi + _gauss_newton_step(J, p - pos)
+    beyond = outside(kind, xi_free).any(axis=1)
+    facing = np.zeros(len(pt))
+    if point_normals is not None:
+        pn = np.asarray(point_normals, dtype=float).reshape(-1, 3)
+        facing = np.round(_dot(pn[pt], normal), 9)
+    order = np.lexsort((fc, beyond, facing, pt))
+    first = order[np.r_[0, np.flatnonzero(np.diff(pt[order])) + 1]]
+    who = pt[first]
+    out.facet[who] = fc[first]
+    out.xi[who] = xi[first]
+    out.point[who] = pos[first]
+    out.distance[who] = dist[first]
+    out.normal[who] = normal[first]
+    out.xi_free[who] = xi_free[first]
+    return out
+
+
+def _gauss_newton_step(J: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """(JᵀJ)⁻¹ Jᵀ r for J (n, 3, 2), r (n, 3)."""
+    g = (r[:, None, :] @ J)[:, 0]
+    G = np.swapaxes(J, 1, 2) @ J
+    det = G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] ** 2
+    return np.column_stack([G[:, 1, 1] * g[:, 0] - G[:, 0, 1] * g[:, 1],
+                            G[:, 0, 0] * g[:, 1] - G[:, 0, 1] * g[:, 0]]) / det[:, None]
