@@ -41,8 +41,8 @@ RAW = ("components x, y",)
 #: where the remaining lines are, by layer (first match); what the restructuring wants is every
 #: 2D line of the contact core in its geometry layer
 GROUPS = (
-    ("geometry layer (contact/surface.py, contact/search.py)",
-     ("contact/surface.py", "contact/search.py")),
+    ("geometry layer (contact/surface.py, contact/search.py, contact/facets.py)",
+     ("contact/surface.py", "contact/search.py", "contact/facets.py")),
     ("bodies and their 2D mechanics (bodies, nonlinear, kinematics, materials, result types)",
      ("bodies.py", "bodies/", "nonlinear.py", "kinematics.py", "materials/", "result_types.py")),
     ("the thesis variant (kept 2D, issue 18 item 7)", ("contact/algorithm.py",)),

@@ -170,6 +170,37 @@ def test_beyond_the_end_of_a_surface_only_past_its_end_facets(surfaces):
     np.testing.assert_array_equal(beyond(s, seg, t_free, s.surface_ends), [True, False, True])
 
 
+def test_a_2d_surface_reaches_its_facets_through_its_segment_kind(surfaces):
+    """The facet-kind layer (vfem.contact.facets): a 2D surface's kind is Segment(order), and
+    the surface's geometry goes through it (issue 21, C4)."""
+    from vfem.contact.facets import FACET_READINGS, Segment
+    from vfem.contact.search import outward_normals
+
+    s = surfaces[0]  # the lower block's top: 3 facets from x = 0 to 1
+    assert s.kind == Segment(1) and s.kind.corners == 2 and s.kind.nodes == 2
+    np.testing.assert_array_equal(s.kind.readings, FACET_READINGS)
+    np.testing.assert_array_equal(s.facet_normals(), outward_normals(*s.segments(s.X)))
+    seg, xi = np.array([0, 1, 2]), np.array([0.25, 0.5, 1.0])
+    pos, jn = s.surface_map(seg, xi)
+    cpos, tangent = s.curve(seg, xi)
+    np.testing.assert_array_equal(pos, cpos)
+    np.testing.assert_array_equal(np.linalg.norm(jn, axis=1), np.linalg.norm(tangent, axis=1))
+    np.testing.assert_allclose(jn / np.linalg.norm(jn, axis=1)[:, None], [[0.0, 1.0]] * 3)
+    boundary = s.patch_boundary(np.arange(len(s.facets)))
+    np.testing.assert_array_equal(s.boundary_nodes(boundary), s.surface_ends)
+    points = np.array([[0.0, 0.1], [0.5, 0.1], [1.3, 0.1]])
+    seg, _, _, _, xi_free = s.closest(points)
+    np.testing.assert_array_equal(s.on_boundary(seg, xi_free, boundary), [True, False, True])
+    np.testing.assert_array_equal(s.beyond(seg, xi_free, boundary), [False, False, True])
+    np.testing.assert_array_equal(s.kind.strictly_inside(np.array([0.0, 0.5, 1.0])),
+                                  [False, True, False])
+    t = np.array([0.0, 0.5])
+    anchors = s.material_points(seg[:2], s.interpolation(seg[:2], t))
+    np.testing.assert_array_equal(np.floor(anchors), seg[:2])
+    np.testing.assert_allclose(s.material_positions(anchors, s.X), s.curve(seg[:2], t)[0],
+                               atol=1e-15)
+
+
 # -- the formulations' contract and capabilities ---------------------------------------------------
 
 

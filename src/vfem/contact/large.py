@@ -77,7 +77,6 @@ from .complementarity import linear_complementarity
 from .iteration import Check, iterate
 from .paired import PairSet
 from .pairing import overlap, virtual_nodes
-from .search import project_points
 from .state import ContactState, IterationRecord, SolveResult, closing_motion
 from .surface import ContactSurface
 
@@ -341,8 +340,7 @@ class LargeDeformationContact(PairSet):
             if not len(on):
                 continue
             sc = self.surfaces[pair.coarse]
-            A, B = sc.segments(x[pair.coarse])
-            seg, _, _ = project_points(x[pair.fine][pair.nodes[on]], A, B)
+            seg = sc.closest(x[pair.fine][pair.nodes[on]], x[pair.coarse])[0]
             near = np.isin(sc.facets, sc.facets[seg]).any(axis=1)  # the facets and neighbours
             for body, nodes in ((pair.fine, pair.nodes[on]), (pair.coarse, sc.facets[near])):
                 nodes = np.unique(nodes)
@@ -350,7 +348,7 @@ class LargeDeformationContact(PairSet):
         J = np.array(sorted(coords), dtype=int)
         if not len(J):
             return J, np.zeros((off[-1], 0))
-        h = 1e-7 * max(float(s.lengths.max()) for s in self.surfaces)
+        h = 1e-7 * max(float(s.sizes.max()) for s in self.surfaces)
         body_of = np.searchsorted(off, J, side="right") - 1
         Bj = np.zeros((off[-1], len(J)))
 

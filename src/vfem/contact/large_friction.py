@@ -109,17 +109,12 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
                 continue
             _, _, interp, seg, _ = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse],
                                                  pair.nodes, *pair.patches)
-            t = np.asarray(interp[np.arange(len(seg)), sc.facets[seg, 1]]).ravel()
-            out.append(seg + np.clip(t, 0.0, 1.0 - 1e-12))
+            out.append(sc.material_points(seg, interp))
         return out
 
     def _anchor_positions(self, k: int, xc: np.ndarray, anchor: np.ndarray) -> np.ndarray:
         """Where the opposing surface's material points ``anchor`` (``facet + t``) now are."""
-        sc = self.surfaces[self.contact_pairs[k].coarse]
-        seg = np.floor(anchor).astype(int)
-        t = (anchor - seg)[:, None]
-        ends = sc.facets[seg]
-        return (1.0 - t) * xc[ends[:, 0]] + t * xc[ends[:, 1]]
+        return self.surfaces[self.contact_pairs[k].coarse].material_positions(anchor, xc)
 
     def slips(self, state: FrictionState, x: list[np.ndarray] | None = None
               ) -> list[np.ndarray]:

@@ -61,7 +61,6 @@ from .pairing import (  # noqa: F401 - the pairing's parts, here too for those w
     read_facets,
     virtual_nodes,
 )
-from .search import outward_normals
 from .state import (
     ContactState,
     IterationRecord,
@@ -159,27 +158,27 @@ class PairSet(SurfaceGroup):
         patch, opatch = facing(s, s.X, so, so.X), facing(so, so.X, s, s.X)
         if not len(patch) or not len(opatch):
             return 0.0, False
-        oends = patch_ends(so, opatch)
-        normals = outward_normals(*s.segments(s.X))[patch]
+        oends = so.patch_boundary(opatch)
+        normals = s.facet_normals()[patch]
         inside = np.zeros(len(patch), dtype=bool)  # a facet over the other surface, even partly
         for seg, _, tf in read_facets(s, patch, None, so, None, opatch, normals):
-            inside |= ~beyond(so, seg, tf, oends)
+            inside |= ~so.beyond(seg, tf, oends)
         over = patch[inside]
         if not len(over):
             return 0.0, False
         # ends of the patch at a corner of the body (another candidate facet, not facing j,
         # meets it there), not where the candidates or the boundary stop
-        ends = np.flatnonzero(patch_ends(s, patch) & (s.vertex_valence >= 2))
+        ends = np.flatnonzero(s.boundary_nodes(s.patch_boundary(patch))
+                              & (s.vertex_valence >= 2))
         normals = s.node_normals(None, patch)
         seg, _, _, _, tf = so.closest(s.X[ends], None, opatch, normals[ends])
-        e = so.facets[seg]
-        shared = ((tf <= 1e-9) & oends[e[:, 0]]) | ((tf >= 1 - 1e-9) & oends[e[:, 1]])
+        shared = so.on_boundary(seg, tf, oends)
         # (where both surfaces end together, at a symmetry plane, there is no edge)
-        edge = bool((~beyond(so, seg, tf, oends) & ~shared).any())
+        edge = bool((~so.beyond(seg, tf, oends) & ~shared).any())
         nodes = np.unique(s.facets[over])
         stiffness = s.normal_stiffness(nodes, s.node_normals(None, over)[nodes])
         flexibility = 1.0 / stiffness[np.isfinite(stiffness) & (stiffness > 0)]
-        return (float(np.median(flexibility) / np.median(s.lengths[over]))
+        return (float(np.median(flexibility) / np.median(s.sizes[over]))
                 if len(flexibility) else 0.0), edge
 
     def _facing_nodes(self, i: int, j: int) -> np.ndarray:
@@ -331,7 +330,7 @@ class PairSet(SurfaceGroup):
         qf = np.zeros(sf.nc)
         qf[pair.nodes] = q
         p = sf.interpolation(seg, t) @ qf
-        p[beyond(sf, seg, tf, patch_ends(sf, fpatch))] = 0.0
+        p[sf.beyond(seg, tf, sf.patch_boundary(fpatch))] = 0.0
         out[nodes] = p
         return out
 

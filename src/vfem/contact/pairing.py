@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .search import outward_normals
-from .surface import ContactSurface, beyond, patch_ends
+from .facets import FACET_READINGS  # noqa: F401 - here too for those who import it here
+from .surface import ContactSurface, beyond, patch_ends  # noqa: F401 - likewise
 from .transfer import transfer_matrices
 
 
@@ -62,8 +62,7 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray)
     (at ``xo``): its patch in their pair (:data:`FACING`)."""
     if len(s.facets) == 0 or len(so.facets) == 0:
         return np.zeros(0, dtype=int)
-    a, b = s.segments(x)
-    n = outward_normals(a, b)
+    n = s.facet_normals(x)
     faces = np.zeros(len(s.facets), dtype=bool)
     for _, m, _ in read_facets(s, np.arange(len(s.facets)), x, so, xo, None, n):
         faces |= np.einsum("ij,ij->i", n, m) <= -FACING
@@ -73,29 +72,24 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray)
     verts = so.vertices
     vn = so.node_normals(xo)[verts]
     seg, _, dist, _, tf = s.closest(xo[verts], x, None, vn)
-    reach = 2.0 * (s.lengths.max() + so.lengths.max())
-    over = ((tf > 1e-9) & (tf < 1 - 1e-9) & (dist < reach)
+    reach = 2.0 * (s.sizes.max() + so.sizes.max())
+    over = (s.kind.strictly_inside(tf) & (dist < reach)
             & (np.einsum("ij,ij->i", vn, n[seg]) <= -FACING))
     faces[seg[over]] = True
     return np.flatnonzero(faces)
 
 
-#: Where a facet is read against the other surface: its midpoint and near its ends. A facet
-#: partly under the other body, its midpoint just past the other's corner, faces that corner's
-#: side at its midpoint only (read there alone, such a facet was dropped and the contact missed
-#: altogether: a punch overhanging a block's edge, tests/test_fuzz_placement.py).
-FACET_READINGS = (0.5, 0.05, 0.95)
-
-
 def read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
                  so: ContactSurface, xo: np.ndarray | None, ofacets: np.ndarray | None,
                  normals: np.ndarray):
-    """For each of :data:`FACET_READINGS`: the closest point on ``so`` (its facets
+    """For each of the kind's readings (``s.kind.readings``; 2D:
+    :data:`~vfem.contact.facets.FACET_READINGS`): the closest point on ``so`` (its facets
     ``ofacets``, all if None) of that point of each of ``facets`` of ``s`` (positions ``x``,
-    ``xo``; ties by ``normals``), as (facet of so, its normal there, unclamped t)."""
+    ``xo``; ties by ``normals``), as (facet of so, its normal there, unclamped xi)."""
     n = len(facets)
-    k = len(FACET_READINGS)
-    pts, _ = s.curve(np.tile(facets, k), np.repeat(FACET_READINGS, n), x)
+    readings = s.kind.readings
+    k = len(readings)
+    pts, _ = s.surface_map(np.tile(facets, k), np.repeat(readings, n, axis=0), x)
     # one projection for all the readings (each point's is its own)
     seg, _, _, m, tf = so.closest(pts, xo, ofacets, np.tile(normals, (k, 1)))
     for i in range(k):
@@ -110,8 +104,8 @@ def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np
     """
     pts = xf[nodes]
     seg, t, _, _, tf = sc.closest(pts, xc, cpatch, sf.node_normals(xf, fpatch)[nodes])
-    closest, _ = sc.curve(seg, t, xc)
-    past = beyond(sc, seg, tf, patch_ends(sc, cpatch))
+    closest, _ = sc.surface_map(seg, t, xc)
+    past = sc.beyond(seg, tf, sc.patch_boundary(cpatch))
     interp = sc.interpolation(seg, t)
     normal = interp @ sc.node_normals(xc, cpatch)
     d = pts - closest
@@ -200,7 +194,7 @@ def overlap(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray | None = None
     reach = float(np.abs(gap[~past]).max()) if (~past).any() else 0.0
     mass, transfer = transfer_matrices(sf, sc, fpatch, cpatch,
                                              sc.node_normals(xc, cpatch),
-                                             patch_ends(sc, cpatch), reach, xf, xc)
+                                             sc.patch_boundary(cpatch), reach, xf, xc)
     carries = mass[:, nodes].any(axis=0)
     return Overlap(nodes, normal, gap, interp, sc.rind_depth[seg], past, carries, mass,
                    transfer, fpatch, cpatch)

@@ -30,7 +30,14 @@ from skfem.refdom import RefLine
 from ..bodies import COMPONENTS, Body
 from ..errors import InputError
 from ..mesh.checks import _corners
-from .search import normal_of_tangent, outward_normals, project_points
+from .facets import (  # noqa: F401 - the 2D facet's functions, here too for those who import them here
+    _SECOND,
+    FacetKind,
+    Segment,
+    facet_shape,
+    facet_shape_derivative,
+)
+from .search import project_points
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +67,8 @@ class ContactSurface:
         facet_ids: (nf,) indices of the candidate facets in ``mesh.facets``.
         facets: (nf, 2) local node numbers, ordered so the outward normal is (t_y, -t_x) (the
             first node to the second); with quadratic elements (nf, 3), the midpoint third.
+            What a facet is (its shape functions, normals, closest point, patch boundary,
+            readings, overlap quadrature) is its ``kind`` (:mod:`vfem.contact.facets`).
         nodes: (nt,) point numbers (``Body.points``) of the tracked nodes; the first ``nc`` are
             the candidate nodes (on candidate facets), the rest the other vertices of the rind
             elements.
@@ -75,6 +84,8 @@ class ContactSurface:
             tracked nodes' with ``rind_rows``, else only the candidates', nr = nc) for the
             candidate dofs.
         platen_row: (2 nc,) the platen reaction per unit contact force on the candidate dofs.
+        kind: the :class:`~vfem.contact.facets.FacetKind` of the facets: ``Segment(order)`` in
+            2D (set from ``facets`` when not given).
     """
 
     body: Body
@@ -93,6 +104,13 @@ class ContactSurface:
     rind_rows: bool = True
     #: whether ``C`` equals its transpose to the last bit (set by :meth:`compute_flexibility`)
     exactly_symmetric: bool = False
+    #: what a facet is (:mod:`vfem.contact.facets`): ``Segment(order)`` in 2D; None for a 3D
+    #: surface until its kinds come (issue 21)
+    kind: FacetKind | None = None
+
+    def __post_init__(self):
+        if self.kind is None and self.X.shape[1] == 2:
+            self.kind = Segment(self.facets.shape[1] - 1)
 
     @classmethod
     def build(cls, body: Body, facet_ids: np.ndarray) -> ContactSurface:
@@ -100,13 +118,11 @@ class ContactSurface:
         fn = body.facet_points(facet_ids).copy()  # (nf, 2 or 3) point numbers
         if body.dim == 3:
             return cls._untouched(body, fn)
-        # Orient each facet so that (t_y, -t_x) points away from its element.
+        kind = Segment(fn.shape[1] - 1)
+        # Orient each facet so that its normal points away from its element.
         elem = mesh.f2t[0, facet_ids]
         centroid = mesh.p[:, mesh.t[:, elem]].mean(axis=1).T
-        a, b = mesh.p[:, fn[:, 0]].T, mesh.p[:, fn[:, 1]].T
-        normal = normal_of_tangent(b - a)
-        flip = np.einsum("ij,ij->i", normal, 0.5 * (a + b) - centroid) < 0
-        fn[flip, :2] = fn[flip][:, 1::-1]
+        kind.orient(mesh.p, fn, centroid)
 
         cand = np.unique(fn)
         rind_elems = np.flatnonzero(np.isin(mesh.t, cand).any(axis=0))
@@ -120,7 +136,7 @@ class ContactSurface:
         lengths = np.linalg.norm(X[facets[:, 1]] - X[facets[:, 0]], axis=1)
         surface = cls(body=body, facet_ids=np.asarray(facet_ids), facets=facets, nodes=nodes,
                       nc=len(cand), X=X, lengths=lengths, tributary=np.zeros(len(cand)),
-                      rind=local[t_rind])
+                      rind=local[t_rind], kind=kind)
         if len(facets):
             # a unit pressure's consistent nodal forces: the integral of each shape function
             ones = np.ones(len(facets))
@@ -157,7 +173,7 @@ class ContactSurface:
     def shape(self, t: np.ndarray) -> np.ndarray:
         """(n, 2 or 3) facet shape functions at local coordinates t (0 at the first node, 1 at
         the second), in the column order of ``facets``."""
-        return facet_shape(np.asarray(t, dtype=float), self.order)
+        return self.kind.shape(t)
 
     # -- dofs -----------------------------------------------------------------------------------
 
@@ -216,7 +232,7 @@ class ContactSurface:
         positions ``x``."""
         ids = np.arange(len(self.facets)) if facets is None else np.asarray(facets)
         x = self.X if x is None else x
-        n = outward_normals(x[self.facets[ids, 0]], x[self.facets[ids, 1]])
+        n = self.kind.facet_normals(x, self.facets[ids])
         out = np.zeros((self.nc, self.dim))
         for col in self.facets[ids].T:
             np.add.at(out, col, n)
@@ -238,12 +254,13 @@ class ContactSurface:
     @property
     def vertex_valence(self) -> np.ndarray:
         """(nc,) how many candidate facets each candidate node is a vertex of."""
-        return np.bincount(self.facets[:, :2].ravel(), minlength=self.nc)[: self.nc]
+        return np.bincount(self.facets[:, : self.kind.corners].ravel(),
+                           minlength=self.nc)[: self.nc]
 
     @property
     def vertices(self) -> np.ndarray:
         """The candidate facets' vertices (their end nodes, not a quadratic facet's middle)."""
-        return np.unique(self.facets[:, :2])
+        return np.unique(self.facets[:, : self.kind.corners])
 
     @property
     def surface_ends(self) -> np.ndarray:
@@ -301,10 +318,26 @@ class ContactSurface:
         undeformed).
         """
         x = self.X if x is None else x
-        nodes = x[self.facets[seg]]  # (n, k, 2)
-        pos = np.einsum("nk,nkd->nd", self.shape(t), nodes)
-        tangent = np.einsum("nk,nkd->nd", facet_shape_derivative(t, self.order), nodes)
-        return pos, tangent
+        return self.kind.curve(x, self.facets[seg], t)
+
+    def surface_map(self, seg: np.ndarray, xi: np.ndarray, x: np.ndarray | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+        """(pos, jn) at local coordinates ``xi`` of facets ``seg`` (positions ``x``, default
+        undeformed): the position and the Jacobian times the unit outward normal, whose norm is
+        the measure per unit local coordinate (:meth:`FacetKind.surface_map`)."""
+        x = self.X if x is None else x
+        return self.kind.surface_map(x, self.facets[seg], xi)
+
+    def facet_normals(self, x: np.ndarray | None = None) -> np.ndarray:
+        """(nf, dim) unit outward normals of the candidate facets (their chords), undeformed or
+        at tracked positions ``x``."""
+        x = self.X if x is None else x
+        return self.kind.facet_normals(x, self.facets)
+
+    @property
+    def sizes(self) -> np.ndarray:
+        """(nf,) undeformed facet sizes: their lengths in 2D."""
+        return self.lengths
 
     def project(self, points: np.ndarray, x: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -322,27 +355,41 @@ class ContactSurface:
         facet, a first t and ``t_free``, the unclamped coordinate along the chord (outside
         [0, 1]: the point lies beyond that end of the facet); on curved facets a few Newton
         steps then find the closest point on the curve. Ties between facets are broken by
-        ``point_normals`` (:func:`~vfem.contact.search.project_points`).
+        ``point_normals`` (:func:`~vfem.contact.search.project_points`);
+        :meth:`FacetKind.closest`.
         """
         x = self.X if x is None else x
         ids = np.arange(len(self.facets)) if facets is None else np.asarray(facets)
-        a, b = x[self.facets[ids, 0]], x[self.facets[ids, 1]]
-        local, t, dist, t_free = project_points(points, a, b, point_normals, free=True)
-        seg = ids[local] if len(ids) else local
-        pos, tangent = self.curve(seg, t, x)
-        if self.order == 2 and len(seg):
-            for _ in range(4):
-                second = np.einsum("k,nkd->nd", _SECOND[:, 0],
-                                   x[self.facets[seg]])  # d2x/dt2, constant on a facet
-                r = pos - points
-                f = np.einsum("nd,nd->n", r, tangent)
-                df = np.einsum("nd,nd->n", tangent, tangent) + np.einsum("nd,nd->n", r, second)
-                t = np.clip(t - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
-                pos, tangent = self.curve(seg, t, x)
-            dist = np.linalg.norm(points - pos, axis=1)
-        normal = normal_of_tangent(tangent)
-        normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
-        return seg, t, dist, normal, t_free
+        return self.kind.closest(points, x, self.facets, ids, point_normals)
+
+    def patch_boundary(self, patch: np.ndarray):
+        """The boundary of a patch of candidate facets (facet numbers ``patch``), as
+        :meth:`beyond` and :meth:`on_boundary` read it (:meth:`FacetKind.patch_boundary`; in 2D
+        (nc,) True at the patch's end vertices)."""
+        return self.kind.patch_boundary(self.facets, patch, self.nc)
+
+    def boundary_nodes(self, boundary) -> np.ndarray:
+        """(nc,) True at the candidate nodes on a patch boundary (:meth:`patch_boundary`)."""
+        return self.kind.boundary_nodes(self.facets, boundary, self.nc)
+
+    def beyond(self, seg: np.ndarray, xi_free: np.ndarray, boundary) -> np.ndarray:
+        """Points whose closest point on a patch (boundary ``boundary``) is on its boundary,
+        outside the facet ``seg`` there (unclamped ``xi_free``): not over the patch."""
+        return self.kind.beyond(self.facets, seg, xi_free, boundary)
+
+    def on_boundary(self, seg: np.ndarray, xi_free: np.ndarray, boundary) -> np.ndarray:
+        """Points whose closest point on a patch is one of its boundary vertices (to 1e-9)."""
+        return self.kind.on_boundary(self.facets, seg, xi_free, boundary)
+
+    def material_points(self, seg: np.ndarray, interp: np.ndarray) -> np.ndarray:
+        """Points on facets ``seg`` (interpolation rows ``interp``) as material points of the
+        surface (a friction anchor; 2D: ``facet + t``)."""
+        return self.kind.material_points(self.facets, seg, interp)
+
+    def material_positions(self, points: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """Where the material points ``points`` (:meth:`material_points`) are at positions
+        ``x``."""
+        return self.kind.material_positions(x, self.facets, points)
 
     def locate(self, x_tracked: np.ndarray, points: np.ndarray) -> np.ndarray:
         """Rind triangle containing each point (current configuration), or -1
@@ -416,16 +463,17 @@ def _most_distorted(mesh, facet_ids: np.ndarray) -> str:
 
 
 def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:
-    """(nc,) True at the ends of a patch of facets (vertices on one facet of it)."""
-    return np.bincount(s.facets[patch, :2].ravel(), minlength=s.nc)[: s.nc] == 1
+    """(nc,) True at the ends of a patch of facets (vertices on one facet of it): a 2D
+    surface's :meth:`ContactSurface.patch_boundary`."""
+    return s.patch_boundary(patch)
 
 
 def beyond(s: ContactSurface, seg: np.ndarray, t_free: np.ndarray, ends: np.ndarray
            ) -> np.ndarray:
     """Points whose closest point on a patch is one of its ends (``ends``), outside the end
-    facet's normal strip (``t_free`` off [0, 1]): they are not over the patch."""
-    e = s.facets[seg]
-    return (((t_free < -1e-9) & ends[e[:, 0]]) | ((t_free > 1 + 1e-9) & ends[e[:, 1]]))
+    facet's normal strip (``t_free`` off [0, 1]): they are not over the patch
+    (:meth:`ContactSurface.beyond`)."""
+    return s.beyond(seg, t_free, ends)
 
 
 def triangles(t: np.ndarray) -> np.ndarray:
@@ -531,24 +579,6 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
             "mesh.translate; a built-in example's own parameters, e.g. hertz's initial_gap >= 0) "
             "so that they start touching, and apply the overlap as a prescribed displacement or "
             "a platen force")
-
-
-def facet_shape(t: np.ndarray, order: int) -> np.ndarray:
-    """(n, order + 1) shape functions of a straight 2- or 3-node facet at local coordinates t:
-    the ends (t = 0, 1) first, then the midpoint."""
-    if order == 1:
-        return np.column_stack([1 - t, t])
-    return np.column_stack([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])
-
-
-def facet_shape_derivative(t: np.ndarray, order: int) -> np.ndarray:
-    """(n, order + 1) derivatives d/dt of :func:`facet_shape`."""
-    if order == 1:
-        return np.column_stack([-np.ones_like(t), np.ones_like(t)])
-    return np.column_stack([4 * t - 3, 4 * t - 1, 4 - 8 * t])
-
-
-_SECOND = np.array([[4.0], [4.0], [-8.0]])  # second derivatives of the 3-node shape functions
 
 
 def predicted_translation(body: Body, load_factor: float) -> np.ndarray:

@@ -12,11 +12,8 @@ and back.
 from __future__ import annotations
 
 import numpy as np
-from skfem.quadrature import get_quadrature
-from skfem.refdom import RefLine
 
-from .search import normal_of_tangent
-from .surface import ContactSurface, beyond
+from .surface import ContactSurface
 
 
 def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray,
@@ -32,52 +29,25 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
     equal and opposite for any traction, to round-off, and force reaches only nodes whose
     facets overlap the other surface.
 
-    Integrated over the fine facets, split where the projection onto the coarse patch passes
-    one of its vertices (seen along its nodal normal), with a Gauss rule exact to degree 5
-    on each piece: exact for the piecewise polynomial integrand (degree 4 at most, with
-    quadratic elements) on straight facets, so a uniform traction crosses exactly. On
-    curved (quadratic) facets the points and weights follow the curve; the splits are found
-    on the chords. Positions ``xf``, ``xc`` may be deformed; the measure stays the fine
-    side's undeformed length (the traction is nominal).
+    ``ends`` is the coarse patch's boundary (:meth:`ContactSurface.patch_boundary`). The
+    quadrature is the fine side's kind's
+    (:meth:`~vfem.contact.facets.FacetKind.overlap_quadrature`); for segments: over the fine
+    facets, split where the projection onto the coarse patch passes one of its vertices (seen
+    along its nodal normal), with a Gauss rule exact to degree 5 on each piece: exact for the
+    piecewise polynomial integrand (degree 4 at most, with quadratic elements) on straight
+    facets, so a uniform traction crosses exactly. On curved (quadratic) facets the points and
+    weights follow the curve; the splits are found on the chords. Positions ``xf``, ``xc`` may
+    be deformed; the measure stays the fine side's undeformed length (the traction is
+    nominal).
     """
-    fa, fb = sf.segments(xf)
-    fa, fb = fa[fpatch], fb[fpatch]
-    d = fb - fa
-    # the coarse patch's vertices seen along their normals: where they split the fine facets
-    verts = np.unique(sc.facets[cpatch, :2])
-    vn = cnormals[verts]
-    P = xc[verts]
-    # solve fa + s d = P + tau vn for every (facet, coarse vertex)
-    det = d[:, None, 0] * (-vn[None, :, 1]) - d[:, None, 1] * (-vn[None, :, 0])
-    rx = P[None, :, 0] - fa[:, None, 0]
-    ry = P[None, :, 1] - fa[:, None, 1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = (rx * (-vn[None, :, 1]) - ry * (-vn[None, :, 0])) / det
-        tau = (d[:, None, 0] * ry - d[:, None, 1] * rx) / det
     # points farther than this from the coarse surface face something else (``gap``: the
     # largest gap of the pair's nodes)
-    reach = gap + 2.0 * (sf.lengths.max() + sc.lengths.max())
-    ok = np.isfinite(s) & (s > 1e-12) & (s < 1 - 1e-12) & (np.abs(tau) < reach)
-    X, W = get_quadrature(RefLine, 5)
-    xi, w = X[0], W
-    # each fine facet's pieces between its ends and its cuts, in order along it (all facets at
-    # once: the cuts sorted per row, repeated cuts giving empty pieces that are dropped)
-    cuts = np.sort(np.hstack([np.zeros((len(fpatch), 1)), np.ones((len(fpatch), 1)),
-                              np.where(ok, s, np.nan)]), axis=1)  # NaN (no cut) last
-    lo, hi = cuts[:, :-1], cuts[:, 1:]
-    piece = hi > lo  # False where either is NaN
-    row = np.broadcast_to(np.arange(len(fpatch))[:, None], piece.shape)[piece]
-    lo, hi = lo[piece], hi[piece]
-    sloc = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
-    wts = ((hi - lo)[:, None] * w[None, :]).ravel()
-    fac = np.repeat(np.asarray(fpatch)[row], len(xi))
-    _, tangent = sf.curve(fac, sloc)
-    wts = wts * np.linalg.norm(tangent, axis=1)
-    pts, tangent = sf.curve(fac, sloc, xf)
-    own = normal_of_tangent(tangent)
-    own /= np.maximum(np.linalg.norm(own, axis=1), 1e-300)[:, None]
+    reach = gap + 2.0 * (sf.sizes.max() + sc.sizes.max())
+    fac, sloc, wts = sf.kind.overlap_quadrature(sf, fpatch, sc, cpatch, cnormals, reach, xf, xc)
+    pts, jn = sf.surface_map(fac, sloc, xf)
+    own = jn / np.maximum(np.linalg.norm(jn, axis=1), 1e-300)[:, None]
     seg, tt, dist, _, tf = sc.closest(pts, xc, cpatch, own)
-    wts = np.where(beyond(sc, seg, tf, ends) | (dist > reach), 0.0, wts)
+    wts = np.where(sc.beyond(seg, tf, ends) | (dist > reach), 0.0, wts)
     N = np.zeros((sf.nc, sf.nc))
     T = np.zeros((sc.nc, sf.nc))
     fend, cend = sf.facets[fac], sc.facets[seg]

@@ -1,0 +1,293 @@
+"""What a contact facet is: the facet-kind layer of the contact surfaces (issue 21, C4 of the 3D
+plan).
+
+Everything that knows the shape of a facet — its shape functions and their derivatives, its
+outward normal, the closest point on a set of such facets, where a patch of them ends and when a
+point lies beyond it, where a facet is read against the other surface, and the quadrature of the
+overlap of two surfaces for the exact transfer — lives behind one object, a :class:`FacetKind`,
+held by each :class:`~vfem.contact.surface.ContactSurface` as ``kind``. The contact core
+(pairing, paired, large, large friction, transfer) reaches facets through it (or through the
+surface's methods that delegate to it), so it never branches on the dimension.
+
+* :class:`Segment` (``order`` 1 or 2): the 2- and 3-node facets of a 2D surface, straight or a
+  parabola through the midpoint. Local coordinates ``xi`` are one number per point, 0 at the
+  facet's first node and 1 at its second.
+
+3D kinds (triangles and quadrilaterals, ``xi`` of two numbers per point) are to come on
+:mod:`vfem.contact.facets3d` and :mod:`vfem.contact.overlap3d`; callers treat ``xi`` and the
+patch boundary as opaque.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefLine
+
+from .search import normal_of_tangent, outward_normals, project_points
+
+#: Where a facet is read against the other surface (:func:`~vfem.contact.pairing.read_facets`),
+#: in a segment's local coordinate: its midpoint and near its ends. A facet partly under the
+#: other body, its midpoint just past the other's corner, faces that corner's side at its
+#: midpoint only (read there alone, such a facet was dropped and the contact missed altogether:
+#: a punch overhanging a block's edge, tests/test_fuzz_placement.py).
+FACET_READINGS = (0.5, 0.05, 0.95)
+
+
+class FacetKind:
+    """The interface of a kind of facet (:class:`Segment`; triangles and quadrilaterals to come).
+
+    Arrays: ``x`` (n, dim) nodal positions of a surface (local node numbers), ``facets`` (nf,
+    nodes) its facets' local node numbers (oriented: the outward normal is the kind's),
+    ``seg`` facet numbers (rows of ``facets``), ``xi`` local coordinates of points on facets
+    ((n,) for segments; opaque to callers).
+    """
+
+    #: the dimension of the space (columns of ``x``)
+    dim: int
+    #: 1 for linear facets, 2 for quadratic ones
+    order: int
+    #: the vertices of a facet (its first ``corners`` nodes)
+    corners: int
+    #: the nodes of a facet (the columns of ``facets``)
+    nodes: int
+    #: the local coordinates at which a facet is read against the other surface, one row each
+    readings: np.ndarray
+
+    def shape(self, xi: np.ndarray) -> np.ndarray:
+        """(n, nodes) shape functions at ``xi``, in the column order of ``facets``."""
+        raise NotImplementedError
+
+    def derivatives(self, xi: np.ndarray) -> np.ndarray:
+        """Derivatives of :meth:`shape` with respect to ``xi``."""
+        raise NotImplementedError
+
+    def orient(self, p: np.ndarray, fn: np.ndarray, centroid: np.ndarray) -> None:
+        """Reorder, in place, the rows of ``fn`` (point numbers of ``p`` (dim, np)) whose
+        normal points into their element (``centroid`` (nf, dim)), so every normal is outward."""
+        raise NotImplementedError
+
+    def curve(self, x: np.ndarray, facets: np.ndarray, xi: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """Position and Jacobian dx/dxi at ``xi`` of the facets (rows) ``facets``."""
+        raise NotImplementedError
+
+    def surface_map(self, x: np.ndarray, facets: np.ndarray, xi: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+        """(pos, jn): position and the Jacobian times the unit outward normal (its norm the
+        measure per unit reference measure) at ``xi`` of the facets (rows) ``facets``."""
+        raise NotImplementedError
+
+    def facet_normals(self, x: np.ndarray, facets: np.ndarray) -> np.ndarray:
+        """(nf, dim) unit outward normals of the facets' chords (rows ``facets``)."""
+        raise NotImplementedError
+
+    def closest(self, points: np.ndarray, x: np.ndarray, facets: np.ndarray, ids: np.ndarray,
+                point_normals: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Closest point on the facets ``ids`` (rows of ``facets``) for each point: (facet
+        number, xi, distance, unit outward normal there, xi_free: unclamped)."""
+        raise NotImplementedError
+
+    def strictly_inside(self, xi_free: np.ndarray) -> np.ndarray:
+        """Whether unclamped local coordinates lie inside the facet, off its boundary."""
+        raise NotImplementedError
+
+    def patch_boundary(self, facets: np.ndarray, patch: np.ndarray, nc: int):
+        """The boundary of the patch ``patch`` (facet numbers) of a surface of ``nc`` candidate
+        nodes, in the form :meth:`beyond` and :meth:`on_boundary` read (opaque to callers)."""
+        raise NotImplementedError
+
+    def boundary_nodes(self, facets: np.ndarray, boundary, nc: int) -> np.ndarray:
+        """(nc,) the candidate nodes on a patch boundary (:meth:`patch_boundary`)."""
+        raise NotImplementedError
+
+    def beyond(self, facets: np.ndarray, seg: np.ndarray, xi_free: np.ndarray, boundary
+               ) -> np.ndarray:
+        """Points whose closest point on a patch (on facet ``seg`` at unclamped ``xi_free``) is
+        on its boundary and that lie outside the facet there: not over the patch."""
+        raise NotImplementedError
+
+    def on_boundary(self, facets: np.ndarray, seg: np.ndarray, xi_free: np.ndarray, boundary
+                    ) -> np.ndarray:
+        """Points whose closest point on a patch is (to 1e-9) a vertex on its boundary."""
+        raise NotImplementedError
+
+    def overlap_quadrature(self, sf, fpatch: np.ndarray, sc, cpatch: np.ndarray,
+                           cnormals: np.ndarray, reach: float, xf: np.ndarray, xc: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Quadrature over the part of patch ``fpatch`` of surface ``sf`` (this kind) that lies
+        over patch ``cpatch`` of ``sc`` (nodal normals ``cnormals``; points farther than
+        ``reach`` face something else), positions ``xf``, ``xc``: (facet (q,), xi, weight
+        (q,)), the weights times the undeformed measure of ``sf``."""
+        raise NotImplementedError
+
+    def material_points(self, facets: np.ndarray, seg: np.ndarray, interp: np.ndarray
+                        ) -> np.ndarray:
+        """Points on facets ``seg`` (their interpolation rows ``interp``) as material points
+        of the surface (what a friction anchor keeps)."""
+        raise NotImplementedError
+
+    def material_positions(self, x: np.ndarray, facets: np.ndarray, points: np.ndarray
+                           ) -> np.ndarray:
+        """Where :meth:`material_points` ``points`` are at positions ``x``."""
+        raise NotImplementedError
+
+
+def facet_shape(t: np.ndarray, order: int) -> np.ndarray:
+    """(n, order + 1) shape functions of a straight 2- or 3-node facet at local coordinates t:
+    the ends (t = 0, 1) first, then the midpoint."""
+    if order == 1:
+        return np.column_stack([1 - t, t])
+    return np.column_stack([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])
+
+
+def facet_shape_derivative(t: np.ndarray, order: int) -> np.ndarray:
+    """(n, order + 1) derivatives d/dt of :func:`facet_shape`."""
+    if order == 1:
+        return np.column_stack([-np.ones_like(t), np.ones_like(t)])
+    return np.column_stack([4 * t - 3, 4 * t - 1, 4 - 8 * t])
+
+
+_SECOND = np.array([[4.0], [4.0], [-8.0]])  # second derivatives of the 3-node shape functions
+
+
+class Segment(FacetKind):
+    """2- or 3-node facets of a 2D surface (``order`` 1 or 2), oriented so that ``(t_y, -t_x)``
+    of the tangent is the outward normal. The patch boundary is (nc,) True at the patch's end
+    vertices (vertices on one facet of it)."""
+
+    dim = 2
+    corners = 2
+
+    def __init__(self, order: int):
+        self.order = order
+        self.nodes = order + 1
+        self.readings = np.asarray(FACET_READINGS, dtype=float)
+
+    def __repr__(self) -> str:
+        return f"Segment({self.order})"
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Segment) and other.order == self.order
+
+    def __hash__(self) -> int:
+        return hash(("Segment", self.order))
+
+    def shape(self, xi: np.ndarray) -> np.ndarray:
+        return facet_shape(np.asarray(xi, dtype=float), self.order)
+
+    def derivatives(self, xi: np.ndarray) -> np.ndarray:
+        return facet_shape_derivative(xi, self.order)
+
+    def orient(self, p: np.ndarray, fn: np.ndarray, centroid: np.ndarray) -> None:
+        a, b = p[:, fn[:, 0]].T, p[:, fn[:, 1]].T
+        normal = normal_of_tangent(b - a)
+        flip = np.einsum("ij,ij->i", normal, 0.5 * (a + b) - centroid) < 0
+        fn[flip, :2] = fn[flip][:, 1::-1]
+
+    def curve(self, x, facets, xi):
+        nodes = x[facets]  # (n, k, 2)
+        pos = np.einsum("nk,nkd->nd", self.shape(xi), nodes)
+        tangent = np.einsum("nk,nkd->nd", self.derivatives(xi), nodes)
+        return pos, tangent
+
+    def surface_map(self, x, facets, xi):
+        pos, tangent = self.curve(x, facets, xi)
+        return pos, normal_of_tangent(tangent)
+
+    def facet_normals(self, x, facets):
+        return outward_normals(x[facets[:, 0]], x[facets[:, 1]])
+
+    def closest(self, points, x, facets, ids, point_normals=None):
+        """The chords give the facet, a first t and ``t_free``, the unclamped coordinate along
+        the chord (outside [0, 1]: the point lies beyond that end of the facet); on curved
+        facets a few Newton steps then find the closest point on the curve. Ties between facets
+        are broken by ``point_normals`` (:func:`~vfem.contact.search.project_points`)."""
+        a, b = x[facets[ids, 0]], x[facets[ids, 1]]
+        local, t, dist, t_free = project_points(points, a, b, point_normals, free=True)
+        seg = ids[local] if len(ids) else local
+        pos, tangent = self.curve(x, facets[seg], t)
+        if self.order == 2 and len(seg):
+            for _ in range(4):
+                second = np.einsum("k,nkd->nd", _SECOND[:, 0],
+                                   x[facets[seg]])  # d2x/dt2, constant on a facet
+                r = pos - points
+                f = np.einsum("nd,nd->n", r, tangent)
+                df = np.einsum("nd,nd->n", tangent, tangent) + np.einsum("nd,nd->n", r, second)
+                t = np.clip(t - f / np.where(df > 0, df, 1.0), 0.0, 1.0)
+                pos, tangent = self.curve(x, facets[seg], t)
+            dist = np.linalg.norm(points - pos, axis=1)
+        normal = normal_of_tangent(tangent)
+        normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+        return seg, t, dist, normal, t_free
+
+    def strictly_inside(self, xi_free):
+        return (xi_free > 1e-9) & (xi_free < 1 - 1e-9)
+
+    def patch_boundary(self, facets, patch, nc):
+        return np.bincount(facets[patch, :2].ravel(), minlength=nc)[:nc] == 1
+
+    def boundary_nodes(self, facets, boundary, nc):
+        return boundary
+
+    def beyond(self, facets, seg, xi_free, boundary):
+        e = facets[seg]
+        return (((xi_free < -1e-9) & boundary[e[:, 0]])
+                | ((xi_free > 1 + 1e-9) & boundary[e[:, 1]]))
+
+    def on_boundary(self, facets, seg, xi_free, boundary):
+        e = facets[seg]
+        return (((xi_free <= 1e-9) & boundary[e[:, 0]])
+                | ((xi_free >= 1 - 1e-9) & boundary[e[:, 1]]))
+
+    def overlap_quadrature(self, sf, fpatch, sc, cpatch, cnormals, reach, xf, xc):
+        """The fine facets split where the projection onto the coarse patch passes one of its
+        vertices (seen along its nodal normal), with a Gauss rule exact to degree 5 on each
+        piece: exact for the piecewise polynomial integrand (degree 4 at most, with quadratic
+        elements) on straight facets. On curved (quadratic) facets the points and weights
+        follow the curve; the splits are found on the chords. The weights are times the fine
+        side's undeformed length (the traction is nominal)."""
+        fa, fb = xf[sf.facets[:, 0]], xf[sf.facets[:, 1]]
+        fa, fb = fa[fpatch], fb[fpatch]
+        d = fb - fa
+        # the coarse patch's vertices seen along their normals: where they split the fine facets
+        verts = np.unique(sc.facets[cpatch, :2])
+        vn = cnormals[verts]
+        P = xc[verts]
+        # solve fa + s d = P + tau vn for every (facet, coarse vertex)
+        det = d[:, None, 0] * (-vn[None, :, 1]) - d[:, None, 1] * (-vn[None, :, 0])
+        rx = P[None, :, 0] - fa[:, None, 0]
+        ry = P[None, :, 1] - fa[:, None, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = (rx * (-vn[None, :, 1]) - ry * (-vn[None, :, 0])) / det
+            tau = (d[:, None, 0] * ry - d[:, None, 1] * rx) / det
+        ok = np.isfinite(s) & (s > 1e-12) & (s < 1 - 1e-12) & (np.abs(tau) < reach)
+        X, W = get_quadrature(RefLine, 5)
+        xi, w = X[0], W
+        # each fine facet's pieces between its ends and its cuts, in order along it (all
+        # facets at once: the cuts sorted per row, repeated cuts giving empty pieces that are
+        # dropped)
+        cuts = np.sort(np.hstack([np.zeros((len(fpatch), 1)), np.ones((len(fpatch), 1)),
+                                  np.where(ok, s, np.nan)]), axis=1)  # NaN (no cut) last
+        lo, hi = cuts[:, :-1], cuts[:, 1:]
+        piece = hi > lo  # False where either is NaN
+        row = np.broadcast_to(np.arange(len(fpatch))[:, None], piece.shape)[piece]
+        lo, hi = lo[piece], hi[piece]
+        sloc = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
+        wts = ((hi - lo)[:, None] * w[None, :]).ravel()
+        fac = np.repeat(np.asarray(fpatch)[row], len(xi))
+        _, tangent = self.curve(sf.X, sf.facets[fac], sloc)
+        wts = wts * np.linalg.norm(tangent, axis=1)
+        return fac, sloc, wts
+
+    def material_points(self, facets, seg, interp):
+        """``facet + t`` (t clipped below 1, so the facet is its integer part)."""
+        t = np.asarray(interp[np.arange(len(seg)), facets[seg, 1]]).ravel()
+        return seg + np.clip(t, 0.0, 1.0 - 1e-12)
+
+    def material_positions(self, x, facets, points):
+        seg = np.floor(points).astype(int)
+        t = (points - seg)[:, None]
+        ends = facets[seg]
+        return (1.0 - t) * x[ends[:, 0]] + t * x[ends[:, 1]]
