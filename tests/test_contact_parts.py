@@ -224,9 +224,12 @@ def test_each_setting_picks_one_formulation_that_implements_the_contract(method,
 
 
 def fake_model(order=1, dim=2, large=False, **settings):
-    body = SimpleNamespace(name="b", order=order, large=large,
-                           mesh=SimpleNamespace(p=np.zeros((dim, 3))))
-    return SimpleNamespace(name="m", bodies=[body], contact=ContactSettings(**settings))
+    """Two alike bodies that may touch (``contact_pairs`` None: every pair): a body that may
+    touch none is not the contact formulation's to refuse (``bodies_that_may_touch``)."""
+    bodies = [SimpleNamespace(name=name, order=order, large=large,
+                              mesh=SimpleNamespace(p=np.zeros((dim, 3)))) for name in "ab"]
+    return SimpleNamespace(name="m", bodies=bodies, contact=ContactSettings(**settings),
+                           contact_pairs=None)
 
 
 def test_the_model_checks_read_the_declared_capabilities():
