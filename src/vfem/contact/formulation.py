@@ -136,7 +136,8 @@ def check_capabilities(model) -> None:
         if dim not in caps.dimensions and b.name in touching:
             raise InputError(f"model {model.name!r}, body {b.name!r}: {caps.name} contact "
                              f"supports {' and '.join(f'{d}D' for d in caps.dimensions)} "
-                             f"bodies, this one is {dim}D")
+                             f"bodies, this one is {dim}D; 3D contact is not implemented "
+                             "yet (a 3D body that touches no other runs without contact)")
 
 
 def bodies_that_may_touch(model) -> set[str]:
