@@ -13,9 +13,13 @@ surface's methods that delegate to it), so it never branches on the dimension.
   parabola through the midpoint. Local coordinates ``xi`` are one number per point, 0 at the
   facet's first node and 1 at its second.
 
-3D kinds (triangles and quadrilaterals, ``xi`` of two numbers per point) are to come on
-:mod:`vfem.contact.facets3d` and :mod:`vfem.contact.overlap3d`; callers treat ``xi`` and the
-patch boundary as opaque.
+* :class:`Triangle` and :class:`Quad` (``order`` 1 or 2): the 3-/6-node and 4-/9-node facets
+  of a 3D surface (T3, T6, Q4, Q9 of :mod:`vfem.contact.facets3d`, whose kernels they call),
+  ``xi`` two numbers per point in scikit-fem's reference domains. Their patch boundary is an
+  edge table. The overlap quadrature (:mod:`vfem.contact.overlap3d`) and the friction anchor's
+  material points are not theirs yet (C8, C13 of the 3D plan).
+
+Callers treat ``xi`` and the patch boundary as opaque.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
+from . import facets3d
 from .search import normal_of_tangent, outward_normals, project_points
 
 #: Where a facet is read against the other surface (:func:`~vfem.contact.pairing.read_facets`),
@@ -35,12 +40,12 @@ FACET_READINGS = (0.5, 0.05, 0.95)
 
 
 class FacetKind:
-    """The interface of a kind of facet (:class:`Segment`; triangles and quadrilaterals to come).
+    """The interface of a kind of facet (:class:`Segment`, :class:`Triangle`, :class:`Quad`).
 
     Arrays: ``x`` (n, dim) nodal positions of a surface (local node numbers), ``facets`` (nf,
     nodes) its facets' local node numbers (oriented: the outward normal is the kind's),
     ``seg`` facet numbers (rows of ``facets``), ``xi`` local coordinates of points on facets
-    ((n,) for segments; opaque to callers).
+    ((n,) for segments, (n, 2) for triangles and quadrilaterals; opaque to callers).
     """
 
     #: the dimension of the space (columns of ``x``)
@@ -291,3 +296,169 @@ class Segment(FacetKind):
         t = (points - seg)[:, None]
         ends = facets[seg]
         return (1.0 - t) * x[ends[:, 0]] + t * x[ends[:, 1]]
+
+
+class _Facet3D(FacetKind):
+    """Facets of a 3D surface: the kernels of :mod:`vfem.contact.facets3d` (``geometry``, its
+    :class:`~vfem.contact.facets3d.FacetKind`) behind the :class:`FacetKind` interface. A facet
+    is oriented when its corners run counter-clockwise seen from outside: ``x_ξ × x_η`` is then
+    the outward normal. ``xi`` is (n, 2). The patch boundary is an (nf, edges) table: True
+    where an edge (in ``geometry.edges``' order) of a patch facet is an edge of no other facet
+    of the patch (facets off the patch: all False)."""
+
+    dim = 3
+    #: the name of the kind (``Triangle``, ``Quad``)
+    name = ""
+    #: nodes per facet by order
+    _NODES: dict[int, int] = {}
+    #: the column order of a facet turned over (its normal reversed), by nodes per facet
+    _REVERSED: dict[int, tuple[int, ...]] = {}
+
+    def __init__(self, order: int):
+        if order not in (1, 2):
+            raise ValueError(f"{self.name} facets are of order 1 or 2, got {order!r}")
+        self.order = order
+        self.nodes = self._NODES[order]
+        self.geometry = facets3d.KINDS[self.nodes]
+        self.corners = self.geometry.corners
+        centre = np.asarray(self.geometry.centre)
+        # the centre and points 0.9 of the way from it to each corner (2D: 0.5, 0.05, 0.95)
+        self.readings = np.vstack([centre, centre + 0.9 * (self.geometry.vertices - centre)])
+
+    def __repr__(self) -> str:
+        return f"{self.name}({self.order})"
+
+    def __eq__(self, other) -> bool:
+        return type(other) is type(self) and other.order == self.order
+
+    def __hash__(self) -> int:
+        return hash((self.name, self.order))
+
+    def shape(self, xi: np.ndarray) -> np.ndarray:
+        return facets3d.shape_functions(self.geometry, xi)[0]
+
+    def derivatives(self, xi: np.ndarray) -> np.ndarray:
+        """(n, nodes, 2): d/dξ and d/dη of :meth:`shape`."""
+        return facets3d.shape_functions(self.geometry, xi)[1]
+
+    def chord_normals(self, corners: np.ndarray) -> np.ndarray:
+        """(nf, 3) unit normals of facets' chords from their corners (nf, corners, 3): a
+        triangle's ``(b − a) × (c − a)``, a quadrilateral's diagonals' ``(c − a) × (d − b)``
+        (its bilinear normal at the centre)."""
+        if self.corners == 3:
+            n = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        else:
+            n = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
+        return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+
+    def orient(self, p, fn, centroid):
+        corners = p[:, fn[:, : self.corners]].transpose(1, 2, 0)  # (nf, corners, 3)
+        normal = self.chord_normals(corners)
+        flip = np.einsum("ij,ij->i", normal, corners.mean(axis=1) - centroid) < 0
+        fn[flip] = fn[flip][:, list(self._REVERSED[self.nodes])]
+
+    def curve(self, x, facets, xi):
+        """Position (n, 3) and Jacobian (n, 3, 2) (columns x_ξ, x_η)."""
+        facets = np.asarray(facets)
+        return facets3d.facet_map(x, facets, np.arange(len(facets)), np.reshape(xi, (-1, 2)))
+
+    def surface_map(self, x, facets, xi):
+        pos, J = self.curve(x, facets, xi)
+        return pos, np.cross(J[:, :, 0], J[:, :, 1])
+
+    def facet_normals(self, x, facets):
+        return self.chord_normals(np.asarray(x)[np.asarray(facets)[:, : self.corners]])
+
+    def areas(self, x: np.ndarray, facets: np.ndarray, intorder: int = 6) -> np.ndarray:
+        """(nf,) the facets' areas: ∫ |x_ξ × x_η| by scikit-fem's Gauss rule of degree
+        ``intorder`` on the reference domain (exact on flat facets with straight edges)."""
+        from skfem.refdom import RefQuad, RefTri
+
+        X, W = get_quadrature(RefTri if self.corners == 3 else RefQuad, intorder)
+        nf, nq = len(facets), len(W)
+        if nf == 0:
+            return np.zeros(0)
+        xi = np.tile(X.T, (nf, 1))
+        _, jn = self.surface_map(x, np.repeat(np.asarray(facets), nq, axis=0), xi)
+        return (np.linalg.norm(jn, axis=1).reshape(nf, nq) * W[None, :]).sum(axis=1)
+
+    def closest(self, points, x, facets, ids, point_normals=None):
+        """:func:`~vfem.contact.facets3d.closest_on_facets` on the facets ``ids``: its facet
+        (a row of ``facets``), ``xi``, distance, unit outward normal and ``xi_free``."""
+        ids = np.asarray(ids, dtype=np.int64)
+        proj = facets3d.closest_on_facets(points, x, np.asarray(facets)[ids], point_normals)
+        seg = ids[proj.facet] if len(ids) else proj.facet
+        return seg, proj.xi, proj.distance, proj.normal, proj.xi_free
+
+    def strictly_inside(self, xi_free):
+        return ~facets3d.outside(self.geometry, np.reshape(xi_free, (-1, 2)),
+                                 -facets3d.OUTSIDE).any(axis=1)
+
+    def edge_nodes(self, facets: np.ndarray) -> np.ndarray:
+        """(nf, edges, 2) the corner nodes of each facet's edges (``geometry.edges``' order)."""
+        ends = np.array([e[:2] for e in self.geometry.edges])
+        return np.asarray(facets)[:, ends]
+
+    def patch_boundary(self, facets, patch, nc):
+        patch = np.asarray(patch, dtype=np.int64)
+        ends = np.sort(self.edge_nodes(facets[patch]), axis=2)  # (patch, edges, 2)
+        edges = ends.reshape(-1, ends.shape[2])
+        out = np.zeros((len(facets), len(self.geometry.edges)), dtype=bool)
+        if len(edges):
+            _, inverse, counts = np.unique(edges, axis=0, return_inverse=True,
+                                           return_counts=True)
+            out[patch] = (counts[inverse.ravel()] == 1).reshape(len(patch), -1)
+        return out
+
+    def boundary_nodes(self, facets, boundary, nc):
+        """(nc,) True at the corners of the patch's boundary edges."""
+        out = np.zeros(nc, dtype=bool)
+        out[self.edge_nodes(facets)[boundary].ravel()] = True
+        return out
+
+    def beyond(self, facets, seg, xi_free, boundary):
+        """Past (by more than 1e-9 in local coordinates) an edge of facet ``seg`` that is on the
+        patch boundary (:func:`~vfem.contact.facets3d.outside`)."""
+        past = facets3d.outside(self.geometry, np.reshape(xi_free, (-1, 2)))
+        return (past & boundary[seg]).any(axis=1)
+
+    def on_boundary(self, facets, seg, xi_free, boundary):
+        """At (to 1e-9) or past an edge of facet ``seg`` that is on the patch boundary: the
+        closest point on the patch is on its boundary (3D's boundary is edges, 2D's end
+        vertices)."""
+        at = facets3d.outside(self.geometry, np.reshape(xi_free, (-1, 2)), -facets3d.OUTSIDE)
+        return (at & boundary[seg]).any(axis=1)
+
+
+class Triangle(_Facet3D):
+    """3-node (``order`` 1) or 6-node (``order`` 2) triangular facets of a 3D surface:
+    scikit-fem's ``ElementTriP1``/``ElementTriP2`` node order (the corners, then the middles of
+    the edges 0-1, 1-2, 0-2)."""
+
+    name = "Triangle"
+    _NODES = {1: 3, 2: 6}
+    _REVERSED = {3: (0, 2, 1), 6: (0, 2, 1, 5, 4, 3)}
+
+
+class Quad(_Facet3D):
+    """4-node (``order`` 1, bilinear, possibly warped) or 9-node (``order`` 2) quadrilateral
+    facets of a 3D surface: scikit-fem's ``ElementQuad1``/``ElementQuad2`` node order (the
+    corners, the middles of the edges 0-1, 1-2, 2-3, 0-3, the centre)."""
+
+    name = "Quad"
+    _NODES = {1: 4, 2: 9}
+    _REVERSED = {4: (0, 3, 2, 1), 9: (0, 3, 2, 1, 7, 6, 5, 4, 8)}
+
+
+def kind_of(dim: int, facets: np.ndarray) -> FacetKind:
+    """The facet kind of (nf, k) facets of a ``dim``-dimensional surface: ``Segment`` (k = 2,
+    3), ``Triangle`` (3, 6) or ``Quad`` (4, 9)."""
+    k = np.shape(facets)[1]
+    if dim == 2 and k in (2, 3):
+        return Segment(k - 1)
+    if dim == 3 and k in (3, 6):
+        return Triangle(1 if k == 3 else 2)
+    if dim == 3 and k in (4, 9):
+        return Quad(1 if k == 4 else 2)
+    raise ValueError(f"no facet kind of {k} nodes in {dim}D: 2D facets have 2 or 3 nodes, 3D "
+                     "facets 3, 4, 6 or 9")

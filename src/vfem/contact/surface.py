@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
-from skfem import BilinearForm, ElementLineP1, FacetBasis, MeshTri
+from skfem import BilinearForm, ElementLineP1, FacetBasis, MeshHex, MeshTri
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
@@ -36,6 +36,7 @@ from .facets import (  # noqa: F401 - the 2D facet's functions, here too for tho
     Segment,
     facet_shape,
     facet_shape_derivative,
+    kind_of,
 )
 from .search import project_points
 
@@ -66,26 +67,30 @@ class ContactSurface:
         body: the body.
         facet_ids: (nf,) indices of the candidate facets in ``mesh.facets``.
         facets: (nf, 2) local node numbers, ordered so the outward normal is (t_y, -t_x) (the
-            first node to the second); with quadratic elements (nf, 3), the midpoint third.
+            first node to the second); with quadratic elements (nf, 3), the midpoint third. In
+            3D (nf, 3/6/4/9) triangles or quadrilaterals, corners counter-clockwise seen from
+            outside (:class:`~vfem.contact.facets.Triangle`, :class:`~vfem.contact.facets.Quad`).
             What a facet is (its shape functions, normals, closest point, patch boundary,
             readings, overlap quadrature) is its ``kind`` (:mod:`vfem.contact.facets`).
         nodes: (nt,) point numbers (``Body.points``) of the tracked nodes; the first ``nc`` are
             the candidate nodes (on candidate facets), the rest the other vertices of the rind
             elements.
         nc: number of candidate nodes.
-        X: (nt, 2) undeformed coordinates of the tracked nodes.
-        lengths: (nf,) undeformed facet lengths.
+        X: (nt, dim) undeformed coordinates of the tracked nodes.
+        lengths: (nf,) undeformed facet lengths (3D: the square roots of their areas; ``sizes``).
         tributary: (nc,) each candidate node's consistent share of a unit pressure on the
             undeformed candidate facets (half of each adjacent facet for linear elements; 1/6 and
             2/3 for a quadratic facet's ends and midpoint): nodal force / tributary is the
             nominal pressure.
-        rind: (ne, 3) triangles of the rind (quadrilaterals split in two), local node numbers.
+        rind: (ne, 3) triangles of the rind (quadrilaterals split in two), local node numbers;
+            in 3D (ne, 4) tetrahedra (hexahedra split in six, :func:`simplices`).
         G: (2 nr, 2 nc) flexibility rows of the condensed dofs (:attr:`condensed_dofs`: the
             tracked nodes' with ``rind_rows``, else only the candidates', nr = nc) for the
             candidate dofs.
         platen_row: (2 nc,) the platen reaction per unit contact force on the candidate dofs.
         kind: the :class:`~vfem.contact.facets.FacetKind` of the facets: ``Segment(order)`` in
-            2D (set from ``facets`` when not given).
+            2D (set from ``facets`` when not given), ``Triangle(order)`` or ``Quad(order)`` in
+            3D (None for a 3D surface without candidate facets).
     """
 
     body: Body
@@ -104,8 +109,8 @@ class ContactSurface:
     rind_rows: bool = True
     #: whether ``C`` equals its transpose to the last bit (set by :meth:`compute_flexibility`)
     exactly_symmetric: bool = False
-    #: what a facet is (:mod:`vfem.contact.facets`): ``Segment(order)`` in 2D; None for a 3D
-    #: surface until its kinds come (issue 21)
+    #: what a facet is (:mod:`vfem.contact.facets`): ``Segment(order)`` in 2D, ``Triangle`` or
+    #: ``Quad`` in 3D; None for a 3D surface without candidate facets
     kind: FacetKind | None = None
 
     def __post_init__(self):
@@ -116,9 +121,9 @@ class ContactSurface:
     def build(cls, body: Body, facet_ids: np.ndarray) -> ContactSurface:
         mesh = body.mesh
         fn = body.facet_points(facet_ids).copy()  # (nf, 2 or 3) point numbers
-        if body.dim == 3:
+        if body.dim == 3 and not len(fn):
             return cls._untouched(body, fn)
-        kind = Segment(fn.shape[1] - 1)
+        kind = Segment(fn.shape[1] - 1) if body.dim == 2 else kind_of(3, fn)
         # Orient each facet so that its normal points away from its element.
         elem = mesh.f2t[0, facet_ids]
         centroid = mesh.p[:, mesh.t[:, elem]].mean(axis=1).T
@@ -130,10 +135,14 @@ class ContactSurface:
         nodes = np.concatenate([cand, rind_nodes])
         local = np.full(body.npoints, -1)
         local[nodes] = np.arange(len(nodes))
-        t_rind = triangles(mesh.t[:, rind_elems])
+        t_rind = (triangles(mesh.t[:, rind_elems]) if body.dim == 2
+                  else simplices(mesh, mesh.t[:, rind_elems]))
         X = body.points[:, nodes].T.copy()
         facets = local[fn]
-        lengths = np.linalg.norm(X[facets[:, 1]] - X[facets[:, 0]], axis=1)
+        if body.dim == 2:
+            lengths = np.linalg.norm(X[facets[:, 1]] - X[facets[:, 0]], axis=1)
+        else:  # a 3D facet's size: the square root of its area
+            lengths = np.sqrt(kind.areas(X, facets))
         surface = cls(body=body, facet_ids=np.asarray(facet_ids), facets=facets, nodes=nodes,
                       nc=len(cand), X=X, lengths=lengths, tributary=np.zeros(len(cand)),
                       rind=local[t_rind], kind=kind)
@@ -145,12 +154,9 @@ class ContactSurface:
 
     @classmethod
     def _untouched(cls, body: Body, fn: np.ndarray) -> ContactSurface:
-        """The surface of a 3D body that touches nothing (in no pair that may touch,
-        :func:`~vfem.contact.formulation.bodies_that_may_touch`): no candidate, no rind. 3D
-        contact surfaces (triangle and quadrilateral facets) are issue 21's to come."""
-        if len(fn):
-            raise NotImplementedError(f"body {body.name!r}: contact surfaces of 3D bodies are "
-                                      "not implemented yet")
+        """The surface of a 3D body without candidate facets (in no pair that may touch,
+        :func:`~vfem.contact.formulation.bodies_that_may_touch`): no candidate, no rind, no
+        kind."""
         none = np.zeros(0, dtype=np.int64)
         return cls(body=body, facet_ids=none, facets=fn.astype(np.int64), nodes=none, nc=0,
                    X=np.zeros((0, 3)), lengths=np.zeros(0), tributary=np.zeros(0),
@@ -240,10 +246,14 @@ class ContactSurface:
 
     @property
     def rind_depth(self) -> np.ndarray:
-        """(nf,) thickness of the element behind each candidate facet: its area / facet length."""
+        """(nf,) thickness of the element behind each candidate facet: its area / facet length
+        (3D: its volume / facet area)."""
         if not hasattr(self, "_rind_depth"):
             mesh = self.body.mesh
             elem = mesh.f2t[0, self.facet_ids]
+            if self.dim == 3:
+                self._rind_depth = element_volumes(mesh, elem) / self.areas
+                return self._rind_depth
             pts = mesh.p[:, mesh.t[:, elem]]  # (2, nv, nf)
             x, y = pts[0], pts[1]
             area = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y,
@@ -336,8 +346,14 @@ class ContactSurface:
 
     @property
     def sizes(self) -> np.ndarray:
-        """(nf,) undeformed facet sizes: their lengths in 2D."""
+        """(nf,) undeformed facet sizes: their lengths in 2D, the square roots of their areas
+        in 3D (``lengths`` holds them)."""
         return self.lengths
+
+    @property
+    def areas(self) -> np.ndarray:
+        """(nf,) undeformed facet measures: their lengths in 2D, their areas in 3D."""
+        return self.lengths if self.dim == 2 else self.lengths ** 2
 
     def project(self, points: np.ndarray, x: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -481,6 +497,46 @@ def triangles(t: np.ndarray) -> np.ndarray:
     if t.shape[0] == 4:
         t = np.hstack([t[[0, 1, 3]], t[[1, 2, 3]]])
     return t.T.copy()
+
+
+def _kuhn_tets() -> np.ndarray:
+    """(6, 4) local vertex numbers of the six tetrahedra of a scikit-fem hexahedron around its
+    diagonal from reference corner (0, 0, 0) to (1, 1, 1) (Kuhn's split)."""
+    from skfem.refdom import RefHex
+
+    index = {tuple(int(v) for v in c): k for k, c in enumerate(RefHex.p.T)}
+    out = []
+    for perm in itertools.permutations(range(3)):
+        c = [0, 0, 0]
+        path = [index[tuple(c)]]
+        for axis in perm:
+            c[axis] = 1
+            path.append(index[tuple(c)])
+        out.append(path)
+    return np.array(out)
+
+
+def simplices(mesh, t: np.ndarray) -> np.ndarray:
+    """(n, 4) tetrahedra of 3D elements ``t`` (vertices, n) of ``mesh``: tetrahedra as they
+    are, hexahedra split in six (:func:`_kuhn_tets`; the 3D :func:`triangles`)."""
+    if isinstance(mesh, MeshHex):
+        return np.vstack([t[k].T for k in _kuhn_tets()])
+    return t[:4].T.copy()
+
+
+def element_volumes(mesh, elem: np.ndarray) -> np.ndarray:
+    """(len(elem),) volumes of 3D elements ``elem`` of ``mesh`` (its geometry: straight
+    tetrahedra, trilinear hexahedra) by scikit-fem's quadrature of det J, exact for both."""
+    from skfem import Basis, ElementHex1, ElementTetP1
+
+    elem = np.asarray(elem, dtype=np.int64)
+    if not len(elem):
+        return np.zeros(0)
+    uniq, inverse = np.unique(elem, return_inverse=True)
+    hexa = isinstance(mesh, MeshHex)
+    basis = Basis(mesh, ElementHex1() if hexa else ElementTetP1(), elements=uniq,
+                  intorder=3 if hexa else 1)
+    return basis.dx.sum(axis=1)[inverse.ravel()]
 
 
 def locate_in_triangles(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> np.ndarray:
