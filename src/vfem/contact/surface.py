@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
-from skfem import BilinearForm, ElementLineP1, FacetBasis, MeshHex, MeshTri
+from skfem import BilinearForm, ElementLineP1, FacetBasis, MeshHex, MeshTet, MeshTri
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
@@ -38,6 +38,7 @@ from .facets import (  # noqa: F401 - the 2D facet's functions, here too for tho
     facet_shape_derivative,
     kind_of,
 )
+from .facets3d import closest_on_facets
 from .search import project_points
 
 log = logging.getLogger(__name__)
@@ -408,9 +409,9 @@ class ContactSurface:
         return self.kind.material_positions(x, self.facets, points)
 
     def locate(self, x_tracked: np.ndarray, points: np.ndarray) -> np.ndarray:
-        """Rind triangle containing each point (current configuration), or -1
-        (:func:`locate_in_triangles`)."""
-        return locate_in_triangles(x_tracked, self.rind, points)
+        """Rind triangle (3D: tetrahedron) containing each point (current configuration), or -1
+        (:func:`locate_in_simplices`)."""
+        return locate_in_simplices(x_tracked, self.rind, points)
 
     def quadrature(self, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Gauss points of the virtual elements on each candidate facet.
@@ -524,6 +525,14 @@ def simplices(mesh, t: np.ndarray) -> np.ndarray:
     return t[:4].T.copy()
 
 
+def mesh_simplices(mesh) -> np.ndarray:
+    """Every element of ``mesh`` as simplices (its vertices' numbers): triangles in 2D
+    (:func:`triangles`), tetrahedra in 3D (:func:`simplices`)."""
+    if mesh.p.shape[0] == 2:
+        return triangles(mesh.t)
+    return simplices(mesh, mesh.t)
+
+
 def element_volumes(mesh, elem: np.ndarray) -> np.ndarray:
     """(len(elem),) volumes of 3D elements ``elem`` of ``mesh`` (its geometry: straight
     tetrahedra, trilinear hexahedra) by scikit-fem's quadrature of det J, exact for both."""
@@ -541,22 +550,35 @@ def element_volumes(mesh, elem: np.ndarray) -> np.ndarray:
 
 def locate_in_triangles(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> np.ndarray:
     """The triangle (row of ``tri``, (nt, 3) numbers of the positions ``x`` (n, 2)) containing
-    each of ``points`` (m, 2), or -1 (points on an edge count as inside).
+    each of ``points`` (m, 2), or -1 (points on an edge count as inside): the 2D
+    :func:`locate_in_simplices`."""
+    return locate_in_simplices(x, tri, points)
 
-    Uses scikit-fem's affine mapping of the triangles: the inverse map gives a point's local
-    coordinates in a triangle. Nearby triangles (by centroid) are tried first; points they do
-    not contain are tried against every triangle whose centroid is close enough for it to hold
-    them, since elements may be long and thin.
+
+def locate_in_simplices(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The simplex (row of ``tri``, (nt, dim + 1) numbers of the positions ``x`` (n, dim))
+    containing each of ``points`` (m, dim), or -1: triangles in 2D, tetrahedra in 3D (points
+    on an edge or a face count as inside: every barycentric coordinate >= -1e-12).
+
+    Uses scikit-fem's affine mapping of the simplices (``MeshTri``, ``MeshTet``): the inverse
+    map gives a point's local coordinates in a simplex. Nearby simplices (by centroid) are
+    tried first; points they do not contain are tried against every simplex whose centroid is
+    close enough for it to hold them, since elements may be long and thin.
     """
     found = np.full(len(points), -1)
     if len(points) == 0 or len(tri) == 0:
         return found
-    mesh = MeshTri(x.T.copy(), tri.T.copy(), sort_t=False, validate=False)
+    three = x.shape[1] == 3
+    mesh = (MeshTet if three else MeshTri)(x.T.copy(), tri.T.copy(), sort_t=False,
+                                             validate=False)
     mapping = mesh._mapping()
 
     def inside(tind, pts):
         loc = mapping.invF(pts.T[:, :, None], tind=tind)[:, :, 0]
         eps = 1e-12
+        if three:
+            return ((loc[0] >= -eps) & (loc[1] >= -eps) & (loc[2] >= -eps)
+                    & (1 - loc[0] - loc[1] - loc[2] >= -eps))
         return (loc[0] >= -eps) & (loc[1] >= -eps) & (1 - loc[0] - loc[1] >= -eps)
 
     centres = x[tri].mean(axis=1)
@@ -615,8 +637,8 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
             deep = np.flatnonzero(depth > rind)
             if deep.size:
                 mesh = sj.body.mesh
-                deep = deep[locate_in_triangles(mesh.p[:, : mesh.nvertices].T,
-                                                triangles(mesh.t), x[deep]) >= 0]
+                deep = deep[locate_in_simplices(mesh.p[:, : mesh.nvertices].T,
+                                                mesh_simplices(mesh), x[deep]) >= 0]
             if not deep.size:
                 continue
             count += deep.size
@@ -626,10 +648,10 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
     if worst is not None:
         depth, rind, si, sj, k = worst
         a, b = si.body.name, sj.body.name
-        x = si.X[k]
+        where = ", ".join(f"{v:.6g}" for v in si.X[k])  # (x, y) or (x, y, z)
         raise InputError(
             f"bodies {a!r} and {b!r} start deeply interpenetrated: node {int(si.nodes[k])} of "
-            f"{a!r}, at ({x[0]:.6g}, {x[1]:.6g}), lies {depth:.3g} inside {b!r}, deeper than "
+            f"{a!r}, at ({where}), lies {depth:.3g} inside {b!r}, deeper than "
             f"its outer layer of elements there ({rind:.3g}; {count} such node(s) in all); "
             "contact cannot resolve an overlap that deep. Move the bodies apart (an input file's "
             "mesh.translate; a built-in example's own parameters, e.g. hertz's initial_gap >= 0) "
@@ -638,11 +660,11 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
 
 
 def predicted_translation(body: Body, load_factor: float) -> np.ndarray:
-    """(2,) the body's motion at ``load_factor`` as its prescribed displacements predict it, a
+    """(dim,) the body's motion at ``load_factor`` as its prescribed displacements predict it, a
     rigid translation (the mean prescribed value of each component; zero for a component that
     nothing prescribes). What candidate selection needs to see bodies that start apart."""
-    out = np.zeros(2)
-    for c in range(2):
+    out = np.zeros(body.dim)
+    for c in range(body.dim):
         values = [pd.at(load_factor) for pd in body.prescribed
                   if COMPONENTS[pd.component] == c]
         if values:
@@ -652,17 +674,23 @@ def predicted_translation(body: Body, load_factor: float) -> np.ndarray:
 
 def platen_approach(moving: tuple[np.ndarray, np.ndarray], fixed: tuple[np.ndarray, np.ndarray],
                     direction: np.ndarray, chunk: int = 2_000_000) -> float:
-    """How far the facets ``moving`` (ends (s, 2) and (s, 2)) travel along the unit
-    ``direction`` before they first meet the facets ``fixed`` (inf if never): the smallest
-    ray hit of one set's facet ends on the other's facets (``moving``'s ends along
-    ``direction``, ``fixed``'s along its opposite). Where a force-controlled body (a platen)
-    that starts apart from another will touch it; the platen's own motion is not known before
-    the solve, so candidate selection looks there (:func:`select_candidate_facets`)."""
+    """How far the facets ``moving`` (ends (s, 2) and (s, 2); in 3D triangles, corners (s, 3)
+    three times) travel along the unit ``direction`` before they first meet the facets
+    ``fixed`` (inf if never): the smallest ray hit of one set's facet corners on the other's
+    facets (``moving``'s corners along ``direction``, ``fixed``'s along its opposite; in 3D a
+    ray-triangle intersection, Moeller-Trumbore; edges crossing edges are not looked at).
+    Where a force-controlled body (a platen) that starts apart from another will touch it; the
+    platen's own motion is not known before the solve, so candidate selection looks there
+    (:func:`select_candidate_facets`)."""
     best = np.inf
-    for points, (a, b), e in ((np.unique(np.vstack(moving), axis=0), fixed, direction),
+    for points, facets, e in ((np.unique(np.vstack(moving), axis=0), fixed, direction),
                               (np.unique(np.vstack(fixed), axis=0), moving, -direction)):
-        if len(points) == 0 or len(a) == 0:
+        if len(points) == 0 or len(facets[0]) == 0:
             continue
+        if len(facets) == 3:
+            best = min(best, _ray_triangles(points, *facets, e, chunk))
+            continue
+        a, b = facets
         d = b - a
         denom = d[:, 0] * e[1] - d[:, 1] * e[0]  # cross(d, e): zero for facets along the ray
         step = max(1, chunk // len(a))
@@ -675,6 +703,57 @@ def platen_approach(moving: tuple[np.ndarray, np.ndarray], fixed: tuple[np.ndarr
             if hit.any():
                 best = min(best, float(t[hit].min()))
     return best
+
+
+def _ray_triangles(points: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray,
+                   e: np.ndarray, chunk: int) -> float:
+    """The shortest distance along the unit ``e`` from any of ``points`` (m, 3) to any of the
+    triangles (corners ``a``, ``b``, ``c``, (s, 3) each), inf if no ray hits one
+    (Moeller-Trumbore; a hit on an edge or a corner counts)."""
+    best = np.inf
+    e1, e2 = b - a, c - a
+    pvec = np.cross(e, e2)  # (s, 3)
+    det = np.einsum("ij,ij->i", e1, pvec)  # zero for triangles parallel to the ray
+    step = max(1, chunk // len(a))
+    for k in range(0, len(points), step):
+        w = points[k:k + step, None, :] - a[None, :, :]  # (points, triangles, 3)
+        qvec = np.cross(w, e1[None])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = np.einsum("ijk,jk->ij", w, pvec) / det
+            v = (qvec @ e) / det
+            t = np.einsum("ijk,jk->ij", qvec, e2) / det
+            hit = (det != 0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0)
+        if hit.any():
+            best = min(best, float(t[hit].min()))
+    return best
+
+
+def _facet_geometry(body: Body, f: np.ndarray):
+    """(facets, mids, half) of a body's exterior facets ``f`` (their vertices, straight): 2D
+    the ends ``(a, b)``, 3D triangles ``(a, b, c)`` (quadrilaterals split in two); their
+    centres; the largest distance from a centre to a corner (half a 2D facet's length)."""
+    mesh = body.mesh
+    if body.dim == 2:
+        a, c = mesh.p[:, mesh.facets[0, f]].T, mesh.p[:, mesh.facets[1, f]].T
+        return (a, c), 0.5 * (a + c), 0.5 * np.linalg.norm(c - a, axis=1)
+    corners = mesh.p[:, mesh.facets[:, f]].transpose(2, 1, 0)  # (nf, k, 3)
+    mids = corners.mean(axis=1)
+    half = np.linalg.norm(corners - mids[:, None], axis=2).max(axis=1)
+    split = [(0, 1, 2)] if corners.shape[1] == 3 else [(0, 1, 2), (0, 2, 3)]
+    tri = tuple(np.vstack([corners[:, s[k]] for s in split]) for k in range(3))
+    return tri, mids, half
+
+
+def _distance_to_facets(points: np.ndarray, facets: tuple[np.ndarray, ...]) -> np.ndarray:
+    """(m,) each point's distance to the nearest of the facets (:func:`_facet_geometry`)."""
+    if len(facets) == 2:
+        return project_points(points, *facets)[2]
+    a, b, c = facets
+    if len(a) == 0:
+        return np.full(len(points), np.inf)
+    x = np.vstack([a, b, c])
+    tri = np.arange(len(x)).reshape(3, -1).T
+    return closest_on_facets(points, x, tri).distance  # nearest by bounding spheres
 
 
 #: the most load factors :func:`select_candidate_facets` samples to follow a long path
@@ -707,9 +786,10 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
     Bodies that start apart and are driven together must find each other: each body's facets
     are moved by the body's :func:`predicted_translation` at load factors sampled over the
     schedule (its values and 16 between its smallest and largest), and a facet is a candidate
-    when, at one of them, its midpoint is within ``search_distance`` plus its half length of
-    another body's surface (the exact distance to that body's facets, so that one long facet
-    elsewhere does not widen the search) or inside that body (bodies that start overlapping).
+    when, at one of them, its midpoint is within ``search_distance`` plus its half length (3D:
+    its centre, plus the distance from there to its farthest corner) of another body's
+    surface (the exact distance to that body's facets, so that one long facet elsewhere does
+    not widen the search) or inside that body (bodies that start overlapping).
     A body moved by a platen (force control) is also looked at where its platen would first
     bring it within reach of the other body (:func:`platen_approach`): a cylinder pressed onto
     a flat from a small gap finds the flat. ``follow_path`` (large kinematics, where a body may
@@ -724,10 +804,10 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
     moves = [np.array([predicted_translation(b, x) for x in samples]) for b in bodies]
     ends, mids, half = [], [], []
     for b, f in zip(bodies, ext):
-        a, c = b.mesh.p[:, b.mesh.facets[0, f]].T, b.mesh.p[:, b.mesh.facets[1, f]].T
-        ends.append((a, c))
-        mids.append(0.5 * (a + c))
-        half.append(0.5 * np.linalg.norm(c - a, axis=1))
+        facets, mid, h = _facet_geometry(b, f)
+        ends.append(facets)
+        mids.append(mid)
+        half.append(h)
     out = []
     for i in range(len(bodies)):
         keep = np.zeros(len(ext[i]), dtype=bool)
@@ -744,7 +824,7 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
                 for direction in np.unique(np.sign([platen.force_at(x) for x in samples])):
                     if direction == 0.0:
                         continue
-                    e = np.zeros(2)
+                    e = np.zeros(bodies[mover].dim)
                     e[COMPONENTS[platen.component]] = direction
                     t = platen_approach(ends[mover], ends[other], e)
                     if np.isfinite(t) and t > search_distance:  # else the schedule's reach
@@ -757,13 +837,13 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
                 if not np.all(np.abs(r) <= 1e6 * max(scale, 1e-300)):
                     continue  # a motion no step of a contact analysis can follow
                 x = mids[i] + r
-                _, _, d = project_points(x, *ends[j])
+                d = _distance_to_facets(x, ends[j])
                 keep |= d <= search_distance + half[i]
                 # facets that start inside the other body (an initial overlap)
                 box = np.flatnonzero(~keep & np.all((x >= lo) & (x <= hi), axis=1))
                 if len(box):
-                    tri = triangles(mesh.t) if tri is None else tri
-                    inside = locate_in_triangles(mesh.p[:, : mesh.nvertices].T, tri,
+                    tri = mesh_simplices(mesh) if tri is None else tri
+                    inside = locate_in_simplices(mesh.p[:, : mesh.nvertices].T, tri,
                                                  x[box]) >= 0
                     keep[box[inside]] = True
         out.append(ext[i][keep])
