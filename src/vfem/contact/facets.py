@@ -16,8 +16,8 @@ surface's methods that delegate to it), so it never branches on the dimension.
 * :class:`Triangle` and :class:`Quad` (``order`` 1 or 2): the 3-/6-node and 4-/9-node facets
   of a 3D surface (T3, T6, Q4, Q9 of :mod:`vfem.contact.facets3d`, whose kernels they call),
   ``xi`` two numbers per point in scikit-fem's reference domains. Their patch boundary is an
-  edge table. The overlap quadrature (:mod:`vfem.contact.overlap3d`) and the friction anchor's
-  material points are not theirs yet (C8, C13 of the 3D plan).
+  edge table. Their overlap quadrature is :mod:`vfem.contact.overlap3d`'s (linear facets only);
+  the friction anchor's material points are not theirs yet (C13 of the 3D plan).
 
 Callers treat ``xi`` and the patch boundary as opaque.
 """
@@ -428,6 +428,36 @@ class _Facet3D(FacetKind):
         vertices)."""
         at = facets3d.outside(self.geometry, np.reshape(xi_free, (-1, 2)), -facets3d.OUTSIDE)
         return (at & boundary[seg]).any(axis=1)
+
+    def overlap_quadrature(self, sf, fpatch, sc, cpatch, cnormals, reach, xf, xc):
+        """:func:`~vfem.contact.overlap3d.overlap_quadrature` on the facets of ``fpatch``
+        against those of ``cpatch`` whose bounding spheres come within ``reach``
+        (:func:`~vfem.contact.overlap3d.candidate_pairs`): each coarse facet projected along
+        the fine facet's normal onto its plane (not along ``cnormals``: exact on a flat
+        interface, second order on a curved one, overlap3d's docstring), clipped by the fine
+        facet, fanned into triangles with a Gauss rule exact for ``phi_f phi_f`` and ``phi_f
+        psi_c`` on flat parallelograms and triangles. The weights are the fine side's measure
+        at ``xf``, rescaled to its undeformed measure (the traction is nominal) where ``xf``
+        is not the undeformed ``sf.X``. Linear facets (T3, Q4) only."""
+        from . import overlap3d
+
+        if self.order != 1 or sc.kind.order != 1:
+            raise NotImplementedError(
+                f"the 3D overlap quadrature is for linear facets (T3, Q4) only, got {self!r} "
+                f"against {sc.kind!r}: quadratic 3D contact is not implemented yet")
+        fpatch = np.asarray(fpatch, dtype=np.int64)
+        cpatch = np.asarray(cpatch, dtype=np.int64)
+        comp = sf.facets[fpatch][:, : self.corners]
+        opp = sc.facets[cpatch][:, : sc.kind.corners]
+        pairs = overlap3d.candidate_pairs(xf, comp, xc, opp, reach)
+        q = overlap3d.overlap_quadrature(xf, comp, xc, opp, pairs, max_distance=reach)
+        fac, xi, wts = fpatch[q.comp_facet], q.comp_xi, q.weight
+        if len(fac) and not np.array_equal(xf[: sf.nc], sf.X[: sf.nc]):
+            _, now = self.surface_map(xf, sf.facets[fac], xi)
+            _, ref = self.surface_map(sf.X, sf.facets[fac], xi)
+            now = np.linalg.norm(now, axis=1)
+            wts = wts * np.linalg.norm(ref, axis=1) / np.where(now > 0, now, 1.0)
+        return fac, xi, wts
 
 
 class Triangle(_Facet3D):

@@ -15,8 +15,9 @@ opposing shape functions sum to one at every point, ``sum_c T[c, k] = sum_i N[i,
 round-off for any geometry (the two sides' forces ``N q`` and ``-T q`` balance), and where the
 rule is exact a uniform traction crosses non-matching meshes exactly.
 
-Nothing calls this yet; :func:`transfer_matrices` stays 2D until the ``FacetKind`` layer
-(plan C4-C7) routes triangles and quadrilaterals here.
+:func:`transfer_matrices` reaches it through the ``Triangle``/``Quad`` facet kinds'
+``overlap_quadrature`` (:mod:`vfem.contact.facets`, plan C8), which keeps the points and the
+compatibility side's local coordinates and weights.
 
 **Facets.** Linear triangles ``(nf, 3)`` and bilinear quadrilaterals ``(nf, 4)``, one kind per
 surface, corners numbered around the facet (either way: a compatibility facet's frame follows

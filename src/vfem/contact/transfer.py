@@ -38,7 +38,8 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
     facets, so a uniform traction crosses exactly. On curved (quadratic) facets the points and
     weights follow the curve; the splits are found on the chords. Positions ``xf``, ``xc`` may
     be deformed; the measure stays the fine side's undeformed length (the traction is
-    nominal).
+    nominal). For triangles and quadrilaterals (3D, linear facets): the clipped overlaps of
+    :mod:`~vfem.contact.overlap3d`, exact on a flat interface (``Triangle.overlap_quadrature``).
     """
     # points farther than this from the coarse surface face something else (``gap``: the
     # largest gap of the pair's nodes)
