@@ -362,9 +362,10 @@ class Invariants:
                 f"contact force (body {body!r}; tolerance {self.force_tolerance:.3g})")
         if not self.separated and "interpenetration" in self.enforced:
             w = self.where
+            at = ", ".join(f"{w[c]:.6g}" for c in ("x", "y", "z") if c in w)
             parts.append(
                 f"invariant (b) no interpenetration violated: node {w['node']} of body "
-                f"{w['body']!r}, at ({w['x']:.6g}, {w['y']:.6g}) deformed, lies "
+                f"{w['body']!r}, at ({at}) deformed, lies "
                 f"{self.penetration:.3g} inside body {w['into']!r} (allowed {self.allowed:.3g}: "
                 "penetration tolerance and faceting allowance)")
         if not self.compressive and "tension" in self.enforced:
@@ -472,7 +473,7 @@ class InvariantCheck:
         if enforced is not None:
             out.enforced = tuple(enforced)
         if any(b.dim == 3 for b in self.bodies):
-            return self._untouched(fields, out, extra_allowance, t0)
+            return self._three_d(fields, out, extra_allowance, t0)
         ref = self.reference
         u = [np.asarray(fields[b.name].displacement)[g.nodes]
              for b, g in zip(self.bodies, self.boundaries)]
@@ -491,22 +492,38 @@ class InvariantCheck:
         out.seconds = time.perf_counter() - t0
         return out
 
-    def _untouched(self, fields: dict, out: Invariants, extra: float, t0: float
-                   ) -> Invariants:
-        """The invariants of 3D bodies that touch nothing (no pair may touch: the only 3D
-        models analysed before 3D contact, issue 21): (a) their contact forces, all zero,
-        balance; (b) no body is inside another, none being paired; (c) no tension, no node
-        carrying contact force. A 3D model with a pair, or a contact force, is refused: (b) and
-        (c) on triangle and quadrilateral facets are not implemented yet."""
+    def _three_d(self, fields: dict, out: Invariants, extra: float, t0: float
+                 ) -> Invariants:
+        """The invariants of 3D bodies (:mod:`vfem.contact.check3d`: boundaries of triangles
+        and quadrilaterals). Bodies that touch nothing (no pair, no contact force) are not
+        visited: (a) their forces, all zero, balance; (b) and (c) hold."""
+        from . import check3d
+
         F = [np.asarray(fields[b.name].contact_force, dtype=float) for b in self.bodies]
-        if self.pairs or any(np.any(f) for f in F):
-            raise NotImplementedError("the invariants of 3D contact (no interpenetration, no "
-                                      "tension on triangle and quadrilateral facets) are not "
-                                      "implemented yet")
         self._force_balance(F, out)
-        out.allowed = self.penetration_tolerance + extra  # as where no node is inside
-        out.tension_tolerance = min((self._tolerance(b) for b in self.bodies),
-                                    default=self.tension_tolerance)
+        if not self.pairs and not any(np.any(f) for f in F):
+            out.allowed = self.penetration_tolerance + extra  # as where no node is inside
+            out.tension_tolerance = min((self._tolerance(b) for b in self.bodies),
+                                        default=self.tension_tolerance)
+            out.seconds = time.perf_counter() - t0
+            return out
+        if self.tension_measure != "nodal":
+            raise NotImplementedError("the consistent tension measure in 3D is not implemented "
+                                      "(tension_measure='nodal' is)")
+        if self._reference is None:
+            boundaries = [check3d.Boundary3.of(b, _symmetry_facets(b)) for b in self.bodies]
+            self._boundaries = boundaries
+            self._reference = [check3d.Surface3(g, b.points[:, g.nodes].T)
+                               for b, g in zip(self.bodies, boundaries)]
+        ref = self._reference
+        u = [np.asarray(fields[b.name].displacement)[g.nodes]
+             for b, g in zip(self.bodies, self._boundaries)]
+        cur = [r if not np.any(ui) else check3d.Surface3(r.b, r.x + ui) for r, ui in zip(ref, u)]
+        Fb = [f[g.nodes] for f, g in zip(F, self._boundaries)]
+        check3d.interpenetration(self, cur, out, extra,
+                                 [_loaded_or_next(g.b.segments, f) for g, f in zip(cur, Fb)])
+        own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
+        check3d.tension(self, Fb, own, out)
         out.seconds = time.perf_counter() - t0
         return out
 

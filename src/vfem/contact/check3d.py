@@ -1,0 +1,374 @@
+"""The invariants (b) and (c) of :mod:`vfem.contact.check` on 3D bodies (issue 21, C9).
+
+The same checks as in 2D, on a body's boundary of triangles (a quadrilateral split in two
+along its first diagonal) in place of its boundary polygon:
+
+* **inside**: the sign of (p − c)·n at the point's closest point c on the other body's deformed
+  boundary, n the angle-weighted pseudonormal of the closest feature (the face's normal inside
+  a triangle, the sum of the two faces' normals on an edge, the angle-weighted sum of the
+  faces' normals at a vertex: exact for a closed surface, Bærentzen & Aanæs 2005); the whole
+  closed boundary is used, symmetry planes included.
+* **depth**: the distance to the boundary without its symmetry planes (roller supports held
+  normal to a flat boundary, any axis, :func:`~vfem.contact.check._symmetry_facets`); the
+  facet's size L is its longest side.
+* **allowance** (L/2)·tan(α/2), α twice the largest angle between the node's normal and the
+  normal of a boundary node within L of it on the convex side (the 2D "convex turning within
+  L": a box's edge turns 90°), at most 90°, the allowance at most the longer of L/2 and the
+  node's own facets' sides. A node on a symmetry plane takes its normal's component along the
+  plane (the mirrored model's).
+* **linearised depth** under small kinematics: the node's offset r from its closest point on
+  the other undeformed surface moved with the surface's displacement (interpolated linearly on
+  the triangle), read along the facet's normal and along the node's own normal (the smaller);
+  beside an edge or a vertex (the node's projection on the facet's plane outside it), |r| signed
+  by the feature's pseudonormal; the second-order allowance the slip times the angle the facet
+  has turned through.
+* **tension**: F·n with n the angle-weighted nodal normal (undeformed under small kinematics).
+
+Linear facets only: quadratic 3D bodies in contact, and the "consistent" tension measure in
+3D, are refused with NotImplementedError (docs/errors.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .facets import kind_of
+from .facets3d import closest_on_facets
+
+if TYPE_CHECKING:
+    from ..bodies import Body
+    from .check import InvariantCheck, Invariants
+
+#: a feature of a triangle: the barycentric coordinates below this (relative) are on its edge
+FEATURE = 1e-9
+
+
+@dataclass
+class Boundary3:
+    """One 3D body's boundary from its undeformed mesh (computed once), in a local numbering
+    of its boundary nodes (``nodes``: their point numbers)."""
+
+    nodes: np.ndarray  # (nb,)
+    triangles: np.ndarray  # (nt, 3) local numbers, counter-clockwise seen from outside
+    owner: np.ndarray  # (nt,) the boundary facet each triangle is part of
+    facets: np.ndarray  # (nf, 3 or 4) local numbers of the facets, oriented
+    mirror: np.ndarray  # (nt,) bool: the triangle lies on a symmetry plane
+    segments: np.ndarray  # (ne, 2) the facets' sides (local numbers): the nodes' neighbours
+    large: bool
+
+    @classmethod
+    def of(cls, body: Body, symmetry: np.ndarray) -> Boundary3:
+        """``symmetry``: the body's facets on a symmetry plane
+        (:func:`vfem.contact.check._symmetry_facets`)."""
+        if body.order != 1:
+            raise NotImplementedError(
+                f"the invariants of 3D contact on body {body.name!r}: quadratic elements are "
+                "not supported yet (linear triangle and quadrilateral facets only)")
+        mesh = body.mesh
+        bf = mesh.boundary_facets()
+        fp = body.facet_points(bf).copy()
+        if len(bf):
+            elem = mesh.f2t[0, bf]
+            centroid = body.points[:, mesh.t[:, elem]].mean(axis=1).T
+            kind_of(3, fp).orient(body.points, fp, centroid)
+        split = [(0, 1, 2)] if fp.shape[1] == 3 else [(0, 1, 2), (0, 2, 3)]
+        tri = np.vstack([fp[:, s] for s in split])
+        owner = np.tile(np.arange(len(fp)), len(split))
+        mirror = np.isin(bf, symmetry)[owner]
+        k = fp.shape[1]
+        sides = np.vstack([fp[:, [c, (c + 1) % k]] for c in range(k)])
+        sides = np.unique(np.sort(sides, axis=1), axis=0)
+        nodes, local = np.unique(fp, return_inverse=True)
+        lookup = np.full(body.npoints, -1)
+        lookup[nodes] = np.arange(len(nodes))
+        return cls(nodes=nodes, triangles=lookup[tri], owner=owner,
+                   facets=local.reshape(fp.shape), mirror=mirror,
+                   segments=lookup[sides].reshape(-1, 2), large=body.large)
+
+
+def _barycentric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """(m, 3) barycentric coordinates of the projection of ``p`` on the planes of the
+    triangles (a, b, c) (unclamped)."""
+    ab, ac, ap = b - a, c - a, p - a
+    d00, d01, d11 = (np.einsum("ij,ij->i", u, v) for u, v in ((ab, ab), (ab, ac), (ac, ac)))
+    d20, d21 = np.einsum("ij,ij->i", ap, ab), np.einsum("ij,ij->i", ap, ac)
+    den = np.maximum(d00 * d11 - d01 * d01, 1e-300)
+    s = (d11 * d20 - d01 * d21) / den
+    t = (d00 * d21 - d01 * d20) / den
+    return np.column_stack([1 - s - t, s, t])
+
+
+class Surface3:
+    """A 3D body's boundary at positions ``x`` ((nb, 3), local numbering); what is asked is
+    computed on first use (the API of :class:`~vfem.contact.check._Polygon`)."""
+
+    def __init__(self, boundary: Boundary3, x: np.ndarray):
+        self.b, self.x = boundary, x
+        self._cache: dict = {}
+
+    def _get(self, key, make):
+        if key not in self._cache:
+            self._cache[key] = make()
+        return self._cache[key]
+
+    @property
+    def corners(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = self.b.triangles
+        return self._get("corners", lambda: (self.x[t[:, 0]], self.x[t[:, 1]], self.x[t[:, 2]]))
+
+    @property
+    def unit_normals(self) -> np.ndarray:
+        def make():
+            a, b, c = self.corners
+            n = np.cross(b - a, c - a)
+            return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+        return self._get("unit_normals", make)
+
+    @property
+    def angles(self) -> np.ndarray:
+        """(nt, 3) each triangle's angle at its three corners."""
+        def make():
+            p = self.corners
+            out = np.zeros((len(self.b.triangles), 3))
+            for k in range(3):
+                u, v = p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]
+                out[:, k] = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1),
+                                       np.einsum("ij,ij->i", u, v))
+            return out
+        return self._get("angles", make)
+
+    def _vertex_pseudonormals(self, keep: np.ndarray) -> np.ndarray:
+        out = np.zeros_like(self.x)
+        n, w = self.unit_normals[keep], self.angles[keep]
+        for k in range(3):
+            np.add.at(out, self.b.triangles[keep, k], w[:, k, None] * n)
+        return out
+
+    @property
+    def pseudonormals(self) -> np.ndarray:
+        """(nb, 3) the angle-weighted sum of every boundary triangle's normal at each node."""
+        return self._get("pseudonormals", lambda: self._vertex_pseudonormals(
+            np.arange(len(self.b.triangles))))
+
+    @property
+    def edge_normals(self) -> dict:
+        """{(lo, hi): the sum of the normals of the triangles sharing that edge}."""
+        def make():
+            out: dict = {}
+            n = self.unit_normals
+            for f, tri in enumerate(self.b.triangles):
+                for k in range(3):
+                    key = (min(tri[k], tri[(k + 1) % 3]), max(tri[k], tri[(k + 1) % 3]))
+                    out[key] = out.get(key, 0.0) + n[f]
+            return out
+        return self._get("edge_normals", make)
+
+    @property
+    def sizes(self) -> np.ndarray:
+        """(nt,) the longest side of each triangle's facet."""
+        def make():
+            f = self.b.facets
+            k = f.shape[1]
+            side = np.max([np.linalg.norm(self.x[f[:, (c + 1) % k]] - self.x[f[:, c]], axis=1)
+                           for c in range(k)], axis=0)
+            return side[self.b.owner]
+        return self._get("sizes", make)
+
+    @property
+    def surface(self) -> np.ndarray:
+        """The triangles that are surface (not on a symmetry plane)."""
+        return self._get("surface", lambda: np.flatnonzero(~self.b.mirror)
+                         if (~self.b.mirror).any() else np.arange(len(self.b.mirror)))
+
+    @property
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._get("box", lambda: (self.x.min(axis=0), self.x.max(axis=0)))
+
+    def feature_normals(self, tri: np.ndarray, lam: np.ndarray, vertex: np.ndarray
+                        ) -> np.ndarray:
+        """(m, 3) the pseudonormal of the feature of triangles ``tri`` (rows of ``triangles``)
+        at barycentric coordinates ``lam`` (m, 3): the face's, an edge's, or a vertex's
+        (``vertex``: (nb, 3) the vertex pseudonormals to use)."""
+        out = self.unit_normals[tri].copy()
+        zero = lam <= FEATURE
+        nodes = self.b.triangles[tri]
+        edges = self.edge_normals
+        for m in np.flatnonzero(zero.any(axis=1)):
+            z = np.flatnonzero(zero[m])
+            if len(z) >= 2:  # a vertex: the one coordinate not zero
+                out[m] = vertex[nodes[m, 3 - z.sum()]]
+            else:  # an edge: the two corners other than z
+                e = nodes[m, [(z[0] + 1) % 3, (z[0] + 2) % 3]]
+                out[m] = edges[(min(e), max(e))]
+        return out
+
+    def _closest(self, pts: np.ndarray, keep: np.ndarray, point_normals=None):
+        tri = self.b.triangles[keep]
+        pr = closest_on_facets(pts, self.x, tri, point_normals=point_normals)
+        lam = np.column_stack([1 - pr.xi.sum(axis=1), pr.xi])
+        return keep[pr.facet], lam, pr.point, pr.distance
+
+    def inside(self, pts: np.ndarray) -> np.ndarray:
+        """Which of ``pts`` (m, 3) lie inside the closed boundary (on it counts as inside)."""
+        tri, lam, c, _ = self._closest(pts, np.arange(len(self.b.triangles)))
+        direction = self.feature_normals(tri, lam, self.pseudonormals)
+        return np.einsum("ij,ij->i", pts - c, direction) <= 1e-12 * np.maximum(
+            self.sizes[tri], 1e-300)
+
+    def depth(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Distance of ``pts`` to the surface triangles, the size of the closest one's facet
+        and its three nodes (local numbers)."""
+        tri, _, _, dist = self._closest(pts, self.surface)
+        return dist, self.sizes[tri], self.b.triangles[tri]
+
+    @property
+    def normals(self) -> np.ndarray:
+        """(nb, 3) the outward unit normal at each node: the angle-weighted mean of its surface
+        triangles' normals; on a symmetry plane, its component along the plane."""
+        def make():
+            out = self._vertex_pseudonormals(~self.b.mirror)
+            mirror = np.flatnonzero(self.b.mirror)
+            plane = np.zeros_like(self.x)
+            for k in range(3):
+                plane[self.b.triangles[mirror, k]] = self.unit_normals[mirror]
+            on = np.flatnonzero(plane.any(axis=1) & out.any(axis=1))
+            m = plane[on]
+            out[on] -= np.einsum("ij,ij->i", out[on], m)[:, None] * m
+            norm = np.linalg.norm(out, axis=1)
+            return out / np.where(norm > 0, norm, 1.0)[:, None]
+        return self._get("normals", make)
+
+    def turning_within(self, nodes: np.ndarray, radius: np.ndarray) -> np.ndarray:
+        """Twice the largest angle between the normal of each of ``nodes`` and that of a
+        boundary node within ``radius`` of it on the convex side ((x_q − x_p)·(n_q − n_p) > 0)."""
+        tree = self._get("tree", lambda: cKDTree(self.x))
+        n = self.normals
+        out = np.zeros(len(nodes))
+        for k, near in enumerate(tree.query_ball_point(self.x[nodes], radius)):
+            near = np.asarray(near, dtype=np.int64)
+            p = nodes[k]
+            if not len(near):
+                continue
+            convex = np.einsum("ij,ij->i", self.x[near] - self.x[p], n[near] - n[p]) > 0
+            if convex.any():
+                cos = np.clip(n[near[convex]] @ n[p], -1.0, 1.0)
+                out[k] = 2.0 * float(np.arccos(cos).max())
+        return out
+
+    @property
+    def adjacent(self) -> np.ndarray:
+        """(nb,) the longest side of the surface facets at each node."""
+        def make():
+            out = np.zeros(len(self.x))
+            keep = self.surface if (~self.b.mirror).any() else np.zeros(0, dtype=np.int64)
+            for k in range(3):
+                np.maximum.at(out, self.b.triangles[keep, k], self.sizes[keep])
+            return out
+        return self._get("adjacent", make)
+
+
+def linearised_depth(check: InvariantCheck, i: int, j: int, node: np.ndarray,
+                     cur: list[Surface3]) -> tuple[np.ndarray, np.ndarray]:
+    """Small kinematics: the depth of body i's boundary ``node`` (local numbers) into body j as
+    linear theory reads it, and its second-order allowance (2D:
+    :meth:`~vfem.contact.check.InvariantCheck._linearised_depth`)."""
+    ri, rj = check.reference[i], check.reference[j]
+    keep = rj.surface
+    tri, lam, c, dist = rj._closest(ri.x[node], keep, point_normals=ri.normals[node])
+    corners = rj.b.triangles[tri]
+    uj = cur[j].x - rj.x
+    uc = np.einsum("mk,mkd->md", lam, uj[corners])
+    r = cur[i].x[node] - (c + uc)
+    n = rj.unit_normals[tri]
+    depth = np.minimum(-np.einsum("ij,ij->i", r, n), np.einsum("ij,ij->i", r, ri.normals[node]))
+    # beside an edge or a vertex: the node's projection on the facet's plane lies outside it
+    a, b, cc = rj.corners
+    free = _barycentric(ri.x[node], a[tri], b[tri], cc[tri])
+    vertex = (free < -FEATURE).any(axis=1) & (dist > 1e-12 * np.maximum(rj.sizes[tri], 1e-300))
+    if vertex.any():
+        feature = rj.feature_normals(tri, lam, rj._get(
+            "surface_pseudonormals", lambda: rj._vertex_pseudonormals(keep)))
+        outside = np.einsum("ij,ij->i", r, feature) > 0
+        depth[vertex] = np.where(outside, -1.0, 1.0)[vertex] * np.linalg.norm(r, axis=1)[vertex]
+    # second order: the slip along the facet times the angle it has turned through
+    n1 = cur[j].unit_normals[tri]
+    theta = np.arctan2(np.linalg.norm(np.cross(n, n1), axis=1), np.einsum("ij,ij->i", n, n1))
+    slip = np.linalg.norm(r - np.einsum("ij,ij->i", r, n)[:, None] * n, axis=1)
+    cos_beta = np.clip(-np.einsum("ij,ij->i", n, ri.normals[node]), 1e-3, 1.0)
+    slip = slip + dist * np.sqrt(1.0 - cos_beta**2) / cos_beta
+    return depth, np.where(vertex, 0.0, slip * np.abs(theta))
+
+
+def interpenetration(check: InvariantCheck, cur: list[Surface3], out: Invariants,
+                     extra: float, touched: list[np.ndarray]) -> None:
+    """(b) on 3D bodies (2D: :meth:`~vfem.contact.check.InvariantCheck._interpenetration`);
+    ``touched``: per body, its boundary nodes that carry contact force or share a facet side
+    with one that does."""
+    tol = check.penetration_tolerance + extra
+    best = None
+    deepest = 0.0
+    for i, j in check.pairs:
+        gi, gj = cur[i], cur[j]
+        if len(gi.x) == 0 or len(gj.b.triangles) == 0:
+            continue
+        lo, hi = gj.box
+        pad = 1e-9 * max(float(np.linalg.norm(hi - lo)), 1e-300)
+        near = np.flatnonzero(np.all((gi.x >= lo - pad) & (gi.x <= hi + pad), axis=1))
+        if not near.size:
+            continue
+        node = near[gj.inside(gi.x[near])]
+        if not node.size:
+            continue
+        depth, L, ends = gj.depth(gi.x[node])
+        L = np.where(touched[j][ends].any(axis=1), L, 0.0)
+        deformed, linearised, second = depth, None, 0.0
+        if not (gi.b.large or gj.b.large):
+            linearised, second = linearised_depth(check, i, j, node, cur)
+            depth = np.minimum(depth, linearised)
+        alpha = np.minimum(gi.turning_within(node, L), 0.5 * np.pi)
+        allowed = tol + second + np.minimum(0.5 * L * np.tan(0.5 * alpha),
+                                            np.maximum(gi.adjacent[node], 0.5 * L))
+        deepest = max(deepest, float(depth.max()))
+        k = int(np.argmax(depth - allowed))
+        cand = (float(depth[k] - allowed[k]), float(depth[k]), float(allowed[k]), i,
+                int(node[k]), j, float(deformed[k]),
+                None if linearised is None else float(linearised[k]))
+        if best is None or (cand[0] > 0 and cand[0] > best[0]) or (
+                best[0] <= 0 and cand[0] <= 0 and cand[1] > best[1]):
+            best = cand
+    out.max_penetration = max(deepest, 0.0)
+    if best is None:
+        out.allowed = tol
+        return
+    _, out.penetration, out.allowed, i, k, j, deformed, linearised = best
+    pos = cur[i].x[k]
+    out.where = {"body": check.bodies[i].name, "node": int(cur[i].b.nodes[k]),
+                 "into": check.bodies[j].name, "x": float(pos[0]), "y": float(pos[1]),
+                 "z": float(pos[2]), "deformed_depth": deformed,
+                 "linearised_depth": linearised}
+
+
+def tension(check: InvariantCheck, F: list[np.ndarray], own: list[Surface3],
+            out: Invariants) -> None:
+    """(c), the nodal measure, on 3D bodies (linear facets: F·n at every node)."""
+    scale = max((float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in F), default=0.0)
+    out.tension_tolerance = check.tension_tolerance
+    if scale == 0:
+        return
+    worst = None
+    for b, f, g in zip(check.bodies, F, own):
+        if not len(f):
+            continue
+        fn = np.einsum("ij,ij->i", f, g.normals)
+        k = int(np.argmax(fn))
+        ratio = fn[k] / scale / check.tension_tolerance
+        if fn[k] > 0 and (worst is None or ratio > worst[0]):
+            worst = (ratio, float(fn[k]), b, int(g.b.nodes[k]))
+    if worst is not None:
+        _, value, b, node = worst
+        out.tension = value / scale
+        out.tension_where = {"body": b.name, "node": node, "value": value}
