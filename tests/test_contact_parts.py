@@ -215,7 +215,9 @@ def test_each_setting_picks_one_formulation_that_implements_the_contract(method,
     for name in ("new_state", "solve", "fields"):
         assert callable(getattr(picked, name)), name
     caps = picked.capabilities
-    assert caps.dimensions == (2,)
+    # 3D contact: the paired variant's, small kinematics, linear elements (issue 21, C10)
+    assert caps.dimensions == ((2, 3) if cls is PairedContact else (2,))
+    assert caps.orders_3d == ((1,) if cls is PairedContact else ())
     # Coulomb friction: the frictional formulations' (vfem), the lagrange baseline's
     assert caps.friction == (("frictionless", "coulomb") if cls is GlobalContact
                              else ("frictionless",))
@@ -242,8 +244,15 @@ def test_the_model_checks_read_the_declared_capabilities():
         check_capabilities(fake_model(large=True, variant="thesis"))
     with pytest.raises(InputError, match="classical contact methods .* need linear elements"):
         check_capabilities(fake_model(large=True, method="penalty"))
-    with pytest.raises(InputError, match="supports 2D bodies, this one is 3D"):
-        check_capabilities(fake_model(dim=3))
+    check_capabilities(fake_model(dim=3))  # the paired variant: linear 3D bodies too (C10)
+    with pytest.raises(InputError, match="thesis contact supports 2D bodies, this one is 3D"):
+        check_capabilities(fake_model(dim=3, variant="thesis"))
+    with pytest.raises(InputError, match="paired contact supports 2D bodies, this one is 3D"):
+        check_capabilities(fake_model(dim=3, large=True))
+    with pytest.raises(InputError, match="3D contact supports linear elements only"):
+        check_capabilities(fake_model(order=2, dim=3))
+    with pytest.raises(InputError, match="friction in 3D contact is not implemented yet"):
+        check_capabilities(fake_model(dim=3, friction=0.3))
 
 
 # -- each formulation's own typed state ------------------------------------------------------------

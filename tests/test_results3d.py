@@ -336,17 +336,22 @@ def test_a_model_of_2d_and_3d_bodies_is_refused():
         Model("mixed", [flat, solid], contact_pairs=()).validate()
 
 
-def test_3d_bodies_that_may_touch_are_refused():
-    """3D contact is not there yet: two 3D bodies that may touch (every pair, by default)
-    are refused by the contact formulation's capabilities, each named."""
-    model = boxes("hex", 1)
+def test_3d_bodies_that_may_touch_are_refused_where_3d_contact_is_not_there():
+    """3D contact (issue 21, C10) is the paired variant's, frictionless, of linear elements:
+    two quadratic 3D bodies that may touch (every pair, by default) are refused, each named;
+    linear ones are accepted."""
+    model = boxes("hex", 2)
     model.contact_pairs = None
-    with pytest.raises(InputError, match=r"body 'rollers': paired contact supports 2D "
-                                         r"bodies, this one is 3D"):
+    with pytest.raises(InputError, match=r"body 'rollers': 3D contact supports linear "
+                                         r"elements only"):
         model.validate()
     model.contact_pairs = (("rollers", "clamped"),)
-    with pytest.raises(InputError, match="this one is 3D"):
+    with pytest.raises(InputError, match="quadratic 3D contact is not implemented yet"):
         model.validate()
+    boxes("hex", 1).validate()
+    linear = boxes("hex", 1)
+    linear.contact_pairs = None
+    linear.validate()
 
 
 def test_resume_tells_a_3d_default_support_from_x_and_y(tmp_path):

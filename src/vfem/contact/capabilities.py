@@ -19,6 +19,8 @@ class Capabilities:
     locates nodes in the opposing rind as it iterates); the others read only the candidate
     nodes, so each body is condensed to its candidate dofs alone (issue 19, item 4: the dense
     block, its inversion and its memory shrink by about 2, 8 and 4 times on a long surface).
+    ``orders_3d``: the element orders of ``orders`` it supports on 3D bodies that may touch
+    (the 3D overlap quadrature is for linear facets only: issue 21, C10).
     """
 
     name: str
@@ -29,3 +31,4 @@ class Capabilities:
     invariants: str = "enforced"
     cuts_steps: bool = True
     reads_rind: bool = False
+    orders_3d: tuple[int, ...] = ()

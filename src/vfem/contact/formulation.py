@@ -133,12 +133,24 @@ def check_capabilities(model) -> None:
                              f"supports {_orders(caps).replace(' (', ' only (', 1)}; use the "
                              "paired variant for quadratic elements")
         dim = b.mesh.p.shape[0]
-        if dim not in caps.dimensions and b.name in touching:
+        if b.name not in touching:
+            continue
+        if dim not in caps.dimensions:
+            if dim == 3 and settings.frictional:
+                raise InputError(f"model {model.name!r}, body {b.name!r}: friction in 3D "
+                                 "contact is not implemented yet; set the friction to 0 for "
+                                 "frictionless 3D contact (the paired variant, small "
+                                 "kinematics, linear elements)")
             raise InputError(f"model {model.name!r}, body {b.name!r}: {caps.name} contact "
                              f"supports {' and '.join(f'{d}D' for d in caps.dimensions)} "
-                             f"bodies, this one is {dim}D; 3D contact is not implemented "
-                             "yet (a 3D body that touches no other runs without contact)")
-
+                             f"bodies, this one is {dim}D; 3D contact needs the paired "
+                             "variant, small kinematics, linear elements and no friction (a 3D "
+                             "body that touches no other runs without contact)")
+        if dim == 3 and b.order not in caps.orders_3d:
+            raise InputError(f"model {model.name!r}, body {b.name!r}: 3D contact supports "
+                             "linear elements only (order 1); quadratic 3D contact is not "
+                             "implemented yet (a 3D body that touches no other may be "
+                             "quadratic)")
 
 def bodies_that_may_touch(model) -> set[str]:
     """The names of the bodies in a pair that may touch (``contact_pairs``, by default every

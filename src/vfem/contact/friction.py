@@ -216,7 +216,8 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     """The paired variant with Coulomb friction, small displacements (module docstring)."""
 
     capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
-                                       friction=("frictionless", "coulomb"))
+                                       friction=("frictionless", "coulomb"), dimensions=(2,),
+                                       orders_3d=())
     state_type = FrictionState
 
     def __init__(self, surfaces, pairs, settings, backend: str | None = None):

@@ -340,8 +340,8 @@ class PairedContact(PairSet):
     module docstring)."""
 
     capabilities = Capabilities(
-        name="paired", orders=(1, 2), kinematics=("small",), dimensions=(2,),
-        friction=("frictionless",))
+        name="paired", orders=(1, 2), kinematics=("small",), dimensions=(2, 3),
+        friction=("frictionless",), orders_3d=(1,))
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
                  backend: str | None = None):
