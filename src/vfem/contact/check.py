@@ -520,8 +520,8 @@ class InvariantCheck:
              for b, g in zip(self.bodies, self._boundaries)]
         cur = [r if not np.any(ui) else check3d.Surface3(r.b, r.x + ui) for r, ui in zip(ref, u)]
         Fb = [f[g.nodes] for f, g in zip(F, self._boundaries)]
-        check3d.interpenetration(self, cur, out, extra,
-                                 [_loaded_or_next(g.b.segments, f) for g, f in zip(cur, Fb)])
+        self._interpenetration(cur, out, extra, Fb, lambda i, j, node, cur:
+                               check3d.linearised_depth(self, i, j, node, cur))
         own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
         check3d.tension(self, Fb, own, out)
         out.seconds = time.perf_counter() - t0
@@ -541,8 +541,15 @@ class InvariantCheck:
 
     # -- (b) ------------------------------------------------------------------------------------
 
-    def _interpenetration(self, cur: list[_Polygon], out: Invariants, extra: float,
-                          forces: list[np.ndarray] | None = None) -> None:
+    def _interpenetration(self, cur: list, out: Invariants, extra: float,
+                          forces: list[np.ndarray] | None = None, linearised_depth=None) -> None:
+        """(b) on the current surfaces ``cur`` (2D :class:`_Polygon` s, or 3D
+        :class:`~vfem.contact.check3d.Surface3` s, which answer the same questions: box,
+        inside, depth, turning_within, adjacent); ``linearised_depth`` (i, j, node, cur) ->
+        (depth, second-order allowance): small kinematics' reading, 2D's
+        :meth:`_linearised_depth` by default."""
+        if linearised_depth is None:
+            linearised_depth = self._linearised_depth
         tol = self.penetration_tolerance + extra
         # per body: its boundary nodes that carry contact force or neighbour one that does
         touched = None if forces is None else [_loaded_or_next(g.b.segments, f)
@@ -570,7 +577,7 @@ class InvariantCheck:
                 L = np.where(touched[j][ends].any(axis=1), L, 0.0)
             deformed, linearised, second = depth, None, 0.0
             if not (gi.b.large or gj.b.large):
-                linearised, second = self._linearised_depth(i, j, node, cur)
+                linearised, second = linearised_depth(i, j, node, cur)
                 depth = np.minimum(depth, linearised)
             alpha = np.minimum(gi.turning_within(node, L), 0.5 * np.pi)
             allowed = tol + second + np.minimum(0.5 * L * np.tan(0.5 * alpha),
@@ -591,6 +598,7 @@ class InvariantCheck:
         pos = cur[i].x[k]
         out.where = {"body": self.bodies[i].name, "node": int(cur[i].b.nodes[k]),
                      "into": self.bodies[j].name, "x": float(pos[0]), "y": float(pos[1]),
+                     **({"z": float(pos[2])} if len(pos) == 3 else {}),
                      "deformed_depth": deformed, "linearised_depth": linearised}
 
     def _linearised_depth(self, i: int, j: int, node: np.ndarray, cur: list[_Polygon]

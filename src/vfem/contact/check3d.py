@@ -25,7 +25,9 @@ along its first diagonal) in place of its boundary polygon:
 * **tension**: F·n with n the angle-weighted nodal normal (undeformed under small kinematics).
 
 Linear facets only: quadratic 3D bodies in contact, and the "consistent" tension measure in
-3D, are refused with NotImplementedError (docs/errors.md).
+3D, are refused with NotImplementedError (docs/errors.md). The loop of (b) over the pairs is
+:meth:`~vfem.contact.check.InvariantCheck._interpenetration`, shared with 2D: a
+:class:`Surface3` answers the questions a 2D boundary polygon does.
 """
 
 from __future__ import annotations
@@ -301,55 +303,6 @@ def linearised_depth(check: InvariantCheck, i: int, j: int, node: np.ndarray,
     cos_beta = np.clip(-np.einsum("ij,ij->i", n, ri.normals[node]), 1e-3, 1.0)
     slip = slip + dist * np.sqrt(1.0 - cos_beta**2) / cos_beta
     return depth, np.where(vertex, 0.0, slip * np.abs(theta))
-
-
-def interpenetration(check: InvariantCheck, cur: list[Surface3], out: Invariants,
-                     extra: float, touched: list[np.ndarray]) -> None:
-    """(b) on 3D bodies (2D: :meth:`~vfem.contact.check.InvariantCheck._interpenetration`);
-    ``touched``: per body, its boundary nodes that carry contact force or share a facet side
-    with one that does."""
-    tol = check.penetration_tolerance + extra
-    best = None
-    deepest = 0.0
-    for i, j in check.pairs:
-        gi, gj = cur[i], cur[j]
-        if len(gi.x) == 0 or len(gj.b.triangles) == 0:
-            continue
-        lo, hi = gj.box
-        pad = 1e-9 * max(float(np.linalg.norm(hi - lo)), 1e-300)
-        near = np.flatnonzero(np.all((gi.x >= lo - pad) & (gi.x <= hi + pad), axis=1))
-        if not near.size:
-            continue
-        node = near[gj.inside(gi.x[near])]
-        if not node.size:
-            continue
-        depth, L, ends = gj.depth(gi.x[node])
-        L = np.where(touched[j][ends].any(axis=1), L, 0.0)
-        deformed, linearised, second = depth, None, 0.0
-        if not (gi.b.large or gj.b.large):
-            linearised, second = linearised_depth(check, i, j, node, cur)
-            depth = np.minimum(depth, linearised)
-        alpha = np.minimum(gi.turning_within(node, L), 0.5 * np.pi)
-        allowed = tol + second + np.minimum(0.5 * L * np.tan(0.5 * alpha),
-                                            np.maximum(gi.adjacent[node], 0.5 * L))
-        deepest = max(deepest, float(depth.max()))
-        k = int(np.argmax(depth - allowed))
-        cand = (float(depth[k] - allowed[k]), float(depth[k]), float(allowed[k]), i,
-                int(node[k]), j, float(deformed[k]),
-                None if linearised is None else float(linearised[k]))
-        if best is None or (cand[0] > 0 and cand[0] > best[0]) or (
-                best[0] <= 0 and cand[0] <= 0 and cand[1] > best[1]):
-            best = cand
-    out.max_penetration = max(deepest, 0.0)
-    if best is None:
-        out.allowed = tol
-        return
-    _, out.penetration, out.allowed, i, k, j, deformed, linearised = best
-    pos = cur[i].x[k]
-    out.where = {"body": check.bodies[i].name, "node": int(cur[i].b.nodes[k]),
-                 "into": check.bodies[j].name, "x": float(pos[0]), "y": float(pos[1]),
-                 "z": float(pos[2]), "deformed_depth": deformed,
-                 "linearised_depth": linearised}
 
 
 def tension(check: InvariantCheck, F: list[np.ndarray], own: list[Surface3],
