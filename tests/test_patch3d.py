@@ -80,3 +80,73 @@ def test_friction_in_3d_is_refused():
 def test_the_thesis_variant_stays_2d():
     with pytest.raises(InputError, match="thesis contact supports 2D bodies, this one is 3D"):
         stacked(("hex", 3), ("hex", 5), variant="thesis").validate()
+
+
+STIFF_PUNCH = """
+name = "stiff_punch_3d"
+[[bodies]]
+name = "base"
+[bodies.mesh]
+shape = "box"
+x0 = -1.0
+y0 = -1.0
+z0 = -1.0
+width = 2.0
+depth = 2.0
+height = 1.0
+nx = {n}
+ny = {n}
+nz = 4
+[bodies.material]
+youngs_modulus = 1000.0
+poissons_ratio = 0.3
+[[bodies.supports]]
+boundary = "bottom"
+[[bodies]]
+name = "punch"
+[bodies.mesh]
+shape = "box"
+x0 = -0.37
+y0 = -0.29
+z0 = 0.01
+width = 0.6
+depth = 0.5
+height = 0.4
+nx = 5
+ny = 4
+nz = 2
+tetrahedra = true
+[bodies.material]
+youngs_modulus = 100000.0
+poissons_ratio = 0.3
+[[bodies.supports]]
+boundary = "top"
+components = ["x", "y"]
+[[bodies.prescribed]]
+boundary = "top"
+component = "z"
+value = -0.03
+[steps]
+load_factors = [0.25, 0.5, 0.75, 1.0]
+"""
+
+
+@pytest.mark.parametrize("n", [9, pytest.param(18, marks=pytest.mark.xfail(
+    strict=True, reason="found 2026-11-27, open: at first touch a corner of the stiff punch "
+    "lies 2.75e-5 inside the base (allowed 2.9e-6): the faceting allowance is withheld "
+    "where no node of the base's closest facet carries force or neighbours one"))])
+def test_a_stiff_punch_with_corners_inside_the_contact_starting_apart(n):
+    """Not in the issue: a tetrahedral punch 100 times stiffer than a hexahedral base, started
+    0.01 above it, its corners and edges inside the contact, pressed 0.02 into it. On the
+    coarse base (9 x 9 over 2: facets longer than the punch's) every step converges with the
+    forces balanced to round-off and no tension; the punch's corners indent the base between
+    its nodes (9e-3 deep on 0.22 facets), which the faceting allowance accepts, as in 2D
+    (docs/method.md §6: the stiff side keeps equilibrium). On a base twice as fine it stops."""
+    from vfem.io.input import loads
+
+    model = loads(STIFF_PUNCH.format(n=n)).build()
+    result = Analysis(model).run()
+    assert result.converged, result.message
+    for step in result.steps:
+        assert step.invariants["passed"]
+        assert step.invariants["force_balance"] < 1e-12
