@@ -244,12 +244,35 @@ class Surface3:
             return out / np.where(norm > 0, norm, 1.0)[:, None]
         return self._get("normals", make)
 
+    @property
+    def own_turning(self) -> np.ndarray:
+        """Per boundary node, twice the largest angle between its normal and the normals of
+        its own triangles (not those on a symmetry plane) where the node is convex (its
+        triangles' centroids below its tangent plane), else 0: a box's corner or edge turns by
+        itself, as a 2D polygon's corner does, however far its neighbours are."""
+        def make():
+            keep = ~self.b.mirror
+            tri, nt = self.b.triangles[keep], self.unit_normals[keep]
+            n, x = self.normals, self.x
+            angle = np.zeros(len(x))
+            below = np.zeros(len(x))
+            centroid = x[tri].mean(axis=1)
+            for c in range(3):
+                p = tri[:, c]
+                cos = np.clip(np.einsum("ij,ij->i", nt, n[p]), -1.0, 1.0)
+                np.maximum.at(angle, p, np.arccos(cos))
+                np.add.at(below, p, np.einsum("ij,ij->i", centroid - x[p], n[p]))
+            return np.where(below < 0, 2.0 * angle, 0.0)
+        return self._get("own_turning", make)
+
     def turning_within(self, nodes: np.ndarray, radius: np.ndarray) -> np.ndarray:
         """Twice the largest angle between the normal of each of ``nodes`` and that of a
-        boundary node within ``radius`` of it on the convex side ((x_q − x_p)·(n_q − n_p) > 0)."""
+        boundary node within ``radius`` of it on the convex side ((x_q − x_p)·(n_q − n_p) > 0),
+        and at least the node's own turning (:attr:`own_turning`: a corner whose neighbours
+        are farther than ``radius``)."""
         tree = self._get("tree", lambda: cKDTree(self.x))
         n = self.normals
-        out = np.zeros(len(nodes))
+        out = self.own_turning[nodes].astype(float)
         for k, near in enumerate(tree.query_ball_point(self.x[nodes], radius)):
             near = np.asarray(near, dtype=np.int64)
             p = nodes[k]
@@ -258,7 +281,7 @@ class Surface3:
             convex = np.einsum("ij,ij->i", self.x[near] - self.x[p], n[near] - n[p]) > 0
             if convex.any():
                 cos = np.clip(n[near[convex]] @ n[p], -1.0, 1.0)
-                out[k] = 2.0 * float(np.arccos(cos).max())
+                out[k] = max(out[k], 2.0 * float(np.arccos(cos).max()))
         return out
 
     @property
