@@ -279,8 +279,8 @@ def test_prescribed_z_displacement_on_a_3d_body():
      r"body 'b': traction on 'top': value must have 3 components \(tx, ty, tz\) on a 3D "
      r"body, got \[0.0, 1.0\]"),
     ("3d-stress", {}, r"body 'b': plane = 'stress' is an assumption of 2D bodies"),
-    ("3d", {"kinematics": "total"},
-     r"body 'b': large kinematics \('total'\) is not available for 3D bodies yet"),
+    ("3d", {"kinematics": "total", "order": 2},
+     r"body 'b': large kinematics \('total'\) needs linear elements \(order 1\)$"),
 ])
 def test_what_a_body_cannot_take_is_named(make, kw, match):
     mesh = rectangle(nx=2, ny=2) if make == "2d" else box(nx=2, ny=2, nz=2)

@@ -1,7 +1,9 @@
 """Large-deformation kinematics of thesis Chapter 2: strain, its increments, change of reference.
 
 Every function works on fields of 2x2 tensors shaped ``(2, 2, ...)`` (``(2, 2, nelems, nqp)`` at
-scikit-fem quadrature points; a single ``(2, 2)`` matrix works too).
+scikit-fem quadrature points; a single ``(2, 2)`` matrix works too), or of 3x3 tensors
+``(3, 3, ...)`` for 3D bodies (issue 21, C16: the same formulas; only :func:`determinant` and
+:func:`inverse` branch, on ``A.shape[0]``, to their 3x3 closed forms, the 2x2 ones unchanged).
 
 Index convention. scikit-fem's ``grad(u)[i, j] = du_i/dX_j``; the deformation gradient is
 ``F = I + grad(u)`` and the Green–Lagrange strain ``E = (F^T F - I)/2``. The thesis writes the
@@ -23,29 +25,42 @@ import numpy as np
 
 def _eye_like(A: np.ndarray) -> np.ndarray:
     eye = np.zeros_like(A, dtype=float)
-    eye[0, 0] = 1.0
-    eye[1, 1] = 1.0
+    for i in range(A.shape[0]):
+        eye[i, i] = 1.0
     return eye
 
 
 def _t(A: np.ndarray) -> np.ndarray:
-    """Transpose of each 2x2 tensor of the field."""
+    """Transpose of each 2x2 (3x3) tensor of the field."""
     return np.swapaxes(A, 0, 1)
 
 
 def _mul(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """Product of each pair of 2x2 tensors, (A B)_ij = A_ik B_kj."""
+    """Product of each pair of 2x2 (3x3) tensors, (A B)_ij = A_ik B_kj."""
     return np.einsum("ik...,kj...->ij...", A, B)
 
 
 def determinant(A: np.ndarray) -> np.ndarray:
-    """det of each 2x2 tensor of the field (shape ``A.shape[2:]``)."""
+    """det of each 2x2 or 3x3 tensor of the field (shape ``A.shape[2:]``)."""
+    if A.shape[0] == 3:
+        return (A[0, 0] * (A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1])
+                - A[0, 1] * (A[1, 0] * A[2, 2] - A[1, 2] * A[2, 0])
+                + A[0, 2] * (A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]))
     return A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
 
 
 def inverse(A: np.ndarray) -> np.ndarray:
-    """Inverse of each 2x2 tensor of the field (closed form)."""
+    """Inverse of each 2x2 or 3x3 tensor of the field (closed form: the adjugate over the
+    determinant)."""
     d = determinant(A)
+    if A.shape[0] == 3:
+        out = np.empty_like(A, dtype=float)
+        for i in range(3):
+            for j in range(3):
+                # (A^-1)_ij = cofactor_ji / det: rows/columns other than j and i, cyclically
+                j1, j2, i1, i2 = (j + 1) % 3, (j + 2) % 3, (i + 1) % 3, (i + 2) % 3
+                out[i, j] = (A[j1, i1] * A[j2, i2] - A[j1, i2] * A[j2, i1]) / d
+        return out
     out = np.empty_like(A, dtype=float)
     out[0, 0] = A[1, 1] / d
     out[1, 1] = A[0, 0] / d

@@ -1,7 +1,7 @@
 """One hyperelastic body under large displacements, solved incrementally by Newton's method.
 
 This is the geometrically (and materially) nonlinear counterpart of :class:`vfem.bodies.Body`:
-plane strain, a hyperelastic material (:mod:`vfem.materials.hyperelastic`), prescribed
+plane strain or 3D, a hyperelastic material (:mod:`vfem.materials.hyperelastic`), prescribed
 displacements and dead nodal forces scaled by a load factor. A large-kinematics
 :class:`~vfem.bodies.Body` wraps one; the contact iteration (:mod:`vfem.contact.large`) drives it
 through a trial state: :meth:`NonlinearBody.linearize` and :meth:`NonlinearBody.move` for its
@@ -45,6 +45,11 @@ and kept in :attr:`NonlinearBody.steps` / :attr:`NonlinearBody.history`.
 Both are exact discretisations of the same problem on the same quadrature points (with isoparametric
 elements a quadrature point of the moved mesh is the same material point, and ``dV1 = J1 dV0``
 there), so they agree to the Newton tolerance.
+
+3D bodies (tetrahedra, hexahedra; issue 21, C16) take the same path with 3x3 tensors: the
+dimension is the mesh's (``self.dim``), dofs are ``dim * node + component``, no out-of-plane
+stress is carried, and the left stretch ``V_1`` of the updated form is the square root of
+``b_1`` by its eigenvectors (the 2x2 closed form stays the 2D one).
 """
 
 from __future__ import annotations
@@ -64,8 +69,12 @@ from skfem import (
     ElementVector,
     LinearForm,
     Mesh,
+    MeshHex1,
+    MeshHex2,
     MeshQuad1,
     MeshQuad2,
+    MeshTet1,
+    MeshTet2,
     MeshTri1,
     MeshTri2,
     condense,
@@ -90,10 +99,11 @@ log = logging.getLogger(__name__)
 
 TOTAL = "total"
 UPDATED = "updated"
-COMPONENTS = {"x": 0, "y": 1}
+COMPONENTS = {"x": 0, "y": 1, "z": 2}
 
 # linear mesh -> the quadratic-geometry mesh of the same connectivity (for P2/Q2)
-_QUADRATIC_MESH: dict[type, type] = {MeshTri1: MeshTri2, MeshQuad1: MeshQuad2}
+_QUADRATIC_MESH: dict[type, type] = {MeshTri1: MeshTri2, MeshQuad1: MeshQuad2,
+                                     MeshTet1: MeshTet2, MeshHex1: MeshHex2}
 
 
 _MAX_HALVINGS = 8
@@ -200,14 +210,14 @@ class _State:
     not pay for it (about a third of a state's time with the neo-Hookean law)."""
 
     basis: Basis
-    F: np.ndarray  # (2, 2, ne, nq) deformation gradient from the reference of the formulation
-    S: np.ndarray  # (2, 2, ne, nq) 2nd Piola–Kirchhoff stress relative to that reference
+    F: np.ndarray  # (dim, dim, ne, nq) deformation gradient from the reference of the formulation
+    S: np.ndarray  # (dim, dim, ne, nq) 2nd Piola–Kirchhoff stress relative to that reference
     moduli: Callable[[], np.ndarray]  # gives D
-    S33: np.ndarray  # (ne, nq) out-of-plane S_33 (plane strain)
+    S33: np.ndarray | None  # (ne, nq) out-of-plane S_33 (plane strain); None in 3D
 
     @functools.cached_property
     def D(self) -> np.ndarray:
-        """(2, 2, 2, 2, ne, nq) dS/dE."""
+        """(dim, dim, dim, dim, ne, nq) dS/dE."""
         return self.moduli()
 
     def first_piola(self) -> np.ndarray:
@@ -216,8 +226,8 @@ class _State:
     def tangent_moduli(self) -> np.ndarray:
         """``A_iJkL = F_iI D_IJKL F_kK + delta_ik S_JL``."""
         A = np.einsum("iI...,IJKL...,kK...->iJkL...", self.F, self.D, self.F)
-        A[0, :, 0] += self.S
-        A[1, :, 1] += self.S
+        for i in range(A.shape[0]):
+            A[i, :, i] += self.S
         return A
 
 
@@ -264,11 +274,13 @@ Values = float | np.ndarray | Callable[[float], np.ndarray]
 
 
 class NonlinearBody:
-    """A hyperelastic plane-strain body under large displacements (see the module docstring).
+    """A hyperelastic body, plane strain or 3D, under large displacements (see the module
+    docstring).
 
     Args:
         mesh: a scikit-fem ``MeshTri1`` or ``MeshQuad1`` (or their quadratic-geometry ``MeshTri2``
-            / ``MeshQuad2``); named boundaries are used by :meth:`boundary_dofs`.
+            / ``MeshQuad2``), or in 3D ``MeshTet1`` / ``MeshHex1`` (``MeshTet2`` / ``MeshHex2``);
+            named boundaries are used by :meth:`boundary_dofs`.
         material: :class:`SaintVenantKirchhoff` or :class:`NeoHookean`.
         order: 1 (P1/Q1) or 2 (P2/Q2). Elements are isoparametric: with ``order=2`` a linear mesh is
             given quadratic geometry (``MeshTri2.from_mesh``), so that the updated formulation can
@@ -276,9 +288,9 @@ class NonlinearBody:
         formulation: ``"total"`` or ``"updated"`` Lagrangian.
         name: used in messages.
 
-    Dofs are scikit-fem's ``ElementVector`` numbering on :attr:`basis0` (x and y of each node
-    interleaved). Prescribe with :meth:`prescribe` and load with :meth:`add_nodal_forces`, then
-    call :meth:`solve`.
+    Dofs are scikit-fem's ``ElementVector`` numbering on :attr:`basis0` (x and y, and z in 3D, of
+    each node interleaved: ``dim * node + component``). Prescribe with :meth:`prescribe` and load
+    with :meth:`add_nodal_forces`, then call :meth:`solve`.
     """
 
     def __init__(self, mesh: Mesh, material: SaintVenantKirchhoff | NeoHookean, *, order: int = 1,
@@ -300,13 +312,16 @@ class NonlinearBody:
         self.mesh = self._working_mesh(mesh)
         self.basis0 = Basis(self.mesh, ElementVector(self.mesh.elem()))
         self.ndofs = self.basis0.N
+        self.dim = dim = self.mesh.dim()
         # the node of each dof, as positions in mesh.doflocs: isoparametric elements have their
-        # nodes at the mesh's doflocs, x and y interleaved
-        if not (np.allclose(self.basis0.doflocs[:, 0::2], self.mesh.doflocs)
-                and np.allclose(self.basis0.doflocs[:, 1::2], self.mesh.doflocs)):
+        # nodes at the mesh's doflocs, x and y (and z) interleaved
+        if not all(np.allclose(self.basis0.doflocs[:, c::dim], self.mesh.doflocs)
+                   for c in range(dim)):
             raise InputError(f"{name}: dof numbering does not follow the mesh nodes")
         p = self.mesh.doflocs
-        self.length = float(np.hypot(*(p.max(axis=1) - p.min(axis=1))))
+        span = p.max(axis=1) - p.min(axis=1)
+        # (np.hypot takes two coordinates: a third would be its out= argument)
+        self.length = float(np.hypot(*span)) if dim == 2 else float(np.linalg.norm(span))
         self.nodal_forces = np.zeros(self.ndofs)
         self._load_history: Callable[[float], np.ndarray] | None = None
         self._prescribed: list[tuple[np.ndarray, Values]] = []
@@ -319,7 +334,7 @@ class NonlinearBody:
     # -- set-up ---------------------------------------------------------------------------------
 
     def _working_mesh(self, mesh: Mesh) -> Mesh:
-        if isinstance(mesh, (MeshTri2, MeshQuad2)):
+        if isinstance(mesh, (MeshTri2, MeshQuad2, MeshTet2, MeshHex2)):
             if self.order != 2:
                 raise InputError(f"{self.name}: a quadratic-geometry mesh needs order=2")
             return mesh
@@ -331,14 +346,15 @@ class NonlinearBody:
                 if not np.array_equal(m2.facets, mesh.facets):  # boundaries index the facets
                     raise InputError(f"{self.name}: facet numbering changed with the P2 geometry")
                 return m2
-        raise InputError(f"{self.name}: mesh must be MeshTri1/MeshQuad1/MeshTri2/MeshQuad2, "
+        raise InputError(f"{self.name}: mesh must be MeshTri1/MeshQuad1/MeshTri2/MeshQuad2 (2D) "
+                         f"or MeshTet1/MeshHex1/MeshTet2/MeshHex2 (3D), "
                          f"got {type(mesh).__name__}")
 
     def _reset_updated_state(self) -> None:
         self.current_mesh = self.mesh
         self.current_basis = self.basis0
         nq = self.basis0.X.shape[-1]
-        self.pseudo_strain = np.zeros((2, 2, self.mesh.nelements, nq))
+        self.pseudo_strain = np.zeros((self.dim, self.dim, self.mesh.nelements, nq))
         self._u_at_current = np.zeros(self.ndofs)
         self._stretch_cache: tuple[np.ndarray, np.ndarray] | None = None
         self._delta = np.zeros(self.ndofs)  # trial displacement since the converged state
@@ -347,7 +363,7 @@ class NonlinearBody:
 
     def boundary_dofs(self, boundary: str | np.ndarray, component: str | None = None
                       ) -> np.ndarray:
-        """Dofs on a named boundary (or on an array of facet indices), one component or both."""
+        """Dofs on a named boundary (or on an array of facet indices), one component or all."""
         if isinstance(boundary, str):
             if not self._boundaries or boundary not in self._boundaries:
                 names = sorted(self._boundaries or {})
@@ -358,16 +374,22 @@ class NonlinearBody:
         dofs = self.basis0.get_dofs(facets)
         if component is None:
             return np.sort(dofs.all())
-        if component not in COMPONENTS:
-            raise InputError(f"{self.name}: component must be 'x' or 'y', got {component!r}")
+        self._check_component(component)
         return np.sort(dofs.all(f"u^{COMPONENTS[component] + 1}"))
+
+    def _check_component(self, component: str) -> None:
+        if component not in COMPONENTS or COMPONENTS[component] >= self.dim:
+            names = " or ".join(repr(c) for c in list(COMPONENTS)[: self.dim])
+            raise InputError(f"{self.name}: component must be {names}, got {component!r}")
 
     def node_dofs(self, nodes: np.ndarray, component: str | None = None) -> np.ndarray:
         """Dofs of the given nodes (columns of ``mesh.doflocs``)."""
         nodes = np.asarray(nodes, dtype=int)
+        dim = self.dim
         if component is None:
-            return np.stack([2 * nodes, 2 * nodes + 1], axis=-1).ravel()
-        return 2 * nodes + COMPONENTS[component]
+            return np.stack([dim * nodes + c for c in range(dim)], axis=-1).ravel()
+        self._check_component(component)
+        return dim * nodes + COMPONENTS[component]
 
     def prescribe(self, dofs: np.ndarray, values: Values = 0.0) -> None:
         """Prescribe the (total) displacement of ``dofs``.
@@ -458,15 +480,20 @@ class NonlinearBody:
             D = self.material.tangent(E)
             return np.einsum("iI...,jJ...,IJKL...,kK...,lL...->ijkl...", V, V, D, V, V) / J1
 
-        return S_c, D_c, self.material.out_of_plane_stress(E) / J1
+        S33 = self.material.out_of_plane_stress(E)
+        return S_c, D_c, (None if S33 is None else S33 / J1)
 
     def _left_stretch(self) -> tuple[np.ndarray, np.ndarray]:
         """``V_1 = b_1^(1/2)`` and ``J_1 = det V_1`` from the carried pseudo-strain (Almansi).
 
         ``11_1E = (I - b_1^-1)/2`` so ``b_1^-1 = I - 2 11_1E``; the square root of a symmetric
         positive-definite 2x2 matrix ``M`` is ``(M + sqrt(det M) I) / sqrt(tr M + 2 sqrt(det M))``.
+        In 3D, by the eigenvectors of ``b_1^-1`` (:meth:`_left_stretch_3d`).
         """
         if self._stretch_cache is not None:
+            return self._stretch_cache
+        if self.dim == 3:
+            self._stretch_cache = self._left_stretch_3d()
             return self._stretch_cache
         b_inv = -2.0 * self.pseudo_strain
         b_inv[0, 0] += 1.0
@@ -479,6 +506,19 @@ class NonlinearBody:
         V /= np.sqrt(b[0, 0] + b[1, 1] + 2.0 * s)
         self._stretch_cache = (V, s)
         return V, s
+
+    def _left_stretch_3d(self) -> tuple[np.ndarray, np.ndarray]:
+        """``V_1`` and ``J_1`` of a 3D body: ``b_1^-1 = I - 2 11_1E = Q diag(m) Q^T`` (symmetric
+        positive definite), so ``V_1 = Q diag(m^-1/2) Q^T`` and ``J_1 = prod(m)^-1/2``."""
+        b_inv = -2.0 * self.pseudo_strain
+        for i in range(3):
+            b_inv[i, i] += 1.0
+        m, Q = np.linalg.eigh(np.moveaxis(b_inv, (0, 1), (-2, -1)))  # (ne, nq, 3), (ne, nq, 3, 3)
+        if np.any(m <= 0.0):
+            raise AnalysisError(f"{self.name}: the carried strain is not that of a deformation "
+                                "(I - 2 E_Almansi not positive definite)")
+        V = np.einsum("...ik,...k,...jk->...ij", Q, 1.0 / np.sqrt(m), Q)
+        return np.ascontiguousarray(np.moveaxis(V, (-2, -1), (0, 1))), 1.0 / np.sqrt(m.prod(-1))
 
     def _check_orientation(self, F: np.ndarray) -> None:
         J = determinant(F)
@@ -739,12 +779,16 @@ class NonlinearBody:
 
     def cauchy_stress_at(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Element averages over the current volume at the total displacement ``u``: the
-        in-plane Cauchy stress (nelems, 2, 2) and ``sigma_zz`` (nelems,)."""
+        in-plane Cauchy stress (nelems, 2, 2) and ``sigma_zz`` (nelems,); in 3D the Cauchy
+        stress (nelems, 3, 3) and its zz component."""
         state = self._state(np.asarray(u, dtype=float) - self._u_at_current)
         J = determinant(state.F)
         w = state.basis.dx * J
         sig = push_forward_stress(state.S, state.F)
         avg = (sig * w).sum(axis=-1) / w.sum(axis=-1)
+        if state.S33 is None:
+            avg = np.moveaxis(avg, -1, 0)
+            return avg, avg[:, 2, 2].copy()
         szz = (state.S33 / J * w).sum(axis=-1) / w.sum(axis=-1)
         return np.moveaxis(avg, -1, 0), szz
 
@@ -760,7 +804,7 @@ class NonlinearBody:
             E_pseudo = updated_strain_increment(h, self.pseudo_strain).total
             self.pseudo_strain = change_reference(E_pseudo, h)
             self._stretch_cache = None
-            moved = self.current_mesh.doflocs + np.vstack([delta[0::2], delta[1::2]])
+            moved = self.current_mesh.doflocs + self._by_component(delta)
             self.current_mesh = replace(self.current_mesh, doflocs=moved)
             self.current_basis = Basis(self.current_mesh, self.current_basis.elem,
                                        quadrature=(self.basis0.X, self.basis0.W))
@@ -769,28 +813,34 @@ class NonlinearBody:
 
     # -- results --------------------------------------------------------------------------------
 
+    def _by_component(self, u: np.ndarray) -> np.ndarray:
+        """(dim, npoints) of a dof vector: ``u[c::dim]`` stacked."""
+        return np.vstack([u[c::self.dim] for c in range(self.dim)])
+
     def deformed_points(self) -> np.ndarray:
-        """(2, npoints) current positions of the mesh nodes (``mesh.doflocs`` + displacement)."""
-        return self.mesh.doflocs + np.vstack([self.displacement[0::2], self.displacement[1::2]])
+        """(dim, npoints) current positions of the mesh nodes (``mesh.doflocs`` +
+        displacement)."""
+        return self.mesh.doflocs + self._by_component(self.displacement)
 
     def deformed_mesh(self) -> Mesh:
         """The mesh in the current configuration (what contact search runs on)."""
         return replace(self.mesh, doflocs=self.deformed_points())
 
     def green_lagrange_strain(self) -> np.ndarray:
-        """(2, 2, nelems, nqp) Green–Lagrange strain relative to the initial mesh."""
+        """(dim, dim, nelems, nqp) Green–Lagrange strain relative to the initial mesh."""
         return green_lagrange(self.basis0.interpolate(self.displacement).grad)
 
     def second_piola_kirchhoff(self) -> np.ndarray:
-        """(2, 2, nelems, nqp) 2nd Piola–Kirchhoff stress relative to the initial mesh."""
+        """(dim, dim, nelems, nqp) 2nd Piola–Kirchhoff stress relative to the initial mesh."""
         return self.material.second_piola(self.green_lagrange_strain())
 
     def stress(self) -> np.ndarray:
-        """(nelems, 2, 2) element averages (over the current volume) of the Cauchy stress."""
+        """(nelems, dim, dim) element averages (over the current volume) of the Cauchy stress."""
         return self.cauchy_stress_at(self.displacement)[0]
 
     def out_of_plane_stress(self) -> np.ndarray:
-        """(nelems,) element averages of the Cauchy ``sigma_zz = S_33 / J`` (plane strain)."""
+        """(nelems,) element averages of the Cauchy ``sigma_zz = S_33 / J`` (plane strain; in 3D
+        the zz component of :meth:`stress`)."""
         return self.cauchy_stress_at(self.displacement)[1]
 
 

@@ -304,7 +304,7 @@ class Body:
             quadrilaterals; 10-node tetrahedra, 27-node hexahedra) on the same mesh.
         kinematics: ``"small"`` (default: small displacements and strains, linear elasticity)
             or large displacements and strains, by the ``"total"`` or ``"updated"`` Lagrangian
-            formulation (thesis Chapters 2-3; plane strain, linear elements).
+            formulation (thesis Chapters 2-3; plane strain or 3D, linear elements).
         law: under large kinematics, the hyperelastic law whose small-strain constants are the
             material's: ``"saint-venant-kirchhoff"`` (default) or ``"neo-hookean"``.
 
@@ -684,9 +684,9 @@ class Body:
             raise InputError(f"{where}: plane = {self.material.plane!r} is an assumption of 2D "
                              "bodies; a 3D body (tetrahedra or hexahedra) has none: leave "
                              "the material's plane out")
-        if self.dim == 3 and self.large:
-            raise InputError(f"{where}: large kinematics ({self.kinematics!r}) is not "
-                             "available for 3D bodies yet; use kinematics = 'small'")
+        if self.dim == 3 and self.large and self.order != 1:
+            raise InputError(f"{where}: large kinematics ({self.kinematics!r}) needs linear "
+                             "elements (order 1)")
         if self.large and (self.order != 1 or self.material.plane != "strain"):
             raise InputError(f"{where}: large kinematics ({self.kinematics!r}) needs linear "
                              "elements (order 1) and plane strain")

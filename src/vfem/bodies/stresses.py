@@ -23,6 +23,10 @@ def stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
 def cauchy_stress(nonlinear, u: np.ndarray) -> dict[str, np.ndarray]:
     """Element-average Cauchy stresses of a :class:`~vfem.nonlinear.NonlinearBody` at ``u``."""
     sig, szz = nonlinear.cauchy_stress_at(u)
+    if sig.shape[1] == 3:
+        avg = {"sxx": sig[:, 0, 0], "syy": sig[:, 1, 1], "szz": sig[:, 2, 2],
+               "syz": sig[:, 1, 2], "sxz": sig[:, 0, 2], "sxy": sig[:, 0, 1]}
+        return _with_von_mises(avg)
     avg = {"sxx": sig[:, 0, 0], "syy": sig[:, 1, 1], "sxy": sig[:, 0, 1], "szz": szz}
     return _with_von_mises(avg)
 

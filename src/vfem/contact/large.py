@@ -122,7 +122,9 @@ class LargeDeformationContact(PairSet):
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
                  backend: str | None = None):
         for s in surfaces:
-            if s.order != 1:
+            # (the facet kind's order: ``s.order`` counts a 2D facet's nodes; a 3D body that
+            # touches nothing has no kind and no candidate)
+            if s.kind is not None and s.kind.order != 1:
                 raise InputError(f"body {s.body.name!r}: large-displacement contact needs "
                                  "linear elements (order 1)")
         # (its own pairs, built on the undeformed geometry, which side carries compatibility

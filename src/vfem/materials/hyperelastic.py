@@ -1,4 +1,4 @@
-"""Isotropic hyperelastic materials for large deformations in plane strain.
+"""Isotropic hyperelastic materials for large deformations in plane strain or in 3D.
 
 These laws are what :class:`vfem.nonlinear.NonlinearBody` evaluates at its quadrature points: given
 the Green–Lagrange strain ``E`` relative to the unstrained configuration (thesis §2.6, eq. 2.6.18)
@@ -10,7 +10,10 @@ Arrays follow scikit-fem's layout at quadrature points: a strain or stress is ``
 ``D[i, j, k, l] = dS_ij / dE_kl`` taken on symmetric ``E`` (so ``D`` has the minor symmetries
 ``D_ijkl = D_jikl = D_ijlk`` and, being a second derivative of ``W``, the major one
 ``D_ijkl = D_klij``). Plane strain: the out-of-plane stretch is 1 (``E_33 = 0``, ``C_33 = 1``), so
-only the in-plane components are carried; :meth:`out_of_plane_stress` gives ``S_33``.
+only the in-plane components are carried; :meth:`out_of_plane_stress` gives ``S_33``. A 3D body
+(issue 21, C16) passes ``(3, 3, ...)`` strains and gets ``(3, 3, ...)`` stresses and
+``(3, 3, 3, 3, ...)`` tangents: the same formulas with the 3D trace and identity, no plane
+assumption (:meth:`out_of_plane_stress` is then None). The 2D expressions are kept literally.
 
 Both laws reduce to isotropic linear elasticity (:class:`LinearElastic`, plane strain) for small
 strains: ``D(E = 0) = lambda I(x)I + 2 mu I_sym``.
@@ -28,11 +31,18 @@ from .elastic import check_elastic_constants
 
 
 def _eye_like(E: np.ndarray) -> np.ndarray:
-    """The identity broadcast to the shape of the tensor field ``E`` (2, 2, ...)."""
+    """The identity broadcast to the shape of the tensor field ``E`` (2, 2, ...) or (3, 3, ...)."""
     eye = np.zeros_like(E)
-    eye[0, 0] = 1.0
-    eye[1, 1] = 1.0
+    for i in range(E.shape[0]):
+        eye[i, i] = 1.0
     return eye
+
+
+def _trace(E: np.ndarray) -> np.ndarray:
+    """``tr E`` of the field: ``E00 + E11`` in 2D (plane strain, ``E33 = 0``), plus ``E22`` in
+    3D (added last, so the 2D sum is the same expression)."""
+    tr = E[0, 0] + E[1, 1]
+    return tr + E[2, 2] if E.shape[0] == 3 else tr
 
 
 def _lame(E: float, nu: float) -> tuple[float, float]:
@@ -88,7 +98,7 @@ class SaintVenantKirchhoff(_Isotropic):
     def energy(self, E: np.ndarray) -> np.ndarray:
         """Strain energy per unit reference volume, ``W(E)`` (shape ``E.shape[2:]``)."""
         lam, mu = self.lame()
-        tr = E[0, 0] + E[1, 1]
+        tr = _trace(np.asarray(E))
         return 0.5 * lam * tr**2 + mu * np.einsum("ij...,ij...->...", E, E)
 
     def stress(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -99,7 +109,7 @@ class SaintVenantKirchhoff(_Isotropic):
         """``S`` alone (a state whose tangent may never be asked for)."""
         E = np.asarray(E, dtype=float)
         lam, mu = self.lame()
-        return lam * (E[0, 0] + E[1, 1]) * _eye_like(E) + 2.0 * mu * E
+        return lam * _trace(E) * _eye_like(E) + 2.0 * mu * E
 
     def tangent(self, E: np.ndarray) -> np.ndarray:
         """``dS/dE`` alone."""
@@ -107,18 +117,21 @@ class SaintVenantKirchhoff(_Isotropic):
         lam, mu = self.lame()
         return lam * _outer(eye, eye) + 2.0 * mu * _sym_outer(eye)
 
-    def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray:
-        """``S_33 = lambda tr(E)`` (plane strain, ``E_33 = 0``)."""
+    def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray | None:
+        """``S_33 = lambda tr(E)`` (plane strain, ``E_33 = 0``); None for a 3D strain."""
+        if np.asarray(E).shape[0] == 3:
+            return None
         lam, _ = self.lame()
         return lam * (np.asarray(E)[0, 0] + np.asarray(E)[1, 1])
 
 
 @dataclass(frozen=True)
 class NeoHookean(_Isotropic):
-    """Compressible neo-Hookean solid (Ciarlet–Simo form), plane strain.
+    """Compressible neo-Hookean solid (Ciarlet–Simo form), plane strain or 3D.
 
-    With ``C = I + 2E`` the right Cauchy–Green tensor (3D, ``C_33 = 1``),
-    ``J = det F = sqrt(det C)`` and ``I_1 = tr C`` (3D trace, ``= C_11 + C_22 + 1``):
+    With ``C = I + 2E`` the right Cauchy–Green tensor (3D, ``C_33 = 1`` in plane strain),
+    ``J = det F = sqrt(det C)`` and ``I_1 = tr C`` (3D trace, ``= C_11 + C_22 + 1`` in plane
+    strain):
 
         W(E) = mu/2 (I_1 - 3) - mu ln J + lambda/2 (ln J)^2
         S    = mu (I - C^-1) + lambda ln(J) C^-1
@@ -145,7 +158,8 @@ class NeoHookean(_Isotropic):
         """Strain energy per unit reference volume, ``W(E)``."""
         lam, mu = self.lame()
         C, lnJ = self._right_cauchy_green(E)
-        return 0.5 * mu * (C[0, 0] + C[1, 1] - 2.0) - mu * lnJ + 0.5 * lam * lnJ**2
+        i1 = C[0, 0] + C[1, 1] - 2.0 if C.shape[0] == 2 else C[0, 0] + C[1, 1] + C[2, 2] - 3.0
+        return 0.5 * mu * i1 - mu * lnJ + 0.5 * lam * lnJ**2
 
     def stress(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Second Piola–Kirchhoff stress ``S`` and tangent ``dS/dE`` for Green–Lagrange ``E``."""
@@ -170,8 +184,11 @@ class NeoHookean(_Isotropic):
                 + c[:, None, :, None] * Ci[None, :, None, :]
                 + c[:, None, None, :] * Ci[None, :, :, None])
 
-    def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray:
-        """``S_33 = mu (1 - 1/C_33) + lambda ln J / C_33 = lambda ln J`` (``C_33 = 1``)."""
+    def out_of_plane_stress(self, E: np.ndarray) -> np.ndarray | None:
+        """``S_33 = mu (1 - 1/C_33) + lambda ln J / C_33 = lambda ln J`` (``C_33 = 1``); None
+        for a 3D strain."""
+        if np.asarray(E).shape[0] == 3:
+            return None
         lam, _ = self.lame()
         return lam * self._right_cauchy_green(E)[1]
 

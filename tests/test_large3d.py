@@ -1,0 +1,195 @@
+"""Large kinematics in 3D (issue 21, C16): hyperelastic tetrahedra and hexahedra, total and
+updated Lagrangian, and frictionless contact between them.
+
+Bodies (:class:`vfem.nonlinear.NonlinearBody` on :func:`vfem.mesh.solids.box`): a uniform
+uniaxial stretch of 50 % (rollers on three faces, the fourth pulled) and a rigid rotation by
+90 degrees about an oblique axis (one face turned, nothing else held). Both are homogeneous
+states that linear tetrahedra and trilinear hexahedra represent exactly, so the stresses must be
+the material's own at the analytic deformation gradient to round-off, Newton must converge
+quadratically, and the total and updated Lagrangian forms must agree.
+"""
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from vfem.kinematics import green_lagrange, push_forward_stress
+from vfem.materials.hyperelastic import NeoHookean, SaintVenantKirchhoff
+from vfem.mesh.solids import box
+from vfem.nonlinear import NonlinearBody
+
+E_MOD, NU = 1000.0, 0.3
+STRETCH = 1.5  # the pulled face's stretch
+MATERIALS = {"svk": SaintVenantKirchhoff(E_MOD, NU), "neo-hookean": NeoHookean(E_MOD, NU)}
+CELLS = ("hex", "tet")
+FORMULATIONS = ("total", "updated")
+# Newton tolerance: the residual relative to the reference force (NewtonStep); stresses are then
+# round-off away from the exact ones
+TOL = 1e-13
+
+
+def body(cells: str, law: str, formulation: str) -> NonlinearBody:
+    mesh = box(0.0, 0.0, 0.0, 1.0, 0.8, 0.6, 2, 2, 2, tetrahedra=cells == "tet")
+    return NonlinearBody(mesh, MATERIALS[law], formulation=formulation, name=f"{cells}-{law}")
+
+
+def uniaxial_gradient(material) -> np.ndarray:
+    """F = diag(STRETCH, l, l) with l such that S_yy = S_zz = 0 (the material's own law)."""
+
+    def lateral_stress(lat: float) -> float:
+        F = np.diag([STRETCH, lat, lat])
+        return float(material.second_piola(green_lagrange(F - np.eye(3)))[1, 1])
+
+    return np.diag([STRETCH, *[brentq(lateral_stress, 0.5, 1.0, xtol=1e-15)] * 2])
+
+
+def rotation(angle: float) -> np.ndarray:
+    """About the axis (1, 2, 3)/sqrt(14) by ``angle`` (Rodrigues)."""
+    a = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
+    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+def nodal(b: NonlinearBody, u: np.ndarray) -> np.ndarray:
+    return np.vstack([u[0::3], u[1::3], u[2::3]])
+
+
+@pytest.fixture(scope="module")
+def stretched():
+    """Every (cells, law, formulation): the body pulled to STRETCH in 2 steps, and its steps."""
+    out = {}
+    for cells in CELLS:
+        for law in MATERIALS:
+            for form in FORMULATIONS:
+                b = body(cells, law, form)
+                b.prescribe(b.boundary_dofs("left", "x"), 0.0)
+                b.prescribe(b.boundary_dofs("front", "y"), 0.0)
+                b.prescribe(b.boundary_dofs("bottom", "z"), 0.0)
+                b.prescribe(b.boundary_dofs("right", "x"), STRETCH - 1.0)
+                out[cells, law, form] = b, b.solve(2, tol=TOL)
+    return out
+
+
+@pytest.fixture(scope="module")
+def rotated():
+    """Every (cells, law, formulation): the left face turned by 90 degrees in 4 steps."""
+    out = {}
+    for cells in CELLS:
+        for law in MATERIALS:
+            for form in FORMULATIONS:
+                b = body(cells, law, form)
+                left = b.boundary_dofs("left")
+                X = b.basis0.doflocs[:, left]
+                component = left % 3
+
+                def turned(load_factor, X=X, component=component):
+                    u = (rotation(load_factor * np.pi / 2) - np.eye(3)) @ X
+                    return np.choose(component, u)
+
+                b.prescribe(left, turned)
+                out[cells, law, form] = b, b.solve(4, tol=TOL)
+    return out
+
+
+def check_quadratic(step):
+    """Converged in < 10 iterations, quadratically: the last correction reaches round-off,
+    r_k+1 / r_k^2 bounded while r_k is above round-off, the digits gained growing."""
+    assert step.converged
+    assert step.iterations < 10
+    r = step.relative_residuals
+    assert r[-1] < TOL
+    ratios = [q for q, a in zip(step.quadratic_ratios, r[:-1]) if a > 1e-8]
+    assert ratios and max(ratios) < 1e2, (r, ratios)
+    above = [x for x in r if x > 1e-12]  # the iterates above round-off
+    gains = np.log10(np.array(above[:-1]) / np.array(above[1:]))
+    assert len(gains) >= 2 and np.all(np.diff(gains) > 0), r
+
+
+@pytest.mark.parametrize("form", FORMULATIONS)
+@pytest.mark.parametrize("law", list(MATERIALS))
+@pytest.mark.parametrize("cells", CELLS)
+def test_uniform_stretch_gives_the_exact_stress(stretched, cells, law, form):
+    b, steps = stretched[cells, law, form]
+    for step in steps:
+        print(cells, law, form, "relative residuals",
+              ", ".join(f"{r:.1e}" for r in step.relative_residuals))
+        check_quadratic(step)
+    material = MATERIALS[law]
+    F = uniaxial_gradient(material)
+    S = material.second_piola(green_lagrange(F - np.eye(3)))
+    sigma = push_forward_stress(S, F)
+    error = np.abs(b.stress() - sigma[None]).max() / sigma[0, 0]
+    print(cells, law, form, f"sigma_xx = {sigma[0, 0]:.6g}, stress error {error:.1e}")
+    assert error < 1e-12
+    # the nodes move as F says
+    P = b.mesh.doflocs
+    assert np.abs(nodal(b, b.displacement) - (F - np.eye(3)) @ P).max() < 1e-12
+    # the reactions on the pulled face sum to sigma_xx times the deformed area (J F^-T N)
+    right = b.boundary_dofs("right", "x")
+    area = 0.8 * 0.6 * F[1, 1] * F[2, 2]
+    assert abs(b.reactions()[right].sum() / (sigma[0, 0] * area) - 1.0) < 1e-12
+
+
+@pytest.mark.parametrize("form", FORMULATIONS)
+@pytest.mark.parametrize("law", list(MATERIALS))
+@pytest.mark.parametrize("cells", CELLS)
+def test_rigid_rotation_by_90_degrees_leaves_no_stress(rotated, cells, law, form):
+    b, steps = rotated[cells, law, form]
+    for step in steps:
+        print(cells, law, form, "relative residuals",
+              ", ".join(f"{r:.1e}" for r in step.relative_residuals))
+        check_quadratic(step)
+    P = b.mesh.doflocs
+    R = rotation(np.pi / 2)
+    assert np.abs(b.deformed_points() - R @ P).max() < 1e-12
+    assert np.abs(b.green_lagrange_strain()).max() < 1e-12
+    assert np.abs(b.stress()).max() < 1e-12 * E_MOD
+    assert np.abs(b.reactions()).max() < 1e-12 * E_MOD
+    if form == "updated":
+        assert np.abs(b.pseudo_strain).max() < 1e-12
+        assert np.allclose(b.current_mesh.doflocs, b.deformed_points(), atol=1e-13)
+
+
+@pytest.mark.parametrize("law", list(MATERIALS))
+@pytest.mark.parametrize("cells", CELLS)
+def test_total_and_updated_lagrangian_agree(stretched, rotated, cells, law):
+    for runs in (stretched, rotated):
+        (bt, st), (bu, su) = runs[cells, law, "total"], runs[cells, law, "updated"]
+        assert np.abs(bt.displacement - bu.displacement).max() < 1e-12
+        assert np.abs(bt.stress() - bu.stress()).max() < 1e-11 * E_MOD
+        # the same Newton iterates: the same residual sequences, to round-off
+        for a, c in zip(st, su):
+            assert len(a.residuals) == len(c.residuals)
+
+
+@pytest.mark.parametrize("kinematics", FORMULATIONS)
+def test_a_3d_large_body_alone_gives_cauchy_stresses_and_reactions(kinematics):
+    """Through the solver (a :class:`Body` with ``kinematics``, no contact): the stretched
+    tetrahedral box's element stresses are the six Cauchy components, its reactions balance
+    sigma_xx times the deformed area."""
+    from vfem.bodies import Body, PrescribedDisplacement, Support
+    from vfem.bodies.stresses import stress
+    from vfem.materials import LinearElastic
+    from vfem.solver import Analysis, Model
+
+    b = Body("blk", box(0.0, 0.0, 0.0, 1.0, 0.8, 0.6, 2, 2, 2, tetrahedra=True),
+             LinearElastic(E_MOD, NU),
+             supports=(Support("left", ("x",)), Support("front", ("y",)),
+                       Support("bottom", ("z",))),
+             prescribed=(PrescribedDisplacement("right", "x", STRETCH - 1.0),),
+             kinematics=kinematics, law="neo-hookean")
+    result = Analysis(Model("stretched", [b])).run()
+    assert result.converged, result.message
+    F = uniaxial_gradient(MATERIALS["neo-hookean"])
+    S = MATERIALS["neo-hookean"].second_piola(green_lagrange(F - np.eye(3)))
+    sigma = push_forward_stress(S, F)
+    last = result.steps[-1].bodies["blk"]
+    s = stress(b, last.displacement.ravel())
+    assert set(s) == {"sxx", "syy", "szz", "syz", "sxz", "sxy", "von_mises"}
+    assert np.abs(s["sxx"] / sigma[0, 0] - 1).max() < 1e-9
+    for k in ("syy", "szz", "syz", "sxz", "sxy"):
+        assert np.abs(s[k]).max() < 1e-9 * sigma[0, 0]
+    assert np.allclose(s["von_mises"], sigma[0, 0], rtol=1e-9)
+    area = 0.8 * 0.6 * F[1, 1] * F[2, 2]
+    assert last.reactions["right"][0] == pytest.approx(sigma[0, 0] * area, rel=1e-9)
+    assert last.reactions["left"][0] == pytest.approx(-sigma[0, 0] * area, rel=1e-9)
