@@ -1,6 +1,6 @@
 """Meshes from files: one body's elements and named boundaries from a Gmsh or Abaqus mesh.
 
-:func:`read_mesh` reads a mesh file with meshio and returns a scikit-fem 2D mesh for one body,
+:func:`read_mesh` reads a mesh file with meshio and returns a scikit-fem mesh for one body,
 with ``mesh.boundaries`` (name -> boundary facet indices) that supports, loads, platens and
 ``contact_boundaries`` can name. Conventions:
 
@@ -23,6 +23,20 @@ The body (``cells``)
     Only the nodes of the selected elements are kept, renumbered in their order in the file. The
     mesh must lie in the plane z = 0 (z is dropped). Elements are made counter-clockwise (positive
     area), their nodes reordered where the file has them clockwise.
+
+3D files
+    A file with 3D elements (tetrahedra, hexahedra) makes 3D bodies: 4-node tetrahedra ->
+    ``MeshTet1``, 8-node hexahedra -> ``MeshHex1``, 10-node tetrahedra -> ``MeshTet2``, 27-node
+    hexahedra -> ``MeshHex2`` (Abaqus ``C3D4``, ``C3D8``/``C3D8R``/..., ``C3D10``; meshio's
+    VTK node order put in scikit-fem's: ``skfem.io.meshio.INV_HEX_MAPPING`` for hexahedra).
+    Elements of negative volume (left-handed node order) are mirrored, so every element has a
+    positive Jacobian in scikit-fem's order. ``cells`` names a *physical volume* (dimension 3)
+    or an ELSET of volume elements; ``None``: every 3D element of the file, its 2D elements
+    being boundaries. Boundaries: every *physical surface* (Gmsh) or ELSET of faces (Abaqus,
+    e.g. ``CPS3``, ``CPS4``, ``S3``, ``M3D4`` as gmsh writes them) holds the body's boundary
+    facets whose corner nodes are those of one of its faces; every NSET the facets whose
+    corners all lie in it. Refused: 20-node hexahedra, wedges (prisms), pyramids, and a
+    physical surface of a 3D file named as a body.
 
 Boundaries
     Gmsh: every *physical curve* (dimension 1) becomes a boundary of the same name, holding the
@@ -60,7 +74,22 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from skfem import Mesh, MeshQuad1, MeshQuad2, MeshTri1, MeshTri2
+from skfem import (
+    ElementHex1,
+    ElementHex2,
+    ElementTetP1,
+    ElementTetP2,
+    Mesh,
+    MeshHex1,
+    MeshHex2,
+    MeshQuad1,
+    MeshQuad2,
+    MeshTet1,
+    MeshTet2,
+    MeshTri1,
+    MeshTri2,
+)
+from skfem.io.meshio import INV_HEX_MAPPING
 
 from ..errors import InputError
 from .checks import check_mesh
@@ -75,6 +104,28 @@ _SUPPORTED = {
     "quad9": (MeshQuad2, 4, [0, 3, 2, 1, 7, 6, 5, 4, 8]),
 }
 _LINES = ("line", "line3")  # boundary elements; their first two nodes are the ends
+#: 3D: meshio cell type -> (scikit-fem mesh class, number of vertices, its element, the
+#: scikit-fem node of each local node: meshio's (VTK's) order -> scikit-fem's)
+_SOLIDS = {
+    "tetra": (MeshTet1, 4, ElementTetP1, list(range(4))),
+    "hexahedron": (MeshHex1, 8, ElementHex1, list(INV_HEX_MAPPING[:8])),
+    "tetra4": (MeshTet1, 4, ElementTetP1, list(range(4))),  # meshio 5.3's name for C3D4H
+    "tetra10": (MeshTet2, 4, ElementTetP2, list(range(10))),
+    "hexahedron27": (MeshHex2, 8, ElementHex2, list(INV_HEX_MAPPING)),
+}
+#: 3D: boundary elements (faces) of a volume mesh; their first 3 or 4 nodes are the corners
+_FACES = {"triangle": 3, "triangle6": 3, "triangle7": 3, "quad": 4, "quad8": 4, "quad9": 4}
+#: Element types vfem does not read, said plainly (meshio's names, the Abaqus and Gmsh ones)
+_UNSUPPORTED_3D = {
+    "hexahedron20": "20-node hexahedra (Abaqus C3D20, C3D20R; Gmsh with "
+                    "Mesh.SecondOrderIncomplete = 1): use 8- or 27-node hexahedra",
+    "wedge": "6-node wedges or prisms (Abaqus C3D6; Gmsh prisms): use tetrahedra or hexahedra",
+    "wedge15": "15-node wedges (Abaqus C3D15): use tetrahedra or hexahedra",
+    "wedge18": "18-node wedges (Gmsh prisms of order 2): use tetrahedra or hexahedra",
+    "pyramid": "pyramids (Abaqus C3D5; Gmsh pyramids): use tetrahedra or hexahedra",
+    "pyramid13": "13-node pyramids: use tetrahedra or hexahedra",
+    "pyramid14": "14-node pyramids: use tetrahedra or hexahedra",
+}
 _SURFACES = ("triangle", "quad", "polygon")  # a cell type of dimension 2 starts with one of these
 
 #: Abaqus element names meshio 5.3 does not know, read as the meshio type of the same shape
@@ -83,6 +134,15 @@ _ABAQUS_ALIASES = {
     **dict.fromkeys(["CPE4", "CPE4H", "CPE4I", "CPE4IH", "CPE4R", "CPE4RH", "CPS4I"], "quad"),
     **dict.fromkeys(["CPE6", "CPE6H", "CPE6M", "CPE6MH", "CPS6", "CPS6M"], "triangle6"),
     **dict.fromkeys(["CPE8", "CPE8H", "CPE8R", "CPE8RH", "CPS8", "CPS8R"], "quad8"),
+    # faces of 3D meshes (boundaries only), as gmsh writes them: membranes and plane elements
+    **dict.fromkeys(["M3D3"], "triangle"),
+    **dict.fromkeys(["M3D4", "M3D4R"], "quad"),
+    **dict.fromkeys(["M3D6"], "triangle6"),
+    **dict.fromkeys(["M3D8", "M3D8R"], "quad8"),
+    **dict.fromkeys(["M3D9", "M3D9R"], "quad9"),
+    **dict.fromkeys(["C3D5", "C3D5H"], "pyramid"),
+    **dict.fromkeys(["C3D6H"], "wedge"),
+    **dict.fromkeys(["C3D15H"], "wedge15"),
 }
 
 _FORMATS = {".msh": "gmsh", ".inp": "abaqus"}
@@ -104,14 +164,17 @@ def read_mesh(path: str | os.PathLike, cells: str | None = None) -> Mesh:
 
     Args:
         path: the mesh file.
-        cells: the group holding the body's elements: a Gmsh physical surface or an Abaqus
-            ELSET; ``None`` for every 2D element in the file.
+        cells: the group holding the body's elements: a Gmsh physical surface (physical
+            volume in a file with 3D elements) or an Abaqus ELSET; ``None`` for every 2D
+            element in the file (every 3D element, if it has any).
 
     Returns:
         A ``MeshTri1``, ``MeshQuad1``, ``MeshTri2`` or ``MeshQuad2`` with counter-clockwise
         elements, only the body's nodes, and ``mesh.boundaries`` (name -> boundary facet indices)
         from the file's physical curves (Gmsh) or node sets and line element sets (Abaqus) that
-        touch the body. See the module's docstring for the conventions.
+        touch the body; from a file with 3D elements a ``MeshTet1``, ``MeshHex1``,
+        ``MeshTet2`` or ``MeshHex2`` of positive volumes, its boundaries from the physical
+        surfaces, face element sets and node sets. See the module's docstring.
 
     Raises:
         InputError: the file is missing or unreadable, or the selection makes no valid mesh.
@@ -136,11 +199,16 @@ def read_mesh(path: str | os.PathLike, cells: str | None = None) -> Mesh:
         raise InputError(f"{where}: cannot make sense of its groups ({type(e).__name__}: {e}); "
                          f"expected {_EXPECTED}") from None
 
-    what = f"{where}, {'every 2D element' if cells is None else f'group {cells!r}'}"
+    dim = 3 if any(_dim(b.type) == 3 for b in raw.cells) else 2  # a volume mesh: 3D bodies
+    what = f"{where}, {f'every {dim}D element' if cells is None else f'group {cells!r}'}"
     try:
-        selected = _select(raw, groups, cells, fmt, where)
-        mesh, old_to_vertex = _build(raw, selected, what)
-        boundaries = _boundaries(raw, groups, mesh, old_to_vertex)
+        selected = _select(raw, groups, cells, fmt, where, dim)
+        if dim == 3:
+            mesh, old_to_vertex = _build_3d(raw, selected, what)
+            boundaries = _boundaries_3d(raw, groups, mesh, old_to_vertex)
+        else:
+            mesh, old_to_vertex = _build(raw, selected, what)
+            boundaries = _boundaries(raw, groups, mesh, old_to_vertex)
         mesh = mesh.with_boundaries(boundaries)
     except InputError:
         raise
@@ -204,7 +272,8 @@ def _gmsh_groups(raw) -> list[_Group]:
     """Physical groups: from ``field_data`` (name -> [tag, dim]), the elements of each from
     ``cell_sets`` (msh 4, every physical tag of an entity) and ``gmsh:physical`` (msh 2 and 4,
     the first tag)."""
-    kinds = {0: "physical point", 1: "physical curve", 2: "physical surface"}
+    kinds = {0: "physical point", 1: "physical curve", 2: "physical surface",
+             3: "physical volume"}
     physical = raw.cell_data.get("gmsh:physical")
     groups = []
     for name, value in raw.field_data.items():
@@ -281,16 +350,20 @@ def _abaqus_element_headers(path: Path) -> list[str | None] | None:
 # -- selecting the body ----------------------------------------------------------------------------
 
 
-def _select(raw, groups: list[_Group], cells: str | None, fmt: str, where: str
+def _select(raw, groups: list[_Group], cells: str | None, fmt: str, where: str, dim: int = 2
             ) -> tuple[str, np.ndarray]:
-    """The selected elements: (meshio cell type, connectivity (n, nodes) in the file's points)."""
-    body_kind = "physical surface" if fmt == "gmsh" else "ELSET"
+    """The selected elements: (meshio cell type, connectivity (n, nodes) in the file's points).
+    ``dim``: the bodies' dimension, 3 in a file with 3D elements (its 2D elements are then
+    boundaries), else 2."""
+    body_kind = ("physical volume" if dim == 3 else "physical surface") if fmt == "gmsh" \
+        else "ELSET"
     bodies = sorted({g.name for g in groups
-                     if any(_dim(raw.cells[k].type) == 2 for k in g.blocks)})
-    listing = (f"{body_kind}s with 2D elements in the file: {', '.join(bodies)}" if bodies
-               else f"the file has no {body_kind}s with 2D elements")
+                     if any(_dim(raw.cells[k].type) == dim for k in g.blocks)})
+    listing = (f"{body_kind}s with {dim}D elements in the file: {', '.join(bodies)}" if bodies
+               else f"the file has no {body_kind}s with {dim}D elements")
     if cells is None:
-        chosen = {k: np.arange(len(b.data)) for k, b in enumerate(raw.cells) if _dim(b.type) == 2}
+        chosen = {k: np.arange(len(b.data)) for k, b in enumerate(raw.cells)
+                  if _dim(b.type) == dim}
         if not chosen:
             found = sorted({b.type for b in raw.cells})
             raise InputError(f"{where}: no 2D elements (found {', '.join(found)}); vfem reads "
@@ -303,24 +376,37 @@ def _select(raw, groups: list[_Group], cells: str | None, fmt: str, where: str
             close = difflib.get_close_matches(cells, names, n=3, cutoff=0.5)
             hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
             raise InputError(f"{where}: no group named {cells!r} ({listing}){hint}")
-        chosen = {k: ids for k, ids in group.blocks.items() if _dim(raw.cells[k].type) == 2}
+        chosen = {k: ids for k, ids in group.blocks.items() if _dim(raw.cells[k].type) == dim}
+        if not chosen and dim == 3 and any(_dim(raw.cells[k].type) == 2 for k in group.blocks):
+            raise InputError(f"{where}: group {cells!r} ({group.kind}) holds 2D elements of a 3D "
+                             f"mesh, but a body of a file with 3D elements is 3D; name the "
+                             f"{body_kind} of the body's elements ({listing}): the file's "
+                             f"surfaces become its boundaries")
         if not chosen:
-            raise InputError(f"{where}: group {cells!r} ({group.kind}) has no 2D elements; "
+            raise InputError(f"{where}: group {cells!r} ({group.kind}) has no {dim}D elements; "
                              f"name the {body_kind} of the body's elements ({listing})")
         label = f"group {cells!r}"
 
     types = sorted({raw.cells[k].type for k, ids in chosen.items() if len(ids)})
     if not types:
         raise InputError(f"{where}: {label} selects no elements")
-    unsupported = [t for t in types if t not in _SUPPORTED]
+    readable = _SOLIDS if dim == 3 else _SUPPORTED
+    unsupported = [t for t in types if t not in readable]
+    if unsupported and dim == 3:
+        why = "; ".join(_UNSUPPORTED_3D[t] for t in unsupported if t in _UNSUPPORTED_3D)
+        raise InputError(f"{where}: {label} has elements of unsupported type "
+                         f"{', '.join(unsupported)}; vfem reads "
+                         f"{', '.join(t for t in _SOLIDS if t != 'tetra4')} in 3D"
+                         + (f" ({why})" if why else ""))
     if unsupported:
         raise InputError(f"{where}: {label} has elements of unsupported type "
                          f"{', '.join(unsupported)}; vfem reads {', '.join(_SUPPORTED)}")
     if len(types) > 1:
         others = [b for b in bodies if b != cells]
         if cells is not None:  # the group chosen is itself mixed: the mesh must change
-            how = (f"mesh the group with one element type (in Gmsh, Mesh.RecombineAll or none),"
-                   f" or split it into a {body_kind} per type, one body each")
+            how = ("mesh the group with one element type (in Gmsh, Mesh.RecombineAll or none"
+                   + (", and no prisms or pyramids" if dim == 3 else "")
+                   + f"), or split it into a {body_kind} per type, one body each")
         elif others:
             how = f"select one body's elements with cells = {others[0]!r}"
         else:
@@ -401,6 +487,60 @@ def _signed_area(xy: np.ndarray, t: np.ndarray) -> np.ndarray:
     return 0.5 * np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
 
 
+def _build_3d(raw, selected: tuple[str, np.ndarray], what: str) -> tuple[Mesh, np.ndarray]:
+    """:func:`_build` of tetrahedra and hexahedra: nodes put in scikit-fem's local order
+    (hexahedra: ``skfem.io.meshio.INV_HEX_MAPPING``, not the VTK/Gmsh/Abaqus order meshio
+    gives), and elements of negative volume (Jacobian determinant at the element's centre)
+    mirrored, so every element has a positive volume in scikit-fem's order."""
+    cell_type, t = selected
+    mesh_type, nv, element, order = _SOLIDS[cell_type]
+    t = np.asarray(t, dtype=np.int64)[:, order]
+    used, t = np.unique(t, return_inverse=True)
+    t = t.reshape(-1, len(order))
+    points = np.asarray(raw.points, dtype=float)[used]
+    if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
+        raise InputError(f"{what}: node coordinates are not finite 3D points")
+
+    negative = _signed_volume(points, t, element) < 0
+    if negative.any():
+        t[negative] = t[negative][:, _mirrored(element)]
+        log.debug("%s: %d elements of negative volume reordered", what, int(negative.sum()))
+
+    p = np.ascontiguousarray(points.T)
+    mesh = mesh_type(p, np.ascontiguousarray(t.T))
+    vertices = np.unique(t[:, :nv])
+    new_to_vertex = np.full(len(used), -1, dtype=np.int64)
+    new_to_vertex[vertices] = np.arange(len(vertices))
+    same = np.array_equal(mesh.doflocs[:, : len(vertices)], p[:, vertices])
+    if mesh.nvertices != len(vertices) or not same:
+        raise InputError(f"{what}: the elements do not form a valid mesh (the quadratic nodes "
+                         f"are not shared between neighbouring elements)")
+    check_mesh(mesh, what)
+    old_to_vertex = np.full(len(raw.points), -1, dtype=np.int64)
+    old_to_vertex[used] = new_to_vertex
+    return mesh, old_to_vertex
+
+
+def _signed_volume(points: np.ndarray, t: np.ndarray, element) -> np.ndarray:
+    """The Jacobian determinant of each element (n, nodes) in scikit-fem's local order at
+    the reference element's centre: its sign is the element's orientation."""
+    elem = element()
+    nv = elem.refdom.nnodes
+    centre = np.asarray(elem.doflocs[:nv], dtype=float).mean(axis=0)[:, None]
+    dphi = np.array([elem.lbasis(centre, k)[1][:, 0] for k in range(t.shape[1])])  # (k, 3)
+    J = np.einsum("eki,kj->eij", points[t], dphi)
+    return np.linalg.det(J)
+
+
+def _mirrored(element) -> list[int]:
+    """The local node order that mirrors an element onto itself (its volume's sign flips):
+    the reference tetrahedron's x and y swapped, the reference cube's x -> 1 - x."""
+    d = np.asarray(element.doflocs, dtype=float)
+    tet = element in (ElementTetP1, ElementTetP2)
+    image = d[:, [1, 0, 2]] if tet else d * [-1, 1, 1] + [1, 0, 0]
+    return [int(np.flatnonzero(np.all(np.abs(d - x) < 1e-12, axis=1))[0]) for x in image]
+
+
 # -- boundaries ------------------------------------------------------------------------------------
 
 
@@ -435,6 +575,46 @@ def _boundaries(raw, groups: list[_Group], mesh: Mesh, old_to_vertex: np.ndarray
             if not lines:
                 continue
             hit = matching(np.vstack(lines).astype(np.int64))
+        if hit.size:
+            found[g.name] = np.union1d(found.get(g.name, np.array([], np.int64)), hit)
+        else:
+            log.debug("%s %r touches none of this body's boundary facets", g.kind, g.name)
+    return {name: f.astype(np.int64) for name, f in found.items()}
+
+
+def _boundaries_3d(raw, groups: list[_Group], mesh: Mesh, old_to_vertex: np.ndarray
+                   ) -> dict[str, np.ndarray]:
+    """:func:`_boundaries` of a volume mesh: the boundary facets (triangles or quadrilaterals)
+    that coincide with a group's face elements (matched by their corner nodes: Gmsh physical
+    surfaces, Abaqus ELSETs of triangles or quadrilaterals), or whose corners all lie in an
+    NSET."""
+    facets = mesh.boundary_facets().astype(np.int64)
+    corners = np.sort(mesh.facets[:, facets].T, axis=1).astype(np.int64)  # (nb, 3 or 4)
+    k = corners.shape[1]
+    nv = mesh.nvertices
+
+    def matching(faces: np.ndarray) -> np.ndarray:
+        v = old_to_vertex[faces]
+        v = np.sort(v[(v >= 0).all(axis=1)], axis=1)
+        if not len(v) or not len(corners):
+            return np.array([], dtype=np.int64)
+        _, inverse = np.unique(np.vstack([corners, v]), axis=0, return_inverse=True)
+        inverse = inverse.ravel()
+        return facets[np.isin(inverse[: len(corners)], inverse[len(corners):])]
+
+    found: dict[str, np.ndarray] = {}
+    for g in groups:
+        if g.nodes is not None:  # NSET: the facets with every corner in the set
+            inside = np.zeros(nv, dtype=bool)
+            v = old_to_vertex[g.nodes[(g.nodes >= 0) & (g.nodes < len(old_to_vertex))]]
+            inside[v[v >= 0]] = True
+            hit = facets[inside[corners].all(axis=1)]
+        else:
+            faces = [np.asarray(raw.cells[b].data)[ids][:, :k] for b, ids in g.blocks.items()
+                     if _FACES.get(raw.cells[b].type) == k]
+            if not faces:
+                continue
+            hit = matching(np.vstack(faces).astype(np.int64))
         if hit.size:
             found[g.name] = np.union1d(found.get(g.name, np.array([], np.int64)), hit)
         else:
