@@ -52,6 +52,7 @@ from ..errors import InputError
 from ..linalg import factorize
 from ..materials import LinearElastic
 from ..mesh.checks import check_mesh
+from .assembly import cell_mapping, elasticity_stiffness
 from .mechanics import (
     BodyMechanics,
     LargeMechanics,
@@ -366,9 +367,16 @@ class Body:
         """
         self.validate()
         t0 = time.perf_counter()
-        self.basis = Basis(self.mesh, ElementVector(self.element()))
+        if self.dim == 3:
+            self.basis = Basis(self.mesh, ElementVector(self.element()),
+                               mapping=cell_mapping(self.mesh))
+        else:
+            self.basis = Basis(self.mesh, ElementVector(self.element()))
         lam, mu = self.material.lame()
-        self.K = asm(linear_elasticity(lam, mu), self.basis).tocsr()
+        if self.dim == 3:  # scikit-fem's per-pair loop takes minutes at 3D sizes (assembly.py)
+            self.K = elasticity_stiffness(self.basis, lam, mu)
+        else:
+            self.K = asm(linear_elasticity(lam, mu), self.basis).tocsr()
         self.ndofs = self.K.shape[0]
         t1 = time.perf_counter()
         fixed = self._constraints()

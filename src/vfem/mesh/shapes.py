@@ -614,15 +614,16 @@ def _transfinite(bottom: np.ndarray, top: np.ndarray, left: np.ndarray, right: n
 
 
 def _grid_line(a: float, b: float, h: float, h_fine: float | None, growth: float,
-               fine: Sequence[float]) -> np.ndarray:
-    """Grid positions on [a, b]: uniform (spacing <= h), or graded towards ``fine``."""
+               fine: Sequence[float], plateau: float = 0.0) -> np.ndarray:
+    """Grid positions on [a, b]: uniform (spacing <= h), or graded towards ``fine`` (spacing
+    ``h_fine`` within ``plateau`` of them)."""
     if not h > 0:
         raise ValueError(f"the element size h must be positive, got {h}")
     if h_fine is None or len(fine) == 0:
         check_count((b - a) / h, "the element size h")
         return np.linspace(a, b, max(1, int(np.ceil((b - a) / h - 1e-9))) + 1)
     f = np.asarray(fine, dtype=float)
-    size = size_function(h_fine, growth, h)
+    size = size_function(h_fine, growth, h, plateau)
     hx = lambda x: size(np.min(np.abs(np.asarray(x)[:, None] - f[None, :]), axis=1))  # noqa: E731
     cuts = np.unique(np.concatenate([[a, b], f[(f > a) & (f < b)]]))
     return np.concatenate([graded_nodes(c0, c1, hx)[:-1] for c0, c1 in zip(cuts[:-1], cuts[1:])]

@@ -11,15 +11,16 @@ scikit-fem's facet topology already built (:mod:`vfem.mesh.topology`).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 from skfem import MeshHex, MeshTet
 
 from .parametric import check_count
 from .shapes import _grid_line
-from .topology import named_boundaries
+from .topology import named_boundaries, share_topology
 
-__all__ = ["box", "FACES"]
+__all__ = ["box", "cylinder", "FACES"]
 
 #: The named faces of :func:`box`: name -> (axis, end) (end 0: the face at the smaller
 #: coordinate).
@@ -31,7 +32,8 @@ def box(x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, width: float = 1.0,
         depth: float = 1.0, height: float = 1.0, nx: int = 1, ny: int = 1, nz: int = 1, *,
         h: float | None = None, h_fine: float | None = None, growth: float = 0.2,
         fine_x: Sequence[float] = (), fine_y: Sequence[float] = (),
-        fine_z: Sequence[float] = (), tetrahedra: bool = False) -> MeshHex | MeshTet:
+        fine_z: Sequence[float] = (), plateau: float = 0.0,
+        tetrahedra: bool = False) -> MeshHex | MeshTet:
     """The box ``[x0, x0 + width] x [y0, y0 + depth] x [z0, z0 + height]`` as a tensor grid of
     hexahedra (trilinear, scikit-fem's ``MeshHex``), or with ``tetrahedra`` each hexahedron
     split into six tetrahedra around its diagonal from its lowest to its highest corner (Kuhn's
@@ -41,8 +43,9 @@ def box(x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, width: float = 1.0,
     given ``h`` and ``h_fine``, graded: the spacing along x is ``h_fine`` at the planes
     x = ``fine_x`` (for instance under a punch's edge) and grows with ``growth`` per unit
     distance up to ``h``; likewise along y towards ``fine_y`` and along z towards ``fine_z``
-    (an axis without fine planes is uniform). Planes of ``fine_*`` inside the box are grid
-    planes.
+    (an axis without fine planes is uniform); within ``plateau`` of those planes the spacing
+    stays ``h_fine`` (a contact zone of even elements). Planes of ``fine_*`` inside the box are
+    grid planes.
 
     Named boundaries: ``left`` (x = x0), ``right`` (x = x0 + width), ``front`` (y = y0),
     ``back`` (y = y0 + depth), ``bottom`` (z = z0) and ``top`` (z = z0 + height).
@@ -60,7 +63,7 @@ def box(x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, width: float = 1.0,
     else:
         for size in (width, depth, height):  # the count first: no line of a billion nodes
             check_count(size / h if h > 0 else float("inf"), "the element size h")
-        lines = [_grid_line(a, b, h, h_fine, growth, fine)
+        lines = [_grid_line(a, b, h, h_fine, growth, fine, plateau)
                  for a, b, fine in ((x0, x1, fine_x), (y0, y1, fine_y), (z0, z1, fine_z))]
     check_count(float(np.prod([len(v) for v in lines], dtype=float)), "box")
     mesh = (MeshTet if tetrahedra else MeshHex).init_tensor(*lines)
@@ -72,3 +75,77 @@ def box(x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, width: float = 1.0,
         return lambda p: np.abs(p[axis] - at) < tol
 
     return named_boundaries(mesh, {name: face(axis, end) for name, (axis, end) in FACES.items()})
+
+
+def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | None = None,
+             x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, quarter: bool = True,
+             h_contact: float | None = None, h: float | None = None, growth: float = 0.2,
+             plateau: float = 0.0, blend_from: float = 0.5, tetrahedra: bool = False
+             ) -> MeshHex | MeshTet:
+    """A cylinder of ``radius`` about the vertical axis through (``x0``, ``y0``), its lower end
+    at ``z0`` on the axis and its top face the plane ``z = z0 + height``: flat-ended (a
+    circular punch), or with ``end_radius`` its lower end a spherical cap of that radius
+    touching ``z = z0`` at the axis (a sphere's contact region: Hertz's indenter). With
+    ``quarter`` only the part ``x >= x0, y >= y0`` (a quarter model with two symmetry planes).
+
+    The mesh is a tensor grid of hexahedra (or of six tetrahedra each, as :func:`box`) mapped
+    onto the cylinder, graded towards the axis and the end: the spacing is ``h_contact`` within
+    ``plateau`` of the axis (across) and of the end (up), growing by ``growth`` per unit
+    distance beyond, up to ``h``; without
+    ``h_contact`` it is ``h`` everywhere. In plan the grid's square rings stay squares inside
+    ``blend_from`` times the radius (the contact zone keeps a straight, regular grid) and turn
+    smoothly into the circle beyond; every column is then stretched vertically from the end
+    surface to the top plane, so the nodes of ``contact`` lie on the sphere (or the plane).
+
+    Named boundaries: ``contact`` (the lower end), ``top``, ``side`` (the cylinder's mantle)
+    and, with ``quarter``, ``left`` (x = x0) and ``front`` (y = y0), as on :func:`box`.
+    """
+    R = float(radius)
+    if not (R > 0 and height > 0):
+        raise ValueError(f"radius and height must be positive, got {radius}, {height}")
+    if end_radius is not None:
+        if not end_radius > 0:
+            raise ValueError(f"end_radius must be positive, got {end_radius}")
+        if not end_radius - np.sqrt(max(end_radius ** 2 - R ** 2, 0.0)) < height \
+                or not R < end_radius:
+            raise ValueError(f"a spherical end of radius {end_radius:g} on a cylinder of radius "
+                             f"{R:g} needs end_radius > radius and a height above "
+                             f"{end_radius - np.sqrt(max(end_radius ** 2 - R ** 2, 0.0)):.6g} "
+                             f"(the cap's rise), got {height:g}")
+    if not 0.0 < blend_from <= 0.58:
+        raise ValueError(f"blend_from must lie between 0 and 0.58, got {blend_from}")
+    if h is None:
+        raise ValueError("give the element size h (and h_contact to grade the mesh)")
+    fine = (0.0,) if h_contact is not None else ()
+    across = _grid_line(0.0 if quarter else -R, R, h, h_contact, growth, fine, plateau) / R
+    up = _grid_line(0.0, height, h, h_contact, growth, fine, plateau)
+    check_count(float(len(across)) ** 2 * len(up), "cylinder")
+    mesh = (MeshTet if tetrahedra else MeshHex).init_tensor(across, across, up / height)
+    # names on the reference grid (u, v in [-1, 1] or [0, 1], w in [0, 1]), kept by the map
+    tol = 1e-9
+    ring = lambda p: np.maximum(np.abs(p[0]), np.abs(p[1]))  # noqa: E731
+    tests = {"contact": lambda p: p[2] < tol, "top": lambda p: p[2] > 1 - tol,
+             "side": lambda p: ring(p) > 1 - tol}
+    if quarter:
+        tests.update(left=lambda p: p[0] < tol, front=lambda p: p[1] < tol)
+    mesh = named_boundaries(mesh, tests)
+    u, v, w = mesh.p
+    m = np.maximum(np.abs(u), np.abs(v))  # the square ring through the node
+    r_ref = np.hypot(u, v)
+    # beta: 0 inside blend_from (the square kept), 1 on the rim (the circle), linear between:
+    # the rings stay nested (a ring's diagonal point, m R (sqrt 2 - (sqrt 2 - 1) beta), grows
+    # with m while d beta / dm < 1 / (sqrt 2 - 1)), which blend_from < 0.58 keeps
+    beta = np.clip((m - blend_from) / (1.0 - blend_from), 0.0, 1.0)
+    scale = np.where(r_ref > 0, (1.0 - beta) + beta * m / np.where(r_ref > 0, r_ref, 1.0), 1.0)
+    x, y = R * u * scale, R * v * scale
+    rr = np.hypot(x, y)
+    bottom = (0.0 if end_radius is None
+              else end_radius - np.sqrt(np.maximum(end_radius ** 2 - rr ** 2, 0.0)))
+    # the layers: graded up from the end near the axis, turning into equal layers towards
+    # the rim (where graded ones would make slabs thinner than the end's rise across them)
+    layer = np.searchsorted(up / height, w - 1e-9)
+    equal = layer / (len(up) - 1.0)
+    gamma = np.clip((rr / R - blend_from) / (1.0 - blend_from), 0.0, 1.0)
+    z = bottom + ((1.0 - gamma) * w + gamma * equal) * (height - bottom)
+    p = np.vstack([x + x0, y + y0, z + z0])
+    return share_topology(mesh, replace(mesh, doflocs=p))

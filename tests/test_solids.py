@@ -1,0 +1,92 @@
+"""Built-in 3D shapes (issue 21): the cylinder with a flat or spherical end, and the 3D
+stiffness assembly they are solved with."""
+
+import math
+
+import numpy as np
+import pytest
+from skfem import (
+    Basis,
+    ElementHex1,
+    ElementHex2,
+    ElementTetP1,
+    ElementTetP2,
+    ElementVector,
+    asm,
+)
+from skfem.models.elasticity import linear_elasticity
+
+from vfem.bodies.assembly import cell_mapping, elasticity_stiffness
+from vfem.mesh.checks import check_mesh
+from vfem.mesh.solids import box, cylinder
+
+
+def volume(mesh) -> float:
+    b = Basis(mesh, ElementTetP1() if mesh.t.shape[0] == 4 else ElementHex1())
+    return float(b.dx.sum())
+
+
+@pytest.mark.parametrize("tetrahedra", [False, True], ids=["hex", "tet"])
+@pytest.mark.parametrize("quarter", [True, False], ids=["quarter", "full"])
+def test_cylinder_with_a_spherical_end(quarter, tetrahedra):
+    R, Rc, H = 10.0, 6.0, 5.0
+    m = cylinder(Rc, H, end_radius=R, x0=1.0, y0=-2.0, z0=0.5, quarter=quarter,
+                 h_contact=0.25, h=1.0, plateau=1.0, tetrahedra=tetrahedra)
+    check_mesh(m, "cylinder")  # no inverted or folded element
+    centre = np.array([[1.0], [-2.0], [0.5 + R]])
+    end = np.unique(m.facets[:, m.boundaries["contact"]])
+    assert np.abs(np.linalg.norm(m.p[:, end] - centre, axis=0) - R).max() < 1e-12
+    side = np.unique(m.facets[:, m.boundaries["side"]])
+    assert np.abs(np.hypot(m.p[0, side] - 1.0, m.p[1, side] + 2.0) - Rc).max() < 1e-12
+    top = np.unique(m.facets[:, m.boundaries["top"]])
+    assert np.abs(m.p[2, top] - (0.5 + H)).max() < 1e-12
+    names = {"contact", "top", "side"} | ({"left", "front"} if quarter else set())
+    assert set(m.boundaries) == names
+    if quarter:
+        assert np.abs(m.p[0, np.unique(m.facets[:, m.boundaries["left"]])] - 1.0).max() < 1e-12
+        assert np.abs(m.p[1, np.unique(m.facets[:, m.boundaries["front"]])] + 2.0).max() < 1e-12
+    # the volume: the cylinder less the cap under the sphere, to the faceting error
+    exact = (math.pi * Rc ** 2 * H - math.pi * R * Rc ** 2
+             + 2 * math.pi / 3 * (R ** 3 - (R ** 2 - Rc ** 2) ** 1.5))
+    assert volume(m) * (4 if quarter else 1) == pytest.approx(exact, rel=4e-3)  # 2.3e-3 measured
+    # the contact zone is a regular grid: spacing h_contact within the plateau of the axis
+    near = end[np.hypot(m.p[0, end] - 1.0, m.p[1, end] + 2.0) < 0.9]
+    xs = np.unique(np.round(m.p[0, near], 12))
+    assert np.allclose(np.diff(xs), np.diff(xs)[0], rtol=1e-9)
+    assert np.diff(xs)[0] <= 0.25
+
+
+def test_flat_ended_cylinder_and_refusals():
+    m = cylinder(1.0, 2.0, h=0.25, quarter=False)
+    check_mesh(m, "punch")
+    assert volume(m) == pytest.approx(math.pi * 2.0, rel=1e-2)
+    assert np.abs(m.p[2, np.unique(m.facets[:, m.boundaries["contact"]])]).max() == 0.0
+    with pytest.raises(ValueError, match="end_radius > radius"):
+        cylinder(6.0, 5.0, end_radius=5.0, h=1.0)
+    with pytest.raises(ValueError, match="height above 2"):
+        cylinder(6.0, 1.5, end_radius=10.0, h=1.0)
+    with pytest.raises(ValueError, match="give the element size h"):
+        cylinder(1.0, 1.0)
+
+
+@pytest.mark.parametrize("element,tetrahedra", [(ElementHex1, False), (ElementTetP1, True),
+                                                (ElementTetP2, True), (ElementHex2, False)],
+                         ids=["hex1", "tet1", "tet2", "hex2"])
+def test_3d_stiffness_equals_scikit_fem_assembly(element, tetrahedra):
+    mesh = cylinder(6.0, 5.0, end_radius=10.0, h=3.0 if element is ElementHex2 else 1.5,
+                    tetrahedra=tetrahedra)  # (curved, distorted hexahedra near the rim)
+    plain = Basis(mesh, ElementVector(element()))
+    remembering = Basis(mesh, ElementVector(element()), mapping=cell_mapping(mesh))
+    assert all(np.array_equal(a[0].grad, b[0].grad) for a, b in
+               zip(plain.basis, remembering.basis))  # the same numbers, computed once
+    assert np.array_equal(plain.dx, remembering.dx)
+    reference = asm(linear_elasticity(1.3, 0.7), plain).tocsr()
+    K = elasticity_stiffness(remembering, 1.3, 0.7)
+    assert abs(K - reference).max() < 2e-15 * abs(reference).max()
+
+
+def test_box_plateau_keeps_the_fine_spacing():
+    m = box(0.0, 0.0, 0.0, 4.0, 4.0, 1.0, h=1.0, h_fine=0.1, fine_x=(0.0,), plateau=0.5)
+    xs = np.unique(m.p[0])
+    d = np.diff(xs[xs < 0.5 + 1e-9])
+    assert np.allclose(d, d[0], rtol=1e-12) and 0.09 < d[0] <= 0.1
