@@ -50,9 +50,10 @@ SHAPES = {
     "rounded_punch": shapes.rounded_punch,
     "filleted_punch": shapes.filleted_punch,
     "box": solids.box,
+    "cylinder": solids.cylinder,
 }
 #: The shapes of :data:`SHAPES` that make 3D meshes (tetrahedra, hexahedra).
-SOLID_SHAPES = ("box",)
+SOLID_SHAPES = ("box", "cylinder")
 
 
 @dataclass(frozen=True)

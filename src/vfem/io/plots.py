@@ -64,7 +64,9 @@ def require_matplotlib():
 
 
 def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[str, np.ndarray],
-                   title: str, method: str = "vfem") -> None:
+                   title: str, method: str = "vfem",
+                   xlabel: str = "x / a (undeformed x over Hertz's half-width; dimensionless)",
+                   per: str = "length") -> None:
     """p/p0 against x/a for each body, with Hertz's ellipse (like thesis Fig. 5.3);
     ``method``: the contact method that computed them (the legend's label)."""
     plt = require_matplotlib()
@@ -74,15 +76,42 @@ def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[
     for (name, xa), marker in zip(x_over_a.items(), ("o", "s", "^", "v")):
         order = np.argsort(xa)
         ax.plot(xa[order], p_over_p0[name][order], marker, ms=4, mfc="none", ls="",
-                label=f"{method}, {name} (nodal force / undeformed length)")
+                label=f"{method}, {name} (nodal force / undeformed {per})")
     ax.set_xlim(0, 1.4)
     ax.set_ylim(-0.1, 1.15)
     ax.axhline(0, color="0.7", lw=0.8)
-    ax.set_xlabel("x / a (undeformed x over Hertz's half-width; dimensionless)")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("p / p0 (pressure over Hertz's peak; dimensionless)")
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def pressure_map(path: Path, x: np.ndarray, y: np.ndarray, p: np.ndarray, title: str) -> None:
+    """A 3D contact surface's pressure seen along its normal: filled contours of ``p`` over the
+    nodes' undeformed (``x``, ``y``) (a triangulation of the points in that plane), with the
+    circle of radius 1 (Hertz's r = a when x, y and p are scaled by a and p0)."""
+    import matplotlib.tri as mtri
+
+    plt = require_matplotlib()
+    fig, ax = plt.subplots(figsize=(5.6, 5.0))
+    top = max(1.0, float(np.max(p)) if len(p) else 1.0)
+    if len(p) >= 3:
+        cs = ax.tricontourf(mtri.Triangulation(x, y), np.clip(p, 0.0, None),
+                            levels=np.linspace(0.0, top, 12), cmap="viridis")
+        fig.colorbar(cs, ax=ax, label="p / p0 (pressure over Hertz's peak)")
+    ax.plot(x, y, ".", ms=2, color="0.3")
+    s = np.linspace(0.0, 2.0 * np.pi, 361)
+    ax.plot(np.cos(s), np.sin(s), "w--", lw=1.2)
+    ax.set_xlim(float(np.min(x)), float(np.max(x)))
+    ax.set_ylim(float(np.min(y)), float(np.max(y)))
+    ax.set_aspect("equal")
+    ax.set_xlabel("x / a (undeformed)")
+    ax.set_ylabel("y / a (undeformed)")
+    ax.set_title(title, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)

@@ -1,0 +1,277 @@
+"""Hertz's sphere on a flat (issue 21): the 3D counterpart of the thesis's §5.2 cylinder.
+
+An elastic sphere of radius R is pressed onto an elastic flat by a force P. Hertz's theory
+(both bodies half-spaces near the contact, frictionless):
+
+    1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2,   a = (3 P R / (4 E*))^(1/3),
+    p(r) = p0 sqrt(1 - r^2/a^2),              p0 = 3 P / (2 pi a^2).
+
+The model: the sphere's contact region, a cylinder of radius 0.6 R and height 0.5 R whose lower
+end is the sphere (:func:`vfem.mesh.solids.cylinder`), pushed down by a rigid force-controlled
+platen on its top face (held there against sliding sideways); the flat a block 2 R wide and
+R deep, fixed on its lower face. Both meshes are graded towards the first point of contact:
+elements of size a/n (n = ``facets_per_radius``, doubled per ``refinement`` level) within
+1.2 a of it, the flat's ``flat_size_ratio`` times larger (the surface meshes do not match).
+``quarter`` (the default) models the quarter x >= 0, y >= 0 with two symmetry planes (rollers);
+``quarter = false`` the whole. The defaults: steel-like, R = 10, P = 15,000, so a = 1.008 and
+a/R = 0.1 (small strain: the analysis is linear).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..bodies import Platen, Support
+from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from ..contact.settings import ContactSettings
+from ..errors import InputError
+from ..io.runner import run_status
+from ..materials import LinearElastic
+from ..solver import AnalysisResult, Model
+
+#: The contact region's proportions, over the sphere's radius.
+CYLINDER_RADIUS, CYLINDER_HEIGHT = 0.6, 0.5
+FLAT_HALF_WIDTH, FLAT_DEPTH = 1.0, 1.0
+#: The evenly fine zone's radius, over Hertz's contact radius.
+PLATEAU = 1.2
+
+
+@dataclass(frozen=True)
+class SphereParameters:
+    """Parameters of the sphere example."""
+
+    radius: float = 10.0
+    sphere_youngs_modulus: float = 200e3
+    sphere_poissons_ratio: float = 0.3
+    flat_youngs_modulus: float = 200e3
+    flat_poissons_ratio: float = 0.3
+    force: float = 15000.0  # on the whole sphere (a quarter of it on the quarter model)
+    quarter: bool = True
+    steps: int = 2
+    refinement: int = 0
+    facets_per_radius: int = 6  # over Hertz's contact radius a
+    flat_size_ratio: float = 1.3
+    max_element_size: float = 1.0  # over the sphere's radius, times 10 (the bulk's elements)
+    growth: float = 0.3
+    sphere_cells: str = "hex"  # or "tet"
+    flat_cells: str = "hex"
+    swap_bodies: bool = False
+    equilibrium_tolerance: float = 1e-3
+
+
+Parameters = SphereParameters
+
+
+def theory(p: SphereParameters) -> dict[str, float]:
+    """Hertz's contact radius and peak pressure for the force on the whole sphere."""
+    e1 = LinearElastic(p.sphere_youngs_modulus, p.sphere_poissons_ratio)
+    e2 = LinearElastic(p.flat_youngs_modulus, p.flat_poissons_ratio)
+    e_star = 1.0 / (1.0 / e1.plane_strain_modulus() + 1.0 / e2.plane_strain_modulus())
+    a = (3.0 * p.force * p.radius / (4.0 * e_star)) ** (1.0 / 3.0)
+    return {"a_theory": a, "p0_theory": 3.0 * p.force / (2.0 * math.pi * a * a), "e_star": e_star}
+
+
+def validate(p: SphereParameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    for name in ("force", "radius"):
+        value = getattr(p, name)
+        if not (isinstance(value, (int, float)) and 0 < value < math.inf):
+            raise InputError(f"{name} must be a finite number > 0 (the sphere is pressed onto "
+                             f"the flat), got {value!r}")
+    if p.facets_per_radius < 1 or p.refinement < 0:
+        raise InputError("facets_per_radius must be at least 1 and refinement not negative, "
+                         f"got {p.facets_per_radius} and {p.refinement}")
+    for name in ("sphere_cells", "flat_cells"):
+        if getattr(p, name) not in ("hex", "tet"):
+            raise InputError(f"{name} must be 'hex' or 'tet', got {getattr(p, name)!r}")
+    build(p).validate()
+
+
+def config(p: SphereParameters | None = None) -> ModelConfig:
+    """The model as data (what ``examples/sphere.toml`` holds for the defaults)."""
+    p = p or SphereParameters()
+    try:
+        th = theory(p) if p.sphere_youngs_modulus > 0 and p.flat_youngs_modulus > 0 else None
+    except (ValueError, ArithmeticError):
+        th = None
+    R = p.radius
+    a = th["a_theory"] if th and th["a_theory"] > 0 else 0.1 * R
+    n = p.facets_per_radius * 2 ** p.refinement
+    h = a / n
+    h_max = 0.1 * R * p.max_element_size / 2 ** p.refinement
+    quarter = bool(p.quarter)
+    rollers = (Support("left", ("x",)), Support("front", ("y",))) if quarter else ()
+    sphere = BodyConfig(
+        name="sphere",
+        mesh=MeshSpec(shape="cylinder", parameters=as_parameters(
+            radius=CYLINDER_RADIUS * R, height=CYLINDER_HEIGHT * R, end_radius=R,
+            quarter=quarter, h_contact=h, h=h_max, growth=p.growth, plateau=PLATEAU * a,
+            tetrahedra=p.sphere_cells == "tet")),
+        material=LinearElastic(p.sphere_youngs_modulus, p.sphere_poissons_ratio),
+        supports=(Support("top", ("x", "y")), *rollers),
+        platen=Platen("top", "z", -p.force / (4.0 if quarter else 1.0)),
+        contact_boundaries=("contact",),
+    )
+    L, D = FLAT_HALF_WIDTH * R, FLAT_DEPTH * R
+    flat = BodyConfig(
+        name="flat",
+        mesh=MeshSpec(shape="box", parameters=as_parameters(
+            x0=0.0 if quarter else -L, y0=0.0 if quarter else -L, z0=-D,
+            width=L if quarter else 2 * L, depth=L if quarter else 2 * L, height=D,
+            h=2.0 * h_max, h_fine=p.flat_size_ratio * h, growth=p.growth, fine_x=(0.0,),
+            fine_y=(0.0,), fine_z=(0.0,), plateau=PLATEAU * a,
+            tetrahedra=p.flat_cells == "tet")),
+        material=LinearElastic(p.flat_youngs_modulus, p.flat_poissons_ratio),
+        supports=(Support("bottom"), *rollers),
+        contact_boundaries=("top",),
+    )
+    bodies = (flat, sphere) if p.swap_bodies else (sphere, flat)
+    settings = ContactSettings(equilibrium_tolerance=p.equilibrium_tolerance)
+    return ModelConfig("sphere", bodies, settings, Steps(count=p.steps))
+
+
+def build(p: SphereParameters | None = None) -> Model:
+    return config(p).build()
+
+
+def contour(mesh, boundary: str, touching: np.ndarray) -> np.ndarray:
+    """The contact zone's edge on ``boundary``: the midpoints (x, y) of the boundary facets'
+    edges that join a node in contact (``touching``, per mesh node) to one that is not."""
+    facets = mesh.facets[:, mesh.boundaries[boundary]]
+    # a facet's edges: consecutive nodes (quadrilaterals in cyclic order; a triangle's three)
+    a = facets.ravel()
+    b = np.roll(facets, -1, axis=0).ravel()
+    cut = touching[a] != touching[b]
+    return 0.5 * (mesh.p[:2, a[cut]] + mesh.p[:2, b[cut]]).T
+
+
+def evaluate(result: AnalysisResult, p: SphereParameters) -> dict:
+    """Compare the last step with Hertz: peak pressure, contact radius and its roundness, RMS
+    error, total force. Pressures are nominal (the sphere's nodal contact force over its
+    undeformed tributary area)."""
+    th = theory(p)
+    a, p0 = th["a_theory"], th["p0_theory"]
+    last = result.steps[-1]
+    share = 4.0 if p.quarter else 1.0
+    out = {"p0_theory": p0, "a_theory": a, "applied_force": p.force}
+    for name in ("sphere", "flat"):
+        body = next(b for b in result.model.bodies if b.name == name)
+        r = last.bodies[name]
+        boundary = "contact" if name == "sphere" else "top"
+        on = r.contact_status > 0
+        x = body.mesh.p
+        rr = np.hypot(x[0], x[1])
+        surface = np.unique(body.mesh.facets[:, body.mesh.boundaries[boundary]])
+        edge = np.hypot(*contour(body.mesh, boundary, on).T)
+        inside = surface[rr[surface] < a]
+        p_theory = p0 * np.sqrt(np.clip(1 - (rr[inside] / a) ** 2, 0, None))
+        rms = float(np.sqrt(np.mean((r.contact_pressure[inside] - p_theory) ** 2)) / p0)
+        up = 1.0 if name == "sphere" else -1.0
+        out[name] = {
+            "p_max": float(r.contact_pressure.max()),
+            "p_max_error": float(r.contact_pressure.max() / p0 - 1),
+            "a_estimate": float(edge.mean()) if len(edge) else 0.0,
+            "contour_spread": float(edge.max() - edge.min()) if len(edge) else 0.0,
+            "rms_error_over_p0": rms,
+            "total_contact_force": float(up * share * r.contact_force[:, 2].sum()),
+            "contact_nodes": int(on.sum()),
+        }
+    n = p.facets_per_radius * 2 ** p.refinement
+    out["facet_size"] = a / n
+    out["flat_facet_size"] = p.flat_size_ratio * a / n
+    return out
+
+
+def summarize(result: AnalysisResult, p: SphereParameters) -> dict:
+    """The ``summary.json`` dictionary of a sphere run."""
+    from dataclasses import asdict
+
+    from ..io.results import step_record
+
+    summary = {
+        "example": "sphere",
+        "converged": result.converged,
+        "message": result.message,
+        "steps": [{**step_record(s), "platen_displacement": s.platen_displacement}
+                  for s in result.steps],
+        "bodies": {s.body.name: {"nodes": int(s.body.npoints), "dofs": int(s.body.ndofs),
+                                 "contact_candidate_nodes": int(s.nc)}
+                   for s in result.surfaces},
+        "dofs": int(sum(s.body.ndofs for s in result.surfaces)),
+        "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces)),
+        "pressure_measure": "nominal: nodal contact force / undeformed tributary area",
+        "parameters": asdict(p),
+        "timings": result.timings,
+        "linear_solver": result.backend,
+    }
+    if result.steps and result.steps[-1].load_factor == 1.0:
+        summary["hertz"] = evaluate(result, p)
+    return summary
+
+
+def run(p: SphereParameters, out, on_step=None, figures: bool = True,
+        resume: bool = False) -> dict:
+    """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
+    from ..io.results import run_example
+
+    return run_example(build(p), out, lambda r: summarize(r, p), figures, on_step, resume)
+
+
+def figures(folder) -> list[Path]:
+    """The figures of a sphere results folder (:class:`vfem.io.replot.Folder`), drawn by the
+    run and by ``vfem plot``: ``pressure_map.png``, the sphere's contact pressure over the
+    contact zone seen from below, with Hertz's circle r = a; ``pressure.png``, p/p0 against
+    r/a at both bodies' contact candidate nodes with Hertz's ellipse."""
+    from ..io import plots
+
+    s = folder.summary
+    if not folder.has_steps or "hertz" not in s:
+        return []
+    th = s["hertz"]
+    a, p0 = th["a_theory"], th["p0_theory"]
+    last = folder.steps[-1]
+    ra, pp, maps = {}, {}, {}
+    for b in last.bodies:
+        c = folder.contact(last, b)
+        r = np.hypot(c.x[:, 0], c.x[:, 1])
+        keep = r < 1.4 * a
+        ra[b.name] = r[keep] / a
+        pp[b.name] = c.pressure[keep] / p0
+        maps[b.name] = (c.x[keep, 0] / a, c.x[keep, 1] / a, c.pressure[keep] / p0)
+    out = folder.directory
+    model = "quarter model" if s["parameters"].get("quarter", True) else "whole sphere"
+    sph = th["sphere"]
+    plots.hertz_pressure(out / "pressure.png", ra, pp,
+                         f"Hertz sphere ({model}), {s['dofs']} dofs: p_max "
+                         f"{sph['p_max_error']:+.2%} vs p0, RMS {sph['rms_error_over_p0']:.2%}",
+                         xlabel="r / a (undeformed radius over Hertz's contact radius; "
+                                "dimensionless)", per="area")
+    plots.pressure_map(out / "pressure_map.png", *maps["sphere"],
+                       f"Sphere: contact pressure p / p0 seen from below ({model})\n"
+                       f"dashed: Hertz's r = a; contact edge radius {sph['a_estimate'] / a:.3f} a"
+                       f" (spread {sph['contour_spread'] / a:.3f} a)")
+    return [out / "pressure.png", out / "pressure_map.png"]
+
+
+def report(s: dict) -> list[str]:
+    """The closing lines of a sphere run."""
+    lines = [f"vfem: {run_status(s)} in {len(s['steps'])} "
+             f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
+             f"{s['dofs']} dofs ({s['contact_dofs']} contact dofs), "
+             f"{s['timings']['total_s']:.1f} s"]
+    if "hertz" in s:
+        h = s["hertz"]
+        sph = h["sphere"]
+        lines.append(f"  p_max {sph['p_max']:.1f} (theory {h['p0_theory']:.1f}, "
+                     f"{sph['p_max_error']:+.3%})   contact radius {sph['a_estimate']:.4f} "
+                     f"(theory {h['a_theory']:.4f}; facets {h['facet_size']:.3g})")
+        lines.append(f"  RMS error over r < a: {sph['rms_error_over_p0']:.3%} of p0; the edge's "
+                     f"radius varies by {sph['contour_spread']:.3g} around the circle")
+        lines.append(f"  contact force {sph['total_contact_force']:.2f} on the sphere, "
+                     f"{h['flat']['total_contact_force']:.2f} on the flat "
+                     f"(applied {h['applied_force']:g})")
+    return lines
