@@ -68,3 +68,29 @@ def test_bad_cells_are_refused():
 
     with pytest.raises(InputError, match="sphere_cells must be 'hex' or 'tet'"):
         sphere.validate(sphere.Parameters(sphere_cells="wedge"))
+
+
+@pytest.mark.slow
+def test_refinement_study():
+    """The issue's acceptance (measured 2026-11-27, hexahedra, quarter model): p_max error
+    -2.21, -1.33, -0.50 % at a/6, a/8, a/12 facets (26k, 43k, 92k dofs; -0.12 % at a/16,
+    161k), the contact radius within 0.04-0.13 of a facet of Hertz's, the edge's radius
+    varying by 0.69-0.85 of a facet around the circle; the whole sphere as the quarter to 3e-5
+    of p0 (a/6)."""
+    errors = []
+    for n in (6, 8, 12):
+        p = sphere.Parameters(facets_per_radius=n, steps=1)
+        _, result = solve(p)
+        assert all(s.invariants["passed"] for s in result.steps)
+        ev = sphere.evaluate(result, p)
+        s = ev["sphere"]
+        errors.append(abs(s["p_max_error"]))
+        assert abs(s["a_estimate"] - ev["a_theory"]) < ev["facet_size"]
+        assert s["contour_spread"] < ev["facet_size"]
+        if n == 6:
+            quarter = s["p_max"]
+    assert errors[0] > errors[1] > errors[2] and errors[2] < 0.01
+    p = sphere.Parameters(quarter=False, steps=1)
+    _, result = solve(p)
+    whole = sphere.evaluate(result, p)["sphere"]["p_max"]
+    assert abs(whole / quarter - 1) < 0.005
