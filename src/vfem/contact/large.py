@@ -114,8 +114,8 @@ class LargeDeformationContact(PairSet):
     """Frictionless contact with large displacements and sliding (see the module docstring)."""
 
     capabilities = Capabilities(
-        name="paired", orders=(1,), kinematics=("small", "large"), dimensions=(2,),
-        friction=("frictionless",))
+        name="paired", orders=(1,), kinematics=("small", "large"), dimensions=(2, 3),
+        friction=("frictionless",), orders_3d=(1,))
 
     keep_all_nodes = True  # which nodes are over the other surface changes as bodies slide
 
@@ -127,6 +127,11 @@ class LargeDeformationContact(PairSet):
             if s.kind is not None and s.kind.order != 1:
                 raise InputError(f"body {s.body.name!r}: large-displacement contact needs "
                                  "linear elements (order 1)")
+            if s.dim == 3 and s.nc and settings.frictional:
+                # (the frictional variant's anchors are segment parameters: 2D; check_capabilities
+                # refuses it first, this keeps the formulation from running it)
+                raise InputError(f"body {s.body.name!r}: friction in 3D contact is not available "
+                                 "with large kinematics yet; set the friction to 0")
         # (its own pairs, built on the undeformed geometry, which side carries compatibility
         # and which nodes decided once; :meth:`penetrations` moves them to the current one)
         super().__init__(surfaces, pairs, settings, backend)
