@@ -441,11 +441,46 @@ def cmd_plot(args) -> int:
     return 0
 
 
+def _bench_sphere(args) -> int:
+    """``vfem bench sphere``: the sphere example at each size, each case in its own process
+    (its peak memory its own): dofs, contact dofs, time, ratio to a plain linear solve of the
+    same bodies with the same backend, iterations, p_max error, peak memory."""
+    from .tools import bench
+
+    for option in ("patch", "calculix", "whole_run", "plot"):
+        if getattr(args, option):
+            raise InputError(f"vfem bench sphere: --{option.replace('_', '-')} is for hertz only")
+    if args.methods != ["vfem"] or args.variant != "paired":
+        raise InputError("vfem bench sphere: the paired vfem method only (3D contact)")
+    solvers = args.solver or ["auto"]
+    backends = linalg.available() if "all" in solvers else [linalg.resolve(s) for s in solvers]
+    sizes = ([{"level": level} for level in args.levels] if args.levels
+             else [{"dofs": bench.parse_size(d)} for d in (args.dofs or ["30k", "300k"])])
+    say = None if args.quiet else print
+    if say:
+        say(bench.SPHERE_HEADER)
+    rows = []
+    for size in sizes:
+        for backend in backends:
+            row = (bench._case("sphere", {**size, "backend": backend}) if args.in_process
+                   else bench.run_isolated("sphere", **size, backend=backend))
+            rows.append(row)
+            if say:
+                say(bench.format_sphere_row(row))
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+    if args.markdown:
+        Path(args.markdown).write_text(bench.sphere_markdown(rows), encoding="utf-8")
+    return 0
+
+
 def cmd_bench(args) -> int:
     from .tools import bench
 
-    if args.example != "hertz":
-        raise InputError(f"no benchmark for {args.example!r}; available: hertz")
+    if args.example not in ("hertz", "sphere"):
+        raise InputError(f"no benchmark for {args.example!r}; available: hertz, sphere")
+    if args.example == "sphere":
+        return _bench_sphere(args)
     if args.plot:
         from .io.plots import require_matplotlib
 
@@ -573,7 +608,7 @@ def main(argv: list[str] | None = None) -> int:
     plot = sub.add_parser("plot", help="redraw the figures of a results folder without solving")
     plot.add_argument("results", help="the results folder (holding results.pvd)")
     bench = sub.add_parser("bench", help="time an example at several refinements")
-    bench.add_argument("example", help="hertz")
+    bench.add_argument("example", help="hertz or sphere")
     bench.add_argument("--dofs", nargs="+", metavar="SIZE",
                        help="about this many dofs: 10k, 100k, 1M or a number (default 10k 100k)")
     bench.add_argument("--levels", type=int, nargs="+",

@@ -35,7 +35,7 @@ from ..linalg import factorize, resolve
 from ..solver import Analysis
 
 #: named sizes of ``vfem bench hertz --dofs``
-SIZES = {"10k": 10_000, "100k": 100_000, "1M": 1_000_000}
+SIZES = {"10k": 10_000, "30k": 30_000, "100k": 100_000, "300k": 300_000, "1M": 1_000_000}
 
 #: level 3 of the Hertz example (96 facets across a, largest element 0.05 / 8): 118,648 dofs
 #: (with the cylinder's layered contact zone; 76,964 before it)
@@ -245,6 +245,66 @@ def hertz_case(p: HertzParameters, backend: str | None = None, method: str = "vf
     }
 
 
+#: the sphere example's dofs at facets_per_radius = 6 (its default, 26,160 dofs) and how they
+#: grow with the facets across a: 43,377 at 8, 92,172 at 12, 161,088 at 16 (2026-11-27; the
+#: fine zone, a cube of 1.2 a on each body, dominates: about the power 1.85)
+_SPHERE_DOFS, _SPHERE_POWER = 26_160, 1.85
+
+
+def sphere_parameters(dofs: int | None = None, level: int | None = None):
+    """The sphere example (quarter model, one step) at about ``dofs`` degrees of freedom (more
+    facets across the contact radius, the bulk's elements kept), or at refinement ``level``."""
+    from ..examples.sphere import SphereParameters
+
+    if level is not None:
+        return SphereParameters(refinement=level, steps=1)
+    n = 6.0 * (dofs / _SPHERE_DOFS) ** (1.0 / _SPHERE_POWER)
+    return SphereParameters(facets_per_radius=max(3, round(n)), steps=1)
+
+
+def sphere_case(p, backend: str | None = None, repeat: int = 1) -> dict:
+    """:func:`hertz_case` for the sphere example: vfem's analysis time against one plain
+    linear solve of the same bodies with the same backend, iterations, p_max error."""
+    from ..examples.sphere import build as build_sphere
+    from ..examples.sphere import evaluate as evaluate_sphere
+
+    backend = resolve(backend)
+    model = build_sphere(p)
+    vfem_s = plain = peak = None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        run = Analysis(model, backend).run()
+        seconds = time.perf_counter() - t0
+        if vfem_s is None or seconds < vfem_s:
+            vfem_s, result = seconds, run
+        peak = peak or _peak_mib()
+        again = plain_solve(model, backend)
+        if plain is None or again["total_s"] < plain["total_s"]:
+            plain = again
+    h = evaluate_sphere(result, p) if result.converged else {}
+    t = result.timings
+    return {
+        "example": "sphere", "method": "vfem", "backend": backend,
+        "facets_across_a": p.facets_per_radius * 2 ** p.refinement,
+        "dofs": int(sum(b.ndofs for b in model.bodies)),
+        "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces)),
+        "vfem_s": vfem_s, "plain_solve_s": plain["total_s"],
+        "ratio": vfem_s / plain["total_s"],
+        "ratio_without_assembly": (vfem_s - t.get("assemble_s", 0.0))
+        / (plain["total_s"] - plain["assemble_s"]),
+        "plain_factorize_s": plain["factorize_s"],
+        "search_s": t.get("search_s", 0.0), "assemble_s": t.get("assemble_s", 0.0),
+        "factorize_s": t.get("factorize_s", 0.0), "steps_s": t.get("steps_s", 0.0),
+        "iterations": int(sum(s.iterations for s in result.steps)),
+        "converged": result.converged, "message": result.message,
+        "invariants_passed": all(s.invariants.get("passed", False) for s in result.steps),
+        "peak_mib": peak,
+        "p_max_error": h["sphere"]["p_max_error"] if h else float("nan"),
+        "a_error_over_facet": (abs(h["sphere"]["a_estimate"] - h["a_theory"]) / h["facet_size"]
+                               if h else float("nan")),
+    }
+
+
 def patch_case(method: str = "vfem", backend: str | None = None) -> dict:
     """The patch test (every case of the patch example) with contact ``method``: the largest
     deviation of the contact pressure from the exact uniform one, over the cases."""
@@ -289,11 +349,19 @@ def _warm_up(backend: str | None, method: str) -> None:
 
 def _case(kind: str, kwargs: dict) -> dict:
     _warm_up(kwargs.get("backend"), kwargs.get("method", "vfem"))
+    if kind == "sphere":  # and a tiny 3D model: the 3D code paths' first calls
+        from ..examples.sphere import SphereParameters
+
+        sphere_case(SphereParameters(facets_per_radius=2, max_element_size=4.0, steps=1),
+                    kwargs.get("backend"))
     if kind == "run":
         p = hertz_parameters(kwargs.get("dofs"), kwargs.get("level"))
         return whole_run_case(p, kwargs.get("backend"))
     if kind == "patch":
         return patch_case(kwargs.get("method", "vfem"), kwargs.get("backend"))
+    if kind == "sphere":
+        p = sphere_parameters(kwargs.get("dofs"), kwargs.get("level"))
+        return sphere_case(p, kwargs.get("backend"), repeat=kwargs.get("repeat", 1))
     p = hertz_parameters(kwargs.get("dofs"), kwargs.get("level"),
                          kwargs.get("variant", "paired"), kwargs.get("order", 1))
     return hertz_case(p, kwargs.get("backend"), kwargs.get("method", "vfem"), repeat=2)
@@ -302,6 +370,31 @@ def _case(kind: str, kwargs: dict) -> dict:
 HEADER = (f"{'dofs':>9} {'contact':>7} {'method':>10} {'backend':>8} {'vfem s':>8} "
           f"{'plain s':>8} {'ratio':>6} {'w/o asm':>7} {'iters':>6} {'p_max err':>10} "
           f"{'peak MiB':>9}")
+
+
+SPHERE_HEADER = (f"{'dofs':>9} {'contact':>7} {'n/a':>4} {'backend':>8} {'vfem s':>8} "
+                 f"{'plain s':>8} {'ratio':>6} {'iters':>5} {'p_max err':>10} "
+                 f"{'a err/facet':>11} {'peak MiB':>9}")
+
+
+def format_sphere_row(r: dict) -> str:
+    return (f"{r['dofs']:>9} {r['contact_dofs']:>7} {r['facets_across_a']:>4} "
+            f"{r['backend']:>8} {r['vfem_s']:>8.2f} {r['plain_solve_s']:>8.2f} "
+            f"{r['ratio']:>6.2f} {r['iterations']:>5} {r['p_max_error']:>+10.3%} "
+            f"{r['a_error_over_facet']:>11.2f} {r['peak_mib']:>9.0f}")
+
+
+def sphere_markdown(rows: list[dict]) -> str:
+    """The sphere benchmark's rows as a Markdown table."""
+    lines = ["| dofs | contact dofs | facets across a | backend | vfem s | plain solve s | "
+             "ratio | iterations | p_max error | contact radius error / facet | peak MiB |",
+             "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r['dofs']:,} | {r['contact_dofs']:,} | {r['facets_across_a']} | "
+                     f"{r['backend']} | {r['vfem_s']:.2f} | {r['plain_solve_s']:.2f} | "
+                     f"{r['ratio']:.2f} | {r['iterations']} | {r['p_max_error']:+.3%} | "
+                     f"{r['a_error_over_facet']:.2f} | {r['peak_mib']:.0f} |")
+    return "\n".join(lines) + "\n"
 
 
 def format_row(r: dict) -> str:
