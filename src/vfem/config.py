@@ -81,12 +81,14 @@ class MeshSpec:
             other keys of the same table.
         file: a mesh file read through meshio: Gmsh ``.msh`` (format 4) or Abaqus ``.inp``;
             relative paths are taken from the input file's folder. Physical curves (Gmsh) or
-            node sets (Abaqus) become the body's named boundaries.
-        cells: the group of ``file`` holding this body's elements: a Gmsh physical surface or
-            an Abaqus element set. Default: every 2D element of the file.
-        translate: moves the mesh by (dx, dy) after it is made.
+            node sets (Abaqus) become the body's named boundaries; in a file with 3D elements
+            (tetrahedra, hexahedra), physical surfaces or element sets of faces and node sets.
+        cells: the group of ``file`` holding this body's elements: a Gmsh physical surface
+            (physical volume in 3D) or an Abaqus element set. Default: every 2D element of the
+            file (every 3D element, if it has any).
+        translate: moves the mesh by (dx, dy) after it is made; (dx, dy, dz) for a 3D mesh.
         curve: puts the facet midpoints of a circular boundary on the circle (quadratic
-            elements only).
+            elements only, 2D meshes only).
         parameters: the shape's parameters (in an input file: the other keys of the mesh
             table, not a key of its own).
     """
@@ -94,7 +96,7 @@ class MeshSpec:
     shape: str | None = None
     file: str | None = None
     cells: str | None = None
-    translate: tuple[float, float] = (0.0, 0.0)
+    translate: tuple[float, ...] = (0.0, 0.0)
     curve: Curve | None = None
     parameters: tuple[tuple[str, Any], ...] = ()
 
@@ -115,11 +117,21 @@ class MeshSpec:
             if base is not None and not path.is_absolute():
                 path = Path(base) / path
             mesh = read_mesh(path, self.cells)
+        dim = mesh.p.shape[0]
+        what = (f"the {dim}D shape {self.shape!r}" if self.shape is not None
+                else f"the {dim}D mesh of file {self.file!r}")
+        if len(self.translate) != dim and tuple(self.translate) != (0.0, 0.0):
+            raise InputError(f"mesh.translate: expected {dim} values "
+                             f"({', '.join('d' + a for a in 'xyz'[:dim])}) for {what}, got "
+                             f"{len(self.translate)}")
         if any(self.translate):
             mesh = mesh.translated(tuple(float(v) for v in self.translate))
         if self.curve is not None:
             from .mesh.quadratic import curved
 
+            if dim != 2:
+                raise InputError(f"mesh.curve: curved facets on a circle are for 2D meshes; "
+                                 f"{what} has none (remove mesh.curve)")
             if self.curve.boundary not in (mesh.boundaries or {}):
                 raise InputError(f"mesh.curve: no boundary named {self.curve.boundary!r}; the "
                                  f"mesh has {', '.join(sorted(mesh.boundaries or {}))}")

@@ -276,15 +276,15 @@ def to_data(obj) -> dict:
             out[f.name] = [to_data(x) for x in v]
         else:
             out[f.name] = _listify(v)
-    if isinstance(obj, BodyConfig) and _solid(obj.mesh):
+    if isinstance(obj, BodyConfig) and (_solid(obj.mesh) or obj.mesh.file is not None):
         _exact_components(obj, out)
     return out
 
 
 def _solid(mesh: MeshSpec) -> bool:
-    """Whether a body's mesh is 3D: a solid shape (:data:`vfem.config.SOLID_SHAPES`). A mesh
-    file is 2D: the import refuses 3D (:mod:`vfem.mesh.imports`; 3D import, issue 21's C17,
-    must make this read the file's dimension)."""
+    """Whether a body's mesh is a 3D shape (:data:`vfem.config.SOLID_SHAPES`). A mesh file's
+    dimension is not known without reading it (relative to an input file's folder): its
+    supports are written as :func:`_exact_components` too, right in 2D and 3D alike."""
     return mesh.shape in SOLID_SHAPES
 
 
