@@ -379,7 +379,8 @@ class NonlinearBody:
 
     def _check_component(self, component: str) -> None:
         if component not in COMPONENTS or COMPONENTS[component] >= self.dim:
-            names = " or ".join(repr(c) for c in list(COMPONENTS)[: self.dim])
+            names = [repr(c) for c in list(COMPONENTS)[: self.dim]]
+            names = ", ".join(names[:-1]) + " or " + names[-1]  # 'x' or 'y'; 'x', 'y' or 'z'
             raise InputError(f"{self.name}: component must be {names}, got {component!r}")
 
     def node_dofs(self, nodes: np.ndarray, component: str | None = None) -> np.ndarray:
