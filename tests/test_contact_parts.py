@@ -215,9 +215,11 @@ def test_each_setting_picks_one_formulation_that_implements_the_contract(method,
     for name in ("new_state", "solve", "fields"):
         assert callable(getattr(picked, name)), name
     caps = picked.capabilities
-    # 3D contact: the paired variant's, small kinematics, linear elements (issue 21, C10)
-    assert caps.dimensions == ((2, 3) if cls is PairedContact else (2,))
-    assert caps.orders_3d == ((1,) if cls is PairedContact else ())
+    # 3D contact: the paired variant's, linear elements (issue 21, C10), large kinematics too
+    # (C16)
+    paired = cls in (PairedContact, LargeDeformationContact)
+    assert caps.dimensions == ((2, 3) if paired else (2,))
+    assert caps.orders_3d == ((1,) if paired else ())
     # Coulomb friction: the frictional formulations' (vfem), the lagrange baseline's
     assert caps.friction == (("frictionless", "coulomb") if cls is GlobalContact
                              else ("frictionless",))
@@ -228,7 +230,7 @@ def test_each_setting_picks_one_formulation_that_implements_the_contract(method,
 def fake_model(order=1, dim=2, large=False, **settings):
     """Two alike bodies that may touch (``contact_pairs`` None: every pair): a body that may
     touch none is not the contact formulation's to refuse (``bodies_that_may_touch``)."""
-    bodies = [SimpleNamespace(name=name, order=order, large=large,
+    bodies = [SimpleNamespace(name=name, order=order, large=large, platen=None,
                               mesh=SimpleNamespace(p=np.zeros((dim, 3)))) for name in "ab"]
     return SimpleNamespace(name="m", bodies=bodies, contact=ContactSettings(**settings),
                            contact_pairs=None)
@@ -247,12 +249,13 @@ def test_the_model_checks_read_the_declared_capabilities():
     check_capabilities(fake_model(dim=3))  # the paired variant: linear 3D bodies too (C10)
     with pytest.raises(InputError, match="thesis contact supports 2D bodies, this one is 3D"):
         check_capabilities(fake_model(dim=3, variant="thesis"))
-    with pytest.raises(InputError, match="paired contact supports 2D bodies, this one is 3D"):
-        check_capabilities(fake_model(dim=3, large=True))
+    check_capabilities(fake_model(dim=3, large=True))  # large kinematics in 3D (C16)
     with pytest.raises(InputError, match="3D contact supports linear elements only"):
         check_capabilities(fake_model(order=2, dim=3))
-    with pytest.raises(InputError, match="friction in 3D contact is not implemented yet"):
-        check_capabilities(fake_model(dim=3, friction=0.3))
+    check_capabilities(fake_model(dim=3, friction=0.3))  # friction in 3D, small (C13)
+    with pytest.raises(InputError, match="friction in 3D contact is available with small "
+                                         "kinematics only"):
+        check_capabilities(fake_model(dim=3, large=True, friction=0.3))
 
 
 # -- each formulation's own typed state ------------------------------------------------------------

@@ -6,8 +6,8 @@ rollers at x = 0 and y = 0 (supports of single components), so the exact state i
 sigma_zz = -E * D / 2 in both bodies, the contact pressure its opposite, sigma_xx = sigma_yy = 0.
 The interface meshes do not match (hexahedra against tetrahedra, hexahedra or tetrahedra of
 other sizes). The paired variant must reach it to round-off in one contact iteration, with
-every invariant passed, whichever body comes first; quadratic 3D bodies and friction in 3D are
-refused with a message (``check_capabilities``).
+every invariant passed, whichever body comes first; quadratic 3D bodies are refused with a
+message (``check_capabilities``). Friction in 3D: tests/test_friction3d.py.
 """
 
 import numpy as np
@@ -71,10 +71,10 @@ def test_quadratic_3d_bodies_in_contact_are_refused():
         stacked(("hex", 3), ("hex", 5), order=2).validate()
 
 
-def test_friction_in_3d_is_refused():
-    with pytest.raises(InputError, match=r"body 'lower': friction in 3D contact is not "
-                                         "implemented yet; set the friction to 0"):
-        stacked(("hex", 3), ("hex", 5), friction=0.3).validate()
+def test_friction_in_3d_is_accepted_with_small_kinematics():
+    """Friction in 3D: the paired variant, small kinematics, linear elements (C13; its tests:
+    tests/test_friction3d.py); with large kinematics it is refused (there)."""
+    stacked(("hex", 3), ("hex", 5), friction=0.3).validate()
 
 
 def test_the_thesis_variant_stays_2d():

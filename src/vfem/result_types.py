@@ -50,18 +50,19 @@ class BodyStepResult:
     applied_load: np.ndarray | None = None
     # -- with friction (vfem.contact.friction; None without): at the nodes that carry a contact
     # pair's compatibility (where its traction values live), zero at the others
-    #: (npoints, 2) the tangential traction on the body (x, y), the part of the pair's traction
-    #: field along the contact surface
+    #: (npoints, dim) the tangential traction on the body (x, y[, z]), the part of the pair's
+    #: traction field along the contact surface
     contact_shear: np.ndarray | None = None
     #: (npoints,) the relative tangential displacement against the virtual node in this step
-    #: (signed along the pair's tangent, the opposing surface's outward normal turned by +90°)
+    #: (2D: signed along the pair's tangent, the opposing surface's outward normal turned by
+    #: +90°; 3D: its length, the direction being the opposite of a slipping node's traction)
     slip_increment: np.ndarray | None = None
     #: (npoints,) the slip accumulated over the converged steps so far (length)
     accumulated_slip: np.ndarray | None = None
     #: (npoints,) 0 free, 1 sticking, 2 slipping; -1 at the nodes that carry no pair's
     #: compatibility (the other side of a pair reads the traction field its partner defines)
     friction_status: np.ndarray | None = None
-    #: (npoints, 2) the part of ``contact_force`` that the tangential traction makes (on both
+    #: (npoints, dim) the part of ``contact_force`` that the tangential traction makes (on both
     #: sides of a pair): what the friction's work is measured with
     friction_force: np.ndarray | None = None
 

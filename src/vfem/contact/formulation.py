@@ -135,17 +135,19 @@ def check_capabilities(model) -> None:
         dim = b.mesh.p.shape[0]
         if b.name not in touching:
             continue
+        if dim == 3 and settings.frictional and large:
+            # (the frictional large-kinematics variant's anchors, material points of the
+            # opposing surface, are segment parameters: 2D; issue 21, C16)
+            raise InputError(f"model {model.name!r}, body {b.name!r}: friction in 3D contact "
+                             "is available with small kinematics only, not yet with large "
+                             "kinematics; use small kinematics (the paired variant, linear "
+                             "elements) or set the friction to 0")
         if dim not in caps.dimensions:
-            if dim == 3 and settings.frictional:
-                raise InputError(f"model {model.name!r}, body {b.name!r}: friction in 3D "
-                                 "contact is not implemented yet; set the friction to 0 for "
-                                 "frictionless 3D contact (the paired variant, small "
-                                 "kinematics, linear elements)")
             raise InputError(f"model {model.name!r}, body {b.name!r}: {caps.name} contact "
                              f"supports {' and '.join(f'{d}D' for d in caps.dimensions)} "
                              f"bodies, this one is {dim}D; 3D contact needs the paired "
-                             "variant, small kinematics, linear elements and no friction (a 3D "
-                             "body that touches no other runs without contact)")
+                             "variant, small kinematics and linear elements (a 3D body that "
+                             "touches no other runs without contact)")
         if dim == 3 and b.order not in caps.orders_3d:
             raise InputError(f"model {model.name!r}, body {b.name!r}: 3D contact supports "
                              "linear elements only (order 1); quadratic 3D contact is not "

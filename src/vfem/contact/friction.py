@@ -41,7 +41,15 @@ more traction field per contact pair:
   dependent, and a step that is cut starts again from the last converged state, anchors
   included (they are part of the state the checkpoints save).
 
-Small kinematics here (large: :mod:`vfem.contact.large_friction`): the pairs, normals and
+* **3D** (issue 21, C13): two tangents per node (:func:`tangents`), the tangential arrays
+  (n, 2) where 2D keeps (n,) (:func:`columns` sees both as (n, ntan)); |s| is the row norm and
+  the cone a disk; a slipping node's direction σ = -s / |s| is a unit vector (±1 in 2D), and it
+  turns: besides the tie along σ its traction has a part across σ, solved for with the row that
+  asks its slip across σ to vanish, linearised (a semismooth Newton step on the disk, in
+  :meth:`FrictionalPairedContact._correct_frictional`); the friction's errors add the slip
+  across σ. A roller plane through the contact holds one tangent of its nodes only.
+
+Small kinematics here (large: :mod:`vfem.contact.large_friction`, 2D): the pairs, normals and
 tangents are those of the undeformed configuration, as for the frictionless paired variant.
 """
 
@@ -73,19 +81,51 @@ HELD = 1e-6
 
 
 def tangents(normal: np.ndarray) -> list[np.ndarray]:
-    """The unit tangent directions at nodes with unit ``normal`` (n, dim): in 2D the normal
-    turned by +90 degrees, (-n_y, n_x); one tangent per direction of the tangent space (dim - 1
-    of them), which is all the tangential code reads."""
-    if normal.shape[1] != 2:
-        raise NotImplementedError("friction in 3D (issue 21)")
-    return [np.column_stack([-normal[:, 1], normal[:, 0]])]
+    """The unit tangent directions at nodes with unit ``normal`` (n, dim), one per direction of
+    the tangent space (dim - 1 of them), which is all the tangential code reads.
+
+    2D: the normal turned by +90 degrees, (-n_y, n_x). 3D (issue 21, C13): ``t1`` the unit
+    projection on the tangent plane of the global axis least aligned with the normal (ties,
+    within 1e-12: the lowest axis), ``t2 = n x t1``. Taken from the undeformed normals, so a
+    node's tangents are fixed; where a symmetry plane through the contact (a roller) holds an
+    axis, the axis is the tangent ``t1`` (a normal within the plane has no component along it)
+    and the plane's motion stays one tangential unknown, which :data:`HELD` finds."""
+    if normal.shape[1] == 2:
+        return [np.column_stack([-normal[:, 1], normal[:, 0]])]
+    size = np.abs(normal)
+    axis = np.argmax(size <= size.min(axis=1, keepdims=True) + 1e-12, axis=1)
+    rows = np.arange(len(normal))
+    t1 = -normal[rows, axis, None] * normal
+    t1[rows, axis] += 1.0
+    t1 /= np.linalg.norm(t1, axis=1)[:, None]
+    return [t1, np.cross(normal, t1)]
+
+
+def columns(a: np.ndarray) -> np.ndarray:
+    """A tangential array (2D: (n,), one tangent; 3D: (n, 2)) seen as (n, ntan): a view."""
+    return a.reshape(len(a), -1)
+
+
+def magnitudes(a: np.ndarray) -> np.ndarray:
+    """Per node, the length of a tangential array's vector: |a| in 2D (the same bits as
+    ``np.abs``), the row norm in 3D."""
+    a = columns(a)
+    if a.shape[1] == 1:
+        return np.abs(a[:, 0])
+    return np.sqrt(np.einsum("ij,ij->i", a, a))
+
+
+def _flat(a: np.ndarray) -> np.ndarray:
+    """A tangential array in the pair matrix's order (tangent by tangent): 2D as it is."""
+    return a if a.ndim == 1 else a.T.ravel()
 
 
 def coulomb_status(q: np.ndarray, s: np.ndarray, mu: float) -> np.ndarray:
-    """Per node: 0 no contact (q <= 0), 1 stick (|s| inside the cone mu q), 2 slip (on it)."""
+    """Per node: 0 no contact (q <= 0), 1 stick (|s| inside the cone mu q), 2 slip (on it); s
+    (n,) in 2D, (n, 2) in 3D."""
     status = np.zeros(len(q), dtype=int)
     on = q > 0
-    slipping = np.abs(s) >= (1.0 - CONE_TOLERANCE) * mu * q
+    slipping = magnitudes(s) >= (1.0 - CONE_TOLERANCE) * mu * q
     status[on & ~slipping] = 1
     status[on & slipping] = 2
     return status
@@ -103,11 +143,22 @@ class FrictionHistory:
                                             self.surfaces[p.coarse].body.name).coefficients
                      for p in self.contact_pairs]
         #: per pair, the slip increments of the last converged step (for :meth:`fields`)
-        self._increments = [np.zeros(len(p.nodes)) for p in self.contact_pairs]
+        self._increments = [self._zeros(k) for k in range(len(self.contact_pairs))]
 
     def tangent(self, k: int) -> np.ndarray:
         """Pair k's unit tangent at its nodes (2D: the normal turned by +90 degrees)."""
         return tangents(self.contact_pairs[k].normal)[0]
+
+    def tangent_basis(self, k: int) -> list[np.ndarray]:
+        """Pair k's unit tangents at its nodes, dim - 1 of them (:func:`tangents`)."""
+        return tangents(self.contact_pairs[k].normal)
+
+    def _zeros(self, k: int) -> np.ndarray:
+        """Zeros for pair k's tangential array: (n,) in 2D (one tangent; the storage the 2D
+        checkpoints have), (n, 2) in 3D (:func:`columns` sees both as (n, ntan))."""
+        pair = self.contact_pairs[k]
+        ntan = pair.normal.shape[1] - 1
+        return np.zeros(len(pair.nodes) if ntan == 1 else (len(pair.nodes), ntan))
 
     def _values(self, state: FrictionState, name: str, k: int, dtype=float) -> np.ndarray:
         """Pair k's array ``name`` of the state's history, zeros until first set."""
@@ -117,12 +168,27 @@ class FrictionHistory:
         return table[k]
 
     def shear(self, state: FrictionState, k: int) -> np.ndarray:
-        """Pair k's tangential traction values at its compatibility-side nodes (2D: one)."""
-        return self._values(state, "shear", k)
+        """Pair k's tangential traction values at its compatibility-side nodes, one per
+        tangent: (n,) in 2D, (n, 2) in 3D."""
+        table = state.shear
+        if k not in table:
+            table[k] = self._zeros(k)
+        return table[k]
 
     def anchor(self, state: FrictionState, k: int) -> np.ndarray:
-        """Pair k's relative tangential displacements at the last converged step."""
-        return self._values(state, "anchor", k)
+        """Pair k's relative tangential displacements at the last converged step (as
+        :meth:`shear`, one per tangent)."""
+        table = state.anchor
+        if k not in table:
+            table[k] = self._zeros(k)
+        return table[k]
+
+    def tangential_traction(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's tangential traction vectors (n, dim) at its nodes: sum of s_j t_j."""
+        s = self.shear(state, k)
+        if s.ndim == 1:
+            return s[:, None] * self.tangent(k)
+        return sum(s[:, j, None] * t for j, t in enumerate(self.tangent_basis(k)))
 
     def accumulated_slip(self, state: FrictionState, k: int) -> np.ndarray:
         """Pair k's slip accumulated over the converged steps (length, per node)."""
@@ -152,12 +218,17 @@ class FrictionHistory:
             stick += int((status == 1).sum())
             slip += int((status == 2).sum())
             if (status == 1).any():
-                err = max(err, float(np.abs(dw[status == 1]).max()))
+                err = max(err, float(magnitudes(dw[status == 1]).max()))
             on = status == 2
-            if on.any():
+            if on.any() and s.ndim == 1:
                 sigma = -np.sign(s[on])
                 err = max(err, float(np.maximum(-sigma * dw[on], 0.0).max()))
-            outside = np.abs(s) - self.laws[k][1] * np.maximum(q, 0.0)
+            elif on.any():  # 3D: the slip along sigma, and none across it
+                sigma = -s[on] / magnitudes(s[on])[:, None]
+                along = np.einsum("ij,ij->i", sigma, dw[on])
+                across = magnitudes(dw[on] - along[:, None] * sigma)
+                err = max(err, float(np.maximum(-along, 0.0).max()), float(across.max()))
+            outside = magnitudes(s) - self.laws[k][1] * np.maximum(q, 0.0)
             if len(outside) and scale > 0:
                 excess = max(excess, float(outside.max()) / scale)
             elif np.any(s != 0):
@@ -166,7 +237,8 @@ class FrictionHistory:
 
     def _unknowns(self, state: FrictionState) -> np.ndarray:
         """Every pair's normal then tangential traction values, in the pair matrix's order."""
-        return np.concatenate([np.concatenate([self.tractions(state, k), self.shear(state, k)])
+        return np.concatenate([np.concatenate([self.tractions(state, k),
+                                               _flat(self.shear(state, k))])
                                for k in range(len(self.contact_pairs))] or [np.zeros(0)])
 
     def _sets(self, state: FrictionState) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -176,8 +248,8 @@ class FrictionHistory:
             sf = self.surfaces[pair.fine]
             status = self.status(state, k)
             nodes = sf.nodes[pair.nodes]
-            out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2),
-                    (sf.body.name, nodes, self.shear(state, k) < 0)]
+            out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2)]
+            out += [(sf.body.name, nodes, c < 0) for c in columns(self.shear(state, k)).T]
         return out
 
     def fields(self, state: ContactState, result: SolveResult) -> dict:
@@ -197,9 +269,11 @@ class FrictionHistory:
             sf = self.surfaces[pair.fine]
             r = out[sf.body.name]
             points = sf.nodes[pair.nodes]
-            traction = self.shear(state, k)[:, None] * self.tangent(k)
+            traction = self.tangential_traction(state, k)
             r.contact_shear[points] = traction
-            r.slip_increment[points] = increments[k]
+            # 2D: signed along the tangent; 3D: the length of the slip increment
+            r.slip_increment[points] = (increments[k] if increments[k].ndim == 1 else
+                                        magnitudes(increments[k]))
             r.accumulated_slip[points] = self.accumulated_slip(state, k)
             r.friction_status[points] = self.status(state, k)
             # the nodal forces of the tangential traction alone, on both sides (as
@@ -216,14 +290,15 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     """The paired variant with Coulomb friction, small displacements (module docstring)."""
 
     capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
-                                       friction=("frictionless", "coulomb"), dimensions=(2,),
-                                       orders_3d=())
+                                       friction=("frictionless", "coulomb"))
     state_type = FrictionState
 
     def __init__(self, surfaces, pairs, settings, backend: str | None = None):
         super().__init__(surfaces, pairs, settings, backend)
         self._init_friction(settings)
         self._tangents = [tangents(pair.normal) for pair in self.contact_pairs]
+        #: tangents per node: 1 in 2D, 2 in 3D
+        self._ntan = max((len(t) for t in self._tangents), default=1)
         #: per pair, the nodes released from tension in the current solve
         #: (:meth:`_correct_frictional`)
         self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.contact_pairs]
@@ -235,6 +310,17 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     def tangent(self, k: int) -> np.ndarray:
         """Pair k's unit tangent at its nodes (the undeformed one: small kinematics)."""
         return self._tangents[k][0]
+
+    def tangent_basis(self, k: int) -> list[np.ndarray]:
+        """Pair k's unit tangents at its nodes (the undeformed ones: small kinematics)."""
+        return self._tangents[k]
+
+    def _tangential(self, vector: np.ndarray, k: int) -> np.ndarray:
+        """Pair k's tangential rows of a vector over the pair matrix's unknowns, in the shape
+        of :meth:`shear`: (n,) in 2D, (n, 2) in 3D."""
+        n, base, ntan = len(self.contact_pairs[k].nodes), self._full[3][k], len(self._tangents[k])
+        part = vector[base + n: base + (1 + ntan) * n]
+        return part if ntan == 1 else part.reshape(ntan, n).T
 
     # -- state -----------------------------------------------------------------------------------
 
@@ -263,8 +349,9 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         ``w = t.(u_fine - u_virtual)`` (linear kinematics, as the penetrations; from
         ``relative``, :meth:`relative_displacements`, when given)."""
         relative = self.relative_displacements(state) if relative is None else relative
-        return [np.einsum("ij,ij->i", d, t[0]) for d, t in zip(relative, self._tangents,
-                                                              strict=True)]
+        return [np.einsum("ij,ij->i", d, t[0]) if len(t) == 1 else
+                np.column_stack([np.einsum("ij,ij->i", d, tj) for tj in t])
+                for d, t in zip(relative, self._tangents, strict=True)]
 
     def assemble_forces(self, state: ContactState) -> None:
         """Every body's nodal forces from the pairs' normal and tangential tractions."""
@@ -272,7 +359,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             F[:] = 0.0
         for k, pair in enumerate(self.contact_pairs):
             traction = (self.tractions(state, k)[:, None] * pair.normal
-                        + self.shear(state, k)[:, None] * self._tangents[k][0])
+                        + self.tangential_traction(state, k))
             state.forces[pair.fine] += pair.mass[:, pair.nodes] @ traction
             state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ traction
 
@@ -355,9 +442,9 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             # rows), slip (tangential rows)
             n = [len(p) for p in pens]
             normal = [slice(offsets[k], offsets[k] + n[k]) for k in range(len(n))]
-            tangent = [slice(offsets[k] + n[k], offsets[k] + 2 * n[k]) for k in range(len(n))]
             pens = [p - motion[r] + rate[r] * dplaten for p, r in zip(pens, normal)]
-            relative = [w + motion[r] + rate[r] * dplaten for w, r in zip(relative, tangent)]
+            relative = [w + self._tangential(motion, k) + self._tangential(rate, k) * dplaten
+                        for k, w in enumerate(relative)]
             dw = [w - self.anchor(state, k) + self.laws[k][2] * self.shear(state, k)
                   for k, w in enumerate(relative)]
             traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
@@ -370,9 +457,22 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
                           inner + 1)
                 return
             key = b"".join(m.tobytes() for _, _, m in self._sets(state))
-            if key in seen:
+            # (3D: the same sets while the slip directions still turn are no cycle)
+            if key in seen and (self._ntan == 1 or self._turning(state, dw) <= tol):
                 return
             seen.add(key)
+
+    def _turning(self, state: FrictionState, dw: list[np.ndarray]) -> float:
+        """3D: the largest slip across its slip direction sigma = -s / |s| at a slipping node
+        (what the direction updates of :meth:`_correct_frictional` remove)."""
+        out = 0.0
+        for k, w in enumerate(dw):
+            s, on = columns(self.shear(state, k)), self.status(state, k) == 2
+            if on.any():
+                sigma = -s[on] / magnitudes(s[on])[:, None]
+                along = np.einsum("ij,ij->i", sigma, w[on])
+                out = max(out, float(magnitudes(w[on] - along[:, None] * sigma).max()))
+        return out
 
     def _converged(self, state: FrictionState) -> None:
         """A converged step: accumulate each node's slip and anchor it where it now is (the
@@ -386,8 +486,8 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             on = self.tractions(state, k) > 0
             # where the node is, less its elastic slip (the elastoplastic law's s / k_t)
             new = w + self.laws[k][2] * self.shear(state, k)
-            increment = np.where(on, new - anchor, 0.0)
-            self.accumulated_slip(state, k)[:] += np.abs(increment)
+            increment = np.where(on if new.ndim == 1 else on[:, None], new - anchor, 0.0)
+            self.accumulated_slip(state, k)[:] += magnitudes(increment)
             self._increments.append(increment)
             anchor[:] = new
 
@@ -406,20 +506,28 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             #: the tangential unknowns whose relative tangential displacement no traction moves
             self._held = diagonal <= HELD * diagonal.max(initial=0.0)
         G, dz_dplaten, dR, offsets = self._full
+        ntan = self._ntan
         jump = np.zeros(len(G))  # known changes of the unknowns (cone, release)
         # per pair: the unknowns solved for (normal ones, then tangential), the rows (normal
         # and tangential conditions, pair by pair), their targets, and the slipping nodes' ties
+        # (per tangent: a node's ties to its q, one per tangent)
         q_cols, s_cols, rows, normal_rows, rhs = [], [], [], [], []
-        tie_q, tie_s, ties, elastic, compliances = [], [], [], [], []
+        elastic, compliances = [], []
+        tie_q, tie_s, ties = ([[] for _ in range(ntan)] for _ in range(3))
+        # 3D, per slipping node: its tangential unknowns, the direction across sigma, the
+        # compliance of its traction across sigma and its row's target (below)
+        perp_s, perp_dir, perp_c, perp_rhs = [], [], [], []
         for k, pair in enumerate(self.contact_pairs):
             n, base = len(pair.nodes), offsets[k]
             mu, mu_static, compliance = self.laws[k]
             p, s = pens[k], self.shear(state, k)
+            S = columns(s)  # (n, ntan) views
             tension, contact = self._release_and_hold(state, k, p, platen_ok)
             q = self.tractions(state, k)
             was_sliding = self.sliding(state, k)
             self._torn[k] |= tension
             slip_k = dw[k].copy()
+            slip = columns(slip_k)
             # A node that comes into contact in the prediction (the first iteration of a step:
             # the new loads with the last contact forces held, linear along the step) touched
             # where its penetration, linear along that path, was zero: it sticks from there
@@ -440,85 +548,137 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
                 tau = np.where((before < 0) & (rise > 0), -before / np.where(rise > 0, rise, 1.0),
                                0.0)
                 tau = np.clip(tau, 0.0, 1.0)
-                self.anchor(state, k)[fresh] += tau * slip_k[fresh]
-                slip_k[fresh] *= 1.0 - tau
-            # a node on the cone keeps slipping unless its slip has turned back: the static cone
-            # for a node at rest, the dynamic one for a node that slips (the same for Coulomb)
-            sigma = -np.sign(s)
-            reach = np.abs(s) >= (1.0 - CONE_TOLERANCE) * q * np.where(was_sliding, mu, mu_static)
-            on_cone = (q > 0) & reach & (s != 0)
-            moving = torn & (np.abs(slip_k) > tol)
-            sigma[moving] = np.sign(slip_k[moving])
-            slipping = contact & ((on_cone & (sigma * slip_k >= -tol)) | moving)
+                columns(self.anchor(state, k))[fresh] += tau[:, None] * slip[fresh]
+                slip[fresh] *= (1.0 - tau)[:, None]
             # a node whose relative tangential motion the supports hold (a symmetry plane through
             # the contact, both bodies held along it) has no tangential unknown: its tangential
-            # traction is the supports' (zero on a symmetry plane); nor has a frictionless pair
-            held = self._held[base + n: base + 2 * n] | (mu_static == 0.0)
-            slipping &= ~held
-            sticking = contact & ~slipping & ~held
+            # traction is the supports' (zero on a symmetry plane); nor has a frictionless pair.
+            # In 3D a node may be held along one tangent only (a roller plane): it slides along
+            # the other.
+            held = self._held[base + n: base + (1 + ntan) * n].reshape(ntan, n).T \
+                | (mu_static == 0.0)
+            node_held = held.all(axis=1)
+            if ntan > 1:
+                slip[held] = 0.0  # (round-off: the supports hold it)
+            # a node on the cone keeps slipping unless its slip has turned back: the static cone
+            # for a node at rest, the dynamic one for a node that slips (the same for Coulomb);
+            # sigma, its slip direction, is the one its traction opposes (2D: -sign(s))
+            size = magnitudes(s)
+            sigma = np.divide(-S, size[:, None], out=np.zeros_like(S), where=size[:, None] > 0)
+            reach = size >= (1.0 - CONE_TOLERANCE) * q * np.where(was_sliding, mu, mu_static)
+            on_cone = (q > 0) & reach & (size != 0)
+            amount = magnitudes(slip)
+            moving = torn & (amount > tol)
+            going = amount > 0
+            unit = np.divide(slip, amount[:, None], out=np.zeros_like(slip),
+                             where=going[:, None])
+            sigma[moving] = unit[moving]
+            along = np.einsum("ij,ij->i", sigma, slip) if ntan > 1 else sigma[:, 0] * slip[:, 0]
+            slipping = contact & ((on_cone & (along >= -tol)) | moving)
+            slipping &= ~node_held
+            sticking = contact & ~slipping & ~node_held
             was_sliding[:] = slipping | (contact & (mu_static == 0.0))
-            free = held | ~contact  # no tangential traction (and no normal one off contact)
-            jump[base + n + np.flatnonzero(free)] = -s[free]
-            on, stick, slide = (np.flatnonzero(m) for m in (contact, sticking, slipping))
+            # no tangential traction where held (and none off contact)
+            free = held | ~contact[:, None]
+            for j in range(ntan):
+                jump[base + (1 + j) * n + np.flatnonzero(free[:, j])] = -S[free[:, j], j]
+            on = np.flatnonzero(contact)
+            stick = [np.flatnonzero(sticking & ~held[:, j]) for j in range(ntan)]
+            slide = np.flatnonzero(slipping)
             q_cols.append(base + on)
-            s_cols.append(base + n + stick)
-            rows += [base + on, base + n + stick]
-            normal_rows += [np.ones(len(on), bool), np.zeros(len(stick), bool)]
+            s_cols += [base + (1 + j) * n + st for j, st in enumerate(stick)]
+            rows += [base + on] + [base + (1 + j) * n + st for j, st in enumerate(stick)]
+            normal_rows += [np.ones(len(on), bool)] + [np.zeros(len(st), bool) for st in stick]
             # close the penetrations; undo the slips within the step
-            rhs += [omega * p[on], -omega * slip_k[stick]]
+            rhs += [omega * p[on]] + [-omega * slip[st, j] for j, st in enumerate(stick)]
             if compliance > 0:  # elastoplastic: the slip s / k_t is elastic
-                elastic.append(base + n + stick)
-                compliances.append(np.full(len(stick), compliance))
-            tie = -mu * sigma[slide]  # s follows q on the cone
-            jump[base + n + slide] = tie * q[slide] - s[slide]
-            tie_q.append(base + slide)
-            tie_s.append(base + n + slide)
-            ties.append(tie)
+                for j, st in enumerate(stick):
+                    elastic.append(base + (1 + j) * n + st)
+                    compliances.append(np.full(len(st), compliance))
+            for j in range(ntan):
+                tie = -mu * sigma[slide, j]  # s follows q on the cone
+                jump[base + (1 + j) * n + slide] = tie * q[slide] - S[slide, j]
+                tie_q[j].append(base + slide)
+                tie_s[j].append(base + (1 + j) * n + slide)
+                ties[j].append(tie)
+            if ntan > 1:
+                # 3D: the slip direction sigma turns (the plan's §3.3: a semismooth Newton step
+                # on the disk). A slipping node's traction is -mu q sigma plus a part s_perp
+                # across sigma, solved for with the row that asks its slip across sigma to
+                # vanish, linearised: d(sigma_perp . dw) = sigma_perp . d(dw) + (sigma . dw)
+                # / |s| d(s_perp) (sigma turns with s); the next correction reads sigma from
+                # the new s. (Not where a roller holds a tangent: sigma lies along the other;
+                # nor where s is zero, sigma then the slip's own direction.)
+                turn = slide[~held[slide].any(axis=1) & (size[slide] > 0)]
+                across = np.column_stack([-sigma[turn, 1], sigma[turn, 0]])
+                perp_s.append(base + n * (1 + np.arange(ntan))[None, :] + turn[:, None])
+                perp_dir.append(across)
+                perp_c.append(np.maximum(np.einsum("ij,ij->i", sigma[turn], slip[turn]), 0.0)
+                              / size[turn] + compliance)  # (+ the elastoplastic law's)
+                perp_rhs.append(-omega * np.einsum("ij,ij->i", across, slip[turn]))
         self.assemble_forces(state)  # the releases change the forces the platen sees
         q_cols, s_cols = np.concatenate(q_cols), np.concatenate(s_cols)
         if not len(q_cols):
-            state.shear.update({k: np.zeros(len(p.nodes))
-                                for k, p in enumerate(self.contact_pairs)})
+            state.shear.update({k: self._zeros(k) for k in range(len(self.contact_pairs))})
             self.assemble_forces(state)
             if not self.platen_met(state):
                 self._close_gap(state, pens)
             return None
         cols, rows = np.concatenate([q_cols, s_cols]), np.concatenate(rows)
-        tie_q, tie_s, ties = (np.concatenate(a) for a in (tie_q, tie_s, ties))
+        tie_q, tie_s, ties = ([np.concatenate(a) for a in b] for b in (tie_q, tie_s, ties))
         position = np.full(len(G), -1)  # unknown -> its column in the system
         position[cols] = np.arange(len(cols))
         Gr = G[rows]
+        turning = sum(len(d) for d in perp_dir)
+        if turning:  # 3D: the rows of the slip across sigma (a combination of two tangential)
+            perp_s, perp_dir = np.concatenate(perp_s), np.concatenate(perp_dir)
+            Gr = np.vstack([Gr, np.einsum("ij,ijm->im", perp_dir, G[perp_s])])
         A = Gr[:, cols]
-        A[:, position[tie_q]] += Gr[:, tie_s] * ties
+        for tq, ts, t in zip(tie_q, tie_s, ties):  # (one tangent at a time: no index twice)
+            A[:, position[tq]] += Gr[:, ts] * t
         if elastic:
             unknowns = np.concatenate(elastic)  # their rows are their own tangential ones
             at = np.full(len(G), -1)
             at[rows] = np.arange(len(rows))
             A[at[unknowns], position[unknowns]] += np.concatenate(compliances)
-        b = np.concatenate(rhs) - Gr @ jump
+        b = np.concatenate(rhs) - (Gr[:len(rows)] if turning else Gr) @ jump
+        if turning:  # their columns (the traction across sigma) and the compliance
+            A = np.hstack([A, np.einsum("ij,mij->mi", perp_dir, Gr[:, perp_s])])
+            A[len(rows) + np.arange(turning), len(cols) + np.arange(turning)] += \
+                np.concatenate(perp_c)
+            b = np.concatenate([b, np.concatenate(perp_rhs) - Gr[len(rows):] @ jump])
         if self.platen_body is not None and state.platen_force != 0.0:
             body = self.surfaces[self.platen_body].body
             row = dR[cols].copy()
-            row[position[tie_q]] += ties * dR[tie_s]
+            for tq, ts, t in zip(tie_q, tie_s, ties):
+                row[position[tq]] += t * dR[ts]
             extra = state.platen_force - self.platen_reaction(state) - dR @ jump
             # the rows' change per unit platen motion: penetration reduction (normal rows),
             # relative tangential displacement (tangential rows)
             column = np.where(np.concatenate(normal_rows), -dz_dplaten[rows], dz_dplaten[rows])
+            if turning:
+                row = np.concatenate([row, np.einsum("ij,ij->i", perp_dir, dR[perp_s])])
+                column = np.concatenate([column, np.einsum("ij,ij->i", perp_dir,
+                                                           dz_dplaten[perp_s])])
             x = np.linalg.solve(bordered_matrix(A, column, row, body.platen_stiffness),
                                 np.concatenate([b, [extra]]))
             x, dplaten = x[:-1], float(x[-1])
         else:
             x, dplaten = np.linalg.solve(A, b), 0.0
         delta = jump.copy()
+        if turning:
+            delta[perp_s] += perp_dir * x[len(cols):, None]
+            x = x[:len(cols)]
         delta[cols] += x
-        delta[tie_s] += ties * x[position[tie_q]]
+        for tq, ts, t in zip(tie_q, tie_s, ties):
+            delta[ts] += t * x[position[tq]]
         for k, pair in enumerate(self.contact_pairs):
             n, base = len(pair.nodes), offsets[k]
             self.tractions(state, k)[:] += delta[base:base + n]
-            self.shear(state, k)[:] += delta[base + n:base + 2 * n]
+            self.shear(state, k)[:] += self._tangential(delta, k)
         state.platen_displacement += dplaten
         return dplaten
 
 
-__all__ = ["CONE_TOLERANCE", "FrictionHistory", "FrictionalPairedContact", "coulomb_status",
-           "tangents"]
+__all__ = ["CONE_TOLERANCE", "FrictionHistory", "FrictionalPairedContact", "columns",
+           "coulomb_status", "magnitudes", "tangents"]
