@@ -90,3 +90,37 @@ def test_box_plateau_keeps_the_fine_spacing():
     xs = np.unique(m.p[0])
     d = np.diff(xs[xs < 0.5 + 1e-9])
     assert np.allclose(d, d[0], rtol=1e-12) and 0.09 < d[0] <= 0.1
+
+
+@pytest.mark.parametrize("tetrahedra", [False, True], ids=["hex", "tet"])
+@pytest.mark.parametrize("quarter", [True, False], ids=["quarter", "full"])
+def test_ring(quarter, tetrahedra):
+    from vfem.mesh.solids import ring
+
+    m = ring(1.0, 2.0, 0.5, x0=0.5, quarter=quarter, around=8, radial=3, layers=2,
+             tetrahedra=tetrahedra)
+    check_mesh(m, "ring")
+    turns = 1 if quarter else 4
+    assert volume(m) * 4 / turns == pytest.approx(math.pi * 3 * 0.5, rel=2e-2)
+    for name, radius in (("inner", 1.0), ("outer", 2.0)):
+        nodes = np.unique(m.facets[:, m.boundaries[name]])
+        assert np.abs(np.hypot(m.p[0, nodes] - 0.5, m.p[1, nodes]) - radius).max() < 1e-12
+        angles = np.unique(np.round(np.arctan2(m.p[1, nodes], m.p[0, nodes] - 0.5), 9))
+        assert len(angles) == 8 * turns + (1 if quarter else 0)  # equally spaced, merged
+    faces = 2 if tetrahedra else 1
+    counts = {"inner": 8 * turns * 2 * faces, "outer": 8 * turns * 2 * faces,
+              "bottom": 8 * turns * 3 * faces, "top": 8 * turns * 3 * faces}
+    if quarter:
+        counts.update(left=3 * 2 * faces, front=3 * 2 * faces)
+    assert {k: len(v) for k, v in m.boundaries.items()} == counts
+    assert len(m.boundary_facets()) == sum(counts.values())  # the whole ring closes up
+
+
+def test_cylinder_rim_nodes_are_equally_spaced_in_angle():
+    """With even spacing across, the rim's nodes lie at equal angles (2 n per quarter turn for
+    n divisions across), so a ring of as many facets per turn has its nodes at the same
+    angles (a shaft in a hub: similar polygons)."""
+    m = cylinder(1.0, 0.5, h=1.0 / 12)
+    side = np.unique(m.facets[:, m.boundaries["side"]])
+    angles = np.unique(np.round(np.degrees(np.arctan2(m.p[1, side], m.p[0, side])), 9))
+    assert np.allclose(angles, np.linspace(0.0, 90.0, 25), atol=1e-9)

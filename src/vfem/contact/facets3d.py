@@ -715,6 +715,8 @@ def _project_curved(kind: FacetKind, x: np.ndarray, facets: np.ndarray, points: 
     def newton(sel, start):
         parts = [_newton(kind, x[facets[fc[sel[c]]]], points[pt[sel[c]]], start[c])
                  for c in _chunks(len(sel))]
+        if not parts:  # no pair left at this stage (every point's best found before it)
+            return np.zeros((0, 2)), np.zeros(0)
         return (np.concatenate([v for v, _ in parts]).reshape(-1, 2),
                 np.concatenate([v for _, v in parts]))
 

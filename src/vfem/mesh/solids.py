@@ -18,9 +18,9 @@ from skfem import MeshHex, MeshTet
 
 from .parametric import check_count
 from .shapes import _grid_line
-from .topology import named_boundaries, share_topology
+from .topology import named_boundaries, share_topology, with_topology
 
-__all__ = ["box", "cylinder", "FACES"]
+__all__ = ["box", "cylinder", "ring", "FACES"]
 
 #: The named faces of :func:`box`: name -> (axis, end) (end 0: the face at the smaller
 #: coordinate).
@@ -131,13 +131,22 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     mesh = named_boundaries(mesh, tests)
     u, v, w = mesh.p
     m = np.maximum(np.abs(u), np.abs(v))  # the square ring through the node
-    r_ref = np.hypot(u, v)
     # beta: 0 inside blend_from (the square kept), 1 on the rim (the circle), linear between:
     # the rings stay nested (a ring's diagonal point, m R (sqrt 2 - (sqrt 2 - 1) beta), grows
     # with m while d beta / dm < 1 / (sqrt 2 - 1)), which blend_from < 0.58 keeps
     beta = np.clip((m - blend_from) / (1.0 - blend_from), 0.0, 1.0)
-    scale = np.where(r_ref > 0, (1.0 - beta) + beta * m / np.where(r_ref > 0, r_ref, 1.0), 1.0)
-    x, y = R * u * scale, R * v * scale
+    # the circle's point of a node of ring m: at an angle proportional to the node's place
+    # along its square ring (not on the ray through it), so the rim's nodes are equally spaced
+    # in angle: facets of equal length, and a ring (solids.ring) with as many facets per turn
+    # has its nodes at the same angles (a shaft in a hub: similar polygons, no faceting mismatch)
+    flat = np.abs(u) >= np.abs(v)
+    safe_u = np.where(u != 0, u, 1.0)
+    safe_v = np.where(v != 0, v, 1.0)
+    angle = np.where(flat, 0.25 * np.pi * v / safe_u + np.where(u < 0, np.pi, 0.0),
+                     0.5 * np.pi - 0.25 * np.pi * u / safe_v + np.where(v < 0, np.pi, 0.0))
+    x = R * ((1.0 - beta) * u + beta * m * np.cos(angle))
+    y = R * ((1.0 - beta) * v + beta * m * np.sin(angle))
+    x[m == 0] = y[m == 0] = 0.0
     rr = np.hypot(x, y)
     bottom = (0.0 if end_radius is None
               else end_radius - np.sqrt(np.maximum(end_radius ** 2 - rr ** 2, 0.0)))
@@ -149,3 +158,58 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     z = bottom + ((1.0 - gamma) * w + gamma * equal) * (height - bottom)
     p = np.vstack([x + x0, y + y0, z + z0])
     return share_topology(mesh, replace(mesh, doflocs=p))
+
+
+def ring(inner_radius: float = 1.0, outer_radius: float = 2.0, height: float = 1.0, *,
+         x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, quarter: bool = True,
+         around: int = 16, radial: int = 4, layers: int = 2,
+         tetrahedra: bool = False) -> MeshHex | MeshTet:
+    """A thick-walled tube (a hub, a bearing ring) about the vertical axis through (``x0``,
+    ``y0``): inner and outer radius, from ``z0`` up to ``z0 + height``; with ``quarter`` only
+    the part ``x >= x0, y >= y0``. A polar grid of hexahedra (or of six tetrahedra each, as
+    :func:`box`): ``around`` divisions per quarter turn, ``radial`` through the wall,
+    ``layers`` along the axis; nodes of ``inner`` and ``outer`` lie on their circles.
+
+    Named boundaries: ``inner``, ``outer``, ``bottom``, ``top`` and, with ``quarter``, ``left``
+    (x = x0) and ``front`` (y = y0), as on :func:`box`.
+    """
+    if not (0 < inner_radius < outer_radius and height > 0):
+        raise ValueError(f"need 0 < inner_radius < outer_radius and height > 0, got "
+                         f"{inner_radius}, {outer_radius}, {height}")
+    for name, n in (("around", around), ("radial", radial), ("layers", layers)):
+        if not (isinstance(n, (int, np.integer)) and n >= 1):
+            raise ValueError(f"{name} must be a whole number >= 1, got {n}")
+    turns = 1 if quarter else 4
+    check_count((around * turns + 1.0) * (radial + 1.0) * (layers + 1.0), "ring")
+    r = np.linspace(inner_radius, outer_radius, radial + 1)
+    theta = np.linspace(0.0, 0.5 * np.pi * turns, around * turns + 1)
+    z = np.linspace(0.0, 1.0, layers + 1)
+    mesh = (MeshTet if tetrahedra else MeshHex).init_tensor(r, theta, z)
+    tol = 1e-9
+    tests = {"inner": lambda p: p[0] < inner_radius + tol * outer_radius,
+             "outer": lambda p: p[0] > outer_radius - tol * outer_radius,
+             "bottom": lambda p: p[2] < tol, "top": lambda p: p[2] > 1 - tol}
+    if quarter:
+        tests.update(left=lambda p: p[1] > 0.5 * np.pi - tol, front=lambda p: p[1] < tol)
+    mesh = named_boundaries(mesh, tests)
+    rr, th, w = mesh.p
+    p = np.vstack([x0 + rr * np.cos(th), y0 + rr * np.sin(th), z0 + w * height])
+    if quarter:
+        return share_topology(mesh, replace(mesh, doflocs=p))
+    # the whole ring: the nodes at theta = 2 pi are those at 0, merged by position
+    _, first, index = np.unique(np.rint(p.T / (1e-9 * outer_radius)).astype(np.int64), axis=0,
+                                return_index=True, return_inverse=True)
+    index = index.ravel()
+    order = np.argsort(first)  # keep the nodes in their first-seen order
+    renumber = np.empty_like(order)
+    renumber[order] = np.arange(len(order))
+    t = renumber[index[mesh.t]]
+    whole = type(mesh)(np.ascontiguousarray(p[:, np.sort(first)]), np.ascontiguousarray(t))
+    with_topology(whole)
+    # the named facets again, by their nodes in the merged numbering
+    key = {tuple(sorted(f)): j for j, f in enumerate(whole.facets.T.tolist())}
+    found = {name: np.array(sorted(key[tuple(sorted(f))] for f in
+                                   renumber[index[mesh.facets[:, fac]]].T.tolist()),
+                            dtype=np.int32)
+             for name, fac in mesh.boundaries.items()}
+    return named_boundaries(whole, found)
