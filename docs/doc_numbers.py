@@ -341,6 +341,66 @@ def examples_sliding_friction() -> str:
     ]) + "\n"
 
 
+def examples_sphere() -> str:
+    """docs/examples.md, Sphere: the default run (``vfem run sphere``)."""
+    s = _summary("sphere")
+    h = s["hertz"]
+    sph, flat = h["sphere"], h["flat"]
+    steps = s["steps"]
+    return "\n".join([
+        f"Default model ({_thousands(s['dofs'], 0)} dofs, {_thousands(s['contact_dofs'], 0)} "
+        f"contact dofs, quarter model, facets a/{s['parameters']['facets_per_radius']} = "
+        f"{h['facet_size']:.3f} on the sphere, {h['flat_facet_size']:.3f} on the flat):",
+        "",
+        f"* p_max {_thousands(sph['p_max'], 1)} (theory {_thousands(h['p0_theory'], 1)}, "
+        f"{_percent(sph['p_max_error'], 2, True)}); the flat reads "
+        f"{_percent(flat['p_max_error'], 2, True)}.",
+        f"* Contact radius {sph['a_estimate']:.4f} (theory {h['a_theory']:.4f}: "
+        f"{abs(sph['a_estimate'] - h['a_theory']) / h['facet_size']:.2f} of a facet); around "
+        f"the circle the edge's radius varies by {sph['contour_spread']:.3f} "
+        f"({sph['contour_spread'] / h['facet_size']:.2f} of a facet).",
+        f"* RMS error over r < a {_percent(sph['rms_error_over_p0'], 2)} of p0.",
+        f"* Contact force {sph['total_contact_force']:.2f} on the sphere and "
+        f"{flat['total_contact_force']:.2f} on the flat (applied {h['applied_force']:g}).",
+        f"* {' and '.join(str(x['iterations']) for x in steps)} iterations in the "
+        f"{len(steps)} steps; "
+        + ("every invariant passed at every step." if all(
+            (x["invariants"] or {}).get("passed", False) for x in steps)
+           else "an invariant FAILED at some step."),
+    ]) + "\n"
+
+
+def examples_sphere_study() -> str:
+    """docs/examples.md, Sphere: the refinement study, the whole sphere and the bodies listed
+    the other way round (``tests/test_sphere.py``'s slow study; about five minutes)."""
+    from vfem.examples import sphere
+    from vfem.solver import Analysis
+
+    rows = ["| model | facets across a | dofs | p_max error | flat's p_max error | "
+            "contact radius error / facet | edge's spread / facet | RMS over r < a |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    cases = [("quarter", {"facets_per_radius": n}) for n in (6, 8, 12)]
+    cases += [("whole", {"quarter": False}), ("quarter, flat first", {"swap_bodies": True}),
+              ("quarter, tetrahedral sphere", {"sphere_cells": "tet"}),
+              ("quarter, tetrahedra both", {"sphere_cells": "tet", "flat_cells": "tet"})]
+    for label, kw in cases:
+        p = sphere.Parameters(steps=1, **kw)
+        model = sphere.build(p)
+        result = Analysis(model).run()
+        ev = sphere.evaluate(result, p)
+        sph = ev["sphere"]
+        ok = result.converged and all(x.invariants["passed"] for x in result.steps)
+        rows.append(
+            f"| {label}{'' if ok else ' (NOT converged)'} | {p.facets_per_radius} | "
+            f"{_thousands(sum(b.ndofs for b in model.bodies), 0)} | "
+            f"{_percent(sph['p_max_error'], 2, True)} | "
+            f"{_percent(ev['flat']['p_max_error'], 2, True)} | "
+            f"{abs(sph['a_estimate'] - ev['a_theory']) / ev['facet_size']:.2f} | "
+            f"{sph['contour_spread'] / ev['facet_size']:.2f} | "
+            f"{_percent(sph['rms_error_over_p0'], 2)} |")
+    return "\n".join(rows) + "\n"
+
+
 #: name -> (file, generator, quick: run in the default test suite)
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
@@ -354,6 +414,8 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-wedge": ("docs/examples.md", examples_wedge, True),
     "examples-wedge-coarse": ("docs/examples.md", examples_wedge_coarse, True),
     "examples-sliding-friction": ("docs/examples.md", examples_sliding_friction, False),
+    "examples-sphere": ("docs/examples.md", examples_sphere, True),
+    "examples-sphere-study": ("docs/examples.md", examples_sphere_study, False),
 }
 
 _TIME = re.compile(r"\b\d+(\.\d+)? s\b")

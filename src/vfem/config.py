@@ -51,9 +51,10 @@ SHAPES = {
     "filleted_punch": shapes.filleted_punch,
     "box": solids.box,
     "cylinder": solids.cylinder,
+    "ring": solids.ring,
 }
 #: The shapes of :data:`SHAPES` that make 3D meshes (tetrahedra, hexahedra).
-SOLID_SHAPES = ("box", "cylinder")
+SOLID_SHAPES = ("box", "cylinder", "ring")
 
 
 @dataclass(frozen=True)

@@ -71,6 +71,8 @@ def theory(p: SphereParameters) -> dict[str, float]:
     e1 = LinearElastic(p.sphere_youngs_modulus, p.sphere_poissons_ratio)
     e2 = LinearElastic(p.flat_youngs_modulus, p.flat_poissons_ratio)
     e_star = 1.0 / (1.0 / e1.plane_strain_modulus() + 1.0 / e2.plane_strain_modulus())
+    if not (p.force > 0 and p.radius > 0 and e_star > 0):  # (a complex cube root otherwise)
+        raise ValueError("Hertz's theory needs a positive force, radius and E*")
     a = (3.0 * p.force * p.radius / (4.0 * e_star)) ** (1.0 / 3.0)
     return {"a_theory": a, "p0_theory": 3.0 * p.force / (2.0 * math.pi * a * a), "e_star": e_star}
 

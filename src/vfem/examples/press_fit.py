@@ -1,0 +1,216 @@
+"""A shaft pressed into a hub with a radial interference (issue 21): an interference fit.
+
+The shaft (radius b + delta) and the hub (bore b, outer radius c), of one material, start
+overlapping by delta all round; the contact resolves the overlap in the first step (the
+overlap must lie within the elements behind the surfaces: ``docs/method.md`` §12). Both are
+held on rollers at their two end faces (z = 0 and z = L), so every section is in plane strain,
+and on the two symmetry planes of the quarter model. Lame's thick cylinders in plane strain
+(derived in ``docs/examples.md``): the radial displacement of the hub's bore under a pressure
+p is p b (1 + nu) ((1 - 2 nu) b^2 + c^2) / (E (c^2 - b^2)), the shaft's surface moves by
+-p b (1 + nu)(1 - 2 nu) / E, and their difference is delta:
+
+    p = E delta (c^2 - b^2) / (2 b c^2 (1 - nu^2)).
+
+The meshes: the hub a polar grid (:func:`vfem.mesh.solids.ring`, ``around`` facets per quarter
+turn), the shaft a cylinder whose rim nodes lie at equal angles
+(:func:`vfem.mesh.solids.cylinder` with ``around / 2`` divisions across: as many facets per
+quarter turn), so the two faceted surfaces are similar polygons and the interference is the
+same at every node (with facets at other angles, a faceting sag comparable with delta makes
+the pressure scatter from node to node; ``docs/examples.md``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..bodies import Support
+from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from ..contact.settings import ContactSettings
+from ..errors import InputError
+from ..io.runner import run_status
+from ..materials import LinearElastic
+from ..solver import AnalysisResult, Model
+
+
+@dataclass(frozen=True)
+class PressFitParameters:
+    """Parameters of the press fit example."""
+
+    bore_radius: float = 1.0  # b: the hub's bore; the shaft's radius is b + interference
+    hub_radius: float = 2.0  # c
+    length: float = 0.5
+    interference: float = 0.01  # delta, on the radius
+    youngs_modulus: float = 200e3
+    poissons_ratio: float = 0.3
+    around: int = 24  # facets per quarter turn (even)
+    radial: int = 8  # the hub's elements through its wall
+    layers: int = 2  # along the axis
+    hub_cells: str = "hex"  # or "tet"
+    shaft_cells: str = "hex"
+    swap_bodies: bool = False
+
+
+Parameters = PressFitParameters
+
+
+def lame(p: PressFitParameters) -> float:
+    """Lame's contact pressure of the fit, plane strain, one material."""
+    b, c, E, nu = p.bore_radius, p.hub_radius, p.youngs_modulus, p.poissons_ratio
+    return E * p.interference * (c * c - b * b) / (2 * b * c * c * (1 - nu * nu))
+
+
+def validate(p: PressFitParameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    for name in ("bore_radius", "hub_radius", "length", "interference"):
+        value = getattr(p, name)
+        if not (isinstance(value, (int, float)) and 0 < value < math.inf):
+            raise InputError(f"press_fit: {name} must be a finite number > 0, got {value!r}")
+    if not p.bore_radius < p.hub_radius:
+        raise InputError(f"press_fit: hub_radius must exceed bore_radius, got {p.hub_radius} "
+                         f"and {p.bore_radius}")
+    if not (isinstance(p.around, int) and p.around >= 2 and p.around % 2 == 0):
+        raise InputError(f"press_fit: around must be an even number >= 2, got {p.around!r}")
+    for name in ("hub_cells", "shaft_cells"):
+        if getattr(p, name) not in ("hex", "tet"):
+            raise InputError(f"press_fit: {name} must be 'hex' or 'tet', got "
+                             f"{getattr(p, name)!r}")
+    build(p).validate()
+
+
+def config(p: PressFitParameters | None = None) -> ModelConfig:
+    """The model as data (what ``examples/press_fit.toml`` holds for the defaults)."""
+    p = p or PressFitParameters()
+    b, c, L = p.bore_radius, p.hub_radius, p.length
+    rollers = (Support("left", ("x",)), Support("front", ("y",)))
+    hub = BodyConfig(
+        name="hub",
+        mesh=MeshSpec(shape="ring", parameters=as_parameters(
+            inner_radius=b, outer_radius=c, height=L, around=p.around, radial=p.radial,
+            layers=p.layers, tetrahedra=p.hub_cells == "tet")),
+        material=LinearElastic(p.youngs_modulus, p.poissons_ratio),
+        supports=(Support("bottom", ("z",)), Support("top", ("z",)), *rollers),
+        contact_boundaries=("inner",),
+    )
+    radius = b + p.interference
+    across = max(1, p.around // 2)
+    shaft = BodyConfig(
+        name="shaft",
+        mesh=MeshSpec(shape="cylinder", parameters=as_parameters(
+            radius=radius, height=L, h=radius / across * (1 + 1e-9),
+            tetrahedra=p.shaft_cells == "tet")),
+        material=LinearElastic(p.youngs_modulus, p.poissons_ratio),
+        supports=(Support("contact", ("z",)), Support("top", ("z",)), *rollers),
+        contact_boundaries=("side",),
+    )
+    bodies = (hub, shaft) if p.swap_bodies else (shaft, hub)
+    return ModelConfig("press_fit", bodies, ContactSettings(), Steps(count=1))
+
+
+def build(p: PressFitParameters | None = None) -> Model:
+    return config(p).build()
+
+
+def evaluate(result: AnalysisResult, p: PressFitParameters) -> dict:
+    """Each body's nodal contact pressure on its contact surface against Lame's: the largest
+    and mean relative error, and the radial force against p times the quarter's area."""
+    target = lame(p)
+    last = result.steps[-1]
+    out = {"lame_pressure": target,
+           "radial_force_theory": target * 0.5 * math.pi * p.bore_radius * p.length}
+    for name, boundary in (("hub", "inner"), ("shaft", "side")):
+        body = next(b for b in result.model.bodies if b.name == name)
+        r = last.bodies[name]
+        nodes = np.unique(body.mesh.facets[:, body.mesh.boundaries[boundary]])
+        x = body.mesh.p[:, nodes]
+        radial = x[:2] / np.hypot(*x[:2])
+        rel = r.contact_pressure[nodes] / target - 1
+        out[name] = {
+            "largest_error": float(np.abs(rel).max()),
+            "mean_error": float(rel.mean()),
+            "nodes": int(len(nodes)),
+            "nodes_in_contact": int((r.contact_status[nodes] > 0).sum()),
+            # the force the other body puts on it, outwards (the hub) or inwards (the shaft),
+            # resolved on the 45-degree diagonal of the quarter: p b L (the quarter's)
+            "radial_force": float(np.abs(np.einsum("ij,ij->j", r.contact_force[nodes, :2].T,
+                                                   radial)).sum()),
+        }
+    return out
+
+
+def summarize(result: AnalysisResult, p: PressFitParameters) -> dict:
+    """The ``summary.json`` dictionary of a press fit run."""
+    from dataclasses import asdict
+
+    from ..io.results import step_record
+
+    summary = {
+        "example": "press_fit",
+        "converged": result.converged,
+        "message": result.message,
+        "steps": [step_record(s) for s in result.steps],
+        "bodies": {s.body.name: {"nodes": int(s.body.npoints), "dofs": int(s.body.ndofs),
+                                 "contact_candidate_nodes": int(s.nc)}
+                   for s in result.surfaces},
+        "dofs": int(sum(s.body.ndofs for s in result.surfaces)),
+        "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces)),
+        "pressure_measure": "nominal: nodal contact force / undeformed tributary area",
+        "parameters": asdict(p),
+        "timings": result.timings,
+        "linear_solver": result.backend,
+    }
+    if result.steps and result.steps[-1].load_factor == 1.0:
+        summary["lame"] = evaluate(result, p)
+    return summary
+
+
+def run(p: PressFitParameters, out, on_step=None, figures: bool = True,
+        resume: bool = False) -> dict:
+    """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
+    from ..io.results import run_example
+
+    return run_example(build(p), out, lambda r: summarize(r, p), figures, on_step, resume)
+
+
+def figures(folder) -> list[Path]:
+    """``pressure.png``: both bodies' nodal contact pressure over Lame's against the angle
+    around the axis, every layer of nodes."""
+    from ..io import plots
+
+    s = folder.summary
+    if not folder.has_steps or "lame" not in s:
+        return []
+    target = s["lame"]["lame_pressure"]
+    last = folder.steps[-1]
+    curves = []
+    for frame in last.bodies:
+        c = folder.contact(last, frame)
+        angle = np.degrees(np.arctan2(c.x[:, 1], c.x[:, 0]))
+        order = np.argsort(angle)
+        curves.append((f"{frame.name} (nodal force / undeformed area)", angle[order],
+                       c.pressure[order] / target, np.array([0.0, 90.0]), np.ones(2)))
+    out = folder.directory
+    plots.profiles(out / "pressure.png", curves, "angle around the axis (degrees)",
+                   "p / p_Lame (contact pressure over Lame's)",
+                   f"Press fit, {s['dofs']} dofs: interference "
+                   f"{s['parameters']['interference']:g} on radius "
+                   f"{s['parameters']['bore_radius']:g}\nline: Lame (plane strain)")
+    return [out / "pressure.png"]
+
+
+def report(s: dict) -> list[str]:
+    """The closing lines of a press fit run."""
+    lines = [f"vfem: {run_status(s)} in {len(s['steps'])} "
+             f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
+             f"{s['dofs']} dofs ({s['contact_dofs']} contact dofs), "
+             f"{s['timings']['total_s']:.1f} s"]
+    if "lame" in s:
+        m = s["lame"]
+        lines.append(f"  Lame's pressure {m['lame_pressure']:.6g}: the hub's nodes within "
+                     f"{m['hub']['largest_error']:.2%} (mean {m['hub']['mean_error']:+.2%}), "
+                     f"the shaft's within {m['shaft']['largest_error']:.2%} "
+                     f"(mean {m['shaft']['mean_error']:+.2%})")
+    return lines
