@@ -7,6 +7,7 @@ the bodies listed the other way round. Slow: the refinement study of the issue's
 """
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -94,3 +95,33 @@ def test_refinement_study():
     _, result = solve(p)
     whole = sphere.evaluate(result, p)["sphere"]["p_max"]
     assert abs(whole / quarter - 1) < 0.005
+
+
+def test_run_writes_the_3d_figures_and_plot_redraws_them(tmp_path):
+    from vfem.io.replot import plot_results
+
+    p = sphere.Parameters(facets_per_radius=3, steps=1)
+    summary = sphere.run(p, tmp_path)
+    assert summary["converged"]
+    names = {"pressure.png", "pressure_map.png", "deformed.png"}
+    assert set(summary["figures"]) == names
+    for name in names:
+        assert (tmp_path / name).stat().st_size > 10_000
+    assert {q.name for q in plot_results(tmp_path)} == names
+
+
+def test_plane_section_of_a_3d_frame():
+    """The faces of a hexahedral box's cells in the plane y = 0, as a 2D mesh in (x, z)."""
+    from skfem.io.meshio import to_meshio
+
+    from vfem.io.replot import BodyFrame, plane_section
+    from vfem.mesh.solids import box
+
+    mesh = box(0.0, 0.0, 0.0, 2.0, 1.0, 1.0, 4, 3, 2)
+    m = to_meshio(mesh)
+    cells = m.cells[0].data
+    frame = BodyFrame(0, "box", Path("box.vtu"), m.points, cells, np.zeros_like(m.points), {})
+    points, faces, u = plane_section(frame, 1, 0.0)
+    assert faces.shape == (8, 4)  # 4 x 2 quadrilaterals
+    assert np.allclose(np.abs(points[faces]).max(axis=(0, 1)), [2.0, 1.0])
+    assert u.shape == (len(points), 2)

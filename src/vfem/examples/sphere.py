@@ -227,7 +227,8 @@ def figures(folder) -> list[Path]:
     """The figures of a sphere results folder (:class:`vfem.io.replot.Folder`), drawn by the
     run and by ``vfem plot``: ``pressure_map.png``, the sphere's contact pressure over the
     contact zone seen from below, with Hertz's circle r = a; ``pressure.png``, p/p0 against
-    r/a at both bodies' contact candidate nodes with Hertz's ellipse."""
+    r/a at both bodies' contact candidate nodes with Hertz's ellipse; ``deformed.png``, the
+    symmetry plane y = 0 near the contact, deformed, true scale."""
     from ..io import plots
 
     s = folder.summary
@@ -256,6 +257,25 @@ def figures(folder) -> list[Path]:
                        f"Sphere: contact pressure p / p0 seen from below ({model})\n"
                        f"dashed: Hertz's r = a; contact edge radius {sph['a_estimate'] / a:.3f} a"
                        f" (spread {sph['contour_spread'] / a:.3f} a)")
+    # the contact region in the symmetry plane y = 0 (the whole model: its mid-plane nodes)
+    from ..io.replot import plane_section
+
+    sections = []
+    for b in last.bodies:
+        p2, faces, u2 = plane_section(b, 1, 0.0)
+        if len(faces):
+            sections.append((b.name, p2, faces, u2))
+    if sections:
+        sph_frame = next(b for b in last.bodies if b.name == "sphere")
+        tip = int(np.argmin(np.linalg.norm(sph_frame.points, axis=1)))  # first touch
+        z0 = float(sph_frame.displacement[tip, 2])
+        plots.configurations(out / "deformed.png", [("deformed", sections)],
+                             f"Sphere on a flat ({model}): the plane y = 0 near the contact, "
+                             f"true scale (a = {a:.4f})",
+                             window=(0.0 if s["parameters"].get("quarter", True) else -2.5 * a,
+                                     2.5 * a, z0 - 1.5 * a, z0 + 1.0 * a), magnification=1.0,
+                             axes="xz")
+        return [out / "pressure.png", out / "pressure_map.png", out / "deformed.png"]
     return [out / "pressure.png", out / "pressure_map.png"]
 
 

@@ -191,7 +191,7 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
                                                                    np.ndarray]]]],
                    title: str, window: tuple[float, float, float, float] | None = None,
                    mesh_lines: bool | None = None, legend_loc: str | None = None,
-                   magnification: float | None = None) -> None:
+                   magnification: float | None = None, axes: str = "xy") -> None:
     """One or more configurations of a model drawn over each other (thesis Figs. 5.4-5.23).
 
     ``frames``: (label, bodies) with bodies a list of (points (n, 2), cells (m, k) of vertex
@@ -203,6 +203,7 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     everything. ``legend_loc``: a matplotlib legend position inside the axes; default beside
     them. ``magnification``: the displacements are multiplied by it and the title says so
     (None: the title says nothing, for configurations that are not deformed shapes).
+    ``axes``: the names of the two coordinates drawn ("xz" for a 3D body's plane y = 0).
     """
     plt = require_matplotlib()
     from matplotlib.collections import LineCollection, PolyCollection
@@ -245,7 +246,7 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     if len(styles) > 1:  # which line style is which body
         for body_name, ls in styles.items():
             ax.plot([], [], color="0.3", ls=ls, lw=0.9, label=body_name)
-    ratio = _frame(ax, window, lo, hi)
+    ratio = _frame(ax, window, lo, hi, axes)
     fig.set_size_inches(min(12.0, max(7.0, 3.6 * ratio + (2.9 if legend_loc is None else 1.2))),
                         4.6)
     ax.set_title(title if magnification is None else magnified(title, scale), fontsize=10)
@@ -255,7 +256,7 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     plt.close(fig)
 
 
-def _frame(ax, window, lo: np.ndarray, hi: np.ndarray) -> float:
+def _frame(ax, window, lo: np.ndarray, hi: np.ndarray, axes: str = "xy") -> float:
     """Axes of a configuration figure: ``window`` (xmin, xmax, ymin, ymax; default the box
     ``lo``..``hi`` padded by 3 %), equal scales, coordinate labels. Returns the window's
     width over its height, for the figure's shape."""
@@ -265,8 +266,8 @@ def _frame(ax, window, lo: np.ndarray, hi: np.ndarray) -> float:
     ax.set_xlim(window[0], window[1])
     ax.set_ylim(window[2], window[3])
     ax.set_aspect("equal")
-    ax.set_xlabel(f"x ({LENGTH})")
-    ax.set_ylabel(f"y ({LENGTH})")
+    ax.set_xlabel(f"{axes[0]} ({LENGTH})")
+    ax.set_ylabel(f"{axes[1]} ({LENGTH})")
     return (window[1] - window[0]) / max(window[3] - window[2], 1e-300)
 
 

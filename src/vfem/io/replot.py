@@ -578,6 +578,35 @@ def _cell_field(frame: BodyFrame, name: str) -> np.ndarray:
     return np.asarray(frame.cell_data[name], dtype=float)
 
 
+#: The faces of VTK's 3D cells, by the cells' node positions (hexahedron: bottom 0-3, top
+#: 4-7; tetrahedron: any three of four).
+_VTK_FACES = {8: ((0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6),
+                  (3, 0, 4, 7)),
+              4: ((0, 1, 2), (0, 1, 3), (1, 2, 3), (0, 2, 3))}
+
+
+def plane_section(frame: BodyFrame, axis: int, at: float
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A 3D body's faces that lie in the plane ``x[axis] = at`` (a symmetry plane of its
+    model), for drawing as a 2D mesh: (points (n, 2), faces (m, k), displacement (n, 2)), the
+    two other coordinates in order (y = 0: x and z). Linear cells (tetrahedra, hexahedra)."""
+    cells = np.asarray(frame.polygons)
+    faces = _VTK_FACES.get(cells.shape[1])
+    keep = [a for a in range(3) if a != axis]
+    if faces is None or not len(cells):
+        return np.zeros((0, 2)), np.zeros((0, 3), dtype=int), np.zeros((0, 2))
+    x = frame.points
+    tol = 1e-9 * max(float(np.ptp(x, axis=0).max()), 1e-300)
+    on = np.abs(x[:, axis] - at) <= tol
+    found = []
+    for face in faces:
+        f = cells[:, face]
+        found.append(f[on[f].all(axis=1)])
+    chosen = np.unique(np.sort(np.vstack(found), axis=1), axis=0, return_index=True)[1]
+    f = np.vstack(found)[np.sort(chosen)]
+    return x[:, keep], f, frame.displacement[:, keep]
+
+
 def magnification_for(steps: list[Step]) -> float:
     """A magnification that makes the largest displacement of ``steps`` about 5 % of the
     model's size (1, 2 or 5 times a power of ten; 1 where it already is, or more): small
