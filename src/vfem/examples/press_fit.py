@@ -142,26 +142,13 @@ def evaluate(result: AnalysisResult, p: PressFitParameters) -> dict:
 
 
 def summarize(result: AnalysisResult, p: PressFitParameters) -> dict:
-    """The ``summary.json`` dictionary of a press fit run."""
-    from dataclasses import asdict
+    """The ``summary.json`` dictionary of a press fit run: :func:`~vfem.io.results.
+    example_summary` with the bodies' sizes and ``lame``."""
+    from ..io.results import contact_sizes, example_summary
 
-    from ..io.results import step_record
-
-    summary = {
-        "example": "press_fit",
-        "converged": result.converged,
-        "message": result.message,
-        "steps": [step_record(s) for s in result.steps],
-        "bodies": {s.body.name: {"nodes": int(s.body.npoints), "dofs": int(s.body.ndofs),
-                                 "contact_candidate_nodes": int(s.nc)}
-                   for s in result.surfaces},
-        "dofs": int(sum(s.body.ndofs for s in result.surfaces)),
-        "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces)),
-        "pressure_measure": "nominal: nodal contact force / undeformed tributary area",
-        "parameters": asdict(p),
-        "timings": result.timings,
-        "linear_solver": result.backend,
-    }
+    summary = example_summary("press_fit", result, p)
+    summary.update(contact_sizes(result), pressure_measure="nominal: nodal contact force / "
+                   "undeformed tributary area")
     if result.steps and result.steps[-1].load_factor == 1.0:
         summary["lame"] = evaluate(result, p)
     return summary

@@ -189,27 +189,15 @@ def evaluate(result: AnalysisResult, p: SphereParameters) -> dict:
 
 
 def summarize(result: AnalysisResult, p: SphereParameters) -> dict:
-    """The ``summary.json`` dictionary of a sphere run."""
-    from dataclasses import asdict
+    """The ``summary.json`` dictionary of a sphere run: :func:`~vfem.io.results.example_summary`
+    with the platen's motion per step, the bodies' sizes and, at full load, ``hertz``."""
+    from ..io.results import contact_sizes, example_summary
 
-    from ..io.results import step_record
-
-    summary = {
-        "example": "sphere",
-        "converged": result.converged,
-        "message": result.message,
-        "steps": [{**step_record(s), "platen_displacement": s.platen_displacement}
-                  for s in result.steps],
-        "bodies": {s.body.name: {"nodes": int(s.body.npoints), "dofs": int(s.body.ndofs),
-                                 "contact_candidate_nodes": int(s.nc)}
-                   for s in result.surfaces},
-        "dofs": int(sum(s.body.ndofs for s in result.surfaces)),
-        "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces)),
-        "pressure_measure": "nominal: nodal contact force / undeformed tributary area",
-        "parameters": asdict(p),
-        "timings": result.timings,
-        "linear_solver": result.backend,
-    }
+    summary = example_summary("sphere", result, p)
+    for record, step in zip(summary["steps"], result.steps):
+        record["platen_displacement"] = step.platen_displacement
+    summary.update(contact_sizes(result), pressure_measure="nominal: nodal contact force / "
+                   "undeformed tributary area")
     if result.steps and result.steps[-1].load_factor == 1.0:
         summary["hertz"] = evaluate(result, p)
     return summary

@@ -550,6 +550,16 @@ def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
     return out
 
 
+def contact_sizes(result: AnalysisResult) -> dict:
+    """Per body its nodes, dofs and contact candidate nodes (``bodies``), and the contact dofs
+    of the model (``contact_dofs``): the sizes a 3D example's summary gives beside
+    :func:`example_summary`'s."""
+    return {"bodies": {s.body.name: {"nodes": int(s.body.npoints), "dofs": int(s.body.ndofs),
+                                     "contact_candidate_nodes": int(s.nc)}
+                       for s in result.surfaces},
+            "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces))}
+
+
 def friction_summary(result: AnalysisResult, records: list[dict]) -> dict:
     """With friction (the model's ``contact.frictional``): each step's record (``records``,
     one per ``result.steps``) gets its ``frictional_work`` (:func:`frictional_work`) and its
