@@ -401,6 +401,73 @@ def examples_sphere_study() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_cattaneo3d() -> str:
+    """docs/examples.md, Cattaneo 3D: the steps of the shear of ``vfem run cattaneo3d``."""
+    s = _summary("cattaneo3d")
+    ev = s["cattaneo3d"]
+    steps = s["steps"]
+    ok = all((x["invariants"] or {}).get("passed", False) for x in steps)
+    rows = [f"Default model ({_thousands(s['dofs'], 0)} dofs, half model, facets "
+            f"a/{round(ev['a'] / ev['facet_size'])} = {ev['facet_size']:.3f} on the sphere; "
+            f"{sum(x['iterations'] for x in steps)} contact iterations in {len(steps)} steps, "
+            + ("every invariant passed at every step" if ok else "an invariant FAILED")
+            + f"; tangential forces balanced to "
+            f"{max(r['tangential_balance'] for r in ev['steps']):.1e} of μP):", "",
+            "| Q/(μP) | c/a, Mindlin | outermost sticking node / a | off c (facets) | "
+            "stick/slip edge / a | shear error, largest / RMS (% of μp0) | iterations |",
+            "|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in ev["steps"]:
+        rows.append(f"| {r['Q_over_muP']:.3f} | {r['c_over_a']:.3f} | "
+                    f"{r['last_sticking_over_a']:.3f} | {r['last_sticking_off_c_facets']:+.2f} | "
+                    f"{r['edge_over_a']:.3f} | {100 * r['shear_max_error']:.1f} % / "
+                    f"{100 * r['shear_rms_error']:.1f} % | {r['iterations']} |")
+    return "\n".join(rows) + "\n"
+
+
+def examples_cattaneo3d_study() -> str:
+    """docs/examples.md, Cattaneo 3D: the steps nearest Q/(mu P) = 0.3, 0.6, 0.9 at three
+    meshes, and the bodies listed the other way round (``tests/test_cattaneo3d.py``'s slow
+    acceptance; about three minutes)."""
+    import numpy as np
+
+    from vfem.examples import cattaneo3d
+    from vfem.solver import Analysis
+
+    rows = ["| facets across a | dofs | Q/(μP) | c/a | outermost sticking node / a | off c "
+            "(facets) | shear error, largest / RMS (% of μp0) | iterations | invariants |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+    results = {}
+    for n in (5, 6, 8):
+        p = cattaneo3d.Parameters(facets_per_radius=n)
+        model = cattaneo3d.build(p)
+        result = Analysis(model).run()
+        results[n] = result
+        ok = result.converged and all(x.invariants["passed"] for x in result.steps)
+        ev = cattaneo3d.evaluate(result, p)
+        for i in cattaneo3d.picks(ev["steps"]):
+            r = ev["steps"][i]
+            rows.append(f"| {n} | {_thousands(sum(b.ndofs for b in model.bodies), 0)} | "
+                        f"{r['Q_over_muP']:.3f} | {r['c_over_a']:.3f} | "
+                        f"{r['last_sticking_over_a']:.3f} | "
+                        f"{r['last_sticking_off_c_facets']:+.2f} | "
+                        f"{100 * r['shear_max_error']:.1f} % / "
+                        f"{100 * r['shear_rms_error']:.1f} % | {r['iterations']} | "
+                        f"{'passed' if ok else 'FAILED'} |")
+    p = cattaneo3d.Parameters(swap_bodies=True)
+    swapped = Analysis(cattaneo3d.build(p)).run()
+    mu_p0 = cattaneo3d.theory(p)["mu_p0"]
+    same, diff = True, 0.0
+    for a, b in zip(results[6].steps, swapped.steps, strict=True):
+        sa, sb = cattaneo3d.stick_slip(results[6], a), cattaneo3d.stick_slip(swapped, b)
+        same &= bool(np.array_equal(sa["status"], sb["status"]))
+        diff = max(diff, *(float(np.abs(sa[k] - sb[k]).max()) / mu_p0
+                           for k in ("shear_x", "shear_y", "normal")))
+    rows += ["", f"The flat listed first (a/6): the same stick and slip nodes at every step: "
+             f"{'yes' if same else 'NO'}; tractions "
+             + ("within 1e-8 of μp0." if diff < 1e-8 else f"off by {diff:.1e} of μp0.")]
+    return "\n".join(rows) + "\n"
+
+
 #: name -> (file, generator, quick: run in the default test suite)
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
@@ -416,6 +483,8 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-sliding-friction": ("docs/examples.md", examples_sliding_friction, False),
     "examples-sphere": ("docs/examples.md", examples_sphere, True),
     "examples-sphere-study": ("docs/examples.md", examples_sphere_study, False),
+    "examples-cattaneo3d": ("docs/examples.md", examples_cattaneo3d, False),
+    "examples-cattaneo3d-study": ("docs/examples.md", examples_cattaneo3d_study, False),
 }
 
 _TIME = re.compile(r"\b\d+(\.\d+)? s\b")

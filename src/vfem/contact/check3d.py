@@ -19,8 +19,9 @@ along its first diagonal) in place of its boundary polygon:
 * **linearised depth** under small kinematics: the node's offset r from its closest point on
   the other undeformed surface moved with the surface's displacement (interpolated linearly on
   the triangle), read along the facet's normal and along the node's own normal (the smaller);
-  beside an edge or a vertex (the node's projection on the facet's plane outside it), |r| signed
-  by the feature's pseudonormal; the second-order allowance the slip times the angle the facet
+  beside an edge or a vertex (the node's projection on the facet's plane outside it, not across
+  an edge on a symmetry plane, where the facet's mirror image continues it), |r| signed by the
+  feature's pseudonormal; the second-order allowance the slip times the angle the facet
   has turned through.
 * **tension**: F·n with n the angle-weighted nodal normal (undeformed under small kinematics).
 
@@ -121,6 +122,19 @@ class Surface3:
     def corners(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = self.b.triangles
         return self._get("corners", lambda: (self.x[t[:, 0]], self.x[t[:, 1]], self.x[t[:, 2]]))
+
+    @property
+    def mirror_edges(self) -> np.ndarray:
+        """(nt, 3) bool: the triangle's edge opposite each corner is an edge of a triangle on a
+        symmetry plane (the model continues across it as the facet's mirror image)."""
+        def make():
+            t, m = self.b.triangles, self.b.mirror
+            nb = len(self.x)
+            key = lambda i, j: np.minimum(i, j) * nb + np.maximum(i, j)  # noqa: E731
+            on = np.concatenate([key(t[m, i], t[m, j]) for i, j in ((1, 2), (2, 0), (0, 1))])
+            return np.column_stack([np.isin(key(t[:, i], t[:, j]), on)
+                                    for i, j in ((1, 2), (2, 0), (0, 1))])
+        return self._get("mirror_edges", make)
 
     @property
     def unit_normals(self) -> np.ndarray:
@@ -313,7 +327,9 @@ def linearised_depth(check: InvariantCheck, i: int, j: int, node: np.ndarray,
     # beside an edge or a vertex: the node's projection on the facet's plane lies outside it
     a, b, cc = rj.corners
     free = _barycentric(ri.x[node], a[tri], b[tri], cc[tri])
-    vertex = (free < -FEATURE).any(axis=1) & (dist > 1e-12 * np.maximum(rj.sizes[tri], 1e-300))
+    # (not beside an edge on a symmetry plane: the facet's mirror image continues it there)
+    beside = (free < -FEATURE) & ~rj.mirror_edges[tri]
+    vertex = beside.any(axis=1) & (dist > 1e-12 * np.maximum(rj.sizes[tri], 1e-300))
     if vertex.any():
         feature = rj.feature_normals(tri, lam, rj._get(
             "surface_pseudonormals", lambda: rj._vertex_pseudonormals(keep)))

@@ -101,6 +101,48 @@ def tangents(normal: np.ndarray) -> list[np.ndarray]:
     return [t1, np.cross(normal, t1)]
 
 
+def symmetry_planes(body) -> list[tuple[np.ndarray, int]]:
+    """A 3D body's symmetry planes: per roller ``Support`` (held along one axis) whose boundary
+    has flat facets normal to that axis, the mesh nodes on those facets and the axis."""
+    mesh = body.mesh
+    out = []
+    for sup in body.supports:
+        components = body.support_components(sup)
+        if len(components) != 1 or sup.boundary not in (mesh.boundaries or {}):
+            continue
+        facets = np.asarray(mesh.boundaries[sup.boundary])
+        axis = body.components.index(components[0])
+        if not len(facets):
+            continue
+        ends = mesh.p[axis][mesh.facets[:, facets]]  # (nodes of a facet, nf)
+        size = np.ptp(mesh.p, axis=1).max()
+        flat = np.ptp(ends, axis=0) <= 1e-9 * size
+        if flat.any():
+            out.append((np.unique(mesh.facets[:, facets[flat]]), axis))
+    return out
+
+
+def plane_normals(surface, pair) -> np.ndarray:
+    """Pair ``pair``'s nodal normals for its tangents: in 3D, at a node on a symmetry plane of
+    the compatibility side's body (:func:`symmetry_planes`), the normal less its component
+    across the plane (the facets on one side of the plane tilt the averaged normal out of it;
+    the plane's axis is then a tangent, :data:`HELD`, and the other tangent lies in the plane:
+    without this it would measure mostly the normal's own motion, the normal and that
+    tangent's rows proportional). Elsewhere, and in 2D, the pair's normals themselves."""
+    normal = pair.normal
+    if normal.shape[1] != 3:
+        return normal
+    points = surface.nodes[pair.nodes]
+    out = normal
+    for nodes, axis in symmetry_planes(surface.body):
+        at = np.isin(points, nodes) & (normal[:, axis] != 0.0)
+        if at.any():
+            out = out.copy() if out is normal else out
+            out[at, axis] = 0.0
+            out[at] /= np.linalg.norm(out[at], axis=1)[:, None]
+    return out
+
+
 def columns(a: np.ndarray) -> np.ndarray:
     """A tangential array (2D: (n,), one tangent; 3D: (n, 2)) seen as (n, ntan): a view."""
     return a.reshape(len(a), -1)
@@ -296,7 +338,8 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     def __init__(self, surfaces, pairs, settings, backend: str | None = None):
         super().__init__(surfaces, pairs, settings, backend)
         self._init_friction(settings)
-        self._tangents = [tangents(pair.normal) for pair in self.contact_pairs]
+        self._tangents = [tangents(plane_normals(self.surfaces[pair.fine], pair))
+                          for pair in self.contact_pairs]
         #: tangents per node: 1 in 2D, 2 in 3D
         self._ntan = max((len(t) for t in self._tangents), default=1)
         #: per pair, the nodes released from tension in the current solve

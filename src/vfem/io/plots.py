@@ -117,6 +117,42 @@ def pressure_map(path: Path, x: np.ndarray, y: np.ndarray, p: np.ndarray, title:
     plt.close(fig)
 
 
+def stick_map(path: Path, panels: list[tuple[str, np.ndarray, np.ndarray, np.ndarray, float]],
+              title: str) -> None:
+    """A 3D contact surface's stick and slip zones seen along its normal, one panel per
+    (label, x, y, status, c): the nodes' undeformed (``x``, ``y``) marked by their friction
+    status (1 stick: filled, 2 slip: open, 0 no contact: a dot), the circle of radius ``c``
+    dashed (the stick zone of a theory) and the circle of radius 1 dotted (the contact's; x, y
+    and c scaled by its radius)."""
+    plt = require_matplotlib()
+    fig, axes = plt.subplots(1, max(len(panels), 1), figsize=(4.2 * max(len(panels), 1), 3.4),
+                             squeeze=False)
+    s = np.linspace(0.0, 2.0 * np.pi, 361)
+    for ax, (label, x, y, status, c) in zip(axes[0], panels):
+        status = np.asarray(status)
+        for value, style in ((0, dict(marker=".", ms=2, ls="", color="0.6")),
+                             (2, dict(marker="o", ms=4, ls="", mfc="none", color="tab:orange",
+                                      label="slip")),
+                             (1, dict(marker="o", ms=4, ls="", color="tab:blue",
+                                      label="stick"))):
+            on = status == value
+            ax.plot(x[on], y[on], **style)
+        ax.plot(c * np.cos(s), c * np.sin(s), "k--", lw=1.0)
+        ax.plot(np.cos(s), np.sin(s), "k:", lw=1.0)
+        if len(x):
+            ax.set_xlim(float(np.min(x)), float(np.max(x)))
+            ax.set_ylim(float(np.min(y)), float(np.max(y)))
+        ax.set_aspect("equal")
+        ax.set_xlabel("x / a (undeformed)")
+        ax.set_ylabel("y / a")
+        ax.set_title(label, fontsize=9)
+    axes[0][-1].legend(fontsize=8, **OUTSIDE)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def punch_pressure(path: Path, x: np.ndarray, p: np.ndarray, force: float, a: float,
                    title: str) -> None:
     """Nodal contact pressure against x under a flat punch of half-width ``a``, with Sadowsky's

@@ -79,14 +79,16 @@ def box(x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, width: float = 1.0,
 
 def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | None = None,
              x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, quarter: bool = True,
-             h_contact: float | None = None, h: float | None = None, growth: float = 0.2,
-             plateau: float = 0.0, blend_from: float = 0.5, tetrahedra: bool = False
-             ) -> MeshHex | MeshTet:
+             half: bool = False, h_contact: float | None = None, h: float | None = None,
+             growth: float = 0.2, plateau: float = 0.0, blend_from: float = 0.5,
+             tetrahedra: bool = False) -> MeshHex | MeshTet:
     """A cylinder of ``radius`` about the vertical axis through (``x0``, ``y0``), its lower end
     at ``z0`` on the axis and its top face the plane ``z = z0 + height``: flat-ended (a
     circular punch), or with ``end_radius`` its lower end a spherical cap of that radius
     touching ``z = z0`` at the axis (a sphere's contact region: Hertz's indenter). With
-    ``quarter`` only the part ``x >= x0, y >= y0`` (a quarter model with two symmetry planes).
+    ``quarter`` only the part ``x >= x0, y >= y0`` (a quarter model with two symmetry planes);
+    with ``half`` (and ``quarter = False``) the part ``y >= y0`` (a half model with one symmetry
+    plane: a load along x breaks the symmetry about x = x0).
 
     The mesh is a tensor grid of hexahedra (or of six tetrahedra each, as :func:`box`) mapped
     onto the cylinder, graded towards the axis and the end: the spacing is ``h_contact`` within
@@ -98,9 +100,13 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     surface to the top plane, so the nodes of ``contact`` lie on the sphere (or the plane).
 
     Named boundaries: ``contact`` (the lower end), ``top``, ``side`` (the cylinder's mantle)
-    and, with ``quarter``, ``left`` (x = x0) and ``front`` (y = y0), as on :func:`box`.
+    and, with ``quarter``, ``left`` (x = x0) and ``front`` (y = y0), as on :func:`box`; with
+    ``half``, ``front`` (y = y0).
     """
     R = float(radius)
+    if half and quarter:
+        raise ValueError("half models the part y >= y0 and quarter the part x >= x0, y >= y0: "
+                         "give quarter = False with half")
     if not (R > 0 and height > 0):
         raise ValueError(f"radius and height must be positive, got {radius}, {height}")
     if end_radius is not None:
@@ -118,9 +124,10 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
         raise ValueError("give the element size h (and h_contact to grade the mesh)")
     fine = (0.0,) if h_contact is not None else ()
     across = _grid_line(0.0 if quarter else -R, R, h, h_contact, growth, fine, plateau) / R
+    along = _grid_line(0.0, R, h, h_contact, growth, fine, plateau) / R if half else across
     up = _grid_line(0.0, height, h, h_contact, growth, fine, plateau)
-    check_count(float(len(across)) ** 2 * len(up), "cylinder")
-    mesh = (MeshTet if tetrahedra else MeshHex).init_tensor(across, across, up / height)
+    check_count(float(len(across)) * len(along) * len(up), "cylinder")
+    mesh = (MeshTet if tetrahedra else MeshHex).init_tensor(across, along, up / height)
     # names on the reference grid (u, v in [-1, 1] or [0, 1], w in [0, 1]), kept by the map
     tol = 1e-9
     ring = lambda p: np.maximum(np.abs(p[0]), np.abs(p[1]))  # noqa: E731
@@ -128,6 +135,8 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
              "side": lambda p: ring(p) > 1 - tol}
     if quarter:
         tests.update(left=lambda p: p[0] < tol, front=lambda p: p[1] < tol)
+    elif half:
+        tests.update(front=lambda p: p[1] < tol)
     mesh = named_boundaries(mesh, tests)
     u, v, w = mesh.p
     m = np.maximum(np.abs(u), np.abs(v))  # the square ring through the node
