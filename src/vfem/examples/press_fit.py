@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import Support
+from ..bodies import PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
 from ..errors import InputError
@@ -52,6 +52,9 @@ class PressFitParameters:
     hub_cells: str = "hex"  # or "tet"
     shaft_cells: str = "hex"
     swap_bodies: bool = False
+    friction: float = 0.0  # Coulomb's mu between shaft and hub
+    push: float = 0.0  # after the fit: the shaft's end faces moved this far along the axis
+    push_steps: int = 2
 
 
 Parameters = PressFitParameters
@@ -61,6 +64,12 @@ def lame(p: PressFitParameters) -> float:
     """Lame's contact pressure of the fit, plane strain, one material."""
     b, c, E, nu = p.bore_radius, p.hub_radius, p.youngs_modulus, p.poissons_ratio
     return E * p.interference * (c * c - b * b) / (2 * b * c * c * (1 - nu * nu))
+
+
+def push_out_force(p: PressFitParameters) -> float:
+    """The force that slides the whole shaft in the hub (every node slipping): mu times
+    Lame's pressure times the contact area, 2 pi b L mu p (the whole fit)."""
+    return p.friction * lame(p) * 2.0 * math.pi * p.bore_radius * p.length
 
 
 def validate(p: PressFitParameters) -> None:
@@ -74,6 +83,12 @@ def validate(p: PressFitParameters) -> None:
                          f"and {p.bore_radius}")
     if not (isinstance(p.around, int) and p.around >= 2 and p.around % 2 == 0):
         raise InputError(f"press_fit: around must be an even number >= 2, got {p.around!r}")
+    for name in ("friction", "push"):
+        value = getattr(p, name)
+        if not (isinstance(value, (int, float)) and 0 <= value < math.inf):
+            raise InputError(f"press_fit: {name} must be a finite number >= 0, got {value!r}")
+    if not (isinstance(p.push_steps, int) and p.push_steps >= 1):
+        raise InputError(f"press_fit: push_steps must be at least 1, got {p.push_steps!r}")
     for name in ("hub_cells", "shaft_cells"):
         if getattr(p, name) not in ("hex", "tet"):
             raise InputError(f"press_fit: {name} must be 'hex' or 'tet', got "
@@ -97,17 +112,27 @@ def config(p: PressFitParameters | None = None) -> ModelConfig:
     )
     radius = b + p.interference
     across = max(1, p.around // 2)
+    if p.push > 0:  # the fit at load factor 0.5, then the push on a load curve
+        curve = ((0.0, 0.0), (0.5, 0.0), (1.0, 1.0))
+        ends = {"prescribed": tuple(PrescribedDisplacement(face, "z", p.push, curve)
+                                    for face in ("contact", "top"))}
+        steps = Steps(load_factors=(0.5, *(0.5 + 0.5 * (k + 1) / p.push_steps
+                                          for k in range(p.push_steps))))
+    else:
+        ends = {"supports": (Support("contact", ("z",)), Support("top", ("z",)))}
+        steps = Steps(count=1)
     shaft = BodyConfig(
         name="shaft",
         mesh=MeshSpec(shape="cylinder", parameters=as_parameters(
             radius=radius, height=L, h=radius / across * (1 + 1e-9),
             tetrahedra=p.shaft_cells == "tet")),
         material=LinearElastic(p.youngs_modulus, p.poissons_ratio),
-        supports=(Support("contact", ("z",)), Support("top", ("z",)), *rollers),
+        supports=(*ends.get("supports", ()), *rollers),
+        prescribed=ends.get("prescribed", ()),
         contact_boundaries=("side",),
     )
     bodies = (hub, shaft) if p.swap_bodies else (shaft, hub)
-    return ModelConfig("press_fit", bodies, ContactSettings(), Steps(count=1))
+    return ModelConfig("press_fit", bodies, ContactSettings(friction=p.friction), steps)
 
 
 def build(p: PressFitParameters | None = None) -> Model:
@@ -118,7 +143,8 @@ def evaluate(result: AnalysisResult, p: PressFitParameters) -> dict:
     """Each body's nodal contact pressure on its contact surface against Lame's: the largest
     and mean relative error, and the radial force against p times the quarter's area."""
     target = lame(p)
-    last = result.steps[-1]
+    fit = next((s for s in result.steps if s.load_factor == 0.5), result.steps[-1])
+    last = fit if p.push > 0 else result.steps[-1]
     out = {"lame_pressure": target,
            "radial_force_theory": target * 0.5 * math.pi * p.bore_radius * p.length}
     for name, boundary in (("hub", "inner"), ("shaft", "side")):
@@ -138,6 +164,13 @@ def evaluate(result: AnalysisResult, p: PressFitParameters) -> dict:
             "radial_force": float(np.abs(np.einsum("ij,ij->j", r.contact_force[nodes, :2].T,
                                                    radial)).sum()),
         }
+    if p.push > 0:  # the axial force the hub puts on the shaft, step by step (the whole fit)
+        out["push"] = [{"load_factor": s.load_factor,
+                        "axial_force": float(-4.0 * s.bodies["shaft"].contact_force[:, 2].sum()),
+                        "slipping_nodes": int((s.bodies["shaft"].friction_status == 2).sum())
+                        if s.bodies["shaft"].friction_status is not None else 0}
+                       for s in result.steps if s.load_factor > 0.5]
+        out["push_out_force_theory"] = push_out_force(p)
     return out
 
 
