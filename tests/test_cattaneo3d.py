@@ -137,3 +137,12 @@ def test_acceptance_default():
 @pytest.mark.slow
 def test_acceptance_finer():
     _acceptance(cattaneo3d.Parameters(facets_per_radius=8))
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
+    "facets a/4: the press fails invariant (b) at a flat node on the symmetry plane y = 0 at "
+    "0.92 a (3.7e-4 inside the sphere against 3.2e-4 allowed; measured), the increment cut "
+    "6 times; a/5 and finer pass"))
+def test_coarsest_mesh_fails_invariant_b():
+    solve(cattaneo3d.Parameters(facets_per_radius=4, shear_steps=1))
