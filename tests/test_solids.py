@@ -124,3 +124,24 @@ def test_cylinder_rim_nodes_are_equally_spaced_in_angle():
     side = np.unique(m.facets[:, m.boundaries["side"]])
     angles = np.unique(np.round(np.degrees(np.arctan2(m.p[1, side], m.p[0, side])), 9))
     assert np.allclose(angles, np.linspace(0.0, 90.0, 25), atol=1e-9)
+
+
+def test_cylinder_with_a_grid_circle_under_a_punch_rim():
+    """A block (a wide cylinder graded towards its top) with a grid circle at r = 1 whose nodes
+    lie at the angles of the rim nodes of a punch of radius 1 with the same spacing."""
+    blk = cylinder(8.0, 8.0, z0=-8.0, h_contact=0.125, h=2.0, growth=0.3, plateau=1.2,
+                   circle_from=1 / 8, blend_from=0.5 / 8, graded_end="top", rings=(1.0,))
+    check_mesh(blk, "block")
+    top = np.unique(blk.facets[:, blk.boundaries["top"]])
+    assert np.abs(blk.p[2, top]).max() == 0.0
+    on = top[np.abs(np.hypot(*blk.p[:2, top]) - 1.0) < 1e-9]
+    punch = cylinder(1.0, 1.0, h=0.125)
+    end = np.unique(punch.facets[:, punch.boundaries["contact"]])
+    rim = end[np.abs(np.hypot(*punch.p[:2, end]) - 1.0) < 1e-9]
+    angles = [np.sort(np.arctan2(m.p[1, k], m.p[0, k])) for m, k in ((blk, on), (punch, rim))]
+    assert len(angles[0]) == len(angles[1]) == 17
+    assert np.allclose(*angles, atol=1e-12)
+    z = np.unique(np.round(blk.p[2], 12))
+    assert z[-1] - z[-2] < 0.13 and z[1] - z[0] > 0.25  # graded towards the top
+    with pytest.raises(ValueError, match="blend_from must lie between 0 and 0.58 circle_from"):
+        cylinder(8.0, 1.0, h=1.0, circle_from=0.125)

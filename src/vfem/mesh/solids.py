@@ -81,7 +81,8 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
              x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, quarter: bool = True,
              half: bool = False, h_contact: float | None = None, h: float | None = None,
              growth: float = 0.2, plateau: float = 0.0, blend_from: float = 0.5,
-             tetrahedra: bool = False) -> MeshHex | MeshTet:
+             circle_from: float = 1.0, graded_end: str = "bottom",
+             rings: Sequence[float] = (), tetrahedra: bool = False) -> MeshHex | MeshTet:
     """A cylinder of ``radius`` about the vertical axis through (``x0``, ``y0``), its lower end
     at ``z0`` on the axis and its top face the plane ``z = z0 + height``: flat-ended (a
     circular punch), or with ``end_radius`` its lower end a spherical cap of that radius
@@ -98,6 +99,12 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     ``blend_from`` times the radius (the contact zone keeps a straight, regular grid) and turn
     smoothly into the circle beyond; every column is then stretched vertically from the end
     surface to the top plane, so the nodes of ``contact`` lie on the sphere (or the plane).
+    With ``circle_from`` below 1 the rings are circles already from that fraction of the
+    radius on (``blend_from`` at most 0.58 of it): a block under a circular punch of radius
+    ``circle_from * radius`` then has a grid circle under the punch's rim, with nodes at the
+    punch's rim nodes' angles where both grids are even there (``rings``: radii made grid
+    rings, the grid graded towards them as towards the axis). ``graded_end = "top"`` grades
+    the layers towards the top face instead (a block whose top is the contact).
 
     Named boundaries: ``contact`` (the lower end), ``top``, ``side`` (the cylinder's mantle)
     and, with ``quarter``, ``left`` (x = x0) and ``front`` (y = y0), as on :func:`box`; with
@@ -118,14 +125,22 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
                              f"{R:g} needs end_radius > radius and a height above "
                              f"{end_radius - np.sqrt(max(end_radius ** 2 - R ** 2, 0.0)):.6g} "
                              f"(the cap's rise), got {height:g}")
-    if not 0.0 < blend_from <= 0.58:
-        raise ValueError(f"blend_from must lie between 0 and 0.58, got {blend_from}")
+    if not 0.0 < circle_from <= 1.0:
+        raise ValueError(f"circle_from must lie in (0, 1], got {circle_from}")
+    if not 0.0 < blend_from <= 0.58 * circle_from:
+        raise ValueError(f"blend_from must lie between 0 and 0.58 circle_from, got {blend_from}"
+                         f" (circle_from {circle_from})")
+    if graded_end not in ("bottom", "top"):
+        raise ValueError(f"graded_end must be 'bottom' or 'top', got {graded_end!r}")
     if h is None:
         raise ValueError("give the element size h (and h_contact to grade the mesh)")
-    fine = (0.0,) if h_contact is not None else ()
+    fine = ((0.0, *(float(r) for r in rings), *(-float(r) for r in rings))
+            if h_contact is not None else ())
     across = _grid_line(0.0 if quarter else -R, R, h, h_contact, growth, fine, plateau) / R
     along = _grid_line(0.0, R, h, h_contact, growth, fine, plateau) / R if half else across
     up = _grid_line(0.0, height, h, h_contact, growth, fine, plateau)
+    if graded_end == "top":
+        up = height - up[::-1]
     check_count(float(len(across)) * len(along) * len(up), "cylinder")
     mesh = (MeshTet if tetrahedra else MeshHex).init_tensor(across, along, up / height)
     # names on the reference grid (u, v in [-1, 1] or [0, 1], w in [0, 1]), kept by the map
@@ -143,7 +158,7 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     # beta: 0 inside blend_from (the square kept), 1 on the rim (the circle), linear between:
     # the rings stay nested (a ring's diagonal point, m R (sqrt 2 - (sqrt 2 - 1) beta), grows
     # with m while d beta / dm < 1 / (sqrt 2 - 1)), which blend_from < 0.58 keeps
-    beta = np.clip((m - blend_from) / (1.0 - blend_from), 0.0, 1.0)
+    beta = np.clip((m - blend_from) / (circle_from - blend_from), 0.0, 1.0)
     # the circle's point of a node of ring m: at an angle proportional to the node's place
     # along its square ring (not on the ray through it), so the rim's nodes are equally spaced
     # in angle: facets of equal length, and a ring (solids.ring) with as many facets per turn
