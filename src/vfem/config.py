@@ -49,6 +49,8 @@ SHAPES = {
     "gasket": shapes.gasket,
     "rounded_punch": shapes.rounded_punch,
     "filleted_punch": shapes.filleted_punch,
+    "disk": shapes.disk,
+    "annulus": shapes.annulus,
     "box": solids.box,
     "cylinder": solids.cylinder,
     "ring": solids.ring,

@@ -37,8 +37,8 @@ from .parametric import check_count, farther_than, layer_boundaries, march, size
 from .topology import named_boundaries, share_topology
 
 __all__ = [
-    "block", "gasket", "gasket_pair", "graded_nodes", "rectangle", "wedge", "wedge_grid",
-    "wedge_plate", "wedge_plate_grid",
+    "annulus", "block", "disk", "gasket", "gasket_pair", "graded_nodes", "rectangle", "wedge",
+    "wedge_grid", "wedge_plate", "wedge_plate_grid",
 ]
 
 #: Unit vector of each gasket opening (the side its two cut ends, the back, face).
@@ -719,3 +719,58 @@ def gasket_pair(radius: float = 1.0, thickness: float = 0.1, offset: float = 0.2
     left = gasket((-dx, -0.5 * offset), radius, thickness, "left", n_around, n_through)
     right = gasket((dx, 0.5 * offset), radius, thickness, "right", n_around, n_through)
     return left, right
+
+
+# ---------------------------------------------------------------------------------------------
+# Disk and annulus: a shaft and a hub in section (an interference fit, issue 21)
+
+
+def disk(radius: float = 1.0, h: float = 0.1, *, quarter: bool = True,
+         blend_from: float = 0.5) -> MeshQuad:
+    """The disk of ``radius`` about the origin (with ``quarter``, its part x >= 0, y >= 0) in
+    quadrilaterals: a square grid of spacing about ``h`` mapped onto it as the plan of
+    :func:`vfem.mesh.solids.cylinder` (:func:`vfem.mesh.solids.disk_map`): its rim's nodes at
+    equal angles, 2 n per quarter turn for n divisions across, so an :func:`annulus` with as
+    many facets per quarter turn has its bore's nodes at the same angles.
+
+    Named boundaries: ``rim`` and, with ``quarter``, ``left`` (x = 0) and ``bottom`` (y = 0).
+    """
+    from .solids import disk_map
+
+    if not (radius > 0 and h > 0):
+        raise ValueError(f"radius and h must be positive, got {radius} and {h}")
+    n = max(1, int(np.ceil(radius / h - 1e-9)))
+    check_count((2.0 * n + 1.0) ** 2, "disk")
+    line = np.linspace(0.0 if quarter else -1.0, 1.0, n + 1 if quarter else 2 * n + 1)
+    mesh = MeshQuad.init_tensor(line, line)
+    tol = 1e-9
+    tests = {"rim": lambda p: np.maximum(np.abs(p[0]), np.abs(p[1])) > 1 - tol}
+    if quarter:
+        tests.update(left=lambda p: p[0] < tol, bottom=lambda p: p[1] < tol)
+    mesh = named_boundaries(mesh, tests)
+    x, y = disk_map(mesh.p[0], mesh.p[1], radius, blend_from)
+    return share_topology(mesh, replace(mesh, doflocs=np.vstack([x, y])))
+
+
+def annulus(inner_radius: float = 1.0, outer_radius: float = 2.0, *, around: int = 16,
+            radial: int = 4) -> MeshQuad:
+    """The quarter annulus x >= 0, y >= 0 between two circles about the origin in
+    quadrilaterals: ``around`` divisions per quarter turn (nodes at equal angles), ``radial``
+    through the wall. Named boundaries: ``inner``, ``outer``, ``left`` (x = 0) and ``bottom``
+    (y = 0)."""
+    if not 0 < inner_radius < outer_radius:
+        raise ValueError(f"need 0 < inner_radius < outer_radius, got {inner_radius} and "
+                         f"{outer_radius}")
+    if not (isinstance(around, (int, np.integer)) and isinstance(radial, (int, np.integer))
+            and around >= 1 and radial >= 1):
+        raise ValueError(f"around and radial must be whole numbers >= 1, got {around} and "
+                         f"{radial}")
+    check_count((around + 1.0) * (radial + 1.0), "annulus")
+    mesh = MeshQuad.init_tensor(np.linspace(inner_radius, outer_radius, radial + 1),
+                                np.linspace(0.0, 0.5 * np.pi, around + 1))
+    tol = 1e-9 * outer_radius
+    mesh = named_boundaries(mesh, {
+        "inner": lambda p: p[0] < inner_radius + tol, "outer": lambda p: p[0] > outer_radius - tol,
+        "bottom": lambda p: p[1] < 1e-9, "left": lambda p: p[1] > 0.5 * np.pi - 1e-9})
+    r, t = mesh.p
+    return share_topology(mesh, replace(mesh, doflocs=np.vstack([r * np.cos(t), r * np.sin(t)])))
