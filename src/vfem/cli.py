@@ -444,14 +444,18 @@ def cmd_plot(args) -> int:
 def _bench_sphere(args) -> int:
     """``vfem bench sphere``: the sphere example at each size, each case in its own process
     (its peak memory its own): dofs, contact dofs, time, ratio to a plain linear solve of the
-    same bodies with the same backend, iterations, p_max error, peak memory."""
+    same bodies with the same backend, iterations, p_max error, peak memory; with
+    ``--calculix``, CalculiX on the same mesh right after vfem's case (its time, increments,
+    iterations and p_max error beside vfem's)."""
     from .tools import bench
 
-    for option in ("patch", "calculix", "whole_run", "plot"):
+    for option in ("patch", "whole_run", "plot"):
         if getattr(args, option):
             raise InputError(f"vfem bench sphere: --{option.replace('_', '-')} is for hertz only")
     if args.methods != ["vfem"] or args.variant != "paired":
         raise InputError("vfem bench sphere: the paired vfem method only (3D contact)")
+    if args.calculix and shutil.which("ccx") is None:
+        raise InputError("--calculix: ccx is not installed (Debian: apt install calculix-ccx)")
     solvers = args.solver or ["auto"]
     backends = linalg.available() if "all" in solvers else [linalg.resolve(s) for s in solvers]
     sizes = ([{"level": level} for level in args.levels] if args.levels
@@ -459,7 +463,7 @@ def _bench_sphere(args) -> int:
     say = None if args.quiet else print
     if say:
         say(bench.SPHERE_HEADER)
-    rows = []
+    rows, ccx_rows = [], []
     for size in sizes:
         for backend in backends:
             row = (bench._case("sphere", {**size, "backend": backend}) if args.in_process
@@ -467,10 +471,21 @@ def _bench_sphere(args) -> int:
             rows.append(row)
             if say:
                 say(bench.format_sphere_row(row))
+        if args.calculix:  # right after vfem on the same mesh (its first backend's row)
+            ccx_rows.append(bench.sphere_calculix_row(
+                size, rows[-len(backends)], threads=args.ccx_threads,
+                timeout=args.ccx_timeout))
+            if say:
+                say(bench.SPHERE_CALCULIX_HEADER)
+                say(bench.format_sphere_calculix_row(ccx_rows[-1]))
     if args.json:
-        Path(args.json).write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+        keep = {"sphere": rows, "calculix": ccx_rows} if args.calculix else rows
+        Path(args.json).write_text(json.dumps(keep, indent=2) + "\n", encoding="utf-8")
     if args.markdown:
-        Path(args.markdown).write_text(bench.sphere_markdown(rows), encoding="utf-8")
+        text = bench.sphere_markdown(rows)
+        if ccx_rows:
+            text += "\n" + bench.sphere_calculix_markdown(ccx_rows)
+        Path(args.markdown).write_text(text, encoding="utf-8")
     return 0
 
 
@@ -520,7 +535,9 @@ def cmd_bench(args) -> int:
         if shutil.which("ccx") is None:
             raise InputError("--calculix: ccx is not installed (Debian: apt install "
                              "calculix-ccx)")
-        table["calculix"] = bench.calculix_rows(sizes, print_row=say, backend=backends[0])
+        table["calculix"] = bench.calculix_rows(sizes, print_row=say, backend=backends[0],
+                                                threads=args.ccx_threads,
+                                                timeout=args.ccx_timeout)
     if args.markdown:
         Path(args.markdown).write_text(bench.markdown(table), encoding="utf-8")
     if args.json:
@@ -622,6 +639,11 @@ def main(argv: list[str] | None = None) -> int:
                        help="also the patch-test error of each method")
     bench.add_argument("--calculix", action="store_true",
                        help="also CalculiX (ccx) on the same meshes, one thread")
+    bench.add_argument("--ccx-threads", type=int, default=1, metavar="N",
+                       help="ccx's threads with --calculix (default 1)")
+    bench.add_argument("--ccx-timeout", type=float, default=600.0, metavar="SECONDS",
+                       help="stop ccx after this long with --calculix (default 600; sphere: its "
+                            "row marked timed out, hertz: an error)")
     bench.add_argument("--plot", help="draw time against dofs to this PNG")
     bench.add_argument("--markdown", help="also write the tables to this Markdown file")
     bench.add_argument("--whole-run", action="store_true",

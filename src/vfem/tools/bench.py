@@ -251,6 +251,13 @@ def hertz_case(p: HertzParameters, backend: str | None = None, method: str = "vf
 _SPHERE_DOFS, _SPHERE_POWER = 26_160, 1.85
 
 
+#: the sphere's CalculiX contact stiffness (pressure per unit overclosure): an overclosure of
+#: 7e-6 at Hertz's p0, 7e-5 of the sphere's indentation; measured (docs/benchmarks.md, *Sphere
+#: (3D)*): 1e8 is too soft (p_max 1 % lower at 7.6k dofs), 1e10 and 1e11 raise ccx's p_max
+#: further from vfem's and Hertz's and take twice the iterations
+SPHERE_PENALTY = 1e9
+
+
 def sphere_parameters(dofs: int | None = None, level: int | None = None):
     """The sphere example (quarter model, one step) at about ``dofs`` degrees of freedom (more
     facets across the contact radius, the bulk's elements kept), or at refinement ``level``."""
@@ -300,6 +307,7 @@ def sphere_case(p, backend: str | None = None, repeat: int = 1) -> dict:
         "invariants_passed": all(s.invariants.get("passed", False) for s in result.steps),
         "peak_mib": peak,
         "p_max_error": h["sphere"]["p_max_error"] if h else float("nan"),
+        "rms_error_over_p0": h["sphere"]["rms_error_over_p0"] if h else float("nan"),
         "a_error_over_facet": (abs(h["sphere"]["a_estimate"] - h["a_theory"]) / h["facet_size"]
                                if h else float("nan")),
     }
@@ -530,6 +538,109 @@ def calculix_rows(levels: list[int | dict], print_row: Callable[[str], None] | N
                       f"{row['ccx_p_max_error_raw']:>+9.3%} {row['ccx_p_max_error_nodal']:>+10.4%} "
                       f"{vfem_s:>8.2f} {row['vfem_p_max_error']:>+9.4%} {row['ratio']:>9.1f}")
     return rows
+
+
+SPHERE_CALCULIX_HEADER = (f"{'dofs':>8} {'n/a':>4} {'ccx s':>8} {'incs':>5} {'iters':>6} "
+                          f"{'raw err':>9} {'nodal err':>10} {'ccx RMS':>8} {'force err':>9} "
+                          f"{'vfem s':>8} {'vfem err':>9} {'vfem RMS':>8} {'ccx/vfem':>9}")
+
+
+def sphere_calculix_row(size: dict, vfem: dict, ccx: str = "ccx", threads: int = 1,
+                        penalty: float = SPHERE_PENALTY, timeout: float = 600.0,
+                        keep: str | Path | None = None) -> dict:
+    """CalculiX on the sphere example's mesh of ``size`` (``{"dofs": n}`` or ``{"level": L}``,
+    as :func:`sphere_parameters` takes it) beside vfem's row ``vfem`` (:func:`sphere_case`, run
+    just before on the same mesh): the wall time of the ccx process with ``threads`` threads
+    (deck writing and result reading excluded), its increments and iterations (the
+    contact-making first step's included in ``ccx_iterations_total``), its p_max error read
+    two ways, ccx's own CPRESS ("raw") and the sphere's nodal contact forces ``K u`` per
+    undeformed tributary area (vfem's reading, :func:`vfem.tools.calculix.nodal_reading`), the
+    RMS of that reading's difference from Hertz's over r < a (over p0, as
+    :func:`vfem.examples.sphere.evaluate` measures vfem's), and its total contact force against
+    the applied one. A ccx run stopped at ``timeout`` seconds
+    gives a row with ``ccx_timed_out`` and NaN readings. ``keep``: a folder for ccx's files."""
+    from ..errors import VfemError
+    from ..examples.sphere import build as build_sphere
+    from ..examples.sphere import theory as sphere_theory
+    from .calculix import run, write_deck
+
+    p = sphere_parameters(**size)
+    model = build_sphere(p)
+    th = sphere_theory(p)
+    applied = p.force / (4.0 if p.quarter else 1.0)
+    tag = "_".join(f"{k}{v}" for k, v in size.items())
+    nan = float("nan")
+    with tempfile.TemporaryDirectory(prefix="vfem-bench-ccx-") as tmp:
+        deck = write_deck(model, Path(tmp) / f"sphere_{tag}.inp", penalty=penalty)
+        try:
+            c = run(deck, ccx=ccx, threads=threads, timeout=timeout,
+                    p0=th["p0_theory"],
+                    keep=None if keep is None else Path(keep) / tag)
+            timed_out = False
+        except VfemError as exc:
+            if "did not finish" not in str(exc):
+                raise
+            c, timed_out = {}, True
+    dofs = int(sum(b.mesh.p.size for b in model.bodies))
+    rms = nan
+    if c:
+        a, p0 = th["a_theory"], th["p0_theory"]
+        r = np.hypot(*c["slave"]["x"][:, :2].T)
+        inside = r < a
+        hertz = p0 * np.sqrt(1.0 - (r[inside] / a) ** 2)
+        rms = float(np.sqrt(np.mean((c["slave"]["pressure_nodal"][inside] - hertz) ** 2)) / p0)
+    row = {
+        "example": "sphere", "facets_across_a": p.facets_per_radius * 2 ** p.refinement,
+        "dofs": dofs, "ccx_s": c.get("wall_s", nan), "ccx_timed_out": timed_out,
+        "ccx_timeout_s": timeout, "ccx_threads": threads, "ccx_solver": c.get("solver", ""),
+        "ccx_equations": c.get("equations", 0), "ccx_increments": c.get("increments", 0),
+        "ccx_iterations": c.get("iterations", 0), "ccx_cutbacks": c.get("cutbacks", 0),
+        "ccx_contact_step_iterations": c.get("contact_step_iterations", 0),
+        "ccx_iterations_total": c.get("iterations", 0) + c.get("contact_step_iterations", 0),
+        "ccx_penalty": penalty,
+        "ccx_p_max_error_raw": c.get("p_max_error_raw", nan),
+        "ccx_p_max_error_nodal": c.get("p_max_error_nodal", nan),
+        "ccx_flat_p_max_error_nodal": c.get("p_max_master_error_nodal", nan),
+        "ccx_rms_error_over_p0": rms,
+        "ccx_total_contact_force": c.get("contact_normal_force", nan),
+        # the force balance: the z component of ccx's total contact force on the sphere (its
+        # "normal force" sums the contact elements' own normals: 4e-4 more at 7.6k dofs)
+        "ccx_force_error": (abs(c["total_contact_force"][-1]) / applied - 1.0 if c else nan),
+        "ccx_nodal_residual": c.get("nodal_residual", nan),
+        "vfem_s": vfem["vfem_s"], "vfem_backend": vfem["backend"],
+        "vfem_iterations": vfem["iterations"], "vfem_converged": vfem["converged"],
+        "vfem_p_max_error": vfem["p_max_error"],
+        "vfem_rms_error_over_p0": vfem.get("rms_error_over_p0", nan),
+        "ratio": c.get("wall_s", nan) / vfem["vfem_s"],
+    }
+    return row
+
+
+def format_sphere_calculix_row(r: dict) -> str:
+    ccx = (f"{'> ' + format(r['ccx_timeout_s'], '.0f'):>8}" if r["ccx_timed_out"]
+           else f"{r['ccx_s']:>8.2f}")
+    return (f"{r['dofs']:>8} {r['facets_across_a']:>4} {ccx} {r['ccx_increments']:>5} "
+            f"{r['ccx_iterations_total']:>6} {r['ccx_p_max_error_raw']:>+9.2%} "
+            f"{r['ccx_p_max_error_nodal']:>+10.3%} {r['ccx_rms_error_over_p0']:>8.3%} "
+            f"{r['ccx_force_error']:>+9.1e} {r['vfem_s']:>8.2f} {r['vfem_p_max_error']:>+9.3%} "
+            f"{r['vfem_rms_error_over_p0']:>8.3%} {r['ratio']:>9.1f}")
+
+
+def sphere_calculix_markdown(rows: list[dict]) -> str:
+    """The sphere's CalculiX rows as a Markdown table."""
+    lines = ["| dofs | facets across a | ccx s | increments | iterations | raw p_max error | "
+             "nodal p_max error | ccx RMS / p0 | ccx force error | vfem s | vfem p_max error | "
+             "vfem RMS / p0 | ccx / vfem |",
+             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        ccx = f"> {r['ccx_timeout_s']:.0f}" if r["ccx_timed_out"] else f"{r['ccx_s']:.2f}"
+        lines.append(f"| {r['dofs']:,} | {r['facets_across_a']} | {ccx} | "
+                     f"{r['ccx_increments']} | {r['ccx_iterations_total']} | "
+                     f"{r['ccx_p_max_error_raw']:+.2%} | {r['ccx_p_max_error_nodal']:+.3%} | "
+                     f"{r['ccx_rms_error_over_p0']:.3%} | {r['ccx_force_error']:+.1e} | "
+                     f"{r['vfem_s']:.2f} | {r['vfem_p_max_error']:+.3%} | "
+                     f"{r['vfem_rms_error_over_p0']:.3%} | {r['ratio']:.0f} |".replace(",", " "))
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":  # one case: python -m vfem.tools.bench '["hertz", {...}]' ROW.json

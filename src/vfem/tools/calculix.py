@@ -14,12 +14,17 @@ CalculiX*):
   ``friction``, Coulomb friction (``*FRICTION``: mu and ccx's stick slope); with
   ``steps="curves"``, loads on load curves (prescribed displacements and a platen force with
   amplitudes: the Cattaneo example's press, then shear) as one ccx step per stretch of linear
-  loading, its increments at the model's load factors.
+  loading, its increments at the model's load factors. In 3D (the sphere example's kind of
+  model): 8-node hexahedra as C3D8 (scikit-fem's corners in ccx's order,
+  :data:`C3D8_FROM_SKFEM`) and 4-node tetrahedra as C3D4, each of positive volume (a mirrored
+  element's node order reversed), supports on x, y and z, the platen's ties on its component,
+  the contact surfaces as the elements' faces S1-S6 (S1-S4).
 * :func:`run` runs ``ccx`` in a temporary folder, times it, and reads the results: ccx's own
   nodal contact pressure on the slave surface (CPRESS of ``*CONTACT FILE, CSTR``: "raw"), the
   total contact force ccx reports, and the slave body's nodal contact forces recomputed as
   ``K u`` (its stiffness, the same elements as ccx's, times ccx's displacements) per undeformed
-  tributary length, the reading :func:`vfem.examples.hertz.evaluate` makes of vfem's results;
+  tributary length (3D: area), the reading :func:`vfem.examples.hertz.evaluate` (and
+  :func:`vfem.examples.sphere.evaluate`) makes of vfem's results;
   and per increment (``history``) the slave nodes' contact stresses and slips (CPRESS, CSHEAR1,
   CSHEAR2, COPEN, CSLIP1, CSLIP2), their ``K u`` forces, the reactions of the held boundaries
   and ccx's total contact force: what benchmarks/cattaneo_calculix.py compares with vfem's
@@ -41,7 +46,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from skfem import Basis, ElementVector, MeshTri, asm
+from skfem import Basis, ElementVector, FacetBasis, LinearForm, MeshHex, MeshTri, asm
+from skfem.io.meshio import HEX_MAPPING
 from skfem.models.elasticity import linear_elasticity
 
 from ..contact.search import project_points
@@ -50,7 +56,14 @@ from ..errors import InputError, VfemError
 if TYPE_CHECKING:
     from ..solver import Model
 
-DOF = {"x": 1, "y": 2}
+DOF = {"x": 1, "y": 2, "z": 3}
+
+#: scikit-fem's MeshHex1 corners in ccx's C3D8 order (VTK's and Abaqus's: the face z = 0
+#: counter-clockwise seen from +z, then the face above it)
+C3D8_FROM_SKFEM = tuple(int(k) for k in HEX_MAPPING[:8])
+#: ccx's faces S1..S6 of a C3D8 and S1..S4 of a C3D4 (local nodes, from 0)
+C3D8_FACES = ((0, 1, 2, 3), (4, 7, 6, 5), (0, 4, 5, 1), (1, 5, 6, 2), (2, 6, 7, 3), (3, 7, 4, 0))
+C3D4_FACES = ((0, 1, 2), (0, 3, 1), (1, 3, 2), (2, 3, 0))
 
 
 @dataclass
@@ -62,7 +75,7 @@ class BodyDeck:
     element_offset: int  # ccx element = element_offset + element + 1
     element_type: str
     contact_facets: np.ndarray  # facet ids (into mesh.facets) in the body's contact surface
-    flipped: int  # elements whose node order was reversed to make them counter-clockwise
+    flipped: int  # elements whose node order was reversed (counter-clockwise; 3D: volume > 0)
 
 
 @dataclass
@@ -146,6 +159,58 @@ def _faces(mesh, t: np.ndarray, facets: np.ndarray) -> list[tuple[int, int]]:
     return out
 
 
+def corner_jacobians(x: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(ncorners, nelements) determinants of the edge vectors at each corner of 3D elements in
+    ccx's node order (C3D8: at corner k its edges to the next corner of its face, to the
+    previous one and to the corner across; C3D4: six times the volume): all positive for an
+    element ccx accepts. ``x``: (3, npoints); ``t``: (4 or 8, nelements)."""
+    def det(a, b, c):
+        return np.einsum("i...,i...->...", a, np.cross(b, c, axis=0))
+
+    if t.shape[0] == 4:
+        x0 = x[:, t[0]]
+        return det(x[:, t[1]] - x0, x[:, t[2]] - x0, x[:, t[3]] - x0)[None]
+    out = []
+    for k in range(8):
+        base, ring = divmod(k, 4)
+        ring0 = 4 * base
+        nxt, prv = ring0 + (ring + 1) % 4, ring0 + (ring - 1) % 4
+        other = (k + 4) % 8
+        xk = x[:, t[k]]
+        d = det(x[:, t[nxt]] - xk, x[:, t[prv]] - xk, x[:, t[other]] - xk)
+        out.append(d if base == 0 else -d)  # the top face runs the same way, seen from below
+    return np.array(out)
+
+
+def _positive_solids(mesh) -> tuple[np.ndarray, int]:
+    """(nodes per element, nelements) connectivity in ccx's order (C3D8 or C3D4), every element
+    of positive volume (one whose Jacobian is negative mirrored: its two z faces swapped, or a
+    tetrahedron's second and third nodes)."""
+    hexes = isinstance(mesh, MeshHex)
+    t = mesh.t[list(C3D8_FROM_SKFEM)] if hexes else mesh.t.copy()
+    signs = corner_jacobians(mesh.p, t).sum(axis=0)
+    bad = signs < 0
+    order = [4, 5, 6, 7, 0, 1, 2, 3] if hexes else [0, 2, 1, 3]
+    t[:, bad] = t[order][:, bad]
+    return t, int(bad.sum())
+
+
+def _faces3d(mesh, t: np.ndarray, facets: np.ndarray) -> list[tuple[int, int]]:
+    """(element, face label k) of each boundary facet of a 3D mesh: ccx's face Sk of its
+    element (``C3D8_FACES``, ``C3D4_FACES``)."""
+    faces = C3D8_FACES if t.shape[0] == 8 else C3D4_FACES
+    facets = np.asarray(facets, dtype=int)
+    elems = mesh.f2t[0, facets]
+    want = np.sort(mesh.facets[:, facets], axis=0)
+    label = np.zeros(len(facets), dtype=int)
+    for k, face in enumerate(faces):
+        have = np.sort(t[list(face)][:, elems], axis=0)
+        label[(label == 0) & np.all(have == want, axis=0)] = k + 1
+    if np.any(label == 0):
+        raise VfemError("CalculiX deck: a contact facet is no face of its element")
+    return list(zip(elems.tolist(), label.tolist()))
+
+
 def _num(v: float) -> str:
     """A real as ccx reads it: at most 20 characters (it reads numbers with a 20-character
     format), full precision where that fits, else 14 significant digits."""
@@ -165,17 +230,34 @@ def _lines(values, per_line: int = 8) -> list[str]:
 
 
 def _initial_gap(s, m) -> float:
-    """The smallest distance from a slave candidate node to the master's candidate facets."""
+    """The smallest distance from a slave candidate node to the master's candidate facets; in
+    3D the :data:`APPROACH_NODES`-th smallest (so that the slave facets around the first point
+    of contact overlap the master after the approach step: ccx makes contact elements only
+    where a slave face's integration point penetrates, and a single touching node makes
+    none)."""
     pts = s.X[: s.nc]
+    if pts.shape[1] == 3:
+        from ..contact.facets3d import closest_on_facets
+
+        if not len(pts) or not len(m.facets):
+            return 0.0
+        dist = closest_on_facets(pts, m.X, m.facets).distance
+        dist = np.sort(dist[np.isfinite(dist)])
+        return float(dist[min(APPROACH_NODES, len(dist)) - 1]) if len(dist) else 0.0
     a, b = m.X[m.facets[:, 0]], m.X[m.facets[:, 1]]
     _, _, dist = project_points(pts, a, b)
     return float(dist.min()) if len(dist) else 0.0
 
 
+#: 3D: the platen's approach step brings this many slave candidate nodes onto the master
+APPROACH_NODES = 4
+
+
 def write_deck(model, path, *, slave: str | None = None, penalty: float | None = 1e11,
                tension: float = 0.0, steps: str = "one", approach: float | None = None,
                max_increments: int = 1000, friction: float | None = None,
-               stick_slope: float | None = None) -> Deck:
+               stick_slope: float | None = None,
+               first_increment: float | None = None) -> Deck:
     """Write ``model`` as a CalculiX input deck at ``path`` (see the module docstring).
 
     Args:
@@ -222,6 +304,9 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
             moves with the slope: benchmarks/cattaneo_calculix.py measures it). The elastic slip
             of a sticking node is its shear over lambda, which must be small against the slips
             of the slip zone near its edge, else the stick zone shrinks.
+        first_increment: ccx's first increment of each load step, as a fraction of the step
+            (at most); default the first load factor's share (one increment for a one-step
+            model: on the 3D sphere ccx then cycles through contact states at full load).
     """
     curves = steps == "curves"
     _check_supported(model, curves)
@@ -245,14 +330,19 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     node_off = elem_off = 0
     for b, s in zip(model.bodies, surfaces):
         mesh, tag = b.mesh, tags[b.name]
-        t, flipped = _counter_clockwise(mesh)
-        kind = (("CPE" if b.material.plane == "strain" else "CPS")
-                + ("3" if isinstance(mesh, MeshTri) else "4"))
+        solid = mesh.p.shape[0] == 3
+        if solid:
+            t, flipped = _positive_solids(mesh)
+            kind = "C3D8" if t.shape[0] == 8 else "C3D4"
+        else:
+            t, flipped = _counter_clockwise(mesh)
+            kind = (("CPE" if b.material.plane == "strain" else "CPS")
+                    + ("3" if isinstance(mesh, MeshTri) else "4"))
         out.append(f"** body {b.name}: nodes {node_off + 1}-{node_off + mesh.p.shape[1]}, "
                    f"elements {elem_off + 1}-{elem_off + t.shape[1]} ({kind})")
         out.append(f"*NODE, NSET=N_{tag}")
-        out += [f"{node_off + i + 1}, {_num(x)}, {_num(y)}"
-                for i, (x, y) in enumerate(mesh.p.T.tolist())]
+        out += [f"{node_off + i + 1}, " + ", ".join(_num(v) for v in x)
+                for i, x in enumerate(mesh.p.T.tolist())]
         out.append(f"*ELEMENT, TYPE={kind}, ELSET=E_{tag}")
         out += [f"{elem_off + e + 1}, " + ", ".join(str(node_off + k + 1) for k in conn)
                 for e, conn in enumerate(t.T.tolist())]
@@ -263,10 +353,11 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
             out.append(f"*NSET, NSET=B_{tag}_{_tag(name)}")
             out += _lines(nodes.tolist())
         out.append(f"*SURFACE, NAME=S_{tag}, TYPE=ELEMENT")
-        out += [f"{elem_off + e + 1}, S{k}" for e, k in _faces(mesh, t, s.facet_ids)]
+        out += [f"{elem_off + e + 1}, S{k}"
+                for e, k in (_faces3d if solid else _faces)(mesh, t, s.facet_ids)]
         out += [f"*MATERIAL, NAME=M_{tag}", "*ELASTIC",
                 f"{_num(b.material.youngs_modulus)}, {_num(b.material.poissons_ratio)}",
-                f"*SOLID SECTION, ELSET=E_{tag}, MATERIAL=M_{tag}", "1."]
+                f"*SOLID SECTION, ELSET=E_{tag}, MATERIAL=M_{tag}", *([] if solid else ["1."])]
         decks.append(BodyDeck(b.name, node_off, elem_off, kind, np.asarray(s.facet_ids),
                               flipped))
         node_off += mesh.p.shape[1]
@@ -354,6 +445,8 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     for k, (first, factor) in enumerate(plan):
         span = abs(factor - previous)
         initial, largest = min(abs(first - previous), span), span
+        if first_increment is not None:
+            initial = min(initial, first_increment * span)
         if curves:  # increments no longer than the model's steps (rounded: 0.05, not 0.05 +
             # 4e-17): ccx lands on each of them
             largest = round(float(np.abs(np.diff([previous, *stretches[k]])).max()), 12)
@@ -515,9 +608,15 @@ def _sta(text: str) -> list[dict]:
 
 
 def _stiffness(body):
-    """The body's stiffness on its points (dof 2k: x of point k), the elements ccx's are."""
-    basis = Basis(body.mesh, ElementVector(body.element()))
+    """The body's stiffness on its points (dof d k: x of point k, d the dimension), the
+    elements ccx's are."""
     lam, mu = body.material.lame()
+    if body.mesh.p.shape[0] == 3:  # as Body.assemble does (scikit-fem's loop is slow in 3D)
+        from ..bodies.assembly import cell_mapping, elasticity_stiffness
+
+        basis = Basis(body.mesh, ElementVector(body.element()), mapping=cell_mapping(body.mesh))
+        return elasticity_stiffness(basis, lam, mu).tocsr()
+    basis = Basis(body.mesh, ElementVector(body.element()))
     return asm(linear_elasticity(lam, mu), basis).tocsr()
 
 
@@ -530,32 +629,40 @@ def _constrained(body) -> np.ndarray:
         comps.append((body.platen.boundary, body.platen.component))
     for boundary, c in comps:
         nodes = np.unique(body.mesh.facets[:, body.mesh.boundaries[boundary]])
-        dofs.append(2 * nodes + DOF[c] - 1)
+        dofs.append(body.mesh.p.shape[0] * nodes + DOF[c] - 1)
     return np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, dtype=int)
 
 
 def nodal_reading(body, facets: np.ndarray, u: np.ndarray, stiffness=None) -> dict:
     """The body's nodal contact forces ``K u`` on the nodes of ``facets`` and the nominal pressure.
 
-    ``u``: (npoints, 2) displacements. On a contact node the only forces besides contact are the
-    reactions of its constrained components, which are left out; the pressure is the size of
-    what remains over the node's undeformed tributary length (half of each facet it ends), as
-    :func:`vfem.examples.hertz.evaluate` reads vfem's. ``residual`` is the largest ``|K u|`` on a
-    free dof off the contact surface (zero in exact arithmetic: the check that the elements and
-    the displacements read back are ccx's), relative to the largest nodal contact force.
+    ``u``: (npoints, 2) displacements (3D: (npoints, 3)). On a contact node the only forces
+    besides contact are the reactions of its constrained components, which are left out; the
+    pressure is the size of what remains over the node's undeformed tributary length (half of
+    each facet it ends), as :func:`vfem.examples.hertz.evaluate` reads vfem's; in 3D over its
+    undeformed tributary area (the integral of its shape function over the facets, as vfem's
+    nominal pressure, :func:`vfem.examples.sphere.evaluate`). ``residual`` is the largest
+    ``|K u|`` on a free dof off the contact surface (zero in exact arithmetic: the check that the
+    elements and the displacements read back are ccx's), relative to the largest nodal contact
+    force.
     ``stiffness``: the body's, if already assembled (:func:`_stiffness`).
     """
     K = _stiffness(body) if stiffness is None else stiffness
-    f = (K @ np.asarray(u, dtype=float).ravel()).reshape(-1, 2)
-    held = np.zeros(2 * body.npoints, dtype=bool)
+    d = body.mesh.p.shape[0]
+    f = (K @ np.asarray(u, dtype=float).ravel()).reshape(-1, d)
+    held = np.zeros(d * body.npoints, dtype=bool)
     held[_constrained(body)] = True
-    held = held.reshape(-1, 2)
+    held = held.reshape(-1, d)
     ends = body.mesh.facets[:, facets]
     nodes = np.unique(ends)
-    lengths = np.linalg.norm(np.diff(body.mesh.p[:, ends], axis=1)[:, 0], axis=0)
-    tributary = np.zeros(body.npoints)
-    np.add.at(tributary, ends[0], 0.5 * lengths)
-    np.add.at(tributary, ends[1], 0.5 * lengths)
+    if d == 3:
+        basis = FacetBasis(body.mesh, body.element(), facets=np.asarray(facets))
+        tributary = np.asarray(asm(LinearForm(lambda v, w: v), basis))[: body.npoints]
+    else:
+        lengths = np.linalg.norm(np.diff(body.mesh.p[:, ends], axis=1)[:, 0], axis=0)
+        tributary = np.zeros(body.npoints)
+        np.add.at(tributary, ends[0], 0.5 * lengths)
+        np.add.at(tributary, ends[1], 0.5 * lengths)
     force = np.where(held[nodes], 0.0, f[nodes])
     pressure = np.linalg.norm(force, axis=1) / tributary[nodes]
     off = np.ones(body.npoints, dtype=bool)
@@ -614,8 +721,9 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
                "cpress": v[:, 3], "cshear": v[:, 4:6]}
         rows = _at(displacements, total)
         if rows is not None:
-            u = np.zeros((body.npoints, 2))
-            u[rows[:, 0].astype(int) - bd.node_offset - 1] = rows[:, 1:3]
+            d = body.mesh.p.shape[0]
+            u = np.zeros((body.npoints, d))
+            u[rows[:, 0].astype(int) - bd.node_offset - 1] = rows[:, 1:1 + d]
             reading = nodal_reading(body, bd.contact_facets, u, stiffness)
             where = {int(n): k for k, n in enumerate(reading["nodes"])}
             order = [where[int(n)] for n in nodes]
@@ -625,11 +733,12 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
         for name, blocks in reactions.items():
             r = _at(blocks, total)
             if r is not None:
-                row["reactions"][name] = r[0, :2].copy()
+                row["reactions"][name] = r[0, :body.mesh.p.shape[0]].copy()
         stats = next((st for t, st in statistics
                       if abs(t - total) <= 1e-6 * max(1.0, abs(total))), {})
         if stats:
-            row["contact_force"] = np.asarray(stats.get("force", [np.nan] * 3)[:2])
+            row["contact_force"] = np.asarray(
+                stats.get("force", [np.nan] * 3)[:body.mesh.p.shape[0]])
             row["contact_normal_force"] = abs(stats.get("normal_force", np.nan))
             row["contact_shear_force"] = stats.get("shear_force", np.nan)
         out.append(row)
@@ -732,8 +841,9 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
             raise VfemError(f"CalculiX results: no displacements of body {name!r} in the .dat "
                             "file")
         rows = blocks[-1]
-        u = np.zeros((body.npoints, 2))
-        u[rows[:, 0].astype(int) - bd.node_offset - 1] = rows[:, 1:3]
+        d = body.mesh.p.shape[0]
+        u = np.zeros((body.npoints, d))
+        u[rows[:, 0].astype(int) - bd.node_offset - 1] = rows[:, 1:1 + d]
         readings[name] = nodal_reading(body, bd.contact_facets, u)
     s = readings[deck.slave]
     bd = deck.body(deck.slave)
@@ -747,7 +857,7 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
         "cpus_reported": sorted({int(n) for n in re.findall(r"Using up to (\d+) cpu", log)}),
         "solver": _solver(log),
         "equations": int(eqs[-1]) if eqs else 0,
-        "dofs": int(sum(2 * b.mesh.p.shape[1] for b in model.bodies)),
+        "dofs": int(sum(b.mesh.p.shape[0] * b.mesh.p.shape[1] for b in model.bodies)),
         "increments": len(load_steps),
         "iterations": int(sum(r["iterations"] for r in load_steps)),
         "cutbacks": int(sum(r["attempts"] - 1 for r in load_steps)),
@@ -760,7 +870,7 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
         "p_max_raw": float(raw.max()),
         "p_max_nodal": float(s["pressure"].max()),
         "p_max_master_nodal": float(readings[deck.master]["pressure"].max()),
-        "total_contact_force": stats.get("force", [float("nan")] * 3)[:2],
+        "total_contact_force": stats.get("force", [float("nan")] * 3)[:body.mesh.p.shape[0]],
         "contact_normal_force": abs(stats.get("normal_force", float("nan"))),
         "total_contact_force_nodal": [float(v) for v in s["total_force"]],
         "nodal_residual": s["residual"],
