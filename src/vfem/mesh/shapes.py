@@ -725,6 +725,34 @@ def gasket_pair(radius: float = 1.0, thickness: float = 0.1, offset: float = 0.2
 # Disk and annulus: a shaft and a hub in section (an interference fit, issue 21)
 
 
+def disk_map(u: np.ndarray, v: np.ndarray, R: float, blend_from: float = 0.5,
+             circle_from: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """The plan of :func:`disk` (and of the 3D :func:`vfem.mesh.solids.cylinder`): points
+    (u, v) of a square grid on [-1, 1]^2 (or [0, 1]^2) mapped onto the disk of radius ``R``.
+    The square rings m = max(|u|, |v|) stay squares inside ``blend_from`` and are circles of
+    radius m R from ``circle_from`` on, blended linearly between; a node of a circle sits at an
+    angle proportional to its place along its square ring, so the rim's nodes are equally
+    spaced in angle where the grid is even."""
+    m = np.maximum(np.abs(u), np.abs(v))  # the square ring through the node
+    # beta: 0 inside blend_from (the square kept), 1 on the rim (the circle), linear between:
+    # the rings stay nested (a ring's diagonal point, m R (sqrt 2 - (sqrt 2 - 1) beta), grows
+    # with m while d beta / dm < 1 / (sqrt 2 - 1)), which blend_from < 0.58 keeps
+    beta = np.clip((m - blend_from) / (circle_from - blend_from), 0.0, 1.0)
+    # the circle's point of a node of ring m: at an angle proportional to the node's place
+    # along its square ring (not on the ray through it), so the rim's nodes are equally spaced
+    # in angle: facets of equal length, and a ring (solids.ring) with as many facets per turn
+    # has its nodes at the same angles (a shaft in a hub: similar polygons, no faceting mismatch)
+    flat = np.abs(u) >= np.abs(v)
+    safe_u = np.where(u != 0, u, 1.0)
+    safe_v = np.where(v != 0, v, 1.0)
+    angle = np.where(flat, 0.25 * np.pi * v / safe_u + np.where(u < 0, np.pi, 0.0),
+                     0.5 * np.pi - 0.25 * np.pi * u / safe_v + np.where(v < 0, np.pi, 0.0))
+    x = R * ((1.0 - beta) * u + beta * m * np.cos(angle))
+    y = R * ((1.0 - beta) * v + beta * m * np.sin(angle))
+    x[m == 0] = y[m == 0] = 0.0
+    return x, y
+
+
 def disk(radius: float = 1.0, h: float = 0.1, *, quarter: bool = True,
          blend_from: float = 0.5) -> MeshQuad:
     """The disk of ``radius`` about the origin (with ``quarter``, its part x >= 0, y >= 0) in
@@ -735,8 +763,6 @@ def disk(radius: float = 1.0, h: float = 0.1, *, quarter: bool = True,
 
     Named boundaries: ``rim`` and, with ``quarter``, ``left`` (x = 0) and ``bottom`` (y = 0).
     """
-    from .solids import disk_map
-
     if not (radius > 0 and h > 0):
         raise ValueError(f"radius and h must be positive, got {radius} and {h}")
     n = max(1, int(np.ceil(radius / h - 1e-9)))

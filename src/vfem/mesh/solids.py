@@ -17,7 +17,7 @@ import numpy as np
 from skfem import MeshHex, MeshTet
 
 from .parametric import check_count
-from .shapes import _grid_line
+from .shapes import _grid_line, disk_map
 from .topology import named_boundaries, share_topology, with_topology
 
 __all__ = ["box", "cylinder", "ring", "FACES"]
@@ -75,34 +75,6 @@ def box(x0: float = 0.0, y0: float = 0.0, z0: float = 0.0, width: float = 1.0,
         return lambda p: np.abs(p[axis] - at) < tol
 
     return named_boundaries(mesh, {name: face(axis, end) for name, (axis, end) in FACES.items()})
-
-
-def disk_map(u: np.ndarray, v: np.ndarray, R: float, blend_from: float = 0.5,
-             circle_from: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """The plan of :func:`cylinder` (and of the 2D :func:`vfem.mesh.shapes.disk`): points
-    (u, v) of a square grid on [-1, 1]^2 (or [0, 1]^2) mapped onto the disk of radius ``R``.
-    The square rings m = max(|u|, |v|) stay squares inside ``blend_from`` and are circles of
-    radius m R from ``circle_from`` on, blended linearly between; a node of a circle sits at an
-    angle proportional to its place along its square ring, so the rim's nodes are equally
-    spaced in angle where the grid is even."""
-    m = np.maximum(np.abs(u), np.abs(v))  # the square ring through the node
-    # beta: 0 inside blend_from (the square kept), 1 on the rim (the circle), linear between:
-    # the rings stay nested (a ring's diagonal point, m R (sqrt 2 - (sqrt 2 - 1) beta), grows
-    # with m while d beta / dm < 1 / (sqrt 2 - 1)), which blend_from < 0.58 keeps
-    beta = np.clip((m - blend_from) / (circle_from - blend_from), 0.0, 1.0)
-    # the circle's point of a node of ring m: at an angle proportional to the node's place
-    # along its square ring (not on the ray through it), so the rim's nodes are equally spaced
-    # in angle: facets of equal length, and a ring (solids.ring) with as many facets per turn
-    # has its nodes at the same angles (a shaft in a hub: similar polygons, no faceting mismatch)
-    flat = np.abs(u) >= np.abs(v)
-    safe_u = np.where(u != 0, u, 1.0)
-    safe_v = np.where(v != 0, v, 1.0)
-    angle = np.where(flat, 0.25 * np.pi * v / safe_u + np.where(u < 0, np.pi, 0.0),
-                     0.5 * np.pi - 0.25 * np.pi * u / safe_v + np.where(v < 0, np.pi, 0.0))
-    x = R * ((1.0 - beta) * u + beta * m * np.cos(angle))
-    y = R * ((1.0 - beta) * v + beta * m * np.sin(angle))
-    x[m == 0] = y[m == 0] = 0.0
-    return x, y
 
 
 def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | None = None,
