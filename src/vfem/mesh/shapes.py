@@ -757,7 +757,7 @@ def disk(radius: float = 1.0, h: float = 0.1, *, quarter: bool = True,
          blend_from: float = 0.5) -> MeshQuad:
     """The disk of ``radius`` about the origin (with ``quarter``, its part x >= 0, y >= 0) in
     quadrilaterals: a square grid of spacing about ``h`` mapped onto it as the plan of
-    :func:`vfem.mesh.solids.cylinder` (:func:`vfem.mesh.solids.disk_map`): its rim's nodes at
+    :func:`vfem.mesh.solids.cylinder` (:func:`disk_map`): its rim's nodes at
     equal angles, 2 n per quarter turn for n divisions across, so an :func:`annulus` with as
     many facets per quarter turn has its bore's nodes at the same angles.
 
