@@ -36,23 +36,28 @@ from vfem.solver import Analysis
 A, P, E = 1.0, 10.0, 1000.0
 
 
-def model(n: int):
-    h = A / n
-    rollers = (Support("left", ("x",)), Support("front", ("y",)))
+ROLLERS = (Support("left", ("x",)), Support("front", ("y",)))
+
+
+def punch_on(block_mesh: MeshSpec, fixed: str, h: float):
+    """The quarter punch (facets h across) on a block of ``block_mesh`` fixed on ``fixed``."""
     punch = BodyConfig(
         name="punch",
         mesh=MeshSpec(shape="cylinder", parameters=as_parameters(radius=A, height=A, h=h)),
-        material=LinearElastic(1000 * E, 0.3), supports=(Support("top", ("x", "y")), *rollers),
+        material=LinearElastic(1000 * E, 0.3), supports=(Support("top", ("x", "y")), *ROLLERS),
         platen=Platen("top", "z", -P / 4), contact_boundaries=("contact",))
-    block = BodyConfig(
-        name="block",
-        mesh=MeshSpec(shape="box", parameters=as_parameters(
-            z0=-8 * A, width=8 * A, depth=8 * A, height=8 * A, h=2 * A, h_fine=1.3 * h,
-            growth=0.3, fine_x=(0.0,), fine_y=(0.0,), fine_z=(0.0,), plateau=1.2 * A)),
-        material=LinearElastic(E, 0.3), supports=(Support("bottom"), *rollers),
-        contact_boundaries=("top",))
+    block = BodyConfig(name="block", mesh=block_mesh, material=LinearElastic(E, 0.3),
+                       supports=(Support(fixed), *ROLLERS), contact_boundaries=("top",))
     return ModelConfig("circular_punch", (punch, block), ContactSettings(), Steps(count=1)
                        ).build()
+
+
+def model(n: int):
+    """The block a graded box 8 a wide and deep."""
+    h = A / n
+    return punch_on(MeshSpec(shape="box", parameters=as_parameters(
+        z0=-8 * A, width=8 * A, depth=8 * A, height=8 * A, h=2 * A, h_fine=1.3 * h,
+        growth=0.3, fine_x=(0.0,), fine_y=(0.0,), fine_z=(0.0,), plateau=1.2 * A)), "bottom", h)
 
 
 def block_pressure(m, result):
@@ -103,22 +108,10 @@ def test_finer_punch_converges():
 def aligned_model(n: int):
     """The block a cylinder 8 a wide and deep with a grid circle under the punch's rim."""
     h = A / n
-    rollers = (Support("left", ("x",)), Support("front", ("y",)))
-    punch = BodyConfig(
-        name="punch",
-        mesh=MeshSpec(shape="cylinder", parameters=as_parameters(radius=A, height=A, h=h)),
-        material=LinearElastic(1000 * E, 0.3), supports=(Support("top", ("x", "y")), *rollers),
-        platen=Platen("top", "z", -P / 4), contact_boundaries=("contact",))
-    block = BodyConfig(
-        name="block",
-        mesh=MeshSpec(shape="cylinder", parameters=as_parameters(
-            radius=8 * A, height=8 * A, z0=-8 * A, h_contact=h, h=2 * A, growth=0.3,
-            plateau=1.2 * A, circle_from=1 / 8, blend_from=0.5 / 8, graded_end="top",
-            rings=(A,))),
-        material=LinearElastic(E, 0.3), supports=(Support("contact"), *rollers),
-        contact_boundaries=("top",))
-    return ModelConfig("circular_punch", (punch, block), ContactSettings(), Steps(count=1)
-                       ).build()
+    return punch_on(MeshSpec(shape="cylinder", parameters=as_parameters(
+        radius=8 * A, height=8 * A, z0=-8 * A, h_contact=h, h=2 * A, growth=0.3,
+        plateau=1.2 * A, circle_from=1 / 8, blend_from=0.5 / 8, graded_end="top",
+        rings=(A,))), "contact", h)
 
 
 @pytest.mark.slow
