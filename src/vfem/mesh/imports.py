@@ -465,7 +465,17 @@ def _build(raw, selected: tuple[str, np.ndarray], what: str) -> tuple[Mesh, np.n
         mesh = MeshTri1(p, np.ascontiguousarray(t.T), sort_t=False)
     else:
         mesh = mesh_type(p, np.ascontiguousarray(t.T))
-    # scikit-fem numbers the vertices of quadratic meshes first, in increasing order
+    return _checked(mesh, p, t, nv, used, len(raw.points), what)
+
+
+def _checked(mesh: Mesh, p: np.ndarray, t: np.ndarray, nv: int, used: np.ndarray,
+             npoints: int, what: str) -> tuple[Mesh, np.ndarray]:
+    """``mesh`` (built from points ``p`` and elements ``t`` of the file's nodes ``used``, ``nv``
+    vertices per element) checked, 2D or 3D, and the file's node -> the mesh's vertex (-1 for a
+    node of no element, or a quadratic element's midside node). scikit-fem numbers the vertices
+    of quadratic meshes first, in increasing order; the checks: degenerate, inverted or
+    overlapping elements, duplicate nodes, several pieces (element numbers are those of the
+    selection, in the file's order)."""
     vertices = np.unique(t[:, :nv])
     new_to_vertex = np.full(len(used), -1, dtype=np.int64)
     new_to_vertex[vertices] = np.arange(len(vertices))
@@ -473,10 +483,8 @@ def _build(raw, selected: tuple[str, np.ndarray], what: str) -> tuple[Mesh, np.n
     if mesh.nvertices != len(vertices) or not same:
         raise InputError(f"{what}: the elements do not form a valid mesh (the quadratic nodes "
                          f"are not shared between neighbouring elements)")
-    # degenerate, inverted or overlapping elements, duplicate nodes, several pieces (element
-    # numbers are those of the selection, in the file's order)
     check_mesh(mesh, what)
-    old_to_vertex = np.full(len(raw.points), -1, dtype=np.int64)
+    old_to_vertex = np.full(npoints, -1, dtype=np.int64)
     old_to_vertex[used] = new_to_vertex
     return mesh, old_to_vertex
 
@@ -508,17 +516,7 @@ def _build_3d(raw, selected: tuple[str, np.ndarray], what: str) -> tuple[Mesh, n
 
     p = np.ascontiguousarray(points.T)
     mesh = mesh_type(p, np.ascontiguousarray(t.T))
-    vertices = np.unique(t[:, :nv])
-    new_to_vertex = np.full(len(used), -1, dtype=np.int64)
-    new_to_vertex[vertices] = np.arange(len(vertices))
-    same = np.array_equal(mesh.doflocs[:, : len(vertices)], p[:, vertices])
-    if mesh.nvertices != len(vertices) or not same:
-        raise InputError(f"{what}: the elements do not form a valid mesh (the quadratic nodes "
-                         f"are not shared between neighbouring elements)")
-    check_mesh(mesh, what)
-    old_to_vertex = np.full(len(raw.points), -1, dtype=np.int64)
-    old_to_vertex[used] = new_to_vertex
-    return mesh, old_to_vertex
+    return _checked(mesh, p, t, nv, used, len(raw.points), what)
 
 
 def _signed_volume(points: np.ndarray, t: np.ndarray, element) -> np.ndarray:
