@@ -69,6 +69,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
 
+from .cached_boundary import CachedBoundary
 from .search import project_points
 
 if TYPE_CHECKING:
@@ -146,18 +147,9 @@ def _symmetry_facets(body: Body) -> np.ndarray:
     return np.concatenate(out)
 
 
-class _Polygon:
+class _Polygon(CachedBoundary):
     """A body's boundary at positions ``x`` ((nb, 2), local numbering); what is asked is
     computed on first use."""
-
-    def __init__(self, boundary: _Boundary, x: np.ndarray):
-        self.b, self.x = boundary, x
-        self._cache: dict = {}
-
-    def _get(self, key, make):
-        if key not in self._cache:
-            self._cache[key] = make()
-        return self._cache[key]
 
     @property
     def ends(self) -> tuple[np.ndarray, np.ndarray]:
@@ -176,16 +168,6 @@ class _Polygon:
             return np.column_stack([d[:, 1], -d[:, 0]]) / np.maximum(self.lengths,
                                                                      1e-300)[:, None]
         return self._get("unit_normals", make)
-
-    @property
-    def surface(self) -> np.ndarray:
-        """The segments that are surface (not on a symmetry plane)."""
-        return self._get("surface", lambda: np.flatnonzero(~self.b.mirror)
-                         if (~self.b.mirror).any() else np.arange(len(self.b.mirror)))
-
-    @property
-    def box(self) -> tuple[np.ndarray, np.ndarray]:
-        return self._get("box", lambda: (self.x.min(axis=0), self.x.max(axis=0)))
 
     def inside(self, pts: np.ndarray) -> np.ndarray:
         """Which of ``pts`` (m, 2) lie inside the polygon (on it counts as inside): the sign

@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .cached_boundary import CachedBoundary
 from .facets import kind_of
 from .facets3d import closest_on_facets
 
@@ -105,18 +106,9 @@ def _barycentric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> 
     return np.column_stack([1 - s - t, s, t])
 
 
-class Surface3:
+class Surface3(CachedBoundary):
     """A 3D body's boundary at positions ``x`` ((nb, 3), local numbering); what is asked is
     computed on first use (the API of :class:`~vfem.contact.check._Polygon`)."""
-
-    def __init__(self, boundary: Boundary3, x: np.ndarray):
-        self.b, self.x = boundary, x
-        self._cache: dict = {}
-
-    def _get(self, key, make):
-        if key not in self._cache:
-            self._cache[key] = make()
-        return self._cache[key]
 
     @property
     def corners(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -193,16 +185,6 @@ class Surface3:
                            for c in range(k)], axis=0)
             return side[self.b.owner]
         return self._get("sizes", make)
-
-    @property
-    def surface(self) -> np.ndarray:
-        """The triangles that are surface (not on a symmetry plane)."""
-        return self._get("surface", lambda: np.flatnonzero(~self.b.mirror)
-                         if (~self.b.mirror).any() else np.arange(len(self.b.mirror)))
-
-    @property
-    def box(self) -> tuple[np.ndarray, np.ndarray]:
-        return self._get("box", lambda: (self.x.min(axis=0), self.x.max(axis=0)))
 
     def feature_normals(self, tri: np.ndarray, lam: np.ndarray, vertex: np.ndarray
                         ) -> np.ndarray:
