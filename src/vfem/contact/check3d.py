@@ -269,15 +269,17 @@ class Surface3(CachedBoundary):
         tree = self._get("tree", lambda: cKDTree(self.x))
         n = self.normals
         out = self.own_turning[nodes].astype(float)
-        for k, near in enumerate(tree.query_ball_point(self.x[nodes], radius)):
-            near = np.asarray(near, dtype=np.int64)
-            p = nodes[k]
-            if not len(near):
-                continue
-            convex = np.einsum("ij,ij->i", self.x[near] - self.x[p], n[near] - n[p]) > 0
-            if convex.any():
-                cos = np.clip(n[near[convex]] @ n[p], -1.0, 1.0)
-                out[k] = max(out[k], 2.0 * float(np.arccos(cos).max()))
+        near = tree.query_ball_point(self.x[nodes], radius)
+        if not len(nodes):
+            return out
+        # every (node, neighbour) pair at once: rows k repeated by their neighbour counts
+        counts = np.fromiter((len(q) for q in near), dtype=np.int64, count=len(nodes))
+        k = np.repeat(np.arange(len(nodes)), counts)
+        q = np.fromiter((i for row in near for i in row), dtype=np.int64, count=int(counts.sum()))
+        p = nodes[k]
+        convex = np.einsum("ij,ij->i", self.x[q] - self.x[p], n[q] - n[p]) > 0
+        cos = np.clip(np.einsum("ij,ij->i", n[q[convex]], n[p[convex]]), -1.0, 1.0)
+        np.maximum.at(out, k[convex], 2.0 * np.arccos(cos))
         return out
 
     @property
