@@ -215,9 +215,15 @@ def ring(inner_radius: float = 1.0, outer_radius: float = 2.0, height: float = 1
     whole = type(mesh)(np.ascontiguousarray(p[:, np.sort(first)]), np.ascontiguousarray(t))
     with_topology(whole)
     # the named facets again, by their nodes in the merged numbering
-    key = {tuple(sorted(f)): j for j, f in enumerate(whole.facets.T.tolist())}
-    found = {name: np.array(sorted(key[tuple(sorted(f))] for f in
-                                   renumber[index[mesh.facets[:, fac]]].T.tolist()),
-                            dtype=np.int32)
-             for name, fac in mesh.boundaries.items()}
+    mine = np.sort(whole.facets.T, axis=1)
+    names = list(mesh.boundaries)
+    asked = [np.sort(renumber[index[mesh.facets[:, mesh.boundaries[n]]]].T, axis=1)
+             for n in names]
+    _, inverse = np.unique(np.vstack([mine, *asked]), axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    facet_of = np.full(inverse.max() + 1, -1, dtype=np.int64)
+    facet_of[inverse[: len(mine)]] = np.arange(len(mine))
+    ends = np.cumsum([len(mine)] + [len(a) for a in asked])
+    found = {n: np.sort(facet_of[inverse[lo:hi]]).astype(np.int32)
+             for n, lo, hi in zip(names, ends[:-1], ends[1:])}
     return named_boundaries(whole, found)
