@@ -21,7 +21,6 @@ import copy
 
 import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
-from skfem import CellBasis
 from skfem.mapping import MappingIsoparametric
 
 #: Elements per chunk: a chunk's products take (nodes x 3)^2 x CHUNK doubles (a hexahedron's
@@ -41,20 +40,21 @@ def elasticity_stiffness(basis, lam: float, mu: float) -> csr_matrix:
     with the vector dof (a, c) at local index ``dim * a + c`` (scikit-fem's ``ElementVector``
     order, checked against the basis' dof numbering below).
     """
-    scalar = CellBasis(basis.mesh, basis.elem.elem, mapping=basis.mapping,
-                       quadrature=basis.quadrature)
     dim = basis.mesh.dim()
     dofs = basis.element_dofs  # (nloc, nelems)
-    if not np.array_equal(dofs, (dim * scalar.element_dofs[:, None, :]
-                                 + np.arange(dim)[None, :, None]).reshape(dofs.shape)):
+    nnode, nel = dofs.shape[0] // dim, dofs.shape[1]
+    first = dofs[::dim]  # each scalar function's component 0
+    if not np.array_equal(dofs, (first[:, None, :] + np.arange(dim)[None, :, None]
+                                 ).reshape(dofs.shape)):
         raise AssertionError("unexpected vector dof order")  # a scikit-fem change: not input
-    nnode, nel = scalar.element_dofs.shape
-    grads = np.stack([phi[0].grad for phi in scalar.basis])  # (nnode, dim, nelems, nqp)
+    # grad N_a: row 0 of the gradient of (a, component 0), whose value is (N_a, 0, 0); read
+    # from the vector basis already built (a scalar basis would map every point again)
+    grads = np.stack([basis.basis[dim * a][0].grad[0] for a in range(nnode)])
     data = np.empty((nnode, dim, nnode, dim, nel))
     for start in range(0, nel, CHUNK):
         e = slice(start, min(start + CHUNK, nel))
         g = grads[:, :, e]
-        gw = g * scalar.dx[e]  # the weights on one factor
+        gw = g * basis.dx[e]  # the weights on one factor
         cross = np.einsum("aceq,bdeq->acbde", gw, g)  # sum_q w G_ac G_bd
         dot = np.einsum("aceq,bceq->abe", gw, g)  # sum_q w G_a . G_b
         block = lam * cross + mu * cross.transpose(0, 3, 2, 1, 4)
