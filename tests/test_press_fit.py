@@ -1,13 +1,16 @@
 """The ``press_fit`` example (issue 21): a shaft in a hub with a radial interference, against
 Lame's thick cylinders in plane strain.
 
-Measured (2026-11-27): the default (hexahedra, 24 facets per quarter turn, 8 through the wall,
-5,574 dofs) in one iteration with every invariant, the hub's nodal pressure within 1.59 % of
-Lame's everywhere (mean +0.14 %), the shaft's within 1.36 % (mean -0.86 %); 32 facets per
-quarter turn 1.30 %; 48 and 16 through the wall (interference 0.005) 0.75 %. With
-tetrahedra in the hub the first step fails invariant (b) (a bore node at an end face and the
-symmetry plane 3.9e-4 inside the shaft) and with tetrahedra in both the start is refused (the
-interference is deeper than the shaft's outer tetrahedra): strict expected failures.
+Measured (2026-11-28): the default (hexahedra, 24 facets per quarter turn, 8 through the wall,
+5,574 dofs) in one iteration with every invariant, the hub's nodal pressure within 0.27 % of
+Lame's everywhere (mean +0.18 %), the shaft's within 0.82 % (mean -0.81 %); 32 facets per
+quarter turn 0.23 %; 48 and 16 through the wall (interference 0.005) 0.065 %. (Before the
+symmetry planes' edges stopped counting as the patches' boundary, 2026-11-28, the pressure
+read at the nodes on the symmetry planes was 1.59 % off.) With tetrahedra in the hub: one
+iteration, every invariant, the mean within 0.7 % but the nodal pressure scattering by 9-13 %
+(the tetrahedral bore's facets are not at the shaft's angles: the faceting sag differs from
+node to node); with tetrahedra in both the start is refused (the interference is deeper than
+the shaft's outer tetrahedra).
 """
 
 import numpy as np
@@ -48,7 +51,7 @@ def test_pressure_within_2_percent_of_lame(default):
     ev = press_fit.evaluate(result, p)
     for name in ("hub", "shaft"):
         assert ev[name]["nodes_in_contact"] == ev[name]["nodes"]  # the whole surface
-        assert ev[name]["largest_error"] < 0.02
+        assert ev[name]["largest_error"] < 0.01  # measured 0.27 %, 0.82 %
         assert abs(ev[name]["mean_error"]) < 0.01
     # the resultant on the quarter: p b L along x and along y, equal and opposite
     f_shaft = result.steps[-1].bodies["shaft"].contact_force.sum(axis=0)
@@ -66,15 +69,23 @@ def test_body_order_does_not_matter(default):
         assert np.abs(pa - pb).max() < 1e-8 * press_fit.lame(p)
 
 
-def test_finer_facets_come_closer():
+def test_finer_facets_come_closer(default):
     p, _, result = solve(around=32)
-    assert press_fit.evaluate(result, p)["hub"]["largest_error"] < 0.0159
+    coarse = press_fit.evaluate(default[2], default[0])["hub"]["largest_error"]
+    assert press_fit.evaluate(result, p)["hub"]["largest_error"] < coarse  # 0.23 % < 0.27 %
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="open: a tetrahedral hub fails invariant (b) at a bore corner")
 def test_tetrahedral_hub():
-    solve(hub_cells="tet")
+    """A bore node at an end face and a symmetry plane was read as beyond the shaft's patch
+    (invariant (b) failed there, 3.9e-4 inside) until symmetry-plane edges stopped being the
+    patch's boundary."""
+    p, _, result = solve(hub_cells="tet")
+    assert [s.iterations for s in result.steps] == [1]
+    assert all(s.invariants["passed"] for s in result.steps)
+    ev = press_fit.evaluate(result, p)
+    for name in ("hub", "shaft"):
+        assert abs(ev[name]["mean_error"]) < 0.01  # measured +0.68 %, -0.36 %
+        assert ev[name]["largest_error"] < 0.15  # 9.2 %, 13.4 %: facets at other angles
 
 
 def test_too_deep_an_interference_is_refused():

@@ -65,6 +65,7 @@ from .group import bordered_matrix
 from .iteration import Check, iterate
 from .paired import PairedContact
 from .state import ContactState, FrictionState, IterationRecord, SolveResult
+from .surface import symmetry_planes  # noqa: F401 - its home was here
 
 log = logging.getLogger(__name__)
 
@@ -99,27 +100,6 @@ def tangents(normal: np.ndarray) -> list[np.ndarray]:
     t1[rows, axis] += 1.0
     t1 /= np.linalg.norm(t1, axis=1)[:, None]
     return [t1, np.cross(normal, t1)]
-
-
-def symmetry_planes(body) -> list[tuple[np.ndarray, int]]:
-    """A 3D body's symmetry planes: per roller ``Support`` (held along one axis) whose boundary
-    has flat facets normal to that axis, the mesh nodes on those facets and the axis."""
-    mesh = body.mesh
-    out = []
-    for sup in body.supports:
-        components = body.support_components(sup)
-        if len(components) != 1 or sup.boundary not in (mesh.boundaries or {}):
-            continue
-        facets = np.asarray(mesh.boundaries[sup.boundary])
-        axis = body.components.index(components[0])
-        if not len(facets):
-            continue
-        ends = mesh.p[axis][mesh.facets[:, facets]]  # (nodes of a facet, nf)
-        size = np.ptp(mesh.p, axis=1).max()
-        flat = np.ptp(ends, axis=0) <= 1e-9 * size
-        if flat.any():
-            out.append((np.unique(mesh.facets[:, facets[flat]]), axis))
-    return out
 
 
 def plane_normals(surface, pair) -> np.ndarray:

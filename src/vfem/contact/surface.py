@@ -44,6 +44,27 @@ from .search import project_points
 log = logging.getLogger(__name__)
 
 
+def symmetry_planes(body) -> list[tuple[np.ndarray, int]]:
+    """A 3D body's symmetry planes: per roller ``Support`` (held along one axis) whose boundary
+    has flat facets normal to that axis, the mesh nodes on those facets and the axis."""
+    mesh = body.mesh
+    out = []
+    for sup in body.supports:
+        components = body.support_components(sup)
+        if len(components) != 1 or sup.boundary not in (mesh.boundaries or {}):
+            continue
+        facets = np.asarray(mesh.boundaries[sup.boundary])
+        axis = body.components.index(components[0])
+        if not len(facets):
+            continue
+        ends = mesh.p[axis][mesh.facets[:, facets]]  # (nodes of a facet, nf)
+        size = np.ptp(mesh.p, axis=1).max()
+        flat = np.ptp(ends, axis=0) <= 1e-9 * size
+        if flat.any():
+            out.append((np.unique(mesh.facets[:, facets[flat]]), axis))
+    return out
+
+
 def exterior_facets(body: Body) -> np.ndarray:
     """Facets of the body that may take part in contact (indices into ``mesh.facets``)."""
     mesh = body.mesh
@@ -382,8 +403,29 @@ class ContactSurface:
     def patch_boundary(self, patch: np.ndarray):
         """The boundary of a patch of candidate facets (facet numbers ``patch``), as
         :meth:`beyond` and :meth:`on_boundary` read it (:meth:`FacetKind.patch_boundary`; in 2D
-        (nc,) True at the patch's end vertices)."""
-        return self.kind.patch_boundary(self.facets, patch, self.nc)
+        (nc,) True at the patch's end vertices). In 3D an edge on a symmetry plane of the body
+        (:attr:`symmetry_edges`) is not a boundary: the model goes on across it as the patch's
+        mirror image, so a point whose closest point lies past it is over the mirrored patch,
+        not beyond the surface (a quarter sphere's pole on a flat: read as beyond, the flat's
+        node under it had no virtual node and the sphere went through it)."""
+        boundary = self.kind.patch_boundary(self.facets, patch, self.nc)
+        if self.dim == 3 and self.symmetry_edges.any():
+            boundary = boundary & ~self.symmetry_edges
+        return boundary
+
+    @property
+    def symmetry_edges(self) -> np.ndarray:
+        """3D: (nf, edges) True at each candidate facet's edges whose two corners lie on one
+        symmetry plane of the body (:func:`symmetry_planes`; the planes' facets are flat, so
+        such an edge lies in the plane)."""
+        if not hasattr(self, "_symmetry_edges"):
+            ends = self.kind.edge_nodes(self.facets)  # (nf, edges, 2) candidate numbers
+            points = self.nodes[ends]
+            out = np.zeros(ends.shape[:2], dtype=bool)
+            for nodes, _ in symmetry_planes(self.body):
+                out |= np.isin(points, nodes).all(axis=2)
+            self._symmetry_edges = out
+        return self._symmetry_edges
 
     def boundary_nodes(self, boundary) -> np.ndarray:
         """(nc,) True at the candidate nodes on a patch boundary (:meth:`patch_boundary`)."""
