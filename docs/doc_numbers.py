@@ -468,6 +468,48 @@ def examples_cattaneo3d_study() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_circular_punch() -> str:
+    """docs/examples.md, Circular punch: the default run (``vfem run circular_punch``) and the
+    rim facets' study (``tests/test_circular_punch3d.py``'s slow study; about two minutes)."""
+    from vfem.examples import circular_punch
+    from vfem.solver import Analysis
+
+    s = _summary("circular_punch")
+    b = s["boussinesq"]
+    blk, pun = b["block"], b["punch"]
+    steps = s["steps"]
+    ok = all((x["invariants"] or {}).get("passed", False) for x in steps)
+    rows = [
+        f"Default model ({_thousands(s['dofs'], 0)} dofs, {_thousands(s['contact_dofs'], 0)} "
+        f"contact dofs, quarter model, facets {s['parameters']['rim_size']:g} a at the rim):",
+        "",
+        f"* The block's nodal pressure over r < {b['inner_radius']:g} a ({blk['nodes_inside']} "
+        f"nodes): within {_percent(blk['largest_error'], 2)} of Boussinesq's (the largest at "
+        f"r = {blk['largest_error_at']:.3f} a), RMS {_percent(blk['rms_error'], 2)}, at the "
+        f"centre {_percent(blk['centre_error'], 2, True)}; the punch's face reads within "
+        f"{_percent(pun['largest_error'], 2)}.",
+        f"* Contact force {pun['total_contact_force']:.6g} on the punch and "
+        f"{blk['total_contact_force']:.6g} on the block (applied {b['applied_force']:g}); block "
+        f"nodes beyond the rim carrying force: {blk['nodes_beyond_rim_loaded']}.",
+        f"* {sum(x['iterations'] for x in steps)} contact iteration(s) in {len(steps)} step(s); "
+        + ("every invariant passed." if ok else "an invariant FAILED."),
+        "",
+        "| facets at the rim (over a) | dofs | largest error, r < 0.8 a | at r / a | RMS | "
+        "centre | invariants |",
+        "|---:|---:|---:|---:|---:|---:|---|"]
+    for size in (0.04, 0.03, 0.02, 0.015):
+        p = circular_punch.Parameters(rim_size=size)
+        model = circular_punch.build(p)
+        result = Analysis(model).run()
+        ev = circular_punch.evaluate(result, p)["block"]
+        ok = result.converged and all(x.invariants["passed"] for x in result.steps)
+        rows.append(f"| {size:g} | {_thousands(sum(x.ndofs for x in model.bodies), 0)} | "
+                    f"{_percent(ev['largest_error'], 2)} | {ev['largest_error_at']:.3f} | "
+                    f"{_percent(ev['rms_error'], 2)} | {_percent(ev['centre_error'], 2, True)} | "
+                    f"{'passed' if ok else 'FAILED'} |")
+    return "\n".join(rows) + "\n"
+
+
 #: name -> (file, generator, quick: run in the default test suite)
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
@@ -485,6 +527,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-sphere-study": ("docs/examples.md", examples_sphere_study, False),
     "examples-cattaneo3d": ("docs/examples.md", examples_cattaneo3d, False),
     "examples-cattaneo3d-study": ("docs/examples.md", examples_cattaneo3d_study, False),
+    "examples-circular-punch": ("docs/examples.md", examples_circular_punch, False),
 }
 
 _TIME = re.compile(r"\b\d+(\.\d+)? s\b")

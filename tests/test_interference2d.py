@@ -7,7 +7,9 @@ Measured (2026-11-28): with the shaft's rim nodes at the hub bore's angles (24 f
 quarter turn, 8 elements through the hub's wall), in one iteration with every invariant, the
 hub's nodal pressure within 1.58 % of Lame's at every node (0.39 % off the symmetry planes;
 mean +0.14 %), the shaft's within 1.37 % (mean -0.86 %) — the 3D press_fit's numbers, its
-sections being in plane strain; 16 elements through the wall: 1.35 % and 1.46 %. The bodies
+sections being in plane strain, until 3D stopped reading edges on symmetry planes as patch
+boundaries (3D now 0.27 % and 0.82 %; 2D's symmetry-plane nodes still read low: its patch
+ends are vertices, unchanged); 16 elements through the wall: 1.35 % and 1.46 %. The bodies
 listed the other way round give the same pressures. With the shaft's facets at other angles
 (32 per quarter turn against 24) the faceting sag, comparable with delta, scatters the nodal
 pressure by up to 57 % about a mean within 0.4 %. Finer facets (48 per quarter turn) make the

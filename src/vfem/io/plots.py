@@ -90,10 +90,12 @@ def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[
     plt.close(fig)
 
 
-def pressure_map(path: Path, x: np.ndarray, y: np.ndarray, p: np.ndarray, title: str) -> None:
+def pressure_map(path: Path, x: np.ndarray, y: np.ndarray, p: np.ndarray, title: str,
+                 label: str = "p / p0 (pressure over Hertz's peak)") -> None:
     """A 3D contact surface's pressure seen along its normal: filled contours of ``p`` over the
     nodes' undeformed (``x``, ``y``) (a triangulation of the points in that plane), with the
-    circle of radius 1 (Hertz's r = a when x, y and p are scaled by a and p0)."""
+    circle of radius 1 (Hertz's r = a when x, y and p are scaled by a and p0; a punch's rim);
+    ``label`` names the colour bar's quantity."""
     import matplotlib.tri as mtri
 
     plt = require_matplotlib()
@@ -102,7 +104,7 @@ def pressure_map(path: Path, x: np.ndarray, y: np.ndarray, p: np.ndarray, title:
     if len(p) >= 3:
         cs = ax.tricontourf(mtri.Triangulation(x, y), np.clip(p, 0.0, None),
                             levels=np.linspace(0.0, top, 12), cmap="viridis")
-        fig.colorbar(cs, ax=ax, label="p / p0 (pressure over Hertz's peak)")
+        fig.colorbar(cs, ax=ax, label=label)
     ax.plot(x, y, ".", ms=2, color="0.3")
     s = np.linspace(0.0, 2.0 * np.pi, 361)
     ax.plot(np.cos(s), np.sin(s), "w--", lw=1.2)

@@ -82,7 +82,8 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
              half: bool = False, h_contact: float | None = None, h: float | None = None,
              growth: float = 0.2, plateau: float = 0.0, blend_from: float = 0.5,
              circle_from: float = 1.0, graded_end: str = "bottom",
-             rings: Sequence[float] = (), tetrahedra: bool = False) -> MeshHex | MeshTet:
+             rings: Sequence[float] = (), grade_axis: bool = True,
+             tetrahedra: bool = False) -> MeshHex | MeshTet:
     """A cylinder of ``radius`` about the vertical axis through (``x0``, ``y0``), its lower end
     at ``z0`` on the axis and its top face the plane ``z = z0 + height``: flat-ended (a
     circular punch), or with ``end_radius`` its lower end a spherical cap of that radius
@@ -103,8 +104,12 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     radius on (``blend_from`` at most 0.58 of it): a block under a circular punch of radius
     ``circle_from * radius`` then has a grid circle under the punch's rim, with nodes at the
     punch's rim nodes' angles where both grids are even there (``rings``: radii made grid
-    rings, the grid graded towards them as towards the axis). ``graded_end = "top"`` grades
-    the layers towards the top face instead (a block whose top is the contact).
+    rings, the grid graded in plan towards them as towards the axis; with ``grade_axis``
+    False towards the rings only, the axis' spacing then what the grading from the rings
+    reaches: a punch's or a block's grid graded towards the punch's rim, where the traction
+    is singular). ``graded_end = "top"`` grades the layers towards the top face instead (a
+    block whose top is the contact); on a flat end the layers are graded alike at every
+    radius.
 
     Named boundaries: ``contact`` (the lower end), ``top``, ``side`` (the cylinder's mantle)
     and, with ``quarter``, ``left`` (x = x0) and ``front`` (y = y0), as on :func:`box`; with
@@ -134,11 +139,15 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
         raise ValueError(f"graded_end must be 'bottom' or 'top', got {graded_end!r}")
     if h is None:
         raise ValueError("give the element size h (and h_contact to grade the mesh)")
-    fine = ((0.0, *(float(r) for r in rings), *(-float(r) for r in rings))
-            if h_contact is not None else ())
+    if not (grade_axis or len(rings)):
+        raise ValueError("grade_axis = False grades towards the rings only: give rings")
+    fine = (((0.0,) if grade_axis else ()) + tuple(float(r) for r in rings)
+            + tuple(-float(r) for r in rings)) if h_contact is not None else ()
     across = _grid_line(0.0 if quarter else -R, R, h, h_contact, growth, fine, plateau) / R
     along = _grid_line(0.0, R, h, h_contact, growth, fine, plateau) / R if half else across
-    up = _grid_line(0.0, height, h, h_contact, growth, fine, plateau)
+    # the layers graded towards the end only (the rings are radii, not heights)
+    up = _grid_line(0.0, height, h, h_contact, growth, (0.0,) if h_contact is not None else (),
+                    plateau)
     if graded_end == "top":
         up = height - up[::-1]
     check_count(float(len(across)) * len(along) * len(up), "cylinder")
@@ -162,7 +171,8 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     # the rim (where graded ones would make slabs thinner than the end's rise across them)
     layer = np.searchsorted(up / height, w - 1e-9)
     equal = layer / (len(up) - 1.0)
-    gamma = np.clip((rr / R - blend_from) / (1.0 - blend_from), 0.0, 1.0)
+    gamma = (np.clip((rr / R - blend_from) / (1.0 - blend_from), 0.0, 1.0)
+             if end_radius is not None else np.zeros_like(rr))
     z = bottom + ((1.0 - gamma) * w + gamma * equal) * (height - bottom)
     p = np.vstack([x + x0, y + y0, z + z0])
     return share_topology(mesh, replace(mesh, doflocs=p))
