@@ -3,12 +3,12 @@ example, and the meshes that do not reach Boussinesq.
 
 Boussinesq's rigid punch on a half-space: p(r) = P / (2 pi a sqrt(a^2 - r^2)). The example
 (``vfem run circular_punch``): both meshes graded towards the rim (facets 0.02 a there, growing
-0.15 per unit distance), the block's grid with a circle under the rim at the punch's rim nodes'
+0.2 per unit distance), the block's grid with a circle under the rim at the punch's rim nodes'
 angles and circles from 0.6 a out. Measured 2026-11-28: one iteration, every invariant, the
-force exact, no block node beyond the rim loaded; the block's nodal pressure within 2.08 % of
-Boussinesq's over r < 0.8 a (at r = 0.771 a; RMS 1.46 %, centre -0.29 %) at 173k dofs; 4.46 %,
-3.20 %, 2.08 % and 1.58 % at rim facets 0.04, 0.03, 0.02 and 0.015 a (93k, 113k, 173k, 212k
-dofs).
+force exact, no block node beyond the rim loaded; the block's nodal pressure within 2.25 % of
+Boussinesq's over r < 0.8 a (at r = 0.768 a; RMS 1.66 %, centre +0.04 %) at 91k dofs; 4.19 %,
+3.25 %, 2.25 % and 1.86 % at rim facets 0.04, 0.03, 0.02 and 0.015 a (50k, 70k, 91k, 118k
+dofs); growing 0.15 instead, 2.08 % at 173k dofs; growing 0.3, 2.53 % at 43k.
 
 Meshes that do not get there (kept, as what a user meeting the singular rim should know):
 
@@ -127,12 +127,12 @@ def test_example_within_3_percent_of_boussinesq_inside_0_8_a(example):
     assert all(x["invariants"]["passed"] for x in s["steps"])
     b = s["boussinesq"]
     for name in ("block", "punch"):
-        assert b[name]["largest_error"] < 0.03  # measured 2.08 %
-        assert b[name]["rms_error"] < 0.02  # 1.46 %
-        assert abs(b[name]["centre_error"]) < 0.01  # -0.29 %
+        assert b[name]["largest_error"] < 0.03  # measured 2.25 %
+        assert b[name]["rms_error"] < 0.02  # 1.66 %
+        assert abs(b[name]["centre_error"]) < 0.01  # +0.04 %
         assert b[name]["total_contact_force"] == pytest.approx(p.force, rel=1e-12)
     assert b["block"]["nodes_beyond_rim_loaded"] == 0
-    assert b["block"]["nodes_inside"] == 81  # the nodes the 3 % is read at
+    assert b["block"]["nodes_inside"] == 49  # the nodes the 3 % is read at
     assert json.loads((out / "summary.json").read_text())["boussinesq"] == b
     for name in ("pressure.png", "pressure_map.png"):
         assert (out / name).stat().st_size > 10_000
@@ -158,7 +158,9 @@ def test_body_order_does_not_matter():
 
 @pytest.mark.slow
 def test_example_error_falls_with_the_rim_facets():
-    """Measured: 4.46 %, 3.20 %, 2.08 % at rim facets 0.04, 0.03, 0.02 a."""
+    """Measured: 4.19 %, 3.25 %, 2.25 % at rim facets 0.04, 0.03, 0.02 a; and with growth 0.3
+    (the punch capped at a smaller size than the block before both took one, the grids then
+    apart on r < a) invariant (b) failed at a block ring node: it converges now."""
     errors = []
     for size in (0.04, 0.03, 0.02):
         p = circular_punch.Parameters(rim_size=size)
