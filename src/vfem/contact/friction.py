@@ -237,6 +237,10 @@ class FrictionHistory:
         for k, dw in enumerate(slips):
             q, s = self.tractions(state, k), self.shear(state, k)
             status = self.status(state, k)
+            held = self._held_components(k)
+            if held is not None and held.any():  # 3D: a sticking node's slip along a held
+                dw = dw.copy()  # tangent is the supports', as the solve has it
+                dw[held & (status == 1)[:, None]] = 0.0
             stick += int((status == 1).sum())
             slip += int((status == 2).sum())
             if (status == 1).any():
@@ -256,6 +260,18 @@ class FrictionHistory:
             elif np.any(s != 0):
                 excess = np.inf  # a tangential traction without a normal one
         return err, excess, stick, slip
+
+    def _held_components(self, k: int) -> np.ndarray | None:
+        """3D: pair k's (n, ntan) tangential components whose relative motion no traction moves
+        (:data:`HELD`: supports on both bodies along that tangent); None in 2D (a held node
+        there has no tangential unknown at all, and its slip is round-off) or before the first
+        correction has set up the pair matrix. A sticking node's slip along a held tangent is
+        the supports' (a prescribed motion, as the press fit's pushed end faces), not an error
+        the iteration could correct."""
+        if getattr(self, "_ntan", 1) == 1 or getattr(self, "_full", None) is None:
+            return None  # (2D; or the large-kinematics variant, 2D only, without them)
+        n, base = len(self.contact_pairs[k].nodes), self._full[3][k]
+        return self._held[base + n: base + (1 + self._ntan) * n].reshape(self._ntan, n).T
 
     def _unknowns(self, state: FrictionState) -> np.ndarray:
         """Every pair's normal then tangential traction values, in the pair matrix's order."""
@@ -581,8 +597,15 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             held = self._held[base + n: base + (1 + ntan) * n].reshape(ntan, n).T \
                 | (mu_static == 0.0)
             node_held = held.all(axis=1)
+            # 3D: a node the supports move along a held tangent (both bodies' dofs prescribed
+            # there, but not alike: the press fit's shaft end faces pushed past the hub's held
+            # ones) slips by that motion, known: its traction there is friction's, -mu q along
+            # the slip, a tie like any slipping node's, carried by the supports
+            driven = np.zeros(n, dtype=bool)
             if ntan > 1:
-                slip[held] = 0.0  # (round-off: the supports hold it)
+                driven = contact & (magnitudes(np.where(held, slip, 0.0)) > tol) \
+                    & (mu_static > 0.0)
+                slip[held & ~driven[:, None]] = 0.0  # (round-off: the supports hold it)
             # a node on the cone keeps slipping unless its slip has turned back: the static cone
             # for a node at rest, the dynamic one for a node that slips (the same for Coulomb);
             # sigma, its slip direction, is the one its traction opposes (2D: -sign(s))
@@ -595,14 +618,15 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             going = amount > 0
             unit = np.divide(slip, amount[:, None], out=np.zeros_like(slip),
                              where=going[:, None])
-            sigma[moving] = unit[moving]
+            sigma[moving | driven] = unit[moving | driven]
             along = np.einsum("ij,ij->i", sigma, slip) if ntan > 1 else sigma[:, 0] * slip[:, 0]
             slipping = contact & ((on_cone & (along >= -tol)) | moving)
             slipping &= ~node_held
+            slipping |= driven
             sticking = contact & ~slipping & ~node_held
             was_sliding[:] = slipping | (contact & (mu_static == 0.0))
             # no tangential traction where held (and none off contact)
-            free = held | ~contact[:, None]
+            free = (held & ~driven[:, None]) | ~contact[:, None]
             for j in range(ntan):
                 jump[base + (1 + j) * n + np.flatnonzero(free[:, j])] = -S[free[:, j], j]
             on = np.flatnonzero(contact)

@@ -233,4 +233,9 @@ def report(s: dict) -> list[str]:
                      f"{m['hub']['largest_error']:.2%} (mean {m['hub']['mean_error']:+.2%}), "
                      f"the shaft's within {m['shaft']['largest_error']:.2%} "
                      f"(mean {m['shaft']['mean_error']:+.2%})")
+        if m.get("push"):
+            last, theory = m["push"][-1], m["push_out_force_theory"]
+            lines.append(f"  push-out: axial force {last['axial_force']:.6g} with "
+                         f"{last['slipping_nodes']} nodes slipping (2 pi b L mu p = "
+                         f"{theory:.6g}, {last['axial_force'] / theory - 1:+.2%})")
     return lines
