@@ -42,6 +42,16 @@ estimate 1.05 to 1.85 times the measured peak (1.05 to 1.5 above 100 MiB); PARDI
 to 1.11 times its count above 20,000 dofs (0.82 to 1.14 at all sizes), the whole estimate 0.85
 to 1.24 times the peak above 100 MiB. Far more irregular meshes fill differently; the estimate
 is a guide, not a bound.
+
+In 3D (issue 21) a solid's fill grows as ndofs^(4/3), not as ndofs log ndofs: the fill per dof
+is ``a ndofs^(1/3) + b`` (:data:`PARDISO_3D`, :data:`SUPERLU_3D`, fitted on the sphere
+example's hexahedral bodies), the stiffness's structural count is exact (the distinct pairs of
+points sharing an element, nine entries each) and a body has three dofs a point. Against the
+peaks of ``vfem bench sphere`` (PARDISO, 2026-11-28): 2,752 MiB estimated for 3,050 measured at
+92k dofs, 14,552 for 11,302 at 316k (0.9 to 1.3 times); the 2D law had put them 5 to 7 times
+too low, so a 3D model too large for the machine met the out-of-memory killer instead of this
+check. At 829k dofs the estimate is 52 GiB, the factors' values alone (1.6e9 entries) 13 GiB: a
+million-dof 3D model does not fit a 24 GB machine by a direct factorization, vfem's or plain.
 """
 
 from __future__ import annotations
@@ -52,6 +62,8 @@ import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+
+import numpy as np
 
 from .errors import AnalysisError
 
@@ -77,15 +89,28 @@ PAIR_BYTES = 32
 LARGE_BYTES = 24
 #: PARDISO's fill per dof, ``max(MIN, SLOPE log2(ndofs) - OFFSET)``
 PARDISO_MIN, PARDISO_SLOPE, PARDISO_OFFSET = 10.0, 8.4, 48.0
+#: 3D: fill per dof ``a ndofs^(1/3) + b`` (nested dissection of a 3D grid: nnz(L) ~ n^(4/3)),
+#: fitted 2026-11-28 to the sphere example's two bodies (trilinear hexahedra, 5,000 to 47,000
+#: free dofs a body, condensed dofs last): PARDISO's nnz(L) within 0.96 to 1.02 times the fit,
+#: SuperLU's nnz(L + U) within 0.98 to 1.02 (5,000 to 21,000). The 2D log-law put 3D bodies'
+#: factors 5 to 7 times too low.
+PARDISO_3D = (25.5, -143.0)
+SUPERLU_3D = (65.6, -446.0)
 #: What Python, NumPy and scikit-fem hold besides (measured: about 15 MB).
 BASE_BYTES = 16 * 2**20
 
 
-def factor_entries(ndofs: int, condensed: int, backend: str | None = None) -> float:
+def factor_entries(ndofs: int, condensed: int, backend: str | None = None, dim: int = 2
+                   ) -> float:
     """Estimated entries of a body's factors with ``condensed`` dofs ordered last: SuperLU's
-    nnz(L + U), or with ``backend`` ``"pardiso"`` its nnz(L) (nested dissection, Cholesky)."""
+    nnz(L + U), or with ``backend`` ``"pardiso"`` its nnz(L) (nested dissection, Cholesky).
+    ``dim`` 3: a solid's fill grows as ndofs^(4/3) (:data:`PARDISO_3D`, :data:`SUPERLU_3D`)."""
     if ndofs <= 0:
         return 0.0
+    if dim == 3:
+        a, b = PARDISO_3D if backend == "pardiso" else SUPERLU_3D
+        per_dof = max(PARDISO_MIN, a * float(ndofs) ** (1.0 / 3.0) + b)
+        return ndofs * per_dof + (0.5 if backend == "pardiso" else 0.6) * float(condensed) ** 2
     if backend == "pardiso":
         per_dof = max(PARDISO_MIN, PARDISO_SLOPE * math.log2(max(ndofs, 2)) - PARDISO_OFFSET)
         return ndofs * per_dof + 0.5 * float(condensed) ** 2
@@ -94,8 +119,18 @@ def factor_entries(ndofs: int, condensed: int, backend: str | None = None) -> fl
 
 
 def stiffness_entries(body) -> int:
-    """Structural nnz of a body's stiffness, from its mesh (nothing assembled)."""
+    """Structural nnz of a body's stiffness, from its mesh (nothing assembled). 3D: counted
+    exactly, the distinct pairs of points sharing an element (nine entries each)."""
     mesh = body.mesh
+    if body.dim == 3:
+        import scipy.sparse as sp
+
+        t = mesh.t if body.order == 1 else body.dof_map.element_dofs[::3] // 3
+        k = t.shape[0]
+        rows, cols = np.repeat(t, k, axis=0).ravel(), np.tile(t, (k, 1)).ravel()
+        pattern = sp.coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)),
+                                shape=(body.npoints, body.npoints)).tocsr()
+        return 9 * int(pattern.nnz)
     k = body.element().doflocs.shape[0]  # points per element
     per_facet = 1 if body.order == 1 else 3  # pairs of points on a shared edge
     interior = int((mesh.f2t[1] >= 0).sum())
@@ -110,9 +145,9 @@ def estimate(surfaces, pairs=(), backend: str | None = None) -> dict[str, float]
     parts = dict.fromkeys(("factors", "dense", "stiffness", "pairs", "large"), 0.0)
     for s in surfaces:
         body = s.body
-        ndofs = 2 * body.npoints
+        ndofs = body.dim * body.npoints
         m = len(s.condensed_dofs)
-        parts["factors"] += FACTOR_BYTES * factor_entries(ndofs, m, backend)
+        parts["factors"] += FACTOR_BYTES * factor_entries(ndofs, m, backend, body.dim)
         parts["dense"] += (PARDISO_DENSE_BYTES if backend == "pardiso" else DENSE_BYTES) \
             * float(m) ** 2
         parts["stiffness"] += STIFFNESS_BYTES * stiffness_entries(body)
