@@ -180,8 +180,9 @@ def run(p: CircularPunchParameters, out, on_step=None, figures: bool = True,
 
 
 def figures(folder) -> list[Path]:
-    """``pressure.png``: both bodies' nodal pressure over the mean pressure P / (pi a^2)
-    against r / a up to 0.95 a, with Boussinesq's curve; ``pressure_map.png``: the block's
+    """``pressure.png``: the block's nodal pressure over the mean pressure P / (pi a^2)
+    against r / a up to 0.95 a, with Boussinesq's curve (the punch's face, on the same nodes,
+    reads the same); ``pressure_map.png``: the block's
     pressure seen from above (clipped at three times the mean: the rim's nodes carry the
     singularity)."""
     from ..io import plots
@@ -194,23 +195,24 @@ def figures(folder) -> list[Path]:
     rho = np.linspace(0.0, PLOTTED, 200)
     curves, block_map = [], None
     for frame in folder.steps[-1].bodies:
+        if frame.name != "block":  # (the punch's face reads the same: its nodes are the block's)
+            continue
         c = folder.contact(folder.steps[-1], frame)
         r = np.hypot(c.x[:, 0], c.x[:, 1]) / a
         keep = r <= PLOTTED
         order = np.argsort(r[keep])
-        curves.append((f"{frame.name} (nodal force / undeformed area)", r[keep][order],
+        curves.append(("the block's nodes (nodal force / undeformed area)", r[keep][order],
                        c.pressure[keep][order] / mean, rho, 0.5 / np.sqrt(1.0 - rho * rho)))
-        if frame.name == "block":
-            near = r < 1.3
-            block_map = (c.x[near, 0] / a, c.x[near, 1] / a, c.pressure[near] / mean)
+        near = r < 1.3
+        block_map = (c.x[near, 0] / a, c.x[near, 1] / a, c.pressure[near] / mean)
     out = folder.directory
     blk = b["block"]
     plots.profiles(out / "pressure.png", curves, "r / a (undeformed radius over the punch's)",
                    "p / (P / pi a^2) (pressure over the mean)",
-                   f"Flat circular punch, {s['dofs']} dofs: the block within "
-                   f"{blk['largest_error']:.2%} of\nBoussinesq over r < {INNER:g} a (RMS "
-                   f"{blk['rms_error']:.2%}); line: Boussinesq (rigid punch,\nhalf-space); "
-                   f"the rim's nodes (r > {PLOTTED:g} a, singular) off the plot")
+                   f"Flat circular punch, {s['dofs']} dofs: within "
+                   f"{blk['largest_error']:.2%}\nof Boussinesq over r < {INNER:g} a (RMS "
+                   f"{blk['rms_error']:.2%})\nline: Boussinesq; rim nodes (r > {PLOTTED:g} a) "
+                   f"off the plot")
     files = [out / "pressure.png"]
     if block_map is not None:
         x, y, q = block_map

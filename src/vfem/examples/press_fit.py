@@ -197,14 +197,18 @@ def run(p: PressFitParameters, out, on_step=None, figures: bool = True,
 
 def figures(folder) -> list[Path]:
     """``pressure.png``: both bodies' nodal contact pressure over Lame's against the angle
-    around the axis, every layer of nodes."""
+    around the axis, every layer of nodes, at the fit (before a push)."""
     from ..io import plots
 
     s = folder.summary
     if not folder.has_steps or "lame" not in s:
         return []
     target = s["lame"]["lame_pressure"]
-    last = folder.steps[-1]
+    # the fit (with a push, the step at load factor 0.5: the evaluation's, before any slip)
+    fit = next((st for st in folder.steps
+                if s["parameters"].get("push", 0) > 0 and st.load_factor == 0.5),
+               folder.steps[-1])
+    last = fit
     curves = []
     for frame in last.bodies:
         c = folder.contact(last, frame)
