@@ -383,6 +383,9 @@ def examples_sphere_study() -> str:
     cases += [("whole", {"quarter": False}), ("quarter, flat first", {"swap_bodies": True}),
               ("quarter, tetrahedral sphere", {"sphere_cells": "tet"}),
               ("quarter, tetrahedra both", {"sphere_cells": "tet", "flat_cells": "tet"})]
+    cases += [("quarter, quadratic tetrahedra both", {"sphere_cells": "tet", "flat_cells": "tet",
+                                                      "order": 2, "facets_per_radius": n})
+              for n in (4, 6)]
     for label, kw in cases:
         p = sphere.Parameters(steps=1, **kw)
         model = sphere.build(p)

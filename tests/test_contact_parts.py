@@ -219,7 +219,8 @@ def test_each_setting_picks_one_formulation_that_implements_the_contract(method,
     # (C16)
     paired = cls in (PairedContact, LargeDeformationContact)
     assert caps.dimensions == ((2, 3) if paired else (2,))
-    assert caps.orders_3d == ((1,) if paired else ())
+    assert caps.orders_3d == ({PairedContact: (1, 2), LargeDeformationContact: (1,)}
+                              .get(cls, ()))  # quadratic: tetrahedra, small, frictionless
     # Coulomb friction: the frictional formulations' (vfem), the lagrange baseline's
     assert caps.friction == (("frictionless", "coulomb") if cls is GlobalContact
                              else ("frictionless",))
@@ -227,11 +228,14 @@ def test_each_setting_picks_one_formulation_that_implements_the_contract(method,
     assert caps.cuts_steps == (cls is not GlobalContact)
 
 
-def fake_model(order=1, dim=2, large=False, **settings):
+def fake_model(order=1, dim=2, large=False, corners=4, **settings):
     """Two alike bodies that may touch (``contact_pairs`` None: every pair): a body that may
-    touch none is not the contact formulation's to refuse (``bodies_that_may_touch``)."""
+    touch none is not the contact formulation's to refuse (``bodies_that_may_touch``).
+    ``corners``: of an element (3D: 4 tetrahedra, 8 hexahedra)."""
     bodies = [SimpleNamespace(name=name, order=order, large=large, platen=None,
-                              mesh=SimpleNamespace(p=np.zeros((dim, 3)))) for name in "ab"]
+                              mesh=SimpleNamespace(p=np.zeros((dim, 3)),
+                                                   t=np.zeros((corners, 1), dtype=int)))
+              for name in "ab"]
     return SimpleNamespace(name="m", bodies=bodies, contact=ContactSettings(**settings),
                            contact_pairs=None)
 
@@ -250,8 +254,11 @@ def test_the_model_checks_read_the_declared_capabilities():
     with pytest.raises(InputError, match="thesis contact supports 2D bodies, this one is 3D"):
         check_capabilities(fake_model(dim=3, variant="thesis"))
     check_capabilities(fake_model(dim=3, large=True))  # large kinematics in 3D (C16)
-    with pytest.raises(InputError, match="3D contact supports linear elements only"):
-        check_capabilities(fake_model(order=2, dim=3))
+    check_capabilities(fake_model(order=2, dim=3))  # quadratic tetrahedra (2026-11-28)
+    with pytest.raises(InputError, match="3D contact of quadratic hexahedra"):
+        check_capabilities(fake_model(order=2, dim=3, corners=8))
+    with pytest.raises(InputError, match="3D contact with friction supports linear elements"):
+        check_capabilities(fake_model(order=2, dim=3, friction=0.3))
     check_capabilities(fake_model(dim=3, friction=0.3))  # friction in 3D, small (C13)
     with pytest.raises(InputError, match="friction in 3D contact is available with small "
                                          "kinematics only"):

@@ -119,11 +119,15 @@ def test_a_2d_mesh_file_given_three_translation_values(capsys, tmp_path):
                                           "(dx, dy) for the 2D mesh of file 'square.inp', got 3")
 
 
-def test_a_curve_on_a_3d_mesh_is_refused(capsys, tmp_path):
+def test_a_curve_on_a_hexahedral_mesh_or_with_a_2d_centre_is_refused(capsys, tmp_path):
     text = BOX_PATCH + ('\n[bodies.mesh.curve]\nboundary = "top"\ncentre = [0.0, 0.0]\n'
                         'radius = 1.0\n')
-    check_refuses(capsys, tmp_path, text, "body 'upper': mesh.curve: curved facets on a circle "
-                                          "are for 2D meshes; the 3D shape 'box' has none")
+    check_refuses(capsys, tmp_path, text, "body 'upper': mesh.curve: curved facets in 3D are "
+                                          "for tetrahedra (on a sphere); the 3D shape 'box' is "
+                                          "of hexahedra")
+    text = text.replace('tetrahedra = false', 'tetrahedra = true')
+    check_refuses(capsys, tmp_path, text, "mesh.curve.centre: expected 3 values for the 3D "
+                                          "shape 'box', got 2")
 
 
 # -- loads and components by the body's dimension ----------------------------------------------

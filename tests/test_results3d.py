@@ -337,16 +337,16 @@ def test_a_model_of_2d_and_3d_bodies_is_refused():
 
 
 def test_3d_bodies_that_may_touch_are_refused_where_3d_contact_is_not_there():
-    """3D contact (issue 21, C10) is the paired variant's, frictionless, of linear elements:
-    two quadratic 3D bodies that may touch (every pair, by default) are refused, each named;
-    linear ones are accepted."""
+    """3D contact (issue 21, C10) is the paired variant's, frictionless, of linear elements
+    and quadratic tetrahedra: two quadratic hexahedral bodies that may touch (every pair, by
+    default) are refused, each named; linear ones are accepted."""
     model = boxes("hex", 2)
     model.contact_pairs = None
-    with pytest.raises(InputError, match=r"body 'rollers': 3D contact supports linear "
-                                         r"elements only"):
+    with pytest.raises(InputError, match=r"body 'rollers': 3D contact of quadratic "
+                                         r"hexahedra \(9-node facets\) is not implemented"):
         model.validate()
     model.contact_pairs = (("rollers", "clamped"),)
-    with pytest.raises(InputError, match="quadratic 3D contact is not implemented yet"):
+    with pytest.raises(InputError, match="3D contact of quadratic hexahedra"):
         model.validate()
     boxes("hex", 1).validate()
     linear = boxes("hex", 1)

@@ -109,9 +109,34 @@ def test_an_offset_box_transfers_over_the_overlap_only(upper_compat):
     np.testing.assert_array_equal((T @ q)[out], 0.0)
 
 
-def test_quadratic_facets_are_refused():
-    sf, sc = _surface("tet", 2, True, order=2), _surface("hex", 2, False)
-    with pytest.raises(NotImplementedError, match="linear facets"):
+@pytest.mark.parametrize("upper_compat", [True, False], ids=["upper-compat", "lower-compat"])
+@pytest.mark.parametrize(("other", "n", "order", "degree"), [("tet", 5, 2, 2), ("hex", 2, 1, 1)],
+                         ids=["t6-t6", "t6-q4"])
+def test_quadratic_triangles_transfer_a_traction_they_interpolate_exactly(other, n, order,
+                                                                         degree, upper_compat):
+    """Quadratic tetrahedra's 6-node facets, clipped as their four corner-and-midpoint
+    triangles (``FacetKind.linear_pieces``) with the degree-5 rule: a quadratic traction
+    between two of them, a linear one against linear hexahedra, gives both sides' consistent
+    loads to round-off, and the columns balance."""
+    upper = _surface("tet", 3, True, order=2)
+    lower = _surface(other, n, False, order=order)
+    sf, sc = (upper, lower) if upper_compat else (lower, upper)
+    N, T = _transfer(sf, sc)
+
+    def field(x):
+        linear = 1.0 + 0.7 * x[:, 0] - 0.4 * x[:, 1]
+        return linear + (0.5 * x[:, 0] * x[:, 1] - 0.3 * x[:, 1] ** 2 if degree == 2 else 0.0)
+
+    q = field(sf.X[: sf.nc])
+    np.testing.assert_allclose(N @ q, _consistent(sf, q), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(T @ q, _consistent(sc, field(sc.X[: sc.nc])), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.asarray(T.sum(axis=0)).ravel(),
+                               np.asarray(N.sum(axis=0)).ravel(), rtol=0, atol=1e-12)
+
+
+def test_quadratic_quadrilaterals_are_refused():
+    sf, sc = _surface("hex", 2, True, order=2), _surface("hex", 2, False)
+    with pytest.raises(NotImplementedError, match="quadratic hexahedra"):
         _transfer(sf, sc)
 
 

@@ -61,17 +61,19 @@ SOLID_SHAPES = ("box", "cylinder", "ring")
 
 @dataclass(frozen=True)
 class Curve:
-    """Quadratic geometry on a circular boundary (bodies with ``order = 2``).
+    """Quadratic geometry on a circular boundary (bodies with ``order = 2``), or in 3D on a
+    spherical one (tetrahedra).
 
     Attributes:
         boundary: the boundary whose facet midpoints are moved onto the circle (its vertices
-            must already lie on it), e.g. a cylinder's arc.
-        centre: the circle's centre (x, y).
-        radius: the circle's radius.
+            must already lie on it), e.g. a cylinder's arc; in 3D the midpoints of the edges
+            of its triangles, onto the sphere (a sphere's cap).
+        centre: the circle's centre (x, y); the sphere's (x, y, z).
+        radius: the circle's (sphere's) radius.
     """
 
     boundary: str
-    centre: tuple[float, float]
+    centre: tuple[float, ...]
     radius: float
 
 
@@ -91,7 +93,8 @@ class MeshSpec:
             file (every 3D element, if it has any).
         translate: moves the mesh by (dx, dy) after it is made; (dx, dy, dz) for a 3D mesh.
         curve: puts the facet midpoints of a circular boundary on the circle (quadratic
-            elements only, 2D meshes only).
+            elements only); of a tetrahedral mesh, the triangles' edge midpoints of a
+            spherical boundary on the sphere.
         parameters: the shape's parameters (in an input file: the other keys of the mesh
             table, not a key of its own).
     """
@@ -132,9 +135,12 @@ class MeshSpec:
         if self.curve is not None:
             from .mesh.quadratic import curved
 
-            if dim != 2:
-                raise InputError(f"mesh.curve: curved facets on a circle are for 2D meshes; "
-                                 f"{what} has none (remove mesh.curve)")
+            if dim == 3 and mesh.t.shape[0] != 4:
+                raise InputError(f"mesh.curve: curved facets in 3D are for tetrahedra (on a "
+                                 f"sphere); {what} is of hexahedra (remove mesh.curve)")
+            if len(self.curve.centre) != dim:
+                raise InputError(f"mesh.curve.centre: expected {dim} values for {what}, got "
+                                 f"{len(self.curve.centre)}")
             if self.curve.boundary not in (mesh.boundaries or {}):
                 raise InputError(f"mesh.curve: no boundary named {self.curve.boundary!r}; the "
                                  f"mesh has {', '.join(sorted(mesh.boundaries or {}))}")

@@ -58,31 +58,44 @@ class Boundary3:
 
     nodes: np.ndarray  # (nb,)
     triangles: np.ndarray  # (nt, 3) local numbers, counter-clockwise seen from outside
-    owner: np.ndarray  # (nt,) the boundary facet each triangle is part of
-    facets: np.ndarray  # (nf, 3 or 4) local numbers of the facets, oriented
+    owner: np.ndarray  # (nt,) the facet (row of ``facets``) each triangle is part of
+    facets: np.ndarray  # (nf, 3 or 4) local numbers of the facets (a T6's pieces), oriented
     mirror: np.ndarray  # (nt,) bool: the triangle lies on a symmetry plane
     segments: np.ndarray  # (ne, 2) the facets' sides (local numbers): the nodes' neighbours
     large: bool
+    #: quadratic triangles: each corner with each midpoint of its facets' edges from it,
+    #: (m, 2) local numbers (unique), for (c)'s measure; None on linear facets
+    corner_mid: np.ndarray | None = None
 
     @classmethod
     def of(cls, body: Body, symmetry: np.ndarray) -> Boundary3:
         """``symmetry``: the body's facets on a symmetry plane
         (:func:`vfem.contact.check._symmetry_facets`)."""
-        if body.order != 1:
-            raise NotImplementedError(
-                f"the invariants of 3D contact on body {body.name!r}: quadratic elements are "
-                "not supported yet (linear triangle and quadrilateral facets only)")
         mesh = body.mesh
         bf = mesh.boundary_facets()
         fp = body.facet_points(bf).copy()
+        if body.order != 1 and fp.shape[1] != 6:
+            raise NotImplementedError(
+                f"the invariants of 3D contact on body {body.name!r}: quadratic hexahedra are "
+                "not supported yet (linear facets and quadratic triangles only)")
+        kind = kind_of(3, fp)
         if len(bf):
             elem = mesh.f2t[0, bf]
             centroid = body.points[:, mesh.t[:, elem]].mean(axis=1).T
-            kind_of(3, fp).orient(body.points, fp, centroid)
+            kind.orient(body.points, fp, centroid)
+        # a quadratic triangle is read as its four corner-and-midpoint triangles (the contact's
+        # own pieces, FacetKind.linear_pieces): exact where its edges are straight; on a curved
+        # one the faceting allowance covers the pieces' sag
+        corner_mid = None
+        if fp.shape[1] == 6:  # T6: corner 0 with midpoints 3 (0-1) and 5 (0-2), and so on
+            corner_mid = np.unique(np.vstack([fp[:, [c, m]] for c, m in
+                                              ((0, 3), (0, 5), (1, 3), (1, 4), (2, 4), (2, 5))]),
+                                   axis=0)
+        fp, piece_of = kind.linear_pieces(fp)[:2]
         split = [(0, 1, 2)] if fp.shape[1] == 3 else [(0, 1, 2), (0, 2, 3)]
         tri = np.vstack([fp[:, s] for s in split])
         owner = np.tile(np.arange(len(fp)), len(split))
-        mirror = np.isin(bf, symmetry)[owner]
+        mirror = np.isin(bf, symmetry)[piece_of][owner]
         k = fp.shape[1]
         sides = np.vstack([fp[:, [c, (c + 1) % k]] for c in range(k)])
         sides = np.unique(np.sort(sides, axis=1), axis=0)
@@ -91,7 +104,8 @@ class Boundary3:
         lookup[nodes] = np.arange(len(nodes))
         return cls(nodes=nodes, triangles=lookup[tri], owner=owner,
                    facets=local.reshape(fp.shape), mirror=mirror,
-                   segments=lookup[sides].reshape(-1, 2), large=body.large)
+                   segments=lookup[sides].reshape(-1, 2), large=body.large,
+                   corner_mid=None if corner_mid is None else lookup[corner_mid])
 
 
 def _barycentric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -330,9 +344,16 @@ def linearised_depth(check: InvariantCheck, i: int, j: int, node: np.ndarray,
 
 def tension(check: InvariantCheck, F: list[np.ndarray], own: list[Surface3],
             out: Invariants) -> None:
-    """(c), the nodal measure, on 3D bodies (linear facets: F·n at every node)."""
+    """(c), the nodal measure, on 3D bodies: F·n at every node of linear facets. On quadratic
+    triangles (T6) a corner's shape function L (2 L - 1) is negative near the far edge, so a
+    compressive traction can put a tensile force on a corner (none at all under a uniform one);
+    but phi_corner + (phi_mid1 + phi_mid2) / 2 = L >= 0 on each facet (the midpoints of its
+    two edges from the corner), so the corner is read with half of each such midpoint's force
+    (a midpoint's own phi = 4 L x >= 0: alone), and a body with quadratic elements takes the
+    quadratic tolerance, as in 2D (:mod:`vfem.contact.check`'s docstring)."""
     scale = max((float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in F), default=0.0)
-    out.tension_tolerance = check.tension_tolerance
+    out.tension_tolerance = min((check._tolerance(b) for b in check.bodies),
+                                default=check.tension_tolerance)
     if scale == 0:
         return
     worst = None
@@ -340,11 +361,18 @@ def tension(check: InvariantCheck, F: list[np.ndarray], own: list[Surface3],
         if not len(f):
             continue
         fn = np.einsum("ij,ij->i", f, g.normals)
+        if g.b.corner_mid is not None:
+            corner, mid = g.b.corner_mid.T
+            patch = fn.copy()
+            np.add.at(patch, corner, 0.5 * fn[mid])
+            patch[mid] = fn[mid]
+            fn = patch
         k = int(np.argmax(fn))
-        ratio = fn[k] / scale / check.tension_tolerance
+        ratio = fn[k] / scale / check._tolerance(b)
         if fn[k] > 0 and (worst is None or ratio > worst[0]):
             worst = (ratio, float(fn[k]), b, int(g.b.nodes[k]))
     if worst is not None:
         _, value, b, node = worst
         out.tension = value / scale
+        out.tension_tolerance = check._tolerance(b)
         out.tension_where = {"body": b.name, "node": node, "value": value}

@@ -429,6 +429,29 @@ class _Facet3D(FacetKind):
         at = facets3d.outside(self.geometry, np.reshape(xi_free, (-1, 2)), -facets3d.OUTSIDE)
         return (at & boundary[seg]).any(axis=1)
 
+    def linear_pieces(self, facets: np.ndarray):
+        """The facets as linear pieces for the overlap's clipping: (pieces (m, 3 or 4) node
+        numbers, parent (m,) the row of ``facets`` each comes from, origin (m, 2) and axes
+        (m, 2, 2): the piece's local coordinates mapped affinely into its parent's,
+        ``xi = origin + axes @ xi_piece``). Linear facets are their own piece; a quadratic
+        triangle (T6) is its four corner-and-midpoint triangles, exact where its edges are
+        straight, second order on a curved one."""
+        facets = np.asarray(facets)
+        m = len(facets)
+        if self.order == 1:
+            return (facets[:, : self.corners], np.arange(m), np.zeros((m, 2)),
+                    np.broadcast_to(np.eye(2), (m, 2, 2)).copy())
+        # T6: corners 0, 1, 2, midpoints 3 (0-1), 4 (1-2), 5 (0-2); each piece counter-
+        # clockwise as its parent, given by its corners in the parent's coordinates
+        local = np.array([[0, 3, 5], [3, 1, 4], [5, 4, 2], [4, 5, 3]])
+        ref = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.5, 0.0], [0.5, 0.5],
+                        [0.0, 0.5]])
+        pieces = facets[:, local].reshape(-1, 3)  # parent-major: facet f's pieces 4f..4f+3
+        parent = np.repeat(np.arange(m), 4)
+        c = ref[local]  # (4, 3, 2)
+        axes = np.stack([c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]], axis=2)  # columns: d/dxi_p
+        return pieces, parent, np.tile(c[:, 0], (m, 1)), np.tile(axes, (m, 1, 1))
+
     def overlap_quadrature(self, sf, fpatch, sc, cpatch, cnormals, reach, xf, xc):
         """:func:`~vfem.contact.overlap3d.overlap_quadrature` on the facets of ``fpatch``
         against those of ``cpatch`` whose bounding spheres come within ``reach``
@@ -441,17 +464,24 @@ class _Facet3D(FacetKind):
         is not the undeformed ``sf.X``. Linear facets (T3, Q4) only."""
         from . import overlap3d
 
-        if self.order != 1 or sc.kind.order != 1:
-            raise NotImplementedError(
-                f"the 3D overlap quadrature is for linear facets (T3, Q4) only, got {self!r} "
-                f"against {sc.kind!r}: quadratic 3D contact is not implemented yet")
+        for kind in (self, sc.kind):
+            if kind.order != 1 and not kind.geometry.simplex:
+                raise NotImplementedError(
+                    f"the 3D overlap quadrature takes linear facets (T3, Q4) and quadratic "
+                    f"triangles (T6), got {kind!r}: contact of quadratic hexahedra (Q9 facets) "
+                    "is not implemented yet")
         fpatch = np.asarray(fpatch, dtype=np.int64)
         cpatch = np.asarray(cpatch, dtype=np.int64)
-        comp = sf.facets[fpatch][:, : self.corners]
-        opp = sc.facets[cpatch][:, : sc.kind.corners]
+        comp, parent, origin, axes = self.linear_pieces(sf.facets[fpatch])
+        opp = sc.kind.linear_pieces(sc.facets[cpatch])[0]
+        quadratic = self.order == 2 or sc.kind.order == 2
         pairs = overlap3d.candidate_pairs(xf, comp, xc, opp, reach)
-        q = overlap3d.overlap_quadrature(xf, comp, xc, opp, pairs, max_distance=reach)
-        fac, xi, wts = fpatch[q.comp_facet], q.comp_xi, q.weight
+        q = overlap3d.overlap_quadrature(xf, comp, xc, opp, pairs, max_distance=reach,
+                                         degree=4 if quadratic else None)
+        piece = q.comp_facet
+        fac = fpatch[parent[piece]]
+        xi = origin[piece] + np.einsum("pij,pj->pi", axes[piece], q.comp_xi)
+        wts = q.weight
         if len(fac) and not np.array_equal(xf[: sf.nc], sf.X[: sf.nc]):
             _, now = self.surface_map(xf, sf.facets[fac], xi)
             _, ref = self.surface_map(sf.X, sf.facets[fac], xi)

@@ -149,10 +149,18 @@ def check_capabilities(model) -> None:
                              "variant, small kinematics and linear elements (a 3D body that "
                              "touches no other runs without contact)")
         if dim == 3 and b.order not in caps.orders_3d:
-            raise InputError(f"model {model.name!r}, body {b.name!r}: 3D contact supports "
-                             "linear elements only (order 1); quadratic 3D contact is not "
-                             "implemented yet (a 3D body that touches no other may be "
+            raise InputError(f"model {model.name!r}, body {b.name!r}: 3D contact "
+                             + ("with friction " if settings.frictional else "")
+                             + ("supports linear elements only (order 1)"
+                                if caps.orders_3d == (1,) else "supports linear elements and "
+                                "quadratic tetrahedra")
+                             + "; use linear elements (a 3D body that touches no other may be "
                              "quadratic)")
+        if dim == 3 and b.order == 2 and b.mesh.t.shape[0] == 8:
+            raise InputError(f"model {model.name!r}, body {b.name!r}: 3D contact of quadratic "
+                             "hexahedra (9-node facets) is not implemented; use quadratic "
+                             "tetrahedra or linear hexahedra (a 3D body that touches no other "
+                             "may be a quadratic hexahedron)")
 
 def bodies_that_may_touch(model) -> set[str]:
     """The names of the bodies in a pair that may touch (``contact_pairs``, by default every

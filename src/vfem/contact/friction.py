@@ -328,7 +328,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     """The paired variant with Coulomb friction, small displacements (module docstring)."""
 
     capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
-                                       friction=("frictionless", "coulomb"))
+                                       friction=("frictionless", "coulomb"), orders_3d=(1,))
     state_type = FrictionState
 
     def __init__(self, surfaces, pairs, settings, backend: str | None = None):

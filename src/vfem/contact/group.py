@@ -62,6 +62,39 @@ def bordered_matrix(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: 
     return A
 
 
+
+def quadratic_3d(s) -> bool:
+    """Whether ``s`` is a 3D surface of quadratic facets (with candidate facets)."""
+    return s.dim == 3 and s.kind is not None and s.kind.order == 2 and len(s.facets) > 0
+
+
+def quadratic_status(s, participating: np.ndarray) -> np.ndarray:
+    """In contact, on quadratic triangles (T6): a node the formulation counts in (the
+    compatibility side's positive tractions, the other side's compressive forces), and a
+    corner both of whose edge midpoints in one of its facets are: a corner's force is zero
+    under a uniform pressure and of either sign under a varying one, so it cannot tell."""
+    on = np.asarray(participating, dtype=bool).copy()
+    f = s.facets  # (nf, 6): corners 0, 1, 2, midpoints 3 (0-1), 4 (1-2), 5 (0-2)
+    for corner, m1, m2 in ((0, 3, 5), (1, 3, 4), (2, 4, 5)):
+        both = on[f[:, m1]] & on[f[:, m2]]
+        on[f[both, corner]] = True
+    return on
+
+
+def consistent_pressure(s, force: np.ndarray) -> np.ndarray:
+    """The nodal pressure of normal nodal forces ``force`` (nc,) on surface ``s``: force over
+    tributary (the traction averaged with each node's shape function, ``BodyStepResult.
+    contact_pressure``); on quadratic triangles (3D, T6), whose corners' shape functions
+    integrate to zero (a uniform pressure puts no force on them), the consistent pressure
+    instead, the nodal values p with N p = force (N the surface's mass matrix, ∫ phi phi^T):
+    exact for any pressure the facets can represent (the 3D patch test's to round-off)."""
+    if quadratic_3d(s):
+        from scipy.sparse.linalg import spsolve
+
+        N = s.mass_matrix(np.ones(len(s.facets))).tocsc()
+        return np.asarray(spsolve(N, force), dtype=float).ravel()
+    return force / s.tributary
+
 class ReusedFactor:
     """The LU factors of the last matrix solved, kept for as long as the matrix recurs.
 
@@ -167,13 +200,16 @@ class SurfaceGroup:
             force = np.zeros((nv, s.dim))
             force[cand] = F
             pressure = np.zeros(nv)
-            pressure[cand] = np.where(p.other >= 0, p.force, 0.0) / s.tributary
+            pressure[cand] = consistent_pressure(s, np.where(p.other >= 0, p.force, 0.0))
             traction = None
             if p.pressure is not None:  # the formulation's traction field (paired)
                 traction = np.zeros(nv)
                 traction[cand] = p.pressure
             status = np.zeros(nv, dtype=int)
-            status[cand] = p.participating & (p.force > 0)
+            if quadratic_3d(s):
+                status[cand] = quadratic_status(s, p.participating)
+            else:
+                status[cand] = p.participating & (p.force > 0)
             pen = np.zeros(nv)
             pen[cand] = np.where(np.isfinite(p.penetration), p.penetration, 0.0)
             out[b.name] = add_reactions(

@@ -228,7 +228,8 @@ class OverlapQuadrature:
 
 def overlap_quadrature(comp_points: np.ndarray, comp_facets: np.ndarray,
                        opp_points: np.ndarray, opp_facets: np.ndarray, pairs: np.ndarray,
-                       max_distance: float | None = None) -> OverlapQuadrature:
+                       max_distance: float | None = None, degree: int | None = None
+                       ) -> OverlapQuadrature:
     """Quadrature points of the overlap of each candidate pair (compatibility facet, opposing
     facet), ``pairs`` (p, 2): the opposing facet projected along the compatibility facet's
     normal onto its plane, clipped by the compatibility facet, fanned into triangles and given
@@ -238,6 +239,10 @@ def overlap_quadrature(comp_points: np.ndarray, comp_facets: np.ndarray,
     compatibility plane (either side) gives no point (2D's ``reach``). Pairs are the caller's
     choice otherwise (:func:`candidate_pairs` finds those whose facets may overlap; facing and
     the patch boundary are the pairing's); a pair listed twice counts twice.
+
+    ``degree``: the degree the rule must integrate exactly, when the facets given are linear
+    pieces of quadratic ones (their shape functions of degree 2 in the pieces' coordinates:
+    4, Radon's degree-5 rule); default from the corners (module docstring).
     """
     comp_points = np.asarray(comp_points, float)
     opp_points = np.asarray(opp_points, float)
@@ -276,7 +281,9 @@ def overlap_quadrature(comp_points: np.ndarray, comp_facets: np.ndarray,
     cb = C[:, 2:] - C[:, :1]
     facet_area = 0.5 * np.abs(ca[..., 0] * cb[..., 1] - ca[..., 1] * cb[..., 0]).sum(axis=1)
     row, tri = np.nonzero(area > SLIVER * facet_area[:, None])
-    L, gw = _RULE2 if _degree(kc) + max(_degree(kc), _degree(ko)) <= 2 else _RULE5
+    if degree is None:
+        degree = _degree(kc) + max(_degree(kc), _degree(ko))
+    L, gw = _RULE2 if degree <= 2 else _RULE5
     P0, P1, P2 = V[row, 0], V[row, tri + 1], V[row, tri + 2]
     pts = (L[None, :, 0, None] * P0[:, None] + L[None, :, 1, None] * P1[:, None]
            + L[None, :, 2, None] * P2[:, None]).reshape(-1, 2)

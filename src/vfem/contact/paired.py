@@ -341,7 +341,7 @@ class PairedContact(PairSet):
 
     capabilities = Capabilities(
         name="paired", orders=(1, 2), kinematics=("small",), dimensions=(2, 3),
-        friction=("frictionless",), orders_3d=(1,))
+        friction=("frictionless",), orders_3d=(1, 2))
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
                  backend: str | None = None):
