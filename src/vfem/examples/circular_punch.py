@@ -161,14 +161,9 @@ def evaluate(result: AnalysisResult, p: CircularPunchParameters) -> dict:
 def summarize(result: AnalysisResult, p: CircularPunchParameters) -> dict:
     """The ``summary.json`` dictionary of a run: :func:`~vfem.io.results.example_summary` with
     the bodies' sizes and, at full load, ``boussinesq``."""
-    from ..io.results import contact_sizes, example_summary
+    from ..io.results import solid_summary
 
-    summary = example_summary("circular_punch", result, p)
-    summary.update(contact_sizes(result), pressure_measure="nominal: nodal contact force / "
-                   "undeformed tributary area")
-    if result.steps and result.steps[-1].load_factor == 1.0:
-        summary["boussinesq"] = evaluate(result, p)
-    return summary
+    return solid_summary("circular_punch", result, p, "boussinesq", evaluate)
 
 
 def run(p: CircularPunchParameters, out, on_step=None, figures: bool = True,

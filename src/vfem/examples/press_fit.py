@@ -177,14 +177,9 @@ def evaluate(result: AnalysisResult, p: PressFitParameters) -> dict:
 def summarize(result: AnalysisResult, p: PressFitParameters) -> dict:
     """The ``summary.json`` dictionary of a press fit run: :func:`~vfem.io.results.
     example_summary` with the bodies' sizes and ``lame``."""
-    from ..io.results import contact_sizes, example_summary
+    from ..io.results import solid_summary
 
-    summary = example_summary("press_fit", result, p)
-    summary.update(contact_sizes(result), pressure_measure="nominal: nodal contact force / "
-                   "undeformed tributary area")
-    if result.steps and result.steps[-1].load_factor == 1.0:
-        summary["lame"] = evaluate(result, p)
-    return summary
+    return solid_summary("press_fit", result, p, "lame", evaluate)
 
 
 def run(p: PressFitParameters, out, on_step=None, figures: bool = True,

@@ -204,15 +204,11 @@ def evaluate(result: AnalysisResult, p: SphereParameters) -> dict:
 def summarize(result: AnalysisResult, p: SphereParameters) -> dict:
     """The ``summary.json`` dictionary of a sphere run: :func:`~vfem.io.results.example_summary`
     with the platen's motion per step, the bodies' sizes and, at full load, ``hertz``."""
-    from ..io.results import contact_sizes, example_summary
+    from ..io.results import solid_summary
 
-    summary = example_summary("sphere", result, p)
+    summary = solid_summary("sphere", result, p, "hertz", evaluate)
     for record, step in zip(summary["steps"], result.steps):
         record["platen_displacement"] = step.platen_displacement
-    summary.update(contact_sizes(result), pressure_measure="nominal: nodal contact force / "
-                   "undeformed tributary area")
-    if result.steps and result.steps[-1].load_factor == 1.0:
-        summary["hertz"] = evaluate(result, p)
     return summary
 
 

@@ -560,6 +560,18 @@ def contact_sizes(result: AnalysisResult) -> dict:
             "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces))}
 
 
+def solid_summary(name: str, result: AnalysisResult, parameters, key: str, evaluate) -> dict:
+    """A 3D example's ``summary.json`` (sphere, press fit, circular punch):
+    :func:`example_summary`, the bodies' sizes (:func:`contact_sizes`), the pressure measure and,
+    when the last step is at full load, ``evaluate(result, parameters)`` under ``key``."""
+    summary = example_summary(name, result, parameters)
+    summary.update(contact_sizes(result), pressure_measure="nominal: nodal contact force / "
+                   "undeformed tributary area")
+    if result.steps and result.steps[-1].load_factor == 1.0:
+        summary[key] = evaluate(result, parameters)
+    return summary
+
+
 def friction_summary(result: AnalysisResult, records: list[dict]) -> dict:
     """With friction (the model's ``contact.frictional``): each step's record (``records``,
     one per ``result.steps``) gets its ``frictional_work`` (:func:`frictional_work`) and its
