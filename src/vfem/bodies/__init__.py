@@ -340,6 +340,32 @@ class Body:
         """The body's displacement components: ``("x", "y")``, or ``("x", "y", "z")`` in 3D."""
         return AXES[: self.dim]
 
+    def symmetry_planes(self) -> list[tuple[np.ndarray, int]]:
+        """The body's symmetry planes, as (boundary facets, axis) per roller ``Support`` (held
+        along one axis only, :meth:`support_components`) whose facets are all flat, normal to
+        that axis and on one plane (x, y, or z in 3D). The model continues across them as
+        their mirror image: no surface that contact sees (the invariants,
+        :func:`vfem.contact.check._symmetry_facets`), no edge of a contact patch
+        (:meth:`vfem.contact.surface.ContactSurface.patch_boundary`), a tangent plane for
+        friction (:func:`vfem.contact.friction.plane_normals`)."""
+        mesh = self.mesh
+        out = []
+        for sup in self.supports:
+            components = self.support_components(sup)
+            if len(components) != 1 or sup.boundary not in (mesh.boundaries or {}):
+                continue
+            facets = np.asarray(mesh.boundaries[sup.boundary])
+            if not len(facets):
+                continue
+            axis = self.components.index(components[0])  # x 0, y 1, z 2
+            ends = mesh.p[:, mesh.facets[:, facets]]  # (dim, nodes of a facet, nf)
+            along = np.ptp(ends[axis], axis=0)  # 2D: |the two ends' difference|
+            size = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=0)
+            coord = ends[axis].ravel()
+            if np.all(along <= 1e-9 * size) and np.ptp(coord) <= 1e-9 * max(size.max(), 1e-300):
+                out.append((facets, axis))
+        return out
+
     def support_components(self, support: Support) -> tuple[str, ...]:
         """The components ``support`` fixes on this body: its own, or by default
         (:class:`AllComponents`) all of the body's."""

@@ -124,27 +124,10 @@ class _Boundary:
 
 
 def _symmetry_facets(body: Body) -> np.ndarray:
-    """Facets on a symmetry plane: on a boundary held in one direction only (a roller
-    ``Support``, :meth:`~vfem.bodies.Body.support_components`), flat and normal to that
-    direction (x, y, or z in 3D). The model continues across them as their mirror image, so
-    they are no surface that contact sees."""
-    mesh = body.mesh
-    out = [np.zeros(0, dtype=np.int64)]
-    for sup in body.supports:
-        components = body.support_components(sup)
-        if len(components) != 1 or sup.boundary not in (mesh.boundaries or {}):
-            continue
-        facets = np.asarray(mesh.boundaries[sup.boundary])
-        if not len(facets):
-            continue
-        axis = body.components.index(components[0])  # x 0, y 1, z 2
-        ends = mesh.p[:, mesh.facets[:, facets]]  # (dim, nodes of a facet, nf)
-        along = np.ptp(ends[axis], axis=0)  # 2D: |the two ends' difference|
-        size = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=0)
-        coord = ends[axis].ravel()
-        if np.all(along <= 1e-9 * size) and np.ptp(coord) <= 1e-9 * max(size.max(), 1e-300):
-            out.append(facets)
-    return np.concatenate(out)
+    """Facets on a symmetry plane (:meth:`~vfem.bodies.Body.symmetry_planes`): the model
+    continues across them as their mirror image, so they are no surface that contact sees."""
+    return np.concatenate([np.zeros(0, dtype=np.int64)]
+                          + [facets for facets, _ in body.symmetry_planes()])
 
 
 class _Polygon(CachedBoundary):

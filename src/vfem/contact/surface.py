@@ -45,24 +45,10 @@ log = logging.getLogger(__name__)
 
 
 def symmetry_planes(body) -> list[tuple[np.ndarray, int]]:
-    """A 3D body's symmetry planes: per roller ``Support`` (held along one axis) whose boundary
-    has flat facets normal to that axis, the mesh nodes on those facets and the axis."""
-    mesh = body.mesh
-    out = []
-    for sup in body.supports:
-        components = body.support_components(sup)
-        if len(components) != 1 or sup.boundary not in (mesh.boundaries or {}):
-            continue
-        facets = np.asarray(mesh.boundaries[sup.boundary])
-        axis = body.components.index(components[0])
-        if not len(facets):
-            continue
-        ends = mesh.p[axis][mesh.facets[:, facets]]  # (nodes of a facet, nf)
-        size = np.ptp(mesh.p, axis=1).max()
-        flat = np.ptp(ends, axis=0) <= 1e-9 * size
-        if flat.any():
-            out.append((np.unique(mesh.facets[:, facets[flat]]), axis))
-    return out
+    """A 3D body's symmetry planes (:meth:`~vfem.bodies.Body.symmetry_planes`) as the mesh
+    nodes on each and its axis."""
+    return [(np.unique(body.mesh.facets[:, facets]), axis)
+            for facets, axis in body.symmetry_planes()]
 
 
 def exterior_facets(body: Body) -> np.ndarray:
