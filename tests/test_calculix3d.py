@@ -1,12 +1,12 @@
 """vfem.tools.calculix in 3D: the sphere example as a CalculiX deck of C3D8/C3D4 elements (always
 checked), and run in ccx when it is installed (the total contact force against the applied one)."""
 
-import shutil
-
 import numpy as np
 import pytest
 from skfem import MeshHex, MeshTet
 
+from test_calculix import blocks as cards  # the deck's cards, as the 2D tests read them
+from test_calculix import needs_ccx
 from vfem.examples import sphere
 from vfem.tools.calculix import (
     C3D4_FACES,
@@ -17,24 +17,10 @@ from vfem.tools.calculix import (
     write_deck,
 )
 
-needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None,
-                               reason="CalculiX (ccx) is not installed")
-
 #: the sphere example at its smallest: 2 facets across a, the bulk's elements 4 times larger
 TINY = {"facets_per_radius": 2, "max_element_size": 4.0, "steps": 1}
 
 
-def cards(text: str) -> list[tuple[str, list[str]]]:
-    """(keyword line, data lines) of a deck, comments dropped."""
-    out = []
-    for line in text.splitlines():
-        if line.startswith("**"):
-            continue
-        if line.startswith("*"):
-            out.append((line.upper(), []))
-        elif out:
-            out[-1][1].append(line)
-    return out
 
 
 @pytest.fixture(scope="module", params=["hex", "tet"])

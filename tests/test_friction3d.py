@@ -104,13 +104,19 @@ def patch(request):
     return out
 
 
-def test_3d_friction_patch_sticks_with_the_applied_shear(patch):
-    model, result, tau = patch["stick"]
+def last_carrying(run):
+    """A patch run checked at every step: its result, shear, the carrying body's last step,
+    its carrying nodes, and the sign of the applied shear's traction on that body."""
+    model, result, tau = run
     check_every_step(result, model)
     name, nodes = carrying(result.steps[-1])
-    r = result.steps[-1].bodies[name]
-    assert np.all(r.friction_status[nodes] == 1)
     sign = -1.0 if name == "upper" else 1.0  # the traction on the carrying body
+    return result, tau, result.steps[-1].bodies[name], nodes, sign
+
+
+def test_3d_friction_patch_sticks_with_the_applied_shear(patch):
+    result, tau, r, nodes, sign = last_carrying(patch["stick"])
+    assert np.all(r.friction_status[nodes] == 1)
     error = np.abs(r.contact_shear[nodes] - sign * tau * OBLIQUE).max() / tau
     assert error < 1e-8
     np.testing.assert_allclose(r.contact_traction[nodes], P, rtol=1e-8)
@@ -118,15 +124,11 @@ def test_3d_friction_patch_sticks_with_the_applied_shear(patch):
 
 
 def test_3d_friction_patch_slips_on_the_cone_along_the_shear(patch):
-    model, result, tau = patch["slip"]
-    check_every_step(result, model)
-    name, nodes = carrying(result.steps[-1])
-    r = result.steps[-1].bodies[name]
+    result, tau, r, nodes, sign = last_carrying(patch["slip"])
     assert np.all(r.friction_status[nodes] == 2)
     s = r.contact_shear[nodes]
     size = np.linalg.norm(s, axis=1)
     assert np.abs(size / (MU * P) - 1).max() < 1e-8  # |s| = mu p
-    sign = -1.0 if name == "upper" else 1.0
     across = np.linalg.norm(np.cross(s / size[:, None], sign * OBLIQUE), axis=1)
     assert across.max() < 1e-8  # s along the applied shear
     assert np.all(sign * s @ OBLIQUE > 0)

@@ -34,7 +34,7 @@ from ..bodies import PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.check import largest_penetrations
 from ..contact.settings import ContactSettings
-from ..io.runner import run_status
+from ..io.runner import run_headline
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -214,10 +214,7 @@ def figures(folder) -> list[Path]:
 
 
 def report(s: dict) -> list[str]:
-    steps = s["steps"]
-    lines = [f"vfem: {run_status(s)} in {len(steps)} "
-             f"step(s), {sum(x['iterations'] for x in steps)} contact iterations, "
-             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+    lines = [run_headline(s, "step(s)")]
     if "block" in s:
         b = s["block"]
         lines.append(f"  contact force {b['contact_force']:.4g}; fixed block's reaction "

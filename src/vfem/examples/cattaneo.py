@@ -33,7 +33,7 @@ from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.friction import coulomb_status, tangents
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import friction_line, run_status
+from ..io.runner import friction_line, run_headline
 from ..materials import LinearElastic
 from ..solver import Analysis, AnalysisResult, Model
 
@@ -341,10 +341,7 @@ def figures(folder) -> list[Path]:
 
 
 def report(s: dict) -> list[str]:
-    steps = s["steps"]
-    lines = [f"vfem: {run_status(s)} in {len(steps)} "
-             f"step(s), {sum(x['iterations'] for x in steps)} contact iterations, "
-             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+    lines = [run_headline(s, "step(s)")]
     ev = s.get("cattaneo")
     if ev and ev["steps"]:
         lines.append(f"  a = {ev['a']:.5f} (Hertz, R_eff = 1/2), mu p0 = {ev['mu_p0']:.5g}")

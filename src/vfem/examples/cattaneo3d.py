@@ -35,7 +35,7 @@ from ..bodies import Platen, PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import friction_line, run_status
+from ..io.runner import friction_line, run_headline
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 from .sphere import CYLINDER_HEIGHT, CYLINDER_RADIUS, FLAT_DEPTH, FLAT_HALF_WIDTH, PLATEAU, contour
@@ -339,10 +339,7 @@ def figures(folder) -> list[Path]:
 
 
 def report(s: dict) -> list[str]:
-    steps = s["steps"]
-    lines = [f"vfem: {run_status(s)} in {len(steps)} "
-             f"step(s), {sum(x['iterations'] for x in steps)} contact iterations, "
-             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+    lines = [run_headline(s, "step(s)")]
     ev = s.get("cattaneo3d")
     if ev and ev["steps"]:
         lines.append(f"  a = {ev['a']:.4f} (Hertz), mu p0 = {ev['mu_p0']:.5g}, facets "

@@ -34,7 +34,7 @@ from ..bodies import Platen, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import run_status
+from ..io.runner import run_headline
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -221,10 +221,7 @@ def figures(folder) -> list[Path]:
 
 def report(s: dict) -> list[str]:
     """The closing lines of a circular punch run."""
-    lines = [f"vfem: {run_status(s)} in {len(s['steps'])} "
-             f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
-             f"{s['dofs']} dofs ({s['contact_dofs']} contact dofs), "
-             f"{s['timings']['total_s']:.1f} s"]
+    lines = [run_headline(s, contact_dofs=True)]
     if "boussinesq" in s:
         b = s["boussinesq"]
         for name in ("block", "punch"):

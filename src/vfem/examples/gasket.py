@@ -39,7 +39,7 @@ from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_paramet
 from ..contact.search import project_points
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import run_status
+from ..io.runner import run_headline
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model, StepResult
 
@@ -515,9 +515,7 @@ def _contact_window(bodies) -> tuple[float, float, float, float] | None:
 def report(s: dict) -> list[str]:
     """The closing lines of a gasket run."""
     rows = s["steps"]
-    lines = [f"vfem: {run_status(s)} in {len(rows)} steps, "
-             f"{sum(r['iterations'] for r in rows)} contact iterations, {s['dofs']} dofs, "
-             f"{s['timings']['total_s']:.1f} s"]
+    lines = [run_headline(s)]
     lines.append(f"  first overlap at step {s['first_overlap_step']}, largest contact force "
                  f"{s['largest_force']:.6g} at step {s['largest_force_step']}")
     if "mirror_error" in s:

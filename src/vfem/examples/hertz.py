@@ -24,7 +24,7 @@ from ..bodies import Platen, Support
 from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import run_status
+from ..io.runner import run_headline
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -292,9 +292,7 @@ def figures(folder) -> list[Path]:
 
 def report(s: dict) -> list[str]:
     """The closing lines of a Hertz run."""
-    lines = [f"vfem: {run_status(s)} in {len(s['steps'])} "
-             f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
-             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"
+    lines = [run_headline(s)
              + ("" if s["parameters"].get("method", "vfem") == "vfem"
                 else f", contact method {s['parameters']['method']!r}")]
     if "hertz" in s:

@@ -31,7 +31,7 @@ from ..bodies import PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import run_status
+from ..io.runner import run_headline
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -222,10 +222,7 @@ def figures(folder) -> list[Path]:
 
 def report(s: dict) -> list[str]:
     """The closing lines of a press fit run."""
-    lines = [f"vfem: {run_status(s)} in {len(s['steps'])} "
-             f"steps, {sum(x['iterations'] for x in s['steps'])} contact iterations, "
-             f"{s['dofs']} dofs ({s['contact_dofs']} contact dofs), "
-             f"{s['timings']['total_s']:.1f} s"]
+    lines = [run_headline(s, contact_dofs=True)]
     if "lame" in s:
         m = s["lame"]
         lines.append(f"  Lame's pressure {m['lame_pressure']:.6g}: the hub's nodes within "

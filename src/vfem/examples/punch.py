@@ -31,7 +31,7 @@ from ..bodies import PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import run_status
+from ..io.runner import run_headline
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -265,10 +265,7 @@ def figures(folder) -> list[Path]:
 
 
 def report(s: dict) -> list[str]:
-    steps = s["steps"]
-    lines = [f"vfem: {run_status(s)} in {len(steps)} steps, "
-             f"{sum(x['iterations'] for x in steps)} contact iterations, {s['dofs']} dofs, "
-             f"{s['timings']['total_s']:.1f} s"]
+    lines = [run_headline(s)]
     if "punch" in s:
         c = s["punch"]
         (bx, by), (px, py) = c["block_contact_force"], c["punch_contact_force"]

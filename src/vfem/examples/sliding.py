@@ -41,7 +41,7 @@ from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from ..contact.check import largest_penetrations
 from ..contact.settings import ContactSettings
 from ..errors import InputError
-from ..io.runner import friction_line, run_status
+from ..io.runner import friction_line, run_headline
 from ..materials import LinearElastic
 from ..solver import AnalysisResult, Model
 
@@ -285,9 +285,7 @@ def figures(folder) -> list[Path]:
 
 def report(s: dict) -> list[str]:
     steps = s["steps"]
-    lines = [f"vfem: {run_status(s)} in {len(steps)} "
-             f"step(s), {sum(x['iterations'] for x in steps)} contact iterations, "
-             f"{s['dofs']} dofs, {s['timings']['total_s']:.1f} s"]
+    lines = [run_headline(s, "step(s)")]
     if "sliding" in s:
         e = s["sliding"]
         lines.append(f"  slid {e['slide']:.4g} ({e['slide_in_facets']:.1f} block facets) at "

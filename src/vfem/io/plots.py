@@ -90,6 +90,16 @@ def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[
     plt.close(fig)
 
 
+def _plan_axes(ax, x: np.ndarray, y: np.ndarray, ylabel: str) -> None:
+    """A 3D contact surface seen along its normal: the nodes' extent, equal scales, x / a."""
+    if len(x):
+        ax.set_xlim(float(np.min(x)), float(np.max(x)))
+        ax.set_ylim(float(np.min(y)), float(np.max(y)))
+    ax.set_aspect("equal")
+    ax.set_xlabel("x / a (undeformed)")
+    ax.set_ylabel(ylabel)
+
+
 def pressure_map(path: Path, x: np.ndarray, y: np.ndarray, p: np.ndarray, title: str,
                  label: str = "p / p0 (pressure over Hertz's peak)") -> None:
     """A 3D contact surface's pressure seen along its normal: filled contours of ``p`` over the
@@ -108,11 +118,7 @@ def pressure_map(path: Path, x: np.ndarray, y: np.ndarray, p: np.ndarray, title:
     ax.plot(x, y, ".", ms=2, color="0.3")
     s = np.linspace(0.0, 2.0 * np.pi, 361)
     ax.plot(np.cos(s), np.sin(s), "w--", lw=1.2)
-    ax.set_xlim(float(np.min(x)), float(np.max(x)))
-    ax.set_ylim(float(np.min(y)), float(np.max(y)))
-    ax.set_aspect("equal")
-    ax.set_xlabel("x / a (undeformed)")
-    ax.set_ylabel("y / a (undeformed)")
+    _plan_axes(ax, x, y, "y / a (undeformed)")
     ax.set_title(title, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
@@ -141,12 +147,7 @@ def stick_map(path: Path, panels: list[tuple[str, np.ndarray, np.ndarray, np.nda
             ax.plot(x[on], y[on], **style)
         ax.plot(c * np.cos(s), c * np.sin(s), "k--", lw=1.0)
         ax.plot(np.cos(s), np.sin(s), "k:", lw=1.0)
-        if len(x):
-            ax.set_xlim(float(np.min(x)), float(np.max(x)))
-            ax.set_ylim(float(np.min(y)), float(np.max(y)))
-        ax.set_aspect("equal")
-        ax.set_xlabel("x / a (undeformed)")
-        ax.set_ylabel("y / a")
+        _plan_axes(ax, x, y, "y / a")
         ax.set_title(label, fontsize=9)
     axes[0][-1].legend(fontsize=8, **OUTSIDE)
     fig.suptitle(title, fontsize=9)

@@ -210,6 +210,16 @@ def run_status(s: dict) -> str:
     return "converged"
 
 
+def run_headline(s: dict, unit: str = "steps", contact_dofs: bool = False) -> str:
+    """An example report's first line: "vfem: <status> in N <unit>, M contact iterations, D
+    dofs[ (C contact dofs)], T s" from its ``summary.json`` dictionary ``s``."""
+    steps = s["steps"]
+    dofs = f"{s['dofs']} dofs" + (f" ({s['contact_dofs']} contact dofs)" if contact_dofs else "")
+    return (f"vfem: {run_status(s)} in {len(steps)} {unit}, "
+            f"{sum(x['iterations'] for x in steps)} contact iterations, {dofs}, "
+            f"{s['timings']['total_s']:.1f} s")
+
+
 def report(s: dict, out: Path) -> list[str]:
     """The one-screen summary the CLI prints at the end of a run."""
     n_iter = sum(x["iterations"] for x in s["steps"])
