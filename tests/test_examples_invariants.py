@@ -26,6 +26,7 @@ block.toml                      1 s         hold
 cattaneo.toml                   0.5 s       hold
 cattaneo3d.toml                 25-35 s     hold (slow)
 friction/pushed_block.toml      0.1 s       hold
+friction/slide3d.toml           11-13 s     hold (slow)
 gasket.toml                     0.7-4 s     hold
 hertz.toml                      0.3 s       hold
 hertz_gmsh (needs gmsh)         0.5 s       hold (mesh made by make_mesh.py in tmp first)
@@ -57,7 +58,7 @@ EXAMPLES_DIR = ROOT / "examples"
 FILES = sorted(EXAMPLES_DIR.rglob("*.toml"))
 
 #: Cases that take more than about 10 s (relative path under examples/, or "builtin:NAME[KEY]").
-SLOW = {"sliding.toml", "cattaneo3d.toml", "circular_punch.toml"}
+SLOW = {"sliding.toml", "cattaneo3d.toml", "circular_punch.toml", "friction/slide3d.toml"}
 
 #: Cases known to break an invariant at some converged step, with what was measured (issue 16):
 #: relative path -> reason (an ``xfail(strict=True)``). None now. At commit 32435f5 (before the

@@ -16,7 +16,6 @@ from scipy.optimize import brentq
 from test_patch3d import D, E, stacked
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.bodies.stresses import stress
-from vfem.errors import InputError
 from vfem.kinematics import green_lagrange, push_forward_stress
 from vfem.materials import LinearElastic
 from vfem.materials.hyperelastic import NeoHookean, SaintVenantKirchhoff
@@ -271,17 +270,6 @@ def test_3d_patch_total_and_updated_lagrangian_agree(patch_runs, case):
         print(patch_id(case), body.name, f"|u_TL - u_UL| = {difference:.1e}")
         assert difference < 1e-6 * D
         assert np.abs(a.contact_pressure - b.contact_pressure).max() < 1e-6 * E_MOD
-
-
-def test_large_kinematics_with_friction_in_3d_is_refused():
-    """Frictional contact under large kinematics is 2D only (its anchors are segment
-    parameters): refused with a message, by ``check_capabilities`` and by the formulation."""
-    model = stacked(("hex", 3), ("hex", 5), friction=0.3)
-    for b in model.bodies:
-        b.kinematics = "total"
-    with pytest.raises(InputError, match=r"body 'lower': friction in 3D contact is .*large "
-                                         "kinematics"):
-        Analysis(model).run()
 
 
 # -- slow: a stiff sphere pressed deep into a soft block ------------------------------------------

@@ -369,6 +369,17 @@ class _Facet3D(FacetKind):
     def facet_normals(self, x, facets):
         return self.chord_normals(np.asarray(x)[np.asarray(facets)[:, : self.corners]])
 
+    def material_points(self, facets, seg, interp):
+        """(n, 1 + nodes): the facet, then its nodes' shape function values at the point
+        (the large-kinematics friction's anchors, issue 21): the point moves with them."""
+        seg = np.asarray(seg)
+        weights = np.asarray(interp)[np.arange(len(seg))[:, None], facets[seg]]
+        return np.column_stack([seg.astype(float), weights])
+
+    def material_positions(self, x, facets, points):
+        seg = points[:, 0].astype(int)
+        return np.einsum("ij,ijd->id", points[:, 1:], np.asarray(x)[facets[seg]])
+
     def areas(self, x: np.ndarray, facets: np.ndarray, intorder: int = 6) -> np.ndarray:
         """(nf,) the facets' areas: ∫ |x_ξ × x_η| by scikit-fem's Gauss rule of degree
         ``intorder`` on the reference domain (exact on flat facets with straight edges)."""

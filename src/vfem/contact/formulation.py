@@ -135,13 +135,6 @@ def check_capabilities(model) -> None:
         dim = b.mesh.p.shape[0]
         if b.name not in touching:
             continue
-        if dim == 3 and settings.frictional and large:
-            # (the frictional large-kinematics variant's anchors, material points of the
-            # opposing surface, are segment parameters: 2D; issue 21, C16)
-            raise InputError(f"model {model.name!r}, body {b.name!r}: friction in 3D contact "
-                             "is available with small kinematics only, not yet with large "
-                             "kinematics; use small kinematics (the paired variant, linear "
-                             "elements) or set the friction to 0")
         if dim not in caps.dimensions:
             raise InputError(f"model {model.name!r}, body {b.name!r}: {caps.name} contact "
                              f"supports {' and '.join(f'{d}D' for d in caps.dimensions)} "

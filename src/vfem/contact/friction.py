@@ -81,20 +81,22 @@ CONE_TOLERANCE = 1e-9
 HELD = 1e-6
 
 
-def tangents(normal: np.ndarray) -> list[np.ndarray]:
+def tangents(normal: np.ndarray, axes: np.ndarray | None = None) -> list[np.ndarray]:
     """The unit tangent directions at nodes with unit ``normal`` (n, dim), one per direction of
     the tangent space (dim - 1 of them), which is all the tangential code reads.
 
     2D: the normal turned by +90 degrees, (-n_y, n_x). 3D (issue 21, C13): ``t1`` the unit
-    projection on the tangent plane of the global axis least aligned with the normal (ties,
-    within 1e-12: the lowest axis), ``t2 = n x t1``. Taken from the undeformed normals, so a
-    node's tangents are fixed; where a symmetry plane through the contact (a roller) holds an
-    axis, the axis is the tangent ``t1`` (a normal within the plane has no component along it)
-    and the plane's motion stays one tangential unknown, which :data:`HELD` finds."""
+    projection on the tangent plane of the global axis least aligned with the normal
+    (:func:`tangent_axes`; or ``axes``, one per node, where given), ``t2 = n x t1``. Taken from
+    the undeformed normals, so a node's tangents are fixed; where a symmetry plane through the
+    contact (a roller) holds an axis, the axis is the tangent ``t1`` (a normal within the plane
+    has no component along it) and the plane's motion stays one tangential unknown, which
+    :data:`HELD` finds. Under large kinematics the normals turn: ``axes`` kept from the
+    undeformed ones make the tangents a smooth function of the current normal (the least
+    aligned axis itself jumps between two axes as a normal near a third tilts)."""
     if normal.shape[1] == 2:
         return [np.column_stack([-normal[:, 1], normal[:, 0]])]
-    size = np.abs(normal)
-    axis = np.argmax(size <= size.min(axis=1, keepdims=True) + 1e-12, axis=1)
+    axis = tangent_axes(normal) if axes is None else axes
     rows = np.arange(len(normal))
     t1 = -normal[rows, axis, None] * normal
     t1[rows, axis] += 1.0
@@ -102,20 +104,31 @@ def tangents(normal: np.ndarray) -> list[np.ndarray]:
     return [t1, np.cross(normal, t1)]
 
 
-def plane_normals(surface, pair) -> np.ndarray:
+def tangent_axes(normal: np.ndarray) -> np.ndarray:
+    """3D: per node, the global axis least aligned with its unit ``normal`` (ties within 1e-12:
+    the lowest axis), whose projection on the tangent plane is the first tangent
+    (:func:`tangents`)."""
+    size = np.abs(normal)
+    return np.argmax(size <= size.min(axis=1, keepdims=True) + 1e-12, axis=1)
+
+
+def plane_normals(surface, pair, normal: np.ndarray | None = None,
+                  nodes: np.ndarray | None = None) -> np.ndarray:
     """Pair ``pair``'s nodal normals for its tangents: in 3D, at a node on a symmetry plane of
     the compatibility side's body (:func:`symmetry_planes`), the normal less its component
     across the plane (the facets on one side of the plane tilt the averaged normal out of it;
     the plane's axis is then a tangent, :data:`HELD`, and the other tangent lies in the plane:
     without this it would measure mostly the normal's own motion, the normal and that
-    tangent's rows proportional). Elsewhere, and in 2D, the pair's normals themselves."""
-    normal = pair.normal
+    tangent's rows proportional). Elsewhere, and in 2D, the pair's normals themselves.
+    ``normal`` at ``nodes`` (positions in the pair's nodes): other normals than the pair's, at
+    some of its nodes (the large-kinematics variant's current and perturbed normals)."""
+    normal = pair.normal if normal is None else normal
     if normal.shape[1] != 3:
         return normal
-    points = surface.nodes[pair.nodes]
+    points = surface.nodes[pair.nodes if nodes is None else pair.nodes[nodes]]
     out = normal
-    for nodes, axis in symmetry_planes(surface.body):
-        at = np.isin(points, nodes) & (normal[:, axis] != 0.0)
+    for on_plane, axis in symmetry_planes(surface.body):
+        at = np.isin(points, on_plane) & (normal[:, axis] != 0.0)
         if at.any():
             out = out.copy() if out is normal else out
             out[at, axis] = 0.0
@@ -728,4 +741,4 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
 
 
 __all__ = ["CONE_TOLERANCE", "FrictionHistory", "FrictionalPairedContact", "columns",
-           "coulomb_status", "magnitudes", "tangents"]
+           "coulomb_status", "magnitudes", "tangent_axes", "tangents"]

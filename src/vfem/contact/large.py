@@ -127,11 +127,6 @@ class LargeDeformationContact(PairSet):
             if s.kind is not None and s.kind.order != 1:
                 raise InputError(f"body {s.body.name!r}: large-displacement contact needs "
                                  "linear elements (order 1)")
-            if s.dim == 3 and s.nc and settings.frictional:
-                # (the frictional variant's anchors are segment parameters: 2D; check_capabilities
-                # refuses it first, this keeps the formulation from running it)
-                raise InputError(f"body {s.body.name!r}: friction in 3D contact is not available "
-                                 "with large kinematics yet; set the friction to 0")
         # (its own pairs, built on the undeformed geometry, which side carries compatibility
         # and which nodes decided once; :meth:`penetrations` moves them to the current one)
         super().__init__(surfaces, pairs, settings, backend)
@@ -294,8 +289,11 @@ class LargeDeformationContact(PairSet):
                             np.zeros(0, dtype=int)))
                 continue
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
+            # (a loaded node is over the other surface; perturbed past its edge, it keeps the
+            # normal there: the one-sided derivative, not a 90-degree turn over the step h)
             normal, _, _, seg, _ = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse],
-                                                 pair.nodes[on], *pair.patches)
+                                                 pair.nodes[on], *pair.patches,
+                                                 beyond_normal=False)
             out.append((on, normal, seg))
         return out
 
@@ -305,6 +303,14 @@ class LargeDeformationContact(PairSet):
         given a change of the normals, the change of the vectors): q n (friction adds s t,
         t the normal turned by +90 degrees)."""
         return self.tractions(state, k)[on, None] * normal
+
+    def _traction_change(self, state: ContactState, k: int, on: np.ndarray, normal: np.ndarray,
+                         perturbed: np.ndarray, h: float) -> np.ndarray:
+        """The change of pair k's traction vectors at its nodes ``on`` per unit perturbation
+        when their normals move from ``normal`` to ``perturbed`` (by ``h``): the traction is
+        linear in the normal here (and with 2D friction, the tangent the normal turned), so
+        the traction of the normals' difference quotient."""
+        return self._traction_vectors(state, k, on, (perturbed - normal) / h)
 
     def _forces_at(self, state: ContactState, x: list[np.ndarray]) -> np.ndarray:
         """All bodies' candidate nodal forces (stacked) of the state's traction values with the
@@ -384,8 +390,8 @@ class LargeDeformationContact(PairSet):
                     if not len(hit):
                         continue
                     on = base_n[k][0][hit]
-                    dqn = self._traction_vectors(
-                        state, k, on, (pert_n[k][1][hit] - base_n[k][1][hit]) / h)
+                    dqn = self._traction_change(state, k, on, base_n[k][1][hit],
+                                                pert_n[k][1][hit], h)
                     nodes = pair.nodes[on]
                     for side, M, sign in ((pair.fine, pair.mass, 1.0),
                                           (pair.coarse, pair.transfer, -1.0)):
@@ -537,7 +543,8 @@ class LargeDeformationContact(PairSet):
                     W[rows] = self._motion_along(pair, direction, M, s_)
                     p[rows] = self._slip_now(state, k, s_, direction) + self._motion_along(
                         pair, direction, a, s_)
-                    q0[rows] = self.shear(state, k)[s_]
+                    # (one tangent in 2D, (n,); two in 3D, (n, 2): the j-th's values)
+                    q0[rows] = np.reshape(self.shear(state, k), (len(pair.nodes), -1))[s_, j - 1]
                 row += len(s_)
         rate = _concatenate([r[s_] for r, s_ in zip(rates, sets)])
         dR = -motion @ A[off[self.platen_body]:off[self.platen_body + 1]] if platen else None

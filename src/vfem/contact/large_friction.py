@@ -32,6 +32,12 @@ comes into contact within a step sticks at the point it was over at the last con
 until the iteration finds it slipping (the small-kinematics variant's interpolation of the touch
 point is not made here). Coulomb with one coefficient and with static and dynamic ones; the
 elasto-plastic law and a force-controlled platen are small-kinematics only for now.
+
+**In 3D** (issue 21) the same, with two tangents per node measured from a global axis chosen
+once per node (:meth:`FrictionalLargeContact._basis`), anchors kept as a facet and its nodes'
+shape-function values at the point, and the cone a disk whose slip direction turns in the
+linearised solve (:meth:`FrictionalLargeContact._solve_linearised_3d`); docs/method.md §11,
+*In 3D*.
 """
 
 from __future__ import annotations
@@ -41,12 +47,27 @@ import logging
 
 import numpy as np
 
-from .friction import CONE_TOLERANCE, HELD, FrictionHistory, tangents
+from ..errors import AnalysisError
+from .friction import (
+    CONE_TOLERANCE,
+    HELD,
+    FrictionHistory,
+    columns,
+    magnitudes,
+    plane_normals,
+    tangent_axes,
+    tangents,
+)
 from .large import LargeDeformationContact
 from .pairing import virtual_nodes
 from .state import ContactState, FrictionState
 
 log = logging.getLogger(__name__)
+
+#: 3D: the largest |n . axis| of a contact normal and the axis its first tangent is measured
+#: from (:meth:`FrictionalLargeContact._basis`); the axis was the least aligned with the
+#: undeformed normal (|n . axis| <= 0.577), so a normal may turn by at least 36 degrees
+TURNED = 0.95
 
 
 class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
@@ -60,19 +81,74 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
     def __init__(self, surfaces, pairs, settings, backend: str | None = None):
         super().__init__(surfaces, pairs, settings, backend)
         self._init_friction(settings)
+        #: 3D: per pair and node, the global axis whose projection on the current tangent plane
+        #: is the first tangent (:func:`~vfem.contact.friction.tangents`): the one least aligned
+        #: with the node's own undeformed outward normal (on a symmetry plane, in the plane), so
+        #: the tangents follow the turning normal smoothly and the choice depends on nothing but
+        #: the mesh (not on where the pairing first put the node: a node beyond the other
+        #: surface has the direction to its edge as pair normal, nearly in the surface's plane,
+        #: and the axis across the surface then met the normal once the other body slid over
+        #: it). None in 2D.
+        self._axes = []
+        for p in self.contact_pairs:
+            sf = self.surfaces[p.fine]
+            own = sf.node_normals()[p.nodes] if sf.dim == 3 else None
+            self._axes.append(None if own is None
+                              else tangent_axes(plane_normals(sf, p, own)))
         # (the elasto-plastic law and a force-controlled platen are refused before, by
         # vfem.contact.formulation.check_capabilities)
 
     # -- the traction field ----------------------------------------------------------------------
 
     def directions_now(self, k: int) -> list[np.ndarray]:
-        """The current normal, then the tangent: the order of each pair's unknowns."""
-        return [self.contact_pairs[k].normal, self.tangent(k)]
+        """The current normal, then the tangents (one in 2D, two in 3D): the order of each
+        pair's unknowns."""
+        return [self.contact_pairs[k].normal, *self.tangent_basis(k)]
+
+    def _basis(self, k: int, on: np.ndarray, normal: np.ndarray) -> list[np.ndarray]:
+        """Pair k's tangents at its nodes ``on`` with unit ``normal`` there: 2D the normal
+        turned by +90 degrees; 3D the projection of each node's axis (:attr:`_axes`) on the
+        tangent plane, and the normal times it (the normal less its part across a symmetry
+        plane at a node on one, :func:`~vfem.contact.friction.plane_normals`)."""
+        if self._axes[k] is None:
+            return tangents(normal)
+        pair = self.contact_pairs[k]
+        flat = plane_normals(self.surfaces[pair.fine], pair, normal, on)
+        axes = self._axes[k][on]
+        # (a node whose normal has turned onto its axis: the least aligned axis now; its
+        # tangents then jump, which :meth:`_further_errors` refuses where it carries traction)
+        turned = np.abs(flat[np.arange(len(on)), axes]) > TURNED
+        if turned.any():
+            axes = axes.copy()
+            axes[turned] = tangent_axes(flat[turned])
+        return tangents(flat, axes)
+
+    def tangent_basis(self, k: int) -> list[np.ndarray]:
+        """Pair k's unit tangents at its nodes, on the current geometry."""
+        on = np.arange(len(self.contact_pairs[k].nodes))
+        return self._basis(k, on, self.contact_pairs[k].normal)
+
+    def tangent(self, k: int) -> np.ndarray:
+        """Pair k's (first) unit tangent at its nodes, on the current geometry."""
+        return self.tangent_basis(k)[0]
 
     def _traction_vectors(self, state, k, on, normal):
-        """``q n + s t`` at the nodes ``on`` (t: ``normal`` turned by +90 degrees)."""
-        return (self.tractions(state, k)[on, None] * normal
-                + self.shear(state, k)[on, None] * tangents(normal)[0])
+        """``q n + s t`` at the nodes ``on`` (2D: t is ``normal`` turned by +90 degrees; 3D:
+        ``q n + s1 t1 + s2 t2``, the tangents of :meth:`_basis`)."""
+        q = self.tractions(state, k)[on, None] * normal
+        if self._axes[k] is None:
+            return q + self.shear(state, k)[on, None] * tangents(normal)[0]
+        s = self.shear(state, k)[on]
+        t1, t2 = self._basis(k, on, normal)
+        return q + s[:, 0, None] * t1 + s[:, 1, None] * t2
+
+    def _traction_change(self, state, k, on, normal, perturbed, h):
+        """3D: the tangents are not linear in the normal: the difference of the traction
+        vectors themselves (2D: as without friction)."""
+        if self._axes[k] is None:
+            return super()._traction_change(state, k, on, normal, perturbed, h)
+        return (self._traction_vectors(state, k, on, perturbed)
+                - self._traction_vectors(state, k, on, normal)) / h
 
     def assemble_forces(self, state: ContactState) -> None:
         """Every body's nodal forces from the pairs' normal and tangential tractions, along the
@@ -86,13 +162,16 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ traction
 
     def _add_unknowns(self, state, sets, dq) -> None:
-        """Per pair, the set's normal traction values, then its tangential ones."""
+        """Per pair, the set's normal traction values, then its tangential ones (tangent by
+        tangent)."""
         pos = 0
         for k, s_ in enumerate(sets):
             n = len(s_)
             self.tractions(state, k)[s_] += dq[pos:pos + n]
-            self.shear(state, k)[s_] += dq[pos + n:pos + 2 * n]
-            pos += 2 * n
+            shear = columns(self.shear(state, k))
+            for j in range(shear.shape[1]):
+                shear[s_, j] += dq[pos + (1 + j) * n:pos + (2 + j) * n]
+            pos += (1 + shear.shape[1]) * n
         for k in range(len(self.contact_pairs)):  # no shear without a normal traction
             self.shear(state, k)[self.tractions(state, k) <= 0] = 0.0
 
@@ -104,8 +183,9 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         out = []
         for pair in self.contact_pairs:
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            if pair.patches is None:
-                out.append(np.zeros(len(pair.nodes)))
+            if pair.patches is None:  # (nothing over the other surface: no anchor read)
+                out.append(np.zeros(len(pair.nodes)) if sc.dim == 2 else
+                           np.zeros((len(pair.nodes), 1 + sc.facets.shape[1])))
                 continue
             _, _, interp, seg, _ = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse],
                                                  pair.nodes, *pair.patches)
@@ -116,20 +196,32 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         """Where the opposing surface's material points ``anchor`` (``facet + t``) now are."""
         return self.surfaces[self.contact_pairs[k].coarse].material_positions(anchor, xc)
 
+    def _relative(self, state, k, x) -> np.ndarray:
+        """Pair k's nodes' positions less their anchors' (module docstring)."""
+        pair = self.contact_pairs[k]
+        return x[pair.fine][pair.nodes] - self._anchor_positions(k, x[pair.coarse],
+                                                                 self.anchor(state, k))
+
     def slips(self, state: FrictionState, x: list[np.ndarray] | None = None
               ) -> list[np.ndarray]:
         """Per pair, each node's slip within the step: its distance from its anchor along the
-        current tangent (module docstring)."""
+        current tangent ((n,) in 2D; along both, (n, 2), in 3D) (module docstring)."""
         x = self.positions(state) if x is None else x
         out = []
-        for k, pair in enumerate(self.contact_pairs):
-            xa = self._anchor_positions(k, x[pair.coarse], self.anchor(state, k))
-            out.append(np.einsum("ij,ij->i", x[pair.fine][pair.nodes] - xa, self.tangent(k)))
+        for k in range(len(self.contact_pairs)):
+            d = self._relative(state, k, x)
+            t = self.tangent_basis(k)
+            out.append(np.einsum("ij,ij->i", d, t[0]) if len(t) == 1 else
+                       np.column_stack([np.einsum("ij,ij->i", d, tj) for tj in t]))
         return out
 
     def _slip_now(self, state, k, s_, direction) -> np.ndarray:
-        """The slips of pair k's nodes ``s_`` (the linearised tangential rows' start)."""
-        return self.slips(state)[k][s_]
+        """The slips of pair k's nodes ``s_`` along ``direction`` (a tangent at its nodes; the
+        linearised tangential rows' start)."""
+        if self._axes[k] is None:
+            return self.slips(state)[k][s_]
+        d = self._relative(state, k, self.positions(state))[s_]
+        return np.einsum("ij,ij->i", d, direction[s_])
 
     def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
                   ) -> ContactState:
@@ -144,9 +236,28 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
 
     # -- the iteration ---------------------------------------------------------------------------
 
+    def _turned(self, k: int) -> np.ndarray:
+        """3D: pair k's nodes whose current normal has turned to within ``arccos(TURNED)`` of
+        the axis their tangents are measured from (:meth:`_basis`)."""
+        pair = self.contact_pairs[k]
+        flat = plane_normals(self.surfaces[pair.fine], pair)
+        return np.abs(flat[np.arange(len(pair.nodes)), self._axes[k]]) > TURNED
+
     def _further_errors(self, state: FrictionState) -> tuple[float, bool, str]:
         """The friction's errors: a sticking node's slip, a slipping node's slip against its
-        traction, a tangential traction outside its cone."""
+        traction, a tangential traction outside its cone. 3D: a node carrying traction whose
+        normal has turned onto the axis of its tangents stops the analysis (:meth:`_basis`)."""
+        for k, pair in enumerate(self.contact_pairs):
+            if self._axes[k] is None:
+                continue
+            bad = np.flatnonzero(self._turned(k) & (self.tractions(state, k) > 0))
+            if len(bad):
+                sf = self.surfaces[pair.fine]
+                raise AnalysisError(
+                    f"body {sf.body.name!r}, contact node {sf.nodes[pair.nodes[bad[0]]]}: its "
+                    "contact normal has turned onto the axis its friction tangents are measured "
+                    "from (within 18 degrees); 3D friction with large kinematics takes contact "
+                    "normals turning by up to about 35 degrees from the undeformed ones")
         err, excess, _, _ = self.friction_errors(state, self.slips(state))
         ok = err <= self.penetration_tolerance and excess <= CONE_TOLERANCE
         return err, ok, f", tangential slip error {err:.3g}"
@@ -164,8 +275,8 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         self._increments = []
         for k, (g, v) in enumerate(zip(slips, self._virtual_points(x))):
             on = self.tractions(state, k) > 0
-            increment = np.where(on, g, 0.0)
-            self.accumulated_slip(state, k)[:] += np.abs(increment)
+            increment = np.where(on if g.ndim == 1 else on[:, None], g, 0.0)
+            self.accumulated_slip(state, k)[:] += magnitudes(increment)
             self._increments.append(increment)
             self.anchor(state, k)[:] = v
 
@@ -179,8 +290,10 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         slipping ones (``s = -mu sigma q``, the slip along sigma): an active-set loop, every
         violation swapped at once, each set one dense solve, until no set changes (at most
         ``10 m + 10`` sets; a set that comes back ends it with the last solution, the Newton
-        iteration going on from there).
+        iteration going on from there). 3D: :meth:`_solve_linearised_3d`.
         """
+        if any(a is not None for a in self._axes):
+            return self._solve_linearised_3d(state, W, q0, p, tol, sets)
         m = len(q0)
         pair_of = np.concatenate([np.full(len(s_), k) for k, s_ in enumerate(sets)]
                                  or [np.zeros(0, int)])
@@ -262,5 +375,143 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             self.sliding(state, k)[s_] = (slipping & contact)[pair_of == k]
         return x, 0.0
 
+    def _solve_linearised_3d(self, state, W, q0, p, tol, sets):
+        """:meth:`_solve_linearised` in 3D: per pair, the set's normal unknowns, then those along
+        the first tangent, then along the second. A sticking node's slip vanishes along both
+        tangents; a slipping node's traction is ``-mu q sigma``, sigma the unit direction of its
+        slip in the tangent plane. A tangent along which no traction moves the node (a symmetry
+        plane through the contact, :data:`HELD`) carries no tangential traction, and a node
+        held along one tangent slides along the other only.
+
+        Sigma turns with the solution: as in the small-kinematics variant
+        (:meth:`~vfem.contact.friction.FrictionalPairedContact._correct_frictional`), a
+        slipping node's traction is ``-mu q sigma + s_perp e``, e across sigma, and its row asks
+        its slip across sigma to vanish, linearised in the turn of sigma: ``e . slip +
+        (sigma . slip) / |s| s_perp = 0`` (a semismooth Newton step on the disk); sigma is then
+        read from the new traction and the solve repeated, with the sets swapped as in 2D,
+        until no set changes and no slip crosses its sigma by more than the tolerance. (Taking
+        the predicted slip's direction as the next sigma, a fixed point, diverges at a node
+        that slips little: its own traction turns its slip more than the slip turns it.)
+        """
+        m = len(q0)
+        sizes = [len(s_) for s_ in sets]
+        pair_of = np.concatenate([np.full(n, k) for k, n in enumerate(sizes)]
+                                 or [np.zeros(0, int)])
+        starts = np.cumsum([0] + [3 * n for n in sizes])[:-1]
+        nrm = np.concatenate([starts[k] + np.arange(n) for k, n in enumerate(sizes)]
+                             or [np.zeros(0, int)]).astype(int)
+        offset = np.repeat(sizes, sizes).astype(int)
+        tng = np.column_stack([nrm + offset, nrm + 2 * offset])  # (nodes, 2)
+        mu = np.array([self.laws[k][0] for k in pair_of])
+        mu_static = np.array([self.laws[k][1] for k in pair_of])
+        was_sliding = np.concatenate([self.sliding(state, k)[s_] for k, s_ in enumerate(sets)]
+                                     or [np.zeros(0, bool)])
+        q, S, P = q0[nrm], q0[tng], p[tng]
+        diagonal = np.abs(np.diag(W))
+        held = diagonal[tng] <= HELD * diagonal.max(initial=0.0)
+        free = ~held & (mu_static > 0.0)[:, None]  # the tangents friction acts along
+        rough = free.any(axis=1)
+        both = free.all(axis=1)  # a slipping node's sigma may turn
+
+        def unit(v):
+            v = np.where(free, v, 0.0)
+            size = magnitudes(v)
+            return np.divide(v, size[:, None], out=np.zeros_like(v), where=size[:, None] > 0)
+
+        contact = (q > 0) | (p[nrm] > tol)
+        mu_now = np.where(was_sliding, mu, mu_static)
+        size = magnitudes(np.where(free, S, 0.0))
+        slipping = contact & (q > 0) & (size >= (1.0 - CONE_TOLERANCE) * mu_now * q) \
+            & (size > 0) & rough
+        sigma = np.where((size > 0)[:, None], unit(-S), unit(P))
+        # a node that comes into contact having moved along the other surface since the last
+        # converged step slips the way it moved, until its traction says it sticks
+        entering = contact & (q <= 0) & (magnitudes(np.where(free, P, 0.0)) > tol) & rough
+        slipping |= entering
+        sigma[entering] = unit(P)[entering]
+        seen: set[bytes] = set()
+        x = q0.copy()
+        slip = np.where(free, P, 0.0)  # the slip predicted at x
+        for _ in range(10 * m + 10):
+            stick = contact & ~slipping & rough
+            slide = contact & slipping
+            # the nodes whose sigma turns: slipping along both tangents, with a traction and a
+            # slip along sigma to turn it by
+            q_now = x[nrm]
+            turning = slide & both & (q_now > 0) & (np.einsum("ij,ij->i", sigma, slip) > 0)
+            turn = np.flatnonzero(turning)
+            across_dir = np.column_stack([-sigma[turn, 1], sigma[turn, 0]])
+            cols = np.concatenate([nrm[contact]] + [tng[stick & free[:, j], j]
+                                                    for j in range(2)])
+            n_normal = int(contact.sum())
+            rows_W = np.vstack([W[cols], np.einsum("ij,ijm->im", across_dir, W[tng[turn]])])
+            target = np.concatenate([
+                W[cols] @ q0 + np.concatenate([p[cols[:n_normal]], -p[cols[n_normal:]]]),
+                np.einsum("ij,ijm->im", across_dir, W[tng[turn]]) @ q0
+                - np.einsum("ij,ij->i", across_dir, P[turn])])
+            position = np.full(m, -1)
+            position[cols] = np.arange(len(cols))
+            ties = -mu[:, None] * sigma  # s = ties q (+ s_perp e) on a slipping node
+            A = rows_W[:, cols]
+            for j in range(2):
+                A[:, position[nrm[slide]]] += rows_W[:, tng[slide, j]] * ties[slide, j]
+            if len(turn):
+                A = np.hstack([A, np.einsum("ij,mij->mi", across_dir, rows_W[:, tng[turn]])])
+                compliance = np.einsum("ij,ij->i", sigma[turn], slip[turn]) \
+                    / (mu[turn] * q_now[turn])
+                A[len(cols) + np.arange(len(turn)), len(cols) + np.arange(len(turn))] += \
+                    compliance
+            x = np.zeros(m)
+            if len(target):
+                try:
+                    y = np.linalg.solve(A, target)
+                except np.linalg.LinAlgError:  # dependent rows: the least-squares solution
+                    y = np.linalg.lstsq(A, target, rcond=None)[0]
+                x[cols] = y[:len(cols)]
+                for j in range(2):
+                    x[tng[slide, j]] = ties[slide, j] * x[nrm[slide]]
+                if len(turn):
+                    x[tng[turn]] += across_dir * y[len(cols):, None]
+            dx = x - q0
+            pen = p[nrm] - W[nrm] @ dx
+            slip = np.where(free, P + (W[tng.ravel()] @ dx).reshape(-1, 2), 0.0)
+            qn, sn = x[nrm], x[tng]
+            # sigma from the new traction (where it turned), and the slip's parts along it and
+            # across it
+            new_sigma = sigma.copy()
+            new_sigma[turn] = unit(-sn)[turn]
+            along = np.einsum("ij,ij->i", new_sigma, slip)
+            across = magnitudes(slip - along[:, None] * new_sigma)
+            leave = contact & (qn < 0)
+            join = ~contact & (pen > tol)
+            over = stick & (magnitudes(np.where(free, sn, 0.0)) > (1.0 + CONE_TOLERANCE)
+                            * mu_static * qn)
+            back = slide & (along < -tol)
+            crossing = slide & both & (across > tol)
+            sigma = new_sigma
+            if not (leave.any() or join.any() or over.any() or back.any()):
+                if not crossing.any():
+                    break
+                # not turning yet (no traction or no slip along sigma): the slip's direction
+                late = crossing & ~turning
+                sigma[late] = unit(slip)[late]
+                continue
+            key = np.concatenate([contact, slipping]).tobytes()
+            if key in seen and not crossing.any():
+                log.debug("frictional linearised contact (3D): a set came back")
+                break
+            seen.add(key)
+            contact = (contact & ~leave) | join
+            moved = join & (magnitudes(slip) > tol) & rough
+            sigma[over] = unit(-sn)[over]
+            sigma[moved] = unit(slip)[moved]
+            slipping = (slipping | over | moved) & ~back & contact
+        x[nrm] = np.where(x[nrm] > 0, x[nrm], 0.0)
+        for j in range(2):
+            x[tng[:, j]] = np.where((x[nrm] > 0) & free[:, j], x[tng[:, j]], 0.0)
+        for k, s_ in enumerate(sets):
+            self.sliding(state, k)[:] = False
+            self.sliding(state, k)[s_] = (slipping & contact)[pair_of == k]
+        return x, 0.0
 
 __all__ = ["FrictionalLargeContact"]

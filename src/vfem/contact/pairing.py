@@ -98,9 +98,15 @@ def read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
 
 
 def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np.ndarray,
-                  nodes: np.ndarray, fpatch: np.ndarray, cpatch: np.ndarray):
+                  nodes: np.ndarray, fpatch: np.ndarray, cpatch: np.ndarray,
+                  beyond_normal: bool = True):
     """The virtual nodes of ``nodes`` of ``sf`` on the patch ``cpatch`` of ``sc`` (positions
     ``xf``, ``xc``): (normal, gap, interp, facet, beyond) — see :func:`overlap`.
+    ``beyond_normal=False``: a node beyond the patch keeps the normal interpolated at its
+    virtual node instead of the direction to it (the large-kinematics follower term's
+    differences, :meth:`~vfem.contact.large.LargeDeformationContact._normals_at`: a loaded
+    node on the patch's edge that a perturbation moves past it would otherwise turn its
+    normal by 90 degrees over the perturbation).
     """
     pts = xf[nodes]
     seg, t, _, _, tf = sc.closest(pts, xc, cpatch, sf.node_normals(xf, fpatch)[nodes])
@@ -110,7 +116,9 @@ def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np
     normal = interp @ sc.node_normals(xc, cpatch)
     d = pts - closest
     dn = np.linalg.norm(d, axis=1)
-    normal = np.where((past & (dn > 0))[:, None], d / np.maximum(dn, 1e-300)[:, None], normal)
+    if beyond_normal:
+        normal = np.where((past & (dn > 0))[:, None], d / np.maximum(dn, 1e-300)[:, None],
+                          normal)
     normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
     return normal, np.einsum("ij,ij->i", d, normal), interp, seg, past
 

@@ -1,0 +1,211 @@
+"""Coulomb friction in 3D under large displacements (issue 21; vfem.contact.large_friction): the
+2D variant's anchors (material points of the opposing surface) and traction field
+``q n + s1 t1 + s2 t2`` along the current normal and tangents, with the cone a disk and the slip
+direction turning in the linearised solve.
+
+The slide: a block (0.5 x 0.5 x 0.25) pressed into a wider base by 2 % of its height, then slid
+along a direction in the plane (30 degrees off x unless said) over several of the base's facets,
+both bodies under total Lagrangian kinematics. Sliding, every node in contact slips and the
+tangential force is mu times the normal force, along the slide.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from vfem.bodies import Body, PrescribedDisplacement, Support
+from vfem.contact.settings import ContactSettings
+from vfem.io.results import frictional_work
+from vfem.materials import LinearElastic
+from vfem.mesh.solids import box
+from vfem.solver import Analysis, Model
+
+MU = 0.3
+PRESS = ((0.0, 0.0), (0.5, 1.0), (2.0, 1.0))  # pressed by load factor 0.5
+SHOVE = ((0.0, 0.0), (0.5, 0.0), (2.0, 1.0))  # then slid from 0.5 to 2
+#: pressed in two steps, then slid in five
+FACTORS = (0.25, 0.5, 0.6, 0.9, 1.2, 1.6, 2.0)
+
+
+def direction(degrees: float) -> np.ndarray:
+    a = np.radians(degrees)
+    return np.array([np.cos(a), np.sin(a), 0.0])
+
+
+def turned(mesh, degrees: float):
+    """``mesh`` turned by ``degrees`` about the vertical axis (its named boundaries kept)."""
+    a = np.radians(degrees)
+    R = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    return dataclasses.replace(mesh, doflocs=R @ mesh.doflocs)
+
+
+def slide(degrees: float = 30.0, shift: float = 1.0, kinematics: str = "total",
+          swap: bool = False, press: float = 0.005, tetrahedra: bool = False,
+          factors=FACTORS, mu: float = MU, turn: float = 0.0) -> Model:
+    """The block slid ``shift`` along ``degrees`` over a 2 x 2 base of 8 x 8 facets (4 of them
+    for 1.0), centred on the base's middle; ``press``: the block top's downward motion;
+    ``turn``: the whole model turned by that many degrees about the vertical (the slide too)."""
+    d = direction(degrees + turn)
+    mat = LinearElastic(1000.0, 0.3)
+    base = Body("base", turned(box(-1.0, -1.0, -0.5, 2.0, 2.0, 0.5, 8, 8, 2), turn), mat,
+                supports=(Support("bottom"),), contact_boundaries=("top",),
+                kinematics=kinematics)
+    start = -0.5 * shift * direction(degrees)[:2] - 0.25
+    top = [PrescribedDisplacement("top", "z", -press, amplitude=PRESS)]
+    top += [PrescribedDisplacement("top", c, shift * d[i], amplitude=SHOVE)
+            for i, c in enumerate("xy")]
+    block = Body("block", turned(box(start[0], start[1], 0.0, 0.5, 0.5, 0.25, 4, 4, 2,
+                                     tetrahedra=tetrahedra), turn), mat, prescribed=tuple(top),
+                 contact_boundaries=("bottom",), kinematics=kinematics)
+    bodies = [block, base] if swap else [base, block]
+    return Model("slide 3d", bodies, ContactSettings(friction=mu), list(factors))
+
+
+def run(model: Model):
+    result = Analysis(model).run()
+    assert result.converged, result.message
+    return result
+
+
+def resultant(result, name: str = "block") -> np.ndarray:
+    return np.array([s.bodies[name].contact_force.sum(axis=0) for s in result.steps])
+
+
+def statuses(step) -> np.ndarray:
+    """Every carrying node's friction status (1 stick, 2 slip) over both bodies."""
+    out = [r.friction_status[r.friction_status > 0] for r in step.bodies.values()]
+    return np.concatenate(out)
+
+
+@pytest.fixture(scope="module")
+def slid():
+    return run(slide())
+
+
+def test_a_block_slid_far_in_3d_carries_mu_times_its_normal_force_along_the_slide(slid):
+    """Slid over four facets of the base at 30 degrees: from the first sliding step every node
+    in contact slips, the tangential force is mu times the normal force (measured: 0.2993 to
+    0.3003) and points against the slide (to 1e-6); the two bodies' forces balance to
+    round-off; every invariant holds; the friction dissipates mu N times the slide."""
+    block, base = resultant(slid), resultant(slid, "base")
+    np.testing.assert_allclose(block, -base, rtol=0, atol=1e-12 * np.abs(block).max())
+    assert all(s.invariants["passed"] for s in slid.steps)
+    sliding = block[2:]
+    tangential = np.linalg.norm(sliding[:, :2], axis=1)
+    np.testing.assert_allclose(tangential / sliding[:, 2], MU, rtol=3e-3)
+    along = -sliding[:, :2] @ direction(30.0)[:2] / tangential
+    assert np.all(along > 1 - 1e-6)
+    for step in slid.steps[2:]:
+        assert np.all(statuses(step) == 2)
+    work = np.asarray(frictional_work(slid.steps))
+    assert np.all(work[2:] > 0)
+    # the last step slides 0.4 x 0.5 / 1.5 of the shift at mu times the normal force
+    np.testing.assert_allclose(work[-1], tangential[-1] * 1.0 * 0.4 / 1.5, rtol=5e-3)
+
+
+def test_the_3d_slide_does_not_depend_on_the_body_order_nor_the_lagrangian_form(slid):
+    """Bodies listed the other way round, or both updated Lagrangian: the same forces at every
+    step (the press and two sliding steps; measured: to 1e-14 and 1e-15 of the largest)."""
+    base = resultant(slid)[:4]
+    for model in (slide(swap=True, factors=FACTORS[:4]),
+                  slide(kinematics="updated", factors=FACTORS[:4])):
+        np.testing.assert_allclose(resultant(run(model)), base, rtol=0,
+                                   atol=1e-12 * np.abs(base).max())
+
+
+@pytest.mark.parametrize("degrees", [0.0, -135.0])
+def test_the_3d_slide_turns_with_its_direction(degrees):
+    """The slide along x, and along a diagonal backwards (from the mirrored start): the
+    tangential force is mu times the normal one against the slide (measured 0.2998 to
+    0.3001)."""
+    result = run(slide(degrees=degrees, factors=FACTORS[:4]))
+    f = resultant(result)
+    tangential = np.linalg.norm(f[2:, :2], axis=1)
+    np.testing.assert_allclose(tangential / f[2:, 2], MU, rtol=3e-3)
+    along = -f[2:, :2] @ direction(degrees)[:2] / tangential
+    assert np.all(along > 1 - 1e-6)
+
+
+def test_the_3d_slide_turned_about_the_vertical_gives_the_turned_forces():
+    """The whole model (meshes, slide) turned by 37 degrees about the vertical: the tangents
+    are measured from other axes, the answer is the same turned (measured: 9e-13 of the
+    largest force)."""
+    base = resultant(run(slide(factors=FACTORS[:4])))
+    other = resultant(run(slide(factors=FACTORS[:4], turn=37.0)))
+    a = np.radians(37.0)
+    R = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    np.testing.assert_allclose(other, base @ R.T, rtol=0, atol=1e-11 * np.abs(base).max())
+
+
+def test_a_small_push_in_3d_is_the_small_kinematics_one_to_the_strain():
+    """Pressed and then pushed sideways by a tenth of the press (far less than the slide the
+    friction allows), the block's middle sticks (its rim slips, where the pressure is singular)
+    and its forces are the small-kinematics ones but for the geometric nonlinearity, in
+    proportion to the strain: pressed by 0.05 % of its height they differ by 3.4e-4 of the
+    largest force, pressed ten times more by ten times that (measured 3.4e-3)."""
+    differences = []
+    for press in (0.000125, 0.00125):
+        forces = {}
+        for kinematics in ("total", "small"):
+            result = run(slide(shift=0.1 * press, press=press, kinematics=kinematics,
+                               factors=(0.25, 0.5, 0.75, 1.0)))
+            forces[kinematics] = resultant(result)
+            block = result.steps[-1].bodies["block"]
+            middle = np.flatnonzero(block.friction_status >= 0)[12]  # the contact's centre
+            assert block.friction_status[middle] == 1
+        large, small = forces["total"], forces["small"]
+        assert np.linalg.norm(large[-1, :2]) < MU * large[-1, 2]  # inside the cone
+        differences.append(np.abs(large - small).max() / np.abs(small).max())
+    assert differences[0] < 5e-4
+    assert 5 < differences[1] / differences[0] < 20
+
+
+def test_a_resumed_3d_slide_equals_an_uninterrupted_one(tmp_path):
+    """``examples/friction/slide3d.toml`` (the slide above as an input file) to its first two
+    sliding steps, stopped after the first and resumed from its checkpoint: every number of
+    the uninterrupted run (the 3D anchors, a facet and shape-function values, come back with
+    the bodies' states)."""
+    from pathlib import Path
+
+    from vfem.io import runner
+    from vfem.io.input import loads
+
+    text = (Path(__file__).resolve().parents[1] / "examples" / "friction"
+            / "slide3d.toml").read_text()
+    text = text.replace("load_factors = [0.25, 0.5, 0.6, 0.9, 1.2, 1.6, 2.0]",
+                        "load_factors = [0.5, 0.6, 0.9]")
+    config = loads(text)
+    whole = runner.run(config, tmp_path / "whole", figures=False)
+
+    class Stop(Exception):
+        pass
+
+    def stop_after(step):
+        if step.step == 2:
+            raise Stop
+
+    with pytest.raises(Stop):
+        runner.run(config, tmp_path / "resumed", figures=False, on_step=stop_after)
+    resumed = runner.run(config, tmp_path / "resumed", figures=False, resume=True)
+    assert len(resumed["steps"]) == 3
+    for a, b in zip(whole["steps"], resumed["steps"], strict=True):
+        for name in ("base", "block"):
+            np.testing.assert_array_equal(a["contact_force"][name], b["contact_force"][name])
+        assert a["frictional_work"] == b["frictional_work"]
+    assert (tmp_path / "resumed" / "contact.csv").read_text() == \
+        (tmp_path / "whole" / "contact.csv").read_text()
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="mu = 1: the block's corner node carries a tensile "
+                   "contact force (F.n 9.5e-4 of the largest) at the first sliding increment")
+def test_the_3d_slide_with_mu_1():
+    """Own model, not solved: the slide with mu = 1 converges while pressed, then every cut of
+    the first sliding step stops at invariant (c): the corner node's nodal force, the consistent
+    redistribution of its neighbours' large shear along their slightly different normals, pulls
+    (F.n = 8.0e-4, 9.5e-4 of the largest force; measured 2026-11-28). No converged state is
+    claimed."""
+    run(slide(mu=1.0))
