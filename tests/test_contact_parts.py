@@ -260,9 +260,10 @@ def test_the_model_checks_read_the_declared_capabilities():
     with pytest.raises(InputError, match="3D contact with friction supports linear elements"):
         check_capabilities(fake_model(order=2, dim=3, friction=0.3))
     check_capabilities(fake_model(dim=3, friction=0.3))  # friction in 3D, small (C13)
-    with pytest.raises(InputError, match="friction in 3D contact is available with small "
-                                         "kinematics only"):
-        check_capabilities(fake_model(dim=3, large=True, friction=0.3))
+    # friction in 3D under large kinematics (2026-11-28; tests/test_large_friction3d.py)
+    check_capabilities(fake_model(dim=3, large=True, friction=0.3))
+    with pytest.raises(InputError, match="contact with a large-kinematics body needs linear"):
+        check_capabilities(fake_model(order=2, dim=3, large=True, friction=0.3))
 
 
 # -- each formulation's own typed state ------------------------------------------------------------

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from resume_check import assert_resumed_equals_whole
 from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
 from vfem.contact.formulation import formulation_class
 from vfem.contact.friction import FrictionalPairedContact, coulomb_status, tangents
@@ -397,22 +398,7 @@ def test_friction_output_and_a_resumed_run_equal_to_an_uninterrupted_one(tmp_pat
         sum(x["frictional_work"] for x in saved["steps"]), rel=1e-12)
     assert saved["frictional_work_total"] > 0
 
-    class Stop(Exception):
-        pass
-
-    def stop_after_3(step):
-        if step.step == 3:
-            raise Stop
-
-    with pytest.raises(Stop):
-        runner.run(config, tmp_path / "resumed", figures=False, on_step=stop_after_3)
-    resumed = runner.run(config, tmp_path / "resumed", figures=False, resume=True)
-    for a, b in zip(whole["steps"], resumed["steps"], strict=True):
-        for name in ("lower", "upper"):
-            np.testing.assert_array_equal(a["contact_force"][name], b["contact_force"][name])
-        assert a["frictional_work"] == b["frictional_work"]
-    assert (tmp_path / "resumed" / "contact.csv").read_text() == \
-        (tmp_path / "whole" / "contact.csv").read_text()
+    assert_resumed_equals_whole(config, tmp_path, stop_after=3, whole=whole)
 
     plain = runner.run(loads(BLOCKS.format(mu=0.0, shift=0.02)), tmp_path / "plain",
                        figures=False)

@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+from resume_check import assert_resumed_equals_whole
 from vfem.contact.formulation import formulation_class
 from vfem.contact.large_friction import FrictionalLargeContact
 from vfem.contact.settings import ContactSettings, PairFriction
@@ -208,29 +209,9 @@ def test_a_resumed_large_frictional_run_equals_an_uninterrupted_one(tmp_path):
     """Stopped after the third sliding step and resumed from its checkpoint, the slide ends
     with every number of the uninterrupted run: the anchors (material points of the other
     surface) and the accumulated slip come back with the bodies' states."""
-    from vfem.io import runner
-
     factors = [0.25, 0.5, 0.6, 0.7, 0.8, 0.9]
     config = loads(SLIDE.format(mu=0.3, shift=0.5, kinematics="total", factors=factors))
-    whole = runner.run(config, tmp_path / "whole", figures=False)
-
-    class Stop(Exception):
-        pass
-
-    def stop_after(step):
-        if step.step == 4:
-            raise Stop
-
-    with pytest.raises(Stop):
-        runner.run(config, tmp_path / "resumed", figures=False, on_step=stop_after)
-    resumed = runner.run(config, tmp_path / "resumed", figures=False, resume=True)
-    assert len(resumed["steps"]) == len(factors)
-    for a, b in zip(whole["steps"], resumed["steps"], strict=True):
-        for name in ("base", "block"):
-            np.testing.assert_array_equal(a["contact_force"][name], b["contact_force"][name])
-        assert a["frictional_work"] == b["frictional_work"]
-    assert (tmp_path / "resumed" / "contact.csv").read_text() == \
-        (tmp_path / "whole" / "contact.csv").read_text()
+    assert_resumed_equals_whole(config, tmp_path, stop_after=4)
 
 
 def test_the_sliding_reactions_tend_to_mu_as_the_indentation_shrinks():

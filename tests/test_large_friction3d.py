@@ -16,6 +16,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from resume_check import assert_resumed_equals_whole
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.contact.settings import ContactSettings
 from vfem.io.results import frictional_work
@@ -170,33 +171,13 @@ def test_a_resumed_3d_slide_equals_an_uninterrupted_one(tmp_path):
     the bodies' states)."""
     from pathlib import Path
 
-    from vfem.io import runner
     from vfem.io.input import loads
 
     text = (Path(__file__).resolve().parents[1] / "examples" / "friction"
             / "slide3d.toml").read_text()
     text = text.replace("load_factors = [0.25, 0.5, 0.6, 0.9, 1.2, 1.6, 2.0]",
                         "load_factors = [0.5, 0.6, 0.9]")
-    config = loads(text)
-    whole = runner.run(config, tmp_path / "whole", figures=False)
-
-    class Stop(Exception):
-        pass
-
-    def stop_after(step):
-        if step.step == 2:
-            raise Stop
-
-    with pytest.raises(Stop):
-        runner.run(config, tmp_path / "resumed", figures=False, on_step=stop_after)
-    resumed = runner.run(config, tmp_path / "resumed", figures=False, resume=True)
-    assert len(resumed["steps"]) == 3
-    for a, b in zip(whole["steps"], resumed["steps"], strict=True):
-        for name in ("base", "block"):
-            np.testing.assert_array_equal(a["contact_force"][name], b["contact_force"][name])
-        assert a["frictional_work"] == b["frictional_work"]
-    assert (tmp_path / "resumed" / "contact.csv").read_text() == \
-        (tmp_path / "whole" / "contact.csv").read_text()
+    assert len(assert_resumed_equals_whole(loads(text), tmp_path, stop_after=2)["steps"]) == 3
 
 
 @pytest.mark.slow
