@@ -23,7 +23,8 @@ along its first diagonal) in place of its boundary polygon:
   an edge on a symmetry plane, where the facet's mirror image continues it), |r| signed by the
   feature's pseudonormal; the second-order allowance the slip times the angle the facet
   has turned through.
-* **tension**: F·n with n the angle-weighted nodal normal (undeformed under small kinematics).
+* **tension**: F·n with n the angle-weighted nodal normal (undeformed under small kinematics)
+  of the body's contact boundaries where it names them (:attr:`Surface3.tension_normals`).
 
 Linear facets only: quadratic 3D bodies in contact, and the "consistent" tension measure in
 3D, are refused with NotImplementedError (docs/errors.md). The loop of (b) over the pairs is
@@ -66,6 +67,9 @@ class Boundary3:
     #: quadratic triangles: each corner with each midpoint of its facets' edges from it,
     #: (m, 2) local numbers (unique), for (c)'s measure; None on linear facets
     corner_mid: np.ndarray | None = None
+    #: (nt,) bool: the triangle lies on one of the body's contact boundaries
+    #: (``contact_boundaries``); None where it names none (every boundary may touch)
+    contact: np.ndarray | None = None
 
     @classmethod
     def of(cls, body: Body, symmetry: np.ndarray) -> Boundary3:
@@ -96,6 +100,11 @@ class Boundary3:
         tri = np.vstack([fp[:, s] for s in split])
         owner = np.tile(np.arange(len(fp)), len(split))
         mirror = np.isin(bf, symmetry)[piece_of][owner]
+        contact = None
+        if body.contact_boundaries is not None:
+            named = [mesh.boundaries[n] for n in body.contact_boundaries if n in mesh.boundaries]
+            contact = np.isin(bf, np.concatenate(named or [np.zeros(0, np.int64)])
+                              )[piece_of][owner]
         k = fp.shape[1]
         sides = np.vstack([fp[:, [c, (c + 1) % k]] for c in range(k)])
         sides = np.unique(np.sort(sides, axis=1), axis=0)
@@ -105,7 +114,8 @@ class Boundary3:
         return cls(nodes=nodes, triangles=lookup[tri], owner=owner,
                    facets=local.reshape(fp.shape), mirror=mirror,
                    segments=lookup[sides].reshape(-1, 2), large=body.large,
-                   corner_mid=None if corner_mid is None else lookup[corner_mid])
+                   corner_mid=None if corner_mid is None else lookup[corner_mid],
+                   contact=contact)
 
 
 def _barycentric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -241,18 +251,37 @@ class Surface3(CachedBoundary):
     def normals(self) -> np.ndarray:
         """(nb, 3) the outward unit normal at each node: the angle-weighted mean of its surface
         triangles' normals; on a symmetry plane, its component along the plane."""
+        return self._get("normals", lambda: self._normals_over(~self.b.mirror))
+
+    def _normals_over(self, keep: np.ndarray) -> np.ndarray:
+        """(nb, 3) the angle-weighted unit normal of the triangles ``keep`` at each node (zero
+        at nodes on none); on a symmetry plane, its component along the plane."""
+        out = self._vertex_pseudonormals(keep)
+        mirror = np.flatnonzero(self.b.mirror)
+        plane = np.zeros_like(self.x)
+        for k in range(3):
+            plane[self.b.triangles[mirror, k]] = self.unit_normals[mirror]
+        on = np.flatnonzero(plane.any(axis=1) & out.any(axis=1))
+        m = plane[on]
+        out[on] -= np.einsum("ij,ij->i", out[on], m)[:, None] * m
+        norm = np.linalg.norm(out, axis=1)
+        return out / np.where(norm > 0, norm, 1.0)[:, None]
+
+    @property
+    def tension_normals(self) -> np.ndarray:
+        """(nb, 3) the normal (c) reads a node's force along: :attr:`normals` over the body's
+        contact boundaries' triangles only, where it names some and the node is on one (else
+        :attr:`normals`). At a box's corner the whole boundary's normal leans 55 degrees off
+        the contact face's, and a frictional force inclined by atan(mu) against a slide read
+        positive along it at mu = 1 with a compressive traction (tests/test_large_friction3d.py)."""
         def make():
-            out = self._vertex_pseudonormals(~self.b.mirror)
-            mirror = np.flatnonzero(self.b.mirror)
-            plane = np.zeros_like(self.x)
-            for k in range(3):
-                plane[self.b.triangles[mirror, k]] = self.unit_normals[mirror]
-            on = np.flatnonzero(plane.any(axis=1) & out.any(axis=1))
-            m = plane[on]
-            out[on] -= np.einsum("ij,ij->i", out[on], m)[:, None] * m
-            norm = np.linalg.norm(out, axis=1)
-            return out / np.where(norm > 0, norm, 1.0)[:, None]
-        return self._get("normals", make)
+            out = self.normals
+            if self.b.contact is None:
+                return out
+            faces = self._normals_over(self.b.contact & ~self.b.mirror)
+            on = np.linalg.norm(faces, axis=1) > 0
+            return np.where(on[:, None], faces, out)
+        return self._get("tension_normals", make)
 
     @property
     def own_turning(self) -> np.ndarray:
@@ -360,7 +389,7 @@ def tension(check: InvariantCheck, F: list[np.ndarray], own: list[Surface3],
     for b, f, g in zip(check.bodies, F, own):
         if not len(f):
             continue
-        fn = np.einsum("ij,ij->i", f, g.normals)
+        fn = np.einsum("ij,ij->i", f, g.tension_normals)
         if g.b.corner_mid is not None:
             corner, mid = g.b.corner_mid.T
             patch = fn.copy()
