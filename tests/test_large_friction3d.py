@@ -196,3 +196,23 @@ def test_the_3d_slide_with_mu_1():
     np.testing.assert_allclose(tangential / f[2:, 2], 1.0, rtol=3e-3)
     for step in result.steps[2:]:
         assert np.all(statuses(step) == 2)
+
+
+def test_a_normal_turned_onto_its_tangent_axis_stops_the_step_with_a_message():
+    """A node carrying traction whose normal has turned onto the axis its tangents are measured
+    from (the tangents would jump) is refused by the check, naming the body and node: set here
+    by hand on the pressed slide's pairs (a surface would have to turn by 35 degrees)."""
+    from vfem.errors import AnalysisError
+
+    analysis = Analysis(slide(factors=(0.25,)))
+    assert analysis.run().converged
+    contact = analysis.contact
+    state = contact.new_state(0.25)
+    k = 0
+    pair = contact.contact_pairs[k]
+    contact.tractions(state, k)[:] = 1.0
+    contact._further_errors(state)  # as pressed: no normal near its axis
+    pair.normal[:] = np.eye(3)[contact._axes[k]]
+    with pytest.raises(AnalysisError, match=r"body '(base|block)', contact node \d+: its "
+                                            "contact normal has turned onto the axis"):
+        contact._further_errors(state)
