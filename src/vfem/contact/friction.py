@@ -137,8 +137,9 @@ def plane_normals(surface, pair, normal: np.ndarray | None = None,
 
 
 def columns(a: np.ndarray) -> np.ndarray:
-    """A tangential array (2D: (n,), one tangent; 3D: (n, 2)) seen as (n, ntan): a view."""
-    return a.reshape(len(a), -1)
+    """A tangential array (2D: (n,), one tangent; 3D: (n, 2)) seen as (n, ntan): a view (also
+    of no nodes, which ``reshape(0, -1)`` cannot size)."""
+    return a[:, None] if a.ndim == 1 else a
 
 
 def magnitudes(a: np.ndarray) -> np.ndarray:

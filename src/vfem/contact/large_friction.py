@@ -89,12 +89,9 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         #: surface has the direction to its edge as pair normal, nearly in the surface's plane,
         #: and the axis across the surface then met the normal once the other body slid over
         #: it). None in 2D.
-        self._axes = []
-        for p in self.contact_pairs:
-            sf = self.surfaces[p.fine]
-            own = sf.node_normals()[p.nodes] if sf.dim == 3 else None
-            self._axes.append(None if own is None
-                              else tangent_axes(plane_normals(sf, p, own)))
+        self._axes = [tangent_axes(plane_normals(sf, p, sf.node_normals()[p.nodes]))
+                      if sf.dim == 3 else None
+                      for p, sf in ((p, self.surfaces[p.fine]) for p in self.contact_pairs)]
         # (the elasto-plastic law and a force-controlled platen are refused before, by
         # vfem.contact.formulation.check_capabilities)
 
@@ -112,12 +109,10 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         plane at a node on one, :func:`~vfem.contact.friction.plane_normals`)."""
         if self._axes[k] is None:
             return tangents(normal)
-        pair = self.contact_pairs[k]
-        flat = plane_normals(self.surfaces[pair.fine], pair, normal, on)
+        flat, turned = self._turned(k, on, normal)
         axes = self._axes[k][on]
         # (a node whose normal has turned onto its axis: the least aligned axis now; its
         # tangents then jump, which :meth:`_further_errors` refuses where it carries traction)
-        turned = np.abs(flat[np.arange(len(on)), axes]) > TURNED
         if turned.any():
             axes = axes.copy()
             axes[turned] = tangent_axes(flat[turned])
@@ -135,12 +130,9 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
     def _traction_vectors(self, state, k, on, normal):
         """``q n + s t`` at the nodes ``on`` (2D: t is ``normal`` turned by +90 degrees; 3D:
         ``q n + s1 t1 + s2 t2``, the tangents of :meth:`_basis`)."""
-        q = self.tractions(state, k)[on, None] * normal
-        if self._axes[k] is None:
-            return q + self.shear(state, k)[on, None] * tangents(normal)[0]
-        s = self.shear(state, k)[on]
-        t1, t2 = self._basis(k, on, normal)
-        return q + s[:, 0, None] * t1 + s[:, 1, None] * t2
+        s = columns(self.shear(state, k))[on]
+        return self.tractions(state, k)[on, None] * normal + sum(
+            s[:, j, None] * t for j, t in enumerate(self._basis(k, on, normal)))
 
     def _traction_change(self, state, k, on, normal, perturbed, h):
         """3D: the tangents are not linear in the normal: the difference of the traction
@@ -178,8 +170,9 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
     # -- anchors and slips -----------------------------------------------------------------------
 
     def _virtual_points(self, x: list[np.ndarray]) -> list[np.ndarray]:
-        """Per pair, each node's virtual node at positions ``x`` as ``facet + t`` on the
-        opposing surface (what :attr:`FrictionState.anchor` keeps)."""
+        """Per pair, each node's virtual node at positions ``x`` as a material point of the
+        opposing surface (what :attr:`FrictionState.anchor` keeps: 2D ``facet + t``, 3D the
+        facet and its nodes' shape-function values, :meth:`ContactSurface.material_points`)."""
         out = []
         for pair in self.contact_pairs:
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
@@ -193,7 +186,8 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         return out
 
     def _anchor_positions(self, k: int, xc: np.ndarray, anchor: np.ndarray) -> np.ndarray:
-        """Where the opposing surface's material points ``anchor`` (``facet + t``) now are."""
+        """Where the opposing surface's material points ``anchor`` (:meth:`_virtual_points`)
+        now are."""
         return self.surfaces[self.contact_pairs[k].coarse].material_positions(anchor, xc)
 
     def _relative(self, state, k, x) -> np.ndarray:
@@ -217,9 +211,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
 
     def _slip_now(self, state, k, s_, direction) -> np.ndarray:
         """The slips of pair k's nodes ``s_`` along ``direction`` (a tangent at its nodes; the
-        linearised tangential rows' start)."""
-        if self._axes[k] is None:
-            return self.slips(state)[k][s_]
+        linearised tangential rows' start): :meth:`slips` of this pair and these nodes."""
         d = self._relative(state, k, self.positions(state))[s_]
         return np.einsum("ij,ij->i", d, direction[s_])
 
@@ -236,12 +228,15 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
 
     # -- the iteration ---------------------------------------------------------------------------
 
-    def _turned(self, k: int) -> np.ndarray:
-        """3D: pair k's nodes whose current normal has turned to within ``arccos(TURNED)`` of
-        the axis their tangents are measured from (:meth:`_basis`)."""
+    def _turned(self, k: int, on: np.ndarray | None = None, normal: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
+        """3D: pair k's normals at its nodes ``on`` (all; ``normal`` there, else the pair's)
+        less their part across a symmetry plane, and which have turned to within
+        ``arccos(TURNED)`` of the axis their tangents are measured from (:meth:`_basis`)."""
         pair = self.contact_pairs[k]
-        flat = plane_normals(self.surfaces[pair.fine], pair)
-        return np.abs(flat[np.arange(len(pair.nodes)), self._axes[k]]) > TURNED
+        flat = plane_normals(self.surfaces[pair.fine], pair, normal, on)
+        axes = self._axes[k] if on is None else self._axes[k][on]
+        return flat, np.abs(flat[np.arange(len(flat)), axes]) > TURNED
 
     def _further_errors(self, state: FrictionState) -> tuple[float, bool, str]:
         """The friction's errors: a sticking node's slip, a slipping node's slip against its
@@ -250,7 +245,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         for k, pair in enumerate(self.contact_pairs):
             if self._axes[k] is None:
                 continue
-            bad = np.flatnonzero(self._turned(k) & (self.tractions(state, k) > 0))
+            bad = np.flatnonzero(self._turned(k)[1] & (self.tractions(state, k) > 0))
             if len(bad):
                 sf = self.surfaces[pair.fine]
                 raise AnalysisError(
@@ -444,11 +439,11 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             cols = np.concatenate([nrm[contact]] + [tng[stick & free[:, j], j]
                                                     for j in range(2)])
             n_normal = int(contact.sum())
+            # rows: the normal and sticking ones, then each turning node's slip across sigma
             rows_W = np.vstack([W[cols], np.einsum("ij,ijm->im", across_dir, W[tng[turn]])])
-            target = np.concatenate([
-                W[cols] @ q0 + np.concatenate([p[cols[:n_normal]], -p[cols[n_normal:]]]),
-                np.einsum("ij,ijm->im", across_dir, W[tng[turn]]) @ q0
-                - np.einsum("ij,ij->i", across_dir, P[turn])])
+            target = rows_W @ q0 + np.concatenate([
+                p[cols[:n_normal]], -p[cols[n_normal:]],
+                -np.einsum("ij,ij->i", across_dir, P[turn])])
             position = np.full(m, -1)
             position[cols] = np.arange(len(cols))
             ties = -mu[:, None] * sigma  # s = ties q (+ s_perp e) on a slipping node
