@@ -220,8 +220,7 @@ def test_a_normal_turned_onto_its_tangent_axis_stops_the_step_with_a_message():
 
 def test_a_tilted_block_started_apart_lands_on_its_edge_and_slides():
     """Own model: the block (half as stiff as the base) tilted 8 degrees about x through its
-    lower front edge and lifted 0.001: nothing is within reach at first (an empty linearised
-    problem, which once raised), then the edge lands, the block is pressed onto it and slid:
+    lower front edge and lifted 0.001: the edge lands, the block is pressed onto it and slid:
     every step converges with every invariant, the forces balanced to round-off, mu N once
     sliding (measured 0.2999)."""
     model = slide(factors=(0.25, 0.5, 0.6, 0.9, 1.2))
@@ -239,3 +238,15 @@ def test_a_tilted_block_started_apart_lands_on_its_edge_and_slides():
     np.testing.assert_allclose(f, -base, rtol=0, atol=1e-12 * np.abs(f).max())
     tangential = np.linalg.norm(f[2:, :2], axis=1)
     np.testing.assert_allclose(tangential / f[2:, 2], MU, rtol=3e-3)
+
+
+def test_the_tangential_helpers_take_no_nodes():
+    """A linearised problem with nothing within reach (a 50 times stiffer tilted block started
+    apart met it) has tangential arrays of no nodes: seen as (0, ntan), of no length."""
+    from vfem.contact.friction import columns, magnitudes
+
+    assert columns(np.zeros(0)).shape == (0, 1)
+    assert columns(np.zeros((0, 2))).shape == (0, 2)
+    assert magnitudes(np.zeros((0, 2))).shape == (0,)
+    np.testing.assert_array_equal(magnitudes(np.array([[3.0, 4.0]])), [5.0])
+    np.testing.assert_array_equal(magnitudes(np.array([-2.0])), [2.0])
