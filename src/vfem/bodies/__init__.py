@@ -394,15 +394,13 @@ class Body:
         """
         self.validate()
         t0 = time.perf_counter()
-        if self.dim == 3:
-            self.basis = Basis(self.mesh, ElementVector(self.element()),
-                               mapping=cell_mapping(self.mesh))
+        lam, mu = self.material.lame()
+        if self.dim == 3:  # scikit-fem's per-pair loop takes minutes at 3D sizes (assembly.py),
+            # and its basis, 147 KB a hexahedron, is not kept (:attr:`basis`)
+            self.K = elasticity_stiffness(self.mesh, self.element(), lam, mu,
+                                          self.dof_map.element_dofs)
         else:
             self.basis = Basis(self.mesh, ElementVector(self.element()))
-        lam, mu = self.material.lame()
-        if self.dim == 3:  # scikit-fem's per-pair loop takes minutes at 3D sizes (assembly.py)
-            self.K = elasticity_stiffness(self.basis, lam, mu)
-        else:
             self.K = asm(linear_elasticity(lam, mu), self.basis).tocsr()
         self.ndofs = self.K.shape[0]
         t1 = time.perf_counter()
@@ -429,7 +427,7 @@ class Body:
         fixed = self.assemble()
         t1 = time.perf_counter()
         platen_dofs = self.platen_dofs
-        self.K_ff = self.K[self.free_dofs][:, self.free_dofs].tocsc()
+        K_ff = self.K_ff
         trailing = None
         if condensed_dofs is not None:
             condensed_dofs = np.asarray(condensed_dofs, dtype=int)
@@ -437,9 +435,10 @@ class Body:
             free = self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == condensed_dofs
             trailing = pos[free]
         t2 = time.perf_counter()
-        self.factor = factorize(self.K_ff, backend, trailing=trailing,
+        self.factor = factorize(K_ff, backend, trailing=trailing,
                                 groups=self.free_dofs // self.dim, what=f"body {self.name!r}")
         t3 = time.perf_counter()
+        del K_ff  # the factorization has its own copy (a million-dof 3D model: 1 GB each)
         self.condensed_flexibility = None
         if condensed_dofs is not None:
             if free.all():  # the factor's block is the flexibility: no copy
@@ -773,6 +772,31 @@ class Body:
         return self.dof_map.get_facet_dofs(facets).all(f"u^{COMPONENTS[component] + 1}")
 
     @property
+    def K_ff(self):
+        """The stiffness's block of the free dofs (``free_dofs``), CSC: what :meth:`setup`
+        factorizes; formed when asked, not kept."""
+        return self.K[self.free_dofs][:, self.free_dofs].tocsc()
+
+    @property
+    def basis(self) -> Basis:
+        """scikit-fem's ``CellBasis`` of the body's vector element. A 2D body builds it in
+        :meth:`assemble` and keeps it; a 3D body's assembly and strains work a chunk of
+        elements at a time (:func:`~vfem.bodies.assembly.cell_gradients`) and keep none, since
+        the whole basis takes more memory than the factorization (147 KB per trilinear
+        hexahedron: the million-dof sphere was killed building it), so here it is built on
+        first use, for callers that want scikit-fem's view of the body."""
+        basis = self.__dict__.get("_basis")
+        if basis is None:
+            mapping = cell_mapping(self.mesh) if self.dim == 3 else None
+            basis = self._basis = Basis(self.mesh, ElementVector(self.element()),
+                                        mapping=mapping)
+        return basis
+
+    @basis.setter
+    def basis(self, value: Basis) -> None:
+        self._basis = value
+
+    @property
     def dof_map(self) -> Dofs:
         """scikit-fem's numbering of the body's dofs (the vector element's), as its basis has
         it, without the basis."""
@@ -828,7 +852,8 @@ class Body:
             )
 
     def _traction_vector(self, tr: Traction) -> np.ndarray:
-        fb = FacetBasis(self.mesh, self.basis.elem, facets=self.mesh.boundaries[tr.boundary])
+        fb = FacetBasis(self.mesh, ElementVector(self.element()),
+                        facets=self.mesh.boundaries[tr.boundary])
         t = np.asarray(tr.value, dtype=float)
 
         @LinearForm

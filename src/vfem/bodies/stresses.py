@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .assembly import cell_gradients
+
 
 def stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
     """Element-average stresses of ``body`` at displacement ``u`` (ndofs): sxx, syy, sxy, szz
@@ -61,6 +63,8 @@ def average_strain_operator(body):
     Stresses of every step and body are then one sparse product (issue 19: recomputing them
     by interpolation took 0.6 s per step of a 462k-dof body). A 3D body's is 6 nelems x ndofs:
     exx, eyy, ezz, eyz, exz, exy (tensor shear strains, half the engineering ones)."""
+    if body.mesh.p.shape[0] == 3:
+        return _average_strain_operator_3d(body)
     cached = body.__dict__.get("_average_strain")
     if cached is not None and cached[0] is body.basis:
         return cached[1]
@@ -72,24 +76,6 @@ def average_strain_operator(body):
     nel = basis.nelems
     rows, cols, vals = [], [], []
     elements = np.arange(nel)
-    if body.mesh.p.shape[0] == 3:
-        for i in range(basis.Nbfun):
-            c = i % 3  # ElementVector: shape function i moves component i % 3
-            g = basis.basis[i][0].grad[c]  # (derivative, element, quadrature point)
-            avg = (g * w[None]).sum(axis=2) / total[None]  # (derivative, element)
-            dofs = basis.element_dofs[i]
-            rows.append(c * nel + elements)  # exx, eyy, ezz from d/dx, d/dy, d/dz of u_c
-            cols.append(dofs)
-            vals.append(avg[c])
-            for d in range(3):  # the shears: half of d(u_c)/dd + d(u_d)/dc
-                if d != c:
-                    rows.append(_SHEAR[frozenset((c, d))] * nel + elements)
-                    cols.append(dofs)
-                    vals.append(0.5 * avg[d])
-        op = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                           shape=(6 * nel, basis.N))
-        body.__dict__["_average_strain"] = (basis, op)
-        return op
     for i in range(basis.Nbfun):
         c = i % 2  # ElementVector: shape function i moves component i % 2
         g = basis.basis[i][0].grad[c]  # (derivative, element, quadrature point)
@@ -105,6 +91,41 @@ def average_strain_operator(body):
     return op
 
 
+def _average_strain_operator_3d(body):
+    """:func:`average_strain_operator` of a 3D body, from the gradients of a chunk of elements
+    at a time (:func:`~vfem.bodies.assembly.cell_gradients`: a 3D body keeps no basis)."""
+    cached = body.__dict__.get("_average_strain")
+    if cached is not None and cached[0] is body.mesh:
+        return cached[1]
+    import scipy.sparse as sp
+
+    element_dofs = body.dof_map.element_dofs  # (vector shape functions, elements)
+    nel = body.mesh.nelements
+    rows, cols, vals = [], [], []
+    for e, grads, w in cell_gradients(body.mesh, body.element()):
+        total = w.sum(axis=1)
+        elements = np.arange(e.start, e.stop)
+        for i in range(element_dofs.shape[0]):
+            c = i % 3  # ElementVector: shape function i moves component i % 3
+            g = grads[i // 3]  # (derivative, element, quadrature point): N_a's gradient
+            avg = (g * w[None]).sum(axis=2) / total[None]  # (derivative, element)
+            dofs = element_dofs[i, e]
+            rows.append(c * nel + elements)  # exx, eyy, ezz from d/dx, d/dy, d/dz of u_c
+            cols.append(dofs)
+            vals.append(avg[c])
+            for d in range(3):  # the shears: half of d(u_c)/dd + d(u_d)/dc
+                if d != c:
+                    rows.append(_SHEAR[frozenset((c, d))] * nel + elements)
+                    cols.append(dofs)
+                    vals.append(0.5 * avg[d])
+    n = body.dof_map.N
+    op = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                       shape=(6 * nel, n))
+    op.sort_indices()  # each row's terms in dof order, whatever the chunks
+    body.__dict__["_average_strain"] = (body.mesh, op)
+    return op
+
+
 def max_strain(body, u: np.ndarray) -> tuple[float, int]:
     """The largest strain of displacement ``u`` (ndofs) as small kinematics reads it: the
     largest absolute principal value of the in-plane small-strain tensor sym(grad u)
@@ -116,17 +137,17 @@ def max_strain(body, u: np.ndarray) -> tuple[float, int]:
     0.05 s for 160k dofs; after :meth:`~vfem.bodies.Body.assemble`); for linear triangles,
     whose strain is constant in each element, from :func:`average_strain_operator`. In 3D the
     largest absolute eigenvalue of the 3 x 3 strain tensor (:func:`_largest_eigenvalue`)."""
-    basis = body.basis
     if body.mesh.p.shape[0] == 3:
         if body.order == 1 and body.mesh.t.shape[0] == 4:  # linear tetrahedra: constant
-            nel = basis.nelems
+            nel = body.mesh.nelements
             e = (average_strain_operator(body) @ np.asarray(u, dtype=float)).reshape(6, nel)
             per_element = _largest_eigenvalue(*e)
             if not per_element.size:
                 return 0.0, 0
             element = int(np.argmax(per_element))
             return float(per_element[element]), element
-        return _max_strain_at_quadrature(body, u)
+        return _max_strain_at_quadrature_3d(body, u)
+    basis = body.basis
     if body.order == 1 and body.mesh.t.shape[0] == 3:
         # linear triangles: the strain is constant in each element, its average (one sparse
         # product, :func:`average_strain_operator`) is its value at every quadrature point
@@ -164,6 +185,24 @@ def _max_strain_at_quadrature(body, u: np.ndarray) -> tuple[float, int]:
     per_element = principal.max(axis=1) if principal.size else np.zeros(1)
     element = int(np.argmax(per_element))
     return float(per_element[element]), element
+
+
+def _max_strain_at_quadrature_3d(body, u: np.ndarray) -> tuple[float, int]:
+    """:func:`max_strain` of a 3D body over every quadrature point, a chunk of elements at a
+    time (:func:`~vfem.bodies.assembly.cell_gradients`)."""
+    ue = np.asarray(u, dtype=float)[body.dof_map.element_dofs]  # (shape functions, elements)
+    best, where = -1.0, 0
+    for e, grads, _ in cell_gradients(body.mesh, body.element()):
+        # grad u_c = sum_a u_(a, c) grad N_a: (component, derivative, element, quadrature point)
+        grad = np.einsum("ace,adeq->cdeq", ue[:, e].reshape(-1, 3, e.stop - e.start), grads)
+        principal = _largest_eigenvalue(
+            grad[0, 0], grad[1, 1], grad[2, 2], 0.5 * (grad[1, 2] + grad[2, 1]),
+            0.5 * (grad[0, 2] + grad[2, 0]), 0.5 * (grad[0, 1] + grad[1, 0]))
+        per_element = principal.max(axis=1)
+        k = int(np.argmax(per_element))
+        if per_element[k] > best:
+            best, where = float(per_element[k]), e.start + k
+    return max(best, 0.0), where
 
 
 def _largest_eigenvalue(xx, yy, zz, yz, xz, xy) -> np.ndarray:

@@ -612,10 +612,9 @@ def _stiffness(body):
     elements ccx's are."""
     lam, mu = body.material.lame()
     if body.mesh.p.shape[0] == 3:  # as Body.assemble does (scikit-fem's loop is slow in 3D)
-        from ..bodies.assembly import cell_mapping, elasticity_stiffness
+        from ..bodies.assembly import elasticity_stiffness
 
-        basis = Basis(body.mesh, ElementVector(body.element()), mapping=cell_mapping(body.mesh))
-        return elasticity_stiffness(basis, lam, mu).tocsr()
+        return elasticity_stiffness(body.mesh, body.element(), lam, mu)
     basis = Basis(body.mesh, ElementVector(body.element()))
     return asm(linear_elasticity(lam, mu), basis).tocsr()
 
