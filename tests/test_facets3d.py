@@ -545,3 +545,31 @@ def test_degenerate_facets_are_refused():
     thin = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1e-5, 0]])
     res = closest_on_facets(np.array([[0.5, 5e-6, 1.0]]), thin, np.array([[0, 1, 2]]))
     np.testing.assert_allclose(res.distance, [1.0])
+
+
+def test_tree_search_over_facets_of_many_sizes_finds_the_direct_pairs(monkeypatch):
+    """The KD-tree search takes the facets by classes of size (a graded mesh's far-field
+    facets would otherwise set every point's search radius): the same (point, facet) pairs
+    as the direct search, and the same closest points."""
+    from skfem import MeshQuad
+
+    from vfem.contact.facets3d import candidate_pairs
+
+    g = np.linspace(0.0, 1.0, 13) ** 3  # facets from 1/1728 to 0.42 wide
+    m = MeshQuad.init_tensor(g, g)
+    x = np.vstack([m.p, 0.1 * np.sin(3.0 * m.p[0]) * m.p[1]]).T  # warped a little
+    facets = m.t.T
+    rng = np.random.default_rng(5)
+    points = np.vstack([x + rng.normal(scale=0.01, size=x.shape),
+                        rng.uniform([-0.2, -0.2, -0.3], [1.2, 1.2, 0.4], size=(600, 3))])
+    sizes = facets3d.bounding_spheres(x, facets)[1]
+    assert sizes.max() > 100 * sizes.min()
+    monkeypatch.setattr(facets3d, "DIRECT_PAIRS", 10**9)
+    direct = candidate_pairs(points, x, facets)
+    near_direct = closest_on_facets(points, x, facets)
+    monkeypatch.setattr(facets3d, "DIRECT_PAIRS", 0)
+    tree = candidate_pairs(points, x, facets)
+    for u, v in zip(direct, tree):
+        np.testing.assert_array_equal(u, v)
+    for u, v in zip(near_direct, closest_on_facets(points, x, facets)):
+        np.testing.assert_array_equal(u, v)

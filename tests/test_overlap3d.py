@@ -216,3 +216,29 @@ def test_a_warped_quadrilateral_gets_its_surface_measure():
     jn = np.cross(a + e[..., None] * c, b + x[..., None] * c)
     area = (np.linalg.norm(jn, axis=2) * np.outer(w, w) / 4).sum()
     assert area > 1.0008 and abs(q.weight.sum() - area) < 1e-11
+
+
+def graded(kind, n, power=3.0):
+    """A mesh of the unit square graded towards x = y = 0 (facet sizes from (1/n)^power to
+    about 3/n): the far field of a graded body beside its fine contact zone."""
+    m = plane_mesh(kind, n)
+    return type(m)(m.p**power, m.t)
+
+
+@pytest.mark.parametrize("kc,ko", [("tri", "quad"), ("quad", "tri"), ("quad", "quad")])
+def test_the_plane_test_keeps_every_overlapping_pair_of_graded_meshes(kc, ko):
+    """The candidates drop pairs whose projections on the compatibility plane cannot meet,
+    which a reach that grows with the largest facet lets in by the hundred: the quadrature
+    from the candidates is the one from every pair, to the bit, with far fewer pairs."""
+    mc, mo = graded(kc, 12), graded(ko, 9, power=2.0)
+    xc, fc = lifted(mc)
+    xo, fo = lifted(mo, 0.05, facing=True)
+    reach = 0.05 + 2.0 * 0.3  # the pairing's: the gap and twice the largest facets
+    pairs = candidate_pairs(xc, fc, xo, fo, reach)
+    everything = np.array([(i, j) for i in range(len(fc)) for j in range(len(fo))])
+    wide = overlap_quadrature(xc, fc, xo, fo, everything, max_distance=reach)
+    narrow = overlap_quadrature(xc, fc, xo, fo, pairs, max_distance=reach)
+    for name in ("weight", "comp_facet", "comp_xi", "opp_facet", "opp_xi", "x"):
+        np.testing.assert_array_equal(getattr(wide, name), getattr(narrow, name))
+    assert len(np.unique(wide.pair)) <= len(pairs) < 0.25 * len(everything)
+    assert wide.weight.sum() == pytest.approx(1.0, rel=1e-12)  # the whole unit square

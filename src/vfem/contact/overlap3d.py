@@ -332,8 +332,16 @@ def overlap_matrices(quad: OverlapQuadrature, comp_facets: np.ndarray, opp_facet
 def candidate_pairs(comp_points: np.ndarray, comp_facets: np.ndarray, opp_points: np.ndarray,
                     opp_facets: np.ndarray, reach: float = 0.0) -> np.ndarray:
     """(compatibility facet, opposing facet) pairs (p, 2) whose bounding spheres (about the
-    centroids, radius the farthest corner) come within ``reach``: a superset of the pairs with
-    an overlap, sorted. A k-d tree on the centroids, no loop over facets."""
+    centroids, radius the farthest corner) come within ``reach``, and whose projections on the
+    compatibility facet's plane can meet (their centroids' projections no farther apart than
+    the two radii): a superset of the pairs with an overlap (:func:`overlap_quadrature`
+    projects on that plane, and a projection moves no two points apart), sorted. A k-d tree
+    on the centroids, no loop over facets.
+
+    The plane test matters where ``reach`` is large against the facets in contact: the
+    pairing's reach grows with the largest facet of either surface, and on the graded sphere
+    of ``vfem bench sphere`` at 316k dofs every contact facet met some 700 opposing ones
+    within it, whose clipping took 5 s and 0.9 GB to find 6 to 9 overlaps a facet."""
     from scipy.spatial import cKDTree
 
     def spheres(points, facets):
@@ -349,5 +357,11 @@ def candidate_pairs(comp_points: np.ndarray, comp_facets: np.ndarray, opp_points
                                                output_type="ndarray")
     i, j = found["i"].astype(np.int64), found["j"].astype(np.int64)
     ok = found["v"] <= rc[i] + ro[j] + reach
-    out = np.stack([i[ok], j[ok]], axis=1)
+    i, j = i[ok], j[ok]
+    n = _frames(np.asarray(comp_points, float), np.asarray(comp_facets))[1]
+    d = co[j] - cc[i]
+    along = np.einsum("pd,pd->p", d, n[i])
+    apart = np.einsum("pd,pd->p", d, d) - along**2  # squared, in the plane
+    meet = apart <= ((rc[i] + ro[j]) * (1.0 + 1e-9)) ** 2 + 1e-300
+    out = np.stack([i[meet], j[meet]], axis=1)
     return out[np.lexsort((out[:, 1], out[:, 0]))]
