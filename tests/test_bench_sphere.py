@@ -13,9 +13,21 @@ needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None,
 
 
 def test_sphere_parameters_follow_the_dofs():
-    assert bench.sphere_parameters(26_160).facets_per_radius == 6
-    assert bench.sphere_parameters(300_000).facets_per_radius == 22
+    for facets, dofs in bench._SPHERE_DOFS:  # the measured points are met exactly
+        assert bench.sphere_parameters(dofs).facets_per_radius == facets
+    asked = [5e3, 3e4, 1e5, 3e5, 1e6, 3e6]
+    chosen = [bench.sphere_parameters(d).facets_per_radius for d in asked]
+    assert chosen == sorted(chosen) and chosen[0] == 3 and chosen[-1] > 43
+    assert bench.sphere_parameters(1e6).facets_per_radius == 37  # between 928k and 1.4M
     assert bench.sphere_parameters(level=1).refinement == 1
+
+
+@pytest.mark.parametrize("facets,dofs", bench._SPHERE_DOFS[:3])
+def test_sphere_dofs_table_is_measured(facets, dofs):
+    from vfem.examples.sphere import SphereParameters, build
+
+    model = build(SphereParameters(facets_per_radius=facets, steps=1))
+    assert sum(3 * b.mesh.p.shape[1] for b in model.bodies) == dofs
 
 
 def test_bench_sphere_prints_and_saves_its_rows(tmp_path, capsys):

@@ -46,12 +46,22 @@ is a guide, not a bound.
 In 3D (issue 21) a solid's fill grows as ndofs^(4/3), not as ndofs log ndofs: the fill per dof
 is ``a ndofs^(1/3) + b`` (:data:`PARDISO_3D`, :data:`SUPERLU_3D`, fitted on the sphere
 example's hexahedral bodies), the stiffness's structural count is exact (the distinct pairs of
-points sharing an element, nine entries each) and a body has three dofs a point. Against the
-peaks of ``vfem bench sphere`` (PARDISO, 2026-11-28): 2,752 MiB estimated for 3,050 measured at
-92k dofs, 14,552 for 11,302 at 316k (0.9 to 1.3 times); the 2D law had put them 5 to 7 times
-too low, so a 3D model too large for the machine met the out-of-memory killer instead of this
-check. At 829k dofs the estimate is 52 GiB, the factors' values alone (1.6e9 entries) 13 GiB: a
-million-dof 3D model does not fit a 24 GB machine by a direct factorization, vfem's or plain.
+points sharing an element, nine entries each) and a body has three dofs a point. Under PARDISO
+a 3D body's factors take :data:`PARDISO_3D_FACTOR_BYTES` per entry (PARDISO's own count) and
+its stiffness :data:`PARDISO_3D_STIFFNESS_BYTES`. Against the set-up's peaks on the sphere
+example (``benchmarks/memory_model.py --solver pardiso sphere 1 N``, 2026-11-28; the fill
+model 0.97 to 1.05 times PARDISO's count from 92k dofs up):
+
+| facets across a | dofs | peak MiB | estimate MiB |
+|---:|---:|---:|---:|
+| 12 | 92,172 | 1,106 | 966 |
+| 22 | 315,825 | 4,730 | 4,909 |
+| 29 | 568,008 | 10,293 | 10,721 |
+| 36 | 928,191 | 19,532 | 20,626 |
+
+(the peaks before the bodies stopped keeping scikit-fem's basis, 147 KB a hexahedron, were 2.8
+times these, and the model fitted to them refused the 928k-dof sphere with 52 GiB; it now
+runs on the 24 GB machine, ``vfem bench sphere``).
 """
 
 from __future__ import annotations
@@ -96,6 +106,17 @@ PARDISO_MIN, PARDISO_SLOPE, PARDISO_OFFSET = 10.0, 8.4, 48.0
 #: factors 5 to 7 times too low.
 PARDISO_3D = (25.5, -143.0)
 SUPERLU_3D = (65.6, -446.0)
+#: Bytes per entry of PARDISO's factors of a 3D body: its values and indices, the Schur
+#: complement's block included (PARDISO's own count of its memory, ``iparm[15] + iparm[16]``,
+#: over its nnz(L): 9.0 to 9.6 on the sphere's bodies from 41k to 889k dofs, 2026-11-28).
+#: :data:`FACTOR_BYTES` is SuperLU's, whose copies of L and U at the trailing block cost more;
+#: 2D keeps it for PARDISO too, where the whole 2D estimate was fitted with it.
+PARDISO_3D_FACTOR_BYTES = 10
+#: Bytes per stiffness entry of a 3D body under PARDISO: the matrix kept, PARDISO's copy of its
+#: upper triangle and what the assembly and the contact set-up leave (fitted: 27 to 35 bytes
+#: beside the factors and the dense blocks from 316k to 928k dofs). A 3D body keeps no basis
+#: and no free block (:attr:`vfem.bodies.Body.basis`): :data:`STIFFNESS_BYTES` counts both.
+PARDISO_3D_STIFFNESS_BYTES = 32
 #: What Python, NumPy and scikit-fem hold besides (measured: about 15 MB).
 BASE_BYTES = 16 * 2**20
 
@@ -147,10 +168,13 @@ def estimate(surfaces, pairs=(), backend: str | None = None) -> dict[str, float]
         body = s.body
         ndofs = body.dim * body.npoints
         m = len(s.condensed_dofs)
-        parts["factors"] += FACTOR_BYTES * factor_entries(ndofs, m, backend, body.dim)
+        per_entry = PARDISO_3D_FACTOR_BYTES if backend == "pardiso" and body.dim == 3 \
+            else FACTOR_BYTES
+        parts["factors"] += per_entry * factor_entries(ndofs, m, backend, body.dim)
         parts["dense"] += (PARDISO_DENSE_BYTES if backend == "pardiso" else DENSE_BYTES) \
             * float(m) ** 2
-        parts["stiffness"] += STIFFNESS_BYTES * stiffness_entries(body)
+        parts["stiffness"] += (PARDISO_3D_STIFFNESS_BYTES if backend == "pardiso"
+                               and body.dim == 3 else STIFFNESS_BYTES) * stiffness_entries(body)
         if body.large:
             parts["large"] += LARGE_BYTES * ndofs * 2.0 * s.nc
     for pair in pairs:

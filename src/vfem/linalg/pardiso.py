@@ -171,6 +171,9 @@ class PardisoFactorization:
         else:
             self._call(12, np.zeros(self.n), x, 1)
         self.factor_entries = int(iparm[17])
+        #: PARDISO's own count of the memory its factorization keeps (``iparm[15]``, permanent,
+        #: and ``iparm[16]``, the factors, in KiB): what vfem.memory's 3D bytes per entry fit
+        self.factor_bytes = 1024 * (int(iparm[15]) + int(iparm[16]))
         if m:
             # rows and columns of the Schur complement in increasing dof order
             rank = np.argsort(np.argsort(trailing))
