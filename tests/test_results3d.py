@@ -367,3 +367,14 @@ def test_resume_tells_a_3d_default_support_from_x_and_y(tmp_path):
     run_writing(model(Support("bottom")), tmp_path)
     with pytest.raises(InputError, match=r"supports\[0\]\.components.*'x', 'y', 'z'"):
         run_writing(model(Support("bottom", ("x", "y"))), tmp_path, resume=True)
+
+
+def test_a_3d_run_keeps_no_scikit_fem_basis(run):
+    """Assembly, strains, stresses and the written results of a 3D body work a chunk of
+    elements at a time: no body keeps the whole ``CellBasis`` (147 KB per trilinear
+    hexahedron; the million-dof sphere was killed building it), though ``body.basis`` still
+    builds it for a caller that asks."""
+    _, model, result, _ = run
+    assert all("_basis" not in b.__dict__ for b in model.bodies)
+    body = model.bodies[0]
+    assert body.basis.N == body.ndofs and "_basis" in body.__dict__

@@ -38,7 +38,7 @@ def small_strain_stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
     the element-average strain (the stress is linear in the strain), the average strain by one
     sparse product with :func:`average_strain_operator`."""
     lam, mu = body.material.lame()
-    nel = body.basis.nelems
+    nel = body.mesh.nelements
     e = average_strain_operator(body) @ np.asarray(u, dtype=float)
     if body.mesh.p.shape[0] == 3:
         exx, eyy, ezz, eyz, exz, exy = e.reshape(6, nel)
