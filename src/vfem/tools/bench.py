@@ -252,7 +252,7 @@ def hertz_case(p: HertzParameters, backend: str | None = None, method: str = "vf
 #: facets, so the dofs grow as a power of the facets that rises from 1.8 to 2.2; between
 #: these points :func:`sphere_parameters` interpolates log-log
 _SPHERE_DOFS = ((3, 7_623), (6, 26_160), (8, 43_377), (12, 92_172), (16, 161_088),
-                (22, 315_825), (36, 928_191), (43, 1_415_670))
+                (22, 315_825), (29, 568_008), (36, 928_191), (37, 980_694), (43, 1_415_670))
 
 
 #: the sphere's CalculiX contact stiffness (pressure per unit overclosure): an overclosure of
