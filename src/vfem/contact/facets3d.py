@@ -395,9 +395,10 @@ def candidate_pairs(points: np.ndarray, x: np.ndarray, facets: np.ndarray
         pt, fc = np.nonzero(dc - radius[None] <= (d0 + slack)[:, None])
         return pt.astype(np.int64), fc.astype(np.int64)
     # the nearest centre (the tree's first of its 16 nearest), then per class of radii (a
-    # factor of 2 apart) the centres within d0 + the class's largest radius: with one reach
-    # for all, the largest facet's radius (a graded mesh's far field) set every point's
-    # search, 0.6 GB of pairs for the quadrature points of the sphere at 316k dofs
+    # factor of 2 apart) the centres within d0 + the class's largest radius, by the tree's k
+    # nearest, k doubled for the points whose k-th is still within reach: with one reach for
+    # all, the largest facet's radius (a graded mesh's far field) set every point's search,
+    # 0.6 GB of pairs for the quadrature points of the sphere at 316k dofs
     tree = cKDTree(centre)
     _, j = tree.query(points, k=min(nf, 16), workers=-1)
     d0 = _distance(points, centre[j[:, 0] if j.ndim == 2 else j])
@@ -405,15 +406,18 @@ def candidate_pairs(points: np.ndarray, x: np.ndarray, facets: np.ndarray
     pts, fcs = [], []
     for c in np.unique(level):
         members = np.flatnonzero(level == c)
+        sub = cKDTree(centre[members])
         reach = (d0 + radius[members].max() + slack) * (1 + 1e-12) + 1e-300
-        found = cKDTree(centre[members]).query_ball_point(points, reach, workers=-1,
-                                                          return_sorted=False)
-        counts = np.fromiter((len(f) for f in found), dtype=np.int64, count=m)
-        if counts.sum():
-            pts.append(np.repeat(np.arange(m), counts))
-            fcs.append(members[np.concatenate([f for f in found if len(f)]).astype(np.int64)])
-    if not pts:
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        todo, k = np.arange(m), min(len(members), 16)
+        while len(todo):
+            d, jj = sub.query(points[todo], k=k, workers=-1)
+            d, jj = d.reshape(len(todo), -1), jj.reshape(len(todo), -1)
+            done = (d[:, -1] > reach[todo]) | (k == len(members))
+            rows, cols = np.nonzero(d[done] <= reach[todo][done, None])
+            pts.append(todo[done][rows])
+            fcs.append(members[jj[done][rows, cols]])
+            todo = todo[~done]
+            k = min(2 * k, len(members))
     pt, fc = np.concatenate(pts), np.concatenate(fcs)
     keep = _distance(points[pt], centre[fc]) - radius[fc] <= d0[pt] + slack
     pt, fc = pt[keep], fc[keep]
