@@ -159,15 +159,17 @@ def stiffness_entries(body) -> int:
     return 4 * (body.npoints + 2 * pairs)
 
 
-def estimate(surfaces, pairs=(), backend: str | None = None) -> dict[str, float]:
+def estimate(surfaces, pairs=(), backend: str | None = None, matrix_free: bool = False
+             ) -> dict[str, float]:
     """Estimated peak bytes of the set-up with ``backend`` (SuperLU's model for any other),
     by part: ``{"total", "factors", "dense", "stiffness", "pairs", "large"}`` (see the module
-    docstring for the model)."""
+    docstring for the model). ``matrix_free`` (issue 22): no body is condensed, so no dense
+    block and no condensed block in the factors."""
     parts = dict.fromkeys(("factors", "dense", "stiffness", "pairs", "large"), 0.0)
     for s in surfaces:
         body = s.body
         ndofs = body.dim * body.npoints
-        m = len(s.condensed_dofs)
+        m = 0 if matrix_free else len(s.condensed_dofs)
         per_entry = PARDISO_3D_FACTOR_BYTES if backend == "pardiso" and body.dim == 3 \
             else FACTOR_BYTES
         parts["factors"] += per_entry * factor_entries(ndofs, m, backend, body.dim)
@@ -230,14 +232,15 @@ def _advice(parts: dict[str, float]) -> str:
     return "the bodies' meshes dominate: coarser meshes away from the contact"
 
 
-def check_memory(surfaces, pairs=(), backend: str | None = None) -> dict[str, float]:
+def check_memory(surfaces, pairs=(), backend: str | None = None, matrix_free: bool = False
+                 ) -> dict[str, float]:
     """Log the estimated memory of the set-up and refuse a model that cannot fit.
 
     Raises:
         AnalysisError: the estimate exceeds :func:`available_memory`; the message gives both
             and what to change.
     """
-    parts = estimate(surfaces, pairs, backend)
+    parts = estimate(surfaces, pairs, backend, matrix_free)
     available = available_memory()
     log.info("estimated memory for the set-up: %s (factors %s, dense contact matrices %s, "
              "stiffness %s); available: %s", _size(parts["total"]), _size(parts["factors"]),

@@ -120,6 +120,8 @@ class AnalysisResult:
     surfaces: list[ContactSurface] = field(default_factory=list)
     penetration_tolerance: float = 0.0  # the one the contact iteration used
     backend: str = ""  # the linear-algebra backend that factorized the bodies (vfem.linalg)
+    #: how the contact correction read the flexibility: "dense" or "matrix_free" (issue 22)
+    flexibility: str = "dense"
 
 
 @dataclass

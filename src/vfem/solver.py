@@ -40,6 +40,7 @@ from .bodies import Body, multiplier
 from .bodies.stresses import max_strain
 from .contact.check import InvariantCheck, Invariants
 from .contact.formulation import check_capabilities, formulation_class
+from .contact.matrix_free import matrix_free_refusal
 from .contact.search import project_points
 from .contact.settings import ContactSettings
 from .contact.state import ContactState, IterationRecord, SolveResult
@@ -62,7 +63,7 @@ from .errors import (
     SingularSystem,
 )
 from .linalg import resolve as resolve_backend
-from .memory import check_memory, memory_guard
+from .memory import available_memory, check_memory, estimate, memory_guard
 from .result_types import (  # the result types, here too for those who import them from here
     AnalysisResult,
     BodyStepResult,
@@ -289,6 +290,7 @@ class Analysis:
         is refused, and running out of memory anyway is an :class:`AnalysisError` that says so.
         """
         ensure_threads()  # the thread pools sized once, unless the caller did (vfem.threads)
+        self.matrix_free = False  # the contact flexibility formed (issue 22: or applied)
         if self.model.contact.method != "vfem":  # a classical baseline: one global system
             from .contact.baselines import GlobalContact
 
@@ -311,13 +313,15 @@ class Analysis:
         for note in self.unreachable + idle_load_curves(self.model):
             log.warning("%s", note)
         t1 = time.perf_counter()
-        check_memory(self.surfaces, pairs, self.backend)
+        self.matrix_free = self._matrix_free(pairs)
+        check_memory(self.surfaces, pairs, self.backend, matrix_free=self.matrix_free)
         with memory_guard("factorizing the bodies and computing their flexibility"):
             for b, s in zip(bodies, self.surfaces):
-                b.setup(self.backend, condensed_dofs=s.condensed_dofs)
+                b.setup(self.backend,
+                        condensed_dofs=None if self.matrix_free else s.condensed_dofs)
             t2 = time.perf_counter()
             for s in self.surfaces:
-                s.compute_flexibility()
+                s.compute_flexibility(matrix_free=self.matrix_free)
                 log.info("body %s: %d contact candidate nodes", s.body.name, s.nc)
             self.contact = self._contact(pairs)
         self.invariant_check = self._invariant_check()
@@ -326,6 +330,35 @@ class Analysis:
                             flexibility_s=t3 - t2)
         for key in ("assemble_s", "factorize_s"):
             self.timings[key] = sum(b.timings[key] for b in bodies)
+
+    def _matrix_free(self, pairs: set[frozenset[int]]) -> bool:
+        """Whether the contact correction applies the bodies' flexibility instead of forming
+        it (``contact.flexibility``, issue 22): asked for, or ``"auto"`` and the dense blocks
+        would exceed ``contact.dense_limit_mib`` (default half the memory available). The
+        matrix-free route serves the paired variant under small kinematics without friction;
+        asked for elsewhere, it is refused with the reason."""
+        cfg = self.model.contact
+        if cfg.flexibility == "dense" or not any(s.nc for s in self.surfaces):
+            return False
+        why = matrix_free_refusal(cfg, self.model.bodies)
+        if cfg.flexibility == "matrix_free":
+            if why:
+                raise InputError(f"contact.flexibility = \"matrix_free\": {why}; use "
+                                 "\"dense\" or \"auto\"")
+            return True
+        if why:
+            return False
+        dense = estimate(self.surfaces, pairs, self.backend)["dense"]
+        if cfg.dense_limit_mib is not None:
+            limit = cfg.dense_limit_mib * 2**20
+        else:
+            available = available_memory()
+            limit = None if available is None else 0.5 * available
+        chosen = limit is not None and dense > limit
+        log.info("contact flexibility: %s (dense blocks about %.0f MiB, limit %s)",
+                 "matrix-free" if chosen else "dense", dense / 2**20,
+                 "none" if limit is None else f"{limit / 2**20:.0f} MiB")
+        return chosen
 
     def _contact(self, pairs: set[frozenset[int]]):
         """The contact formulation of the model's settings and kinematics
@@ -536,7 +569,8 @@ class Analysis:
                                       ("search_s", "assemble_factorize_s", "flexibility_s",
                                        "steps_s"))
         return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
-                              self.surfaces, self.contact.penetration_tolerance, self.backend)
+                              self.surfaces, self.contact.penetration_tolerance, self.backend,
+                              "matrix_free" if getattr(self, "matrix_free", False) else "dense")
 
     def _add_time(self, key: str, seconds: float) -> None:
         self.timings[key] = self.timings.get(key, 0.0) + seconds

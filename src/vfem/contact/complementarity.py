@@ -22,7 +22,7 @@ from .group import ReusedFactor, bordered_matrix, bordered_solve
 log = logging.getLogger(__name__)
 
 
-def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: float,
+def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
                            dp_dplaten: np.ndarray | None = None, dR: np.ndarray | None = None,
                            stiffness: float = 0.0, need: float = 0.0,
                            max_pivots: int | None = None, factor: ReusedFactor | None = None
@@ -42,14 +42,17 @@ def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: fl
     a complementary solution in ``max_pivots`` solves, the last set's solution with its negative
     values set to zero.
 
-    ``factor``: keep the LU factors of the last set's matrix (:class:`ReusedFactor`; a step
-    whose set is the last step's solves with the same factors); without it, every set's
-    bordered system is solved by least squares.
+    ``W``: the matrix (:class:`DenseSystem`), or an operator with its ``matvec`` and ``solve``
+    (:class:`~vfem.contact.matrix_free.PairOperator`, issue 22). ``factor``: with a matrix,
+    keep the LU factors of the last set's matrix (:class:`ReusedFactor`; a step whose set is
+    the last step's solves with the same factors); without it, every set's bordered system is
+    solved by least squares.
     """
     n = len(q0)
     max_pivots = max_pivots or 10 * n + 10
     platen = dp_dplaten is not None
-    Wq0 = W @ q0
+    system = W if hasattr(W, "matvec") else DenseSystem(W, factor)
+    Wq0 = system.matvec(q0)
 
     def on(active):
         """q (zero off the set) and d that close the set's gaps exactly; the penetrations."""
@@ -59,21 +62,10 @@ def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: fl
         rhs = p[a] + Wq0[a]
         if platen:
             extra = need + float(dR @ q0)
-            x = None
-            if factor is not None:
-                x = factor.solve((True, a.tobytes()), lambda: bordered_matrix(
-                    W[np.ix_(a, a)], -dp_dplaten[a], dR[a], stiffness),
-                    np.concatenate([rhs, [extra]]))
-            if x is None:  # singular (no node of the platen's body in the set): least squares
-                q[a], d = bordered_solve(W[np.ix_(a, a)], -dp_dplaten[a], dR[a], stiffness,
-                                         rhs, extra)
-            else:
-                q[a], d = x[:-1], float(x[-1])
+            q[a], d = system.solve(a, rhs, (-dp_dplaten[a], dR[a], stiffness, extra), q0[a])
         elif len(a):
-            x = None if factor is None else factor.solve(
-                (False, a.tobytes()), lambda: W[np.ix_(a, a)], rhs)
-            q[a] = np.linalg.solve(W[np.ix_(a, a)], rhs) if x is None else x
-        pen = p - W @ (q - q0) + (d * dp_dplaten if platen else 0.0)
+            q[a], _ = system.solve(a, rhs, None, q0[a])
+        pen = p - system.matvec(q - q0) + (d * dp_dplaten if platen else 0.0)
         return q, d, pen
 
     active = (q0 > 0) | (p > tol)
@@ -98,4 +90,37 @@ def linear_complementarity(W: np.ndarray, q0: np.ndarray, p: np.ndarray, tol: fl
     return np.maximum(q, 0.0), d
 
 
-__all__ = ["linear_complementarity"]
+class DenseSystem:
+    """W formed (the dense route): its products, and each set's system solved with the LU
+    factors of :class:`ReusedFactor` where given (else least squares for a bordered set,
+    ``numpy.linalg.solve`` for a plain one). The matrix-free route's counterpart is
+    :class:`~vfem.contact.matrix_free.PairOperator` (issue 22)."""
+
+    def __init__(self, W: np.ndarray, factor: ReusedFactor | None = None):
+        self.W = W
+        self.factor = factor
+
+    def matvec(self, x: np.ndarray) -> np.ndarray:
+        return self.W @ x
+
+    def solve(self, a: np.ndarray, rhs: np.ndarray, border=None, x0=None
+              ) -> tuple[np.ndarray, float]:
+        """The values on set ``a`` that close its gaps: ``W[a, a] x = rhs``, or with
+        ``border`` = (column, row, corner, extra) the platen's bordered system
+        (:func:`~vfem.contact.group.bordered_solve`). ``x0`` (a first guess) is not needed."""
+        W, factor = self.W, self.factor
+        if border is not None:
+            column, row, corner, extra = border
+            x = None
+            if factor is not None:
+                x = factor.solve((True, a.tobytes()), lambda: bordered_matrix(
+                    W[np.ix_(a, a)], column, row, corner), np.concatenate([rhs, [extra]]))
+            if x is None:  # singular (no node of the platen's body in the set): least squares
+                return bordered_solve(W[np.ix_(a, a)], column, row, corner, rhs, extra)
+            return x[:-1], float(x[-1])
+        x = None if factor is None else factor.solve(
+            (False, a.tobytes()), lambda: W[np.ix_(a, a)], rhs)
+        return (np.linalg.solve(W[np.ix_(a, a)], rhs) if x is None else x), 0.0
+
+
+__all__ = ["DenseSystem", "linear_complementarity"]

@@ -16,51 +16,10 @@ import scipy.linalg as sla
 
 from ..result_types import BodyStepResult, add_reactions
 from ..threads import dense_threads
+from .bordered import bordered_matrix, bordered_solve  # noqa: F401 - here too, as before
 from .settings import ContactSettings
 from .state import ContactState, SolveResult
 from .surface import ContactSurface
-
-
-def bordered_solve(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: float,
-                   rhs: np.ndarray, extra: float, lu_first: bool = False
-                   ) -> tuple[np.ndarray, float]:
-    """The corrections ``x`` and the platen motion ``d`` from the bordered system
-
-        [ W    column ] [x]   [rhs  ]
-        [ row  corner ] [d] = [extra]
-
-    ``W``: the compatibility conditions' flexibility (penetration change per unit force or
-    traction value at the corrected nodes, eq. 4.2.4 in matrix form); ``column``: their change
-    per unit platen motion; ``row``: the platen's reaction per unit correction; ``corner``: the
-    platen's own stiffness (zero for a body only contact holds); ``extra``: the force the platen
-    still lacks. Least squares (the system may be singular: a platen body without a node in
-    contact); ``lu_first``: an LU solve first, least squares (an SVD, ten times dearer) only
-    where that fails.
-    """
-    m = len(rhs)
-    A = bordered_matrix(W, column, row, corner)
-    b = np.concatenate([rhs, [extra]])
-    if lu_first:
-        try:
-            sol = np.linalg.solve(A, b)
-        except np.linalg.LinAlgError:
-            sol = np.linalg.lstsq(A, b, rcond=None)[0]
-    else:
-        sol = np.linalg.lstsq(A, b, rcond=None)[0]
-    return sol[:m], float(sol[m])
-
-
-def bordered_matrix(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: float
-                    ) -> np.ndarray:
-    """The matrix of :func:`bordered_solve`'s system."""
-    m = len(W)
-    A = np.zeros((m + 1, m + 1))
-    A[:m, :m] = W
-    A[:m, m] = column
-    A[m, :m] = row
-    A[m, m] = corner
-    return A
-
 
 
 def quadratic_3d(s) -> bool:
@@ -163,7 +122,7 @@ class SurfaceGroup:
             b = s.body
             dofs = s.condensed_dofs
             u = (b.load_displacement(state.load_factor, dofs) + state.platen_displacement
-                 * b.u_platen[dofs] + s.G @ F.ravel())
+                 * b.u_platen[dofs] + s.motion(F.ravel()))
             out.append(s.X[: len(dofs) // s.dim] + u.reshape(-1, s.dim))
         return out
 

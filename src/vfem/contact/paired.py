@@ -73,6 +73,10 @@ from .surface import ContactSurface
 
 log = logging.getLogger(__name__)
 
+#: the most nodes whose flexibility gives a surface's median compliance
+#: (:meth:`PairSet._compliance_density`): one back-substitution each on the matrix-free route
+SIDE_SAMPLE = 512
+
 
 class PairSet(SurfaceGroup):
     """The paired variant's parts shared by small and large displacements: the contact pairs
@@ -152,7 +156,9 @@ class PairSet(SurfaceGroup):
         pressures would oscillate (measured on Hertz with the flat as compatibility side:
         nodal pressures up to 56 % off). Only the facets where the surfaces overlap count, so
         the mesh far from the contact (a coarse far field, a long exterior facet) does not
-        decide it.
+        decide it. Of more than :data:`SIDE_SAMPLE` such nodes, that many evenly spread over
+        them give the median: where the flexibility is applied, not formed (issue 22), each
+        node read costs a back-substitution, and both routes must choose alike.
         """
         s, so = self.surfaces[i], self.surfaces[j]
         patch, opatch = facing(s, s.X, so, so.X), facing(so, so.X, s, s.X)
@@ -176,7 +182,11 @@ class PairSet(SurfaceGroup):
         # (where both surfaces end together, at a symmetry plane, there is no edge)
         edge = bool((~so.beyond(seg, tf, oends) & ~shared).any())
         nodes = np.unique(s.facets[over])
-        stiffness = s.normal_stiffness(nodes, s.node_normals(None, over)[nodes])
+        normals = s.node_normals(None, over)[nodes]
+        if len(nodes) > SIDE_SAMPLE:  # a large zone: the median of evenly spread nodes
+            pick = np.unique(np.linspace(0, len(nodes) - 1, SIDE_SAMPLE).round().astype(int))
+            nodes, normals = nodes[pick], normals[pick]
+        stiffness = s.normal_stiffness(nodes, normals)
         flexibility = 1.0 / stiffness[np.isfinite(stiffness) & (stiffness > 0)]
         return (float(np.median(flexibility) / np.median(s.sizes[over]))
                 if len(flexibility) else 0.0), edge
@@ -499,7 +509,19 @@ class PairedContact(PairSet):
                      ) -> tuple[np.ndarray, float]:
         """The traction value corrections of the active nodes (and the platen's motion under a
         platen force) that remove the penetrations ``rhs``: the pair matrix W (bordered by the
-        platen's row and column), its factors reused while the active set holds."""
+        platen's row and column), its factors reused while the active set holds; or W's
+        operator (the matrix-free route, issue 22)."""
+        if any(s.matrix_free for s in self.surfaces):
+            if self._full is None:
+                self._full = self._full_flexibility()
+            op, dp_dplaten, dR, offsets = self._full
+            index = np.concatenate([offsets[k] + a for k, a in enumerate(active)])
+            border = None
+            if self.platen_body is not None and state.platen_force != 0.0:
+                border = (-dp_dplaten[index], dR[index],
+                          self.surfaces[self.platen_body].body.platen_stiffness,
+                          state.platen_force - self.platen_reaction(state))
+            return op.solve(index, rhs, border)
         W, dp_dplaten, dR = self._pair_flexibility(state, active)
         bordered = self.platen_body is not None and state.platen_force != 0.0
         key = (bordered,) + tuple(a.tobytes() for a in active)
@@ -536,8 +558,43 @@ class PairedContact(PairSet):
 
         The body forces per unit traction value are sparse (a node's traction reaches the few
         nodes of its facets and of the opposing facets under it), so each body's motion is its
-        flexibility C times a sparse matrix, computed once.
+        flexibility C times a sparse matrix, computed once. Where the surfaces' flexibility is
+        applied, not formed (issue 22), W is the :class:`~vfem.contact.matrix_free.PairOperator`
+        that applies it.
         """
+        directions, offsets, dF = self._force_rows()
+        m = int(offsets[-1])
+        if any(s.matrix_free for s in self.surfaces):
+            from .matrix_free import PairOperator
+
+            W = PairOperator(self.surfaces, [s.flexibility for s in self.surfaces], dF,
+                             self.contact_pairs, directions, offsets)
+            dp_dplaten = np.concatenate(
+                [pair.platen_rate if j == 0 else self._tangent_platen_rate(k, direction)
+                 for k, pair in enumerate(self.contact_pairs)
+                 for j, direction in enumerate(directions[k])] or [np.zeros(0)])
+            return W, dp_dplaten, self._platen_rows(dF, m), offsets
+        du = [np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T).reshape(
+            s.nc, s.dim, m) for s, f in zip(self.surfaces, dF)]
+        W = np.zeros((m, m))
+        dp_dplaten = np.zeros(m)
+        for k, pair in enumerate(self.contact_pairs):
+            n = len(pair.nodes)
+            uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
+            coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
+            uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
+            for j, direction in enumerate(directions[k]):
+                rows = slice(offsets[k] + j * n, offsets[k] + (j + 1) * n)
+                # along the normal: penetration p = -(gap0 + n.(u_f - u_c)), W = -dp/dq; along
+                # a tangent t: the relative displacement t.(u_f - u_c) per unit traction
+                W[rows] = np.einsum("id,idm->im", direction, uf - uc)
+                dp_dplaten[rows] = pair.platen_rate if j == 0 else self._tangent_platen_rate(
+                    k, direction)
+        return W, dp_dplaten, self._platen_rows(dF, m), offsets
+
+    def _force_rows(self):
+        """Per pair the directions of its unknowns, the unknowns' offsets, and per body the
+        sparse nodal forces on its candidate dofs per unit traction value ((dim nc, m))."""
         directions = [self.directions(k) for k in range(len(self.contact_pairs))]
         offsets = np.cumsum([0] + [len(p.nodes) * len(dirs)
                                    for p, dirs in zip(self.contact_pairs, directions)])
@@ -559,29 +616,15 @@ class PairedContact(PairSet):
                               np.concatenate([p[1] for p in ps]) if ps else [])),
                             shape=(s.dim * s.nc, m))
               for s, ps in zip(self.surfaces, parts)]  # body forces per unit traction value
-        # C f as (f^T C^T)^T; C^T is C where the flexibility came symmetric to the bit from the
-        # factorization (no transposed copy of C)
-        du = [np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T).reshape(
-            s.nc, s.dim, m) for s, f in zip(self.surfaces, dF)]
-        W = np.zeros((m, m))
-        dp_dplaten = np.zeros(m)
-        for k, pair in enumerate(self.contact_pairs):
-            n = len(pair.nodes)
-            uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
-            coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
-            uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
-            for j, direction in enumerate(directions[k]):
-                rows = slice(offsets[k] + j * n, offsets[k] + (j + 1) * n)
-                # along the normal: penetration p = -(gap0 + n.(u_f - u_c)), W = -dp/dq; along
-                # a tangent t: the relative displacement t.(u_f - u_c) per unit traction
-                W[rows] = np.einsum("id,idm->im", direction, uf - uc)
-                dp_dplaten[rows] = pair.platen_rate if j == 0 else self._tangent_platen_rate(
-                    k, direction)
+        return directions, offsets, dF
+
+    def _platen_rows(self, dF, m: int) -> np.ndarray:
+        """The platen's reaction per unit traction value (zero without a platen)."""
         dR = np.zeros(m)
         if self.platen_body is not None:
             s = self.surfaces[self.platen_body]
             dR = np.asarray(dF[self.platen_body].T @ s.platen_row).ravel()
-        return W, dp_dplaten, dR, offsets
+        return dR
 
     def directions(self, k: int) -> list[np.ndarray]:
         """The directions of pair k's traction unknowns at its nodes, each (nodes, dim): the

@@ -12,6 +12,8 @@ VARIANTS = ("thesis", "paired")
 METHODS = ("vfem", "penalty", "lagrange", "augmented")
 #: the friction laws of a contact pair (docs/method.md §11)
 FRICTION_LAWS = ("coulomb", "static_dynamic", "elastoplastic")
+#: how the contact correction reads the bodies' flexibility (issue 22)
+FLEXIBILITY_ROUTES = ("auto", "dense", "matrix_free")
 
 
 @dataclass(frozen=True)
@@ -163,6 +165,16 @@ class ContactSettings:
         pairs: the friction of particular pairs of bodies (``[[contact.pairs]]`` tables:
             ``bodies``, ``friction``, ``law`` and its parameters), instead of ``friction``;
             different laws in different contact areas, as the thesis allows (§1.10).
+        flexibility: how the contact correction reads the bodies' flexibility on their contact
+            surfaces (issue 22, :mod:`vfem.contact.matrix_free`): ``"dense"`` — formed, each
+            body condensed to its contact dofs (a dense block of (dim nc)^2 numbers, fastest for
+            small zones); ``"matrix_free"`` — applied through each body's factorization, one
+            back-substitution per body per iteration of a GMRES solve, nothing dense (large
+            contact zones); ``"auto"`` (default) — matrix-free when the dense blocks would take
+            more than ``dense_limit_mib``, else dense. The matrix-free route serves the paired
+            variant, small kinematics, without friction; ``"auto"`` keeps the others dense.
+        dense_limit_mib: the memory (MiB) the dense blocks may take before ``"auto"`` goes
+            matrix-free. Default (None): half the memory available when the analysis starts.
     """
 
     method: str = "vfem"
@@ -187,6 +199,8 @@ class ContactSettings:
     compatibility_side: str | None = None
     friction: float = 0.0
     pairs: tuple[PairFriction, ...] = ()
+    flexibility: str = "auto"
+    dense_limit_mib: float | None = None
 
     def validate(self) -> None:
         for f in fields(self):
@@ -209,7 +223,10 @@ class ContactSettings:
             if key in named:
                 raise InputError(f"contact.pairs: {sorted(pair.bodies)!r} given twice")
             named.add(key)
-        for name in ("penetration_tolerance", "search_distance", "penalty"):
+        if self.flexibility not in FLEXIBILITY_ROUTES:
+            raise InputError(f"contact.flexibility must be one of {FLEXIBILITY_ROUTES}, got "
+                             f"{self.flexibility!r}")
+        for name in ("penetration_tolerance", "search_distance", "penalty", "dense_limit_mib"):
             v = getattr(self, name)
             if v is not None and v <= 0:
                 raise InputError(f"contact.{name} must be > 0, got {v!r}")

@@ -217,16 +217,27 @@ class ContactSurface:
         tracked nodes' with :attr:`rind_rows`, else the candidate nodes' alone."""
         return self.tracked_dofs if self.rind_rows else self.candidate_dofs
 
-    def compute_flexibility(self) -> None:
+    def compute_flexibility(self, matrix_free: bool = False) -> None:
         """The flexibility rows of the condensed dofs for the candidate dofs, and the platen row.
 
         Taken from the body's factorization (condensed dofs ordered last, see ``vfem.linalg``),
         or else one back-substitution per candidate dof. The platen's reaction per unit force at
         a candidate dof is, by reciprocity, minus that dof's motion under a unit platen motion.
+        ``matrix_free`` (issue 22): no dense block at all; the flexibility is applied through
+        the body's factorization when asked (:attr:`flexibility`,
+        :class:`~vfem.contact.matrix_free.SurfaceFlexibility`).
         """
         body = self.body
         nc2 = self.dim * self.nc
         rows = self.condensed_dofs
+        self.platen_row = -body.u_platen[self.candidate_dofs]
+        if matrix_free:
+            from .matrix_free import SurfaceFlexibility
+
+            self.G = None
+            self.flexibility = SurfaceFlexibility(self)
+            self.exactly_symmetric = False
+            return
         if getattr(body, "condensed_flexibility", None) is not None and \
                 len(body.condensed_flexibility) == len(rows):
             self.G = (body.condensed_flexibility if len(rows) == nc2
@@ -237,7 +248,22 @@ class ContactSurface:
             cols = body.flexibility_columns(self.candidate_dofs)
             self.G = cols[rows]
             self.exactly_symmetric = False  # back-substitutions: symmetric to round-off
-        self.platen_row = -body.u_platen[self.candidate_dofs]
+
+    #: the flexibility applied through the body's factorization (matrix-free route, issue 22),
+    #: None where it is formed (``G``)
+    flexibility = None
+
+    @property
+    def matrix_free(self) -> bool:
+        """Whether the flexibility is applied (issue 22), not formed."""
+        return self.G is None and self.flexibility is not None
+
+    def motion(self, F: np.ndarray) -> np.ndarray:
+        """The condensed dofs' motion under nodal forces ``F`` on the candidate dofs ((dim nc,)
+        or (dim nc, k)): ``G F``, formed or applied (:attr:`flexibility`)."""
+        if self.matrix_free:
+            return self.flexibility.apply(F)
+        return self.G @ F
 
     def node_normals(self, x: np.ndarray | None = None, facets: np.ndarray | None = None
                      ) -> np.ndarray:
@@ -299,6 +325,10 @@ class ContactSurface:
         free (vfem-method §3.3). A node whose motion along ``n`` is fully prevented by supports
         gets an infinite stiffness.
         """
+        if self.matrix_free:  # one back-substitution a node (issue 22)
+            c = self.flexibility.normal_compliance(nodes, normal)
+            with np.errstate(divide="ignore"):
+                return np.where(c > 0, 1.0 / np.maximum(c, 1e-300), np.inf)
         C, k = self.C, self.dim
         c = 0.0
         for d in range(k):  # the symmetric form, its off-diagonal terms once, doubled

@@ -11,7 +11,7 @@ from __future__ import annotations
 import importlib
 
 EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
-            "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch")
+            "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack")
 
 
 def load(name: str):

@@ -545,7 +545,8 @@ def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
            "steps": [step_record(s) for s in result.steps],
            "dofs": int(sum(b.ndofs for b in result.model.bodies)),
            "parameters": dataclasses.asdict(parameters), "timings": result.timings,
-           "linear_solver": result.backend, "contact_settings": contact_settings(result.model)}
+           "linear_solver": result.backend, "contact_flexibility": result.flexibility,
+           "contact_settings": contact_settings(result.model)}
     out.update(friction_summary(result, out["steps"]))
     return out
 

@@ -1,0 +1,294 @@
+"""The contact correction without dense blocks (issue 22): the flexibility applied, not formed.
+
+The dense route condenses each body to its contact candidates (PARDISO's Schur complement,
+inverted: ``ContactSurface.G``, (dim nc)^2 numbers) and forms the pair matrix W over every pair
+node from it (:meth:`~vfem.contact.paired.PairedContact._full_flexibility`). Both grow as the
+square of the contact zone: a 3D flat-on-flat interface of 100 x 100 facets has some 30,000
+contact dofs, 7 GB for one body's block and minutes of dense factorization.
+
+Here neither is formed. A body's flexibility on its candidates is applied to a set of nodal
+forces by one back-substitution through its own (plain) factorization
+(:class:`SurfaceFlexibility`), and W to a vector of traction values by one such
+back-substitution per body (:class:`PairOperator`): the forces the traction values make (the
+same sparse ``N`` and ``T`` rows the dense route uses, eq. 4.4.11), each body's motion under
+them, read at the pair nodes and their virtual nodes along the directions (eq. 4.2.4 in matrix
+form). The linear complementarity problem of the correction
+(:func:`~vfem.contact.complementarity.linear_complementarity`) is then solved with the same
+block principal pivoting, each set's system by GMRES on this operator (W is not symmetric: the
+paired variant reads penetrations at the virtual nodes but applies forces through N and T, so
+conjugate gradients do not apply), preconditioned by an estimate of W's diagonal from each
+node's own block of its body's stiffness (:meth:`SurfaceFlexibility.local_blocks`: no
+back-substitution).
+
+The answers are the dense route's to the iteration's tolerance (:data:`RTOL`, relative to the
+right-hand side: the penetrations closed agree to about 1e-11 of the largest, the traction
+values to 1e-8 or better; tests/test_matrix_free.py).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import LinearOperator, gmres
+
+from .bordered import bordered_solve
+
+log = logging.getLogger(__name__)
+
+#: GMRES's tolerance on each active set's system, relative to its right-hand side
+RTOL = 1e-12
+#: GMRES's restart length and the most restarts
+RESTART, MAX_RESTARTS = 200, 50
+#: candidate nodes solved for at once when a surface's nodal flexibilities are computed
+PROBE_CHUNK = 96
+
+
+class SurfaceFlexibility:
+    """A body's flexibility on its contact candidates, applied through its factorization.
+
+    ``apply(F)``: the motion of the surface's condensed dofs (its candidates', and the rind's
+    where the formulation reads it) under nodal forces ``F`` on its candidate dofs, supports
+    held: ``G F`` of the dense route, by one back-substitution (several columns at once).
+    """
+
+    def __init__(self, surface):
+        body = surface.body
+        self.body = body
+        self.dim = surface.dim
+        free = body.free_dofs
+        self.n_free = len(free)
+
+        def positions(dofs):
+            pos = np.searchsorted(free, dofs)
+            ok = (pos < len(free)) & (free[np.minimum(pos, len(free) - 1)] == dofs)
+            return pos, ok
+
+        self._col_pos, self._col_free = positions(surface.candidate_dofs)
+        self._row_pos, self._row_free = positions(surface.condensed_dofs)
+        self.n_cols = len(surface.candidate_dofs)
+        self._cand_dofs = surface.candidate_dofs.reshape(-1, self.dim)
+        self.n_rows = len(surface.condensed_dofs)
+        #: back-substitutions made (columns), for the log and the benchmark
+        self.solves = 0
+
+    def apply(self, F: np.ndarray, rows: int | None = None) -> np.ndarray:
+        """The condensed dofs' motion (their first ``rows``, default all) under candidate-dof
+        forces ``F`` ((n_cols,) or (n_cols, k))."""
+        F = np.asarray(F, dtype=float)
+        vector = F.ndim == 1
+        F2 = F[:, None] if vector else F
+        k = F2.shape[1]
+        rhs = np.zeros((self.n_free, k))
+        rhs[self._col_pos[self._col_free]] = F2[self._col_free]
+        x = self.body.factor.solve(rhs if k > 1 else rhs[:, 0])
+        x = x.reshape(self.n_free, k)
+        self.solves += k
+        n = self.n_rows if rows is None else rows
+        out = np.zeros((n, k))
+        ok = self._row_free[:n]
+        out[ok] = x[self._row_pos[:n][ok]]
+        return out[:, 0] if vector else out
+
+    def normal_compliance(self, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
+        """n^T C_jj n at candidate nodes ``nodes`` along unit ``normals``: each node's motion
+        along its normal under a unit force along it (one back-substitution a node,
+        :data:`PROBE_CHUNK` at a time); what ``ContactSurface.normal_stiffness`` inverts."""
+        nodes = np.asarray(nodes, dtype=int)
+        d = self.dim
+        out = np.zeros(len(nodes))
+        for start in range(0, len(nodes), PROBE_CHUNK):
+            chunk = nodes[start:start + PROBE_CHUNK]
+            n = normals[start:start + PROBE_CHUNK]
+            cols = d * chunk[:, None] + np.arange(d)  # (k, d)
+            k = np.arange(len(chunk))
+            F = np.zeros((self.n_cols, len(chunk)))
+            F[cols, k[:, None]] = n
+            U = self.apply(F, rows=self.n_cols)
+            out[start:start + len(chunk)] = np.einsum("kd,kd->k", U[cols, k[:, None]], n)
+        return out
+
+    def local_blocks(self, nodes: np.ndarray) -> np.ndarray:
+        """(len(nodes), dim, dim) a cheap stand-in for the flexibility's diagonal blocks at
+        candidate nodes ``nodes``: the inverse of each node's own block of the stiffness (its
+        dofs held by the neighbours alone). It scales as the flexibility does with the element
+        size and the modulus (1 / (E h) in 3D), which is what a preconditioner needs, at no
+        back-substitution; a supported dof gets zero."""
+        d = self.dim
+        dofs = self._cand_dofs[np.asarray(nodes, dtype=int)]  # (k, d)
+        K = self.body.K
+        blocks = np.stack([np.stack([np.asarray(K[dofs[:, a], dofs[:, b]]).ravel()
+                                     for b in range(d)], axis=1) for a in range(d)], axis=1)
+        free = self._col_free.reshape(-1, d)[np.asarray(nodes, dtype=int)]
+        mask = free[:, :, None] & free[:, None, :]
+        blocks = np.where(mask, blocks, np.eye(d)[None])
+        inv = np.linalg.inv(blocks)
+        return np.where(mask, inv, 0.0)
+
+
+class PairOperator:
+    """W applied to traction values without forming it (the module docstring), with the
+    platen's column and row (penetration change per unit platen motion, platen reaction per
+    unit traction value) as the dense route has them.
+
+    ``dF``: per body, the sparse nodal forces on its candidate dofs per unit traction value
+    ((dim nc, m), :meth:`~vfem.contact.paired.PairedContact._force_rows`); ``flex``: per body its
+    :class:`SurfaceFlexibility`; ``pairs``, ``directions``, ``offsets``: how the unknowns are
+    laid out (pair by pair, direction by direction, node by node).
+    """
+
+    def __init__(self, surfaces, flex, dF, pairs, directions, offsets):
+        self.surfaces = surfaces
+        self.flex = flex
+        self.dF = dF
+        self.pairs = pairs
+        self.directions = directions
+        self.offsets = offsets
+        self.m = int(offsets[-1])
+        self.interp = [sp.csr_matrix(p.interp) for p in pairs]
+        self.bodies = sorted({b for p in pairs for b in (p.fine, p.coarse)})
+        self.diagonal = self._diagonal()
+        self.applications = 0  # columns of W applied, for the log and the benchmark
+
+    def matvec(self, x: np.ndarray) -> np.ndarray:
+        """W x for x (m,) or (m, k): one back-substitution per body."""
+        x = np.asarray(x, dtype=float)
+        vector = x.ndim == 1
+        X = x[:, None] if vector else x
+        k = X.shape[1]
+        self.applications += k
+        motion = {}
+        for b in self.bodies:
+            s = self.surfaces[b]
+            f = self.dF[b] @ X  # (dim nc, k)
+            u = self.flex[b].apply(np.asarray(f), rows=s.dim * s.nc) if f.any() else \
+                np.zeros((s.dim * s.nc, k))
+            motion[b] = u.reshape(s.nc, s.dim, k)
+        out = np.zeros((self.m, k))
+        for i, pair in enumerate(self.pairs):
+            n = len(pair.nodes)
+            uf = motion[pair.fine][pair.nodes]
+            uc_flat = motion[pair.coarse].reshape(len(motion[pair.coarse]), -1)
+            uc = (self.interp[i] @ uc_flat).reshape(uf.shape)
+            for j, direction in enumerate(self.directions[i]):
+                rows = slice(self.offsets[i] + j * n, self.offsets[i] + (j + 1) * n)
+                out[rows] = np.einsum("id,idk->ik", direction, uf - uc)
+        return out[:, 0] if vector else out
+
+    def _diagonal(self) -> np.ndarray:
+        """An estimate of W's diagonal (the preconditioner): each unknown's own force's motion
+        read at itself, from stand-ins for the bodies' nodal flexibility blocks
+        (:meth:`SurfaceFlexibility.local_blocks`) and the sparse force rows.
+
+        A pair node's traction value moves its own node and its neighbours (its row of N)
+        and, through T, the coarse nodes under it; W_ii reads node i's motion and its virtual
+        node's along the direction. Only the diagonal blocks of each body's flexibility are
+        kept (one node's force read at the same node) and those only estimated, so this is not
+        W's diagonal but scales as it does: enough to weigh the unknowns of graded meshes and of
+        bodies of different stiffness against each other."""
+        diag = np.zeros(self.m)
+        blocks = {}
+        for b in self.bodies:
+            s = self.surfaces[b]
+            touched = np.unique(self.dF[b].nonzero()[0] // s.dim)
+            blocks[b] = (touched, self.flex[b].local_blocks(touched))
+        for i, pair in enumerate(self.pairs):
+            n = len(pair.nodes)
+            for j, direction in enumerate(self.directions[i]):
+                cols = np.arange(self.offsets[i] + j * n, self.offsets[i] + (j + 1) * n)
+                value = np.zeros(n)
+                for b, read in ((pair.fine, None), (pair.coarse, self.interp[i])):
+                    s = self.surfaces[b]
+                    touched, B = blocks[b]
+                    local = np.full(s.nc, -1)
+                    local[touched] = np.arange(len(touched))
+                    f = self.dF[b][:, cols].tocoo()  # forces (body dof, unknown)
+                    node, comp = f.row // s.dim, f.row % s.dim
+                    # motion of each forced node (its own block) per unit traction value
+                    u = B[local[node], :, comp] * f.data[:, None]  # (entries, dim)
+                    if read is None:  # read at the pair node itself
+                        at = pair.nodes[f.col] == node
+                        weight = at.astype(float)
+                    else:  # read at the virtual node: interp's weight of the forced node
+                        weight = np.asarray(read[f.col, node]).ravel()
+                    contrib = np.einsum("ed,ed->e", u, direction[f.col]) * weight
+                    np.add.at(value, f.col, contrib if read is None else -contrib)
+                diag[cols] = value
+        return diag
+
+    def solve(self, index: np.ndarray, rhs: np.ndarray, border=None, x0=None
+              ) -> tuple[np.ndarray, float]:
+        """The traction values on unknowns ``index`` (zero elsewhere) with W's block there
+        times them equal to ``rhs``; with ``border`` = (column, row, corner, extra) the bordered
+        system of :func:`~vfem.contact.group.bordered_solve` (the platen's motion the last
+        unknown). GMRES to :data:`RTOL`, preconditioned by the diagonal."""
+        index = np.asarray(index, dtype=int)
+        na = len(index)
+        bordered = border is not None
+        size = na + (1 if bordered else 0)
+        if size == 0:
+            return np.zeros(0), 0.0
+        b = np.concatenate([rhs, [border[3]]]) if bordered else np.asarray(rhs, float)
+        if bordered and border[2] == 0.0 and not np.any(border[1]):
+            # the platen's equation says nothing (no node of its body in the set, nothing
+            # else holding it): singular, solved by least squares on the set's block, formed
+            # here from na columns, as the dense route does (bordered_solve)
+            E = np.zeros((self.m, na))
+            E[index, np.arange(na)] = 1.0
+            block = self.matvec(E)[index] if na else np.zeros((0, 0))
+            return bordered_solve(block, border[0], border[1], border[2], rhs, border[3])
+
+        def apply(v):
+            full = np.zeros(self.m)
+            full[index] = v[:na]
+            w = self.matvec(full)[index]
+            if not bordered:
+                return w
+            col, row, corner, _ = border
+            return np.concatenate([w + col * v[na], [row @ v[:na] + corner * v[na]]])
+
+        d = np.abs(self.diagonal[index])
+        d = np.where(d > 0, d, d.max() if d.size and d.max() > 0 else 1.0)
+        if bordered:
+            # the platen's row: its own stiffness, or else its largest coupling to the set
+            corner = abs(border[2]) or (np.abs(border[1]).max() if na else 0.0) or 1.0
+            d = np.concatenate([d, [corner]])
+        A = LinearOperator((size, size), matvec=apply, dtype=float)
+        M = LinearOperator((size, size), matvec=lambda v: v / d, dtype=float)
+        start = None
+        if x0 is not None:
+            start = np.concatenate([x0, [0.0]]) if bordered else np.asarray(x0, dtype=float)
+        bnorm = float(np.linalg.norm(b))
+        if bnorm == 0.0:
+            return np.zeros(na), 0.0
+        x, info = gmres(A, b, x0=start, rtol=RTOL, atol=0.0, restart=min(RESTART, size),
+                        maxiter=MAX_RESTARTS, M=M)
+        residual = float(np.linalg.norm(apply(x) - b)) / bnorm
+        if info != 0 and residual > 1e3 * RTOL:
+            raise np.linalg.LinAlgError(
+                f"the matrix-free contact solve did not converge on {na} contact unknowns "
+                f"(relative residual {residual:.2e} after {MAX_RESTARTS} restarts of "
+                f"{RESTART})")
+        log.debug("matrix-free set of %d unknowns: relative residual %.2e", na, residual)
+        return (x[:na], float(x[na])) if bordered else (x, 0.0)
+
+
+def matrix_free_refusal(settings, bodies) -> str | None:
+    """Why the matrix-free route cannot serve a model, or None where it can: it serves the
+    paired variant of the virtual finite element method under small kinematics without
+    friction (friction's tangential unknowns and the large-kinematics tangents are formed
+    dense; a later step)."""
+    if settings.method != "vfem":
+        return f"the {settings.method} baseline solves one global system"
+    if settings.variant != "paired":
+        return "the thesis variant reads the flexibility node by node"
+    large = [b.name for b in bodies if b.large]
+    if large:
+        return f"body {large[0]!r} has large kinematics"
+    if settings.frictional:
+        return "the model has friction"
+    return None
+
+
+__all__ = ["PairOperator", "SurfaceFlexibility", "matrix_free_refusal"]

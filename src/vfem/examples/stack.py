@@ -1,0 +1,203 @@
+"""A stack of blocks pressed together (issue 22): many bodies, and contact zones as large as asked.
+
+``blocks`` plates of alternating stiffness (a steel-like and an aluminium-like modulus) lie on
+each other, each ``shrink`` narrower than the one below, so every upper plate's edges lie inside
+the face of the plate beneath (an edge of the contact zone inside a surface, where the pressure
+peaks). Quarter model (3D) or half model (2D, plane strain): every plate on rollers at the
+symmetry planes (x = 0, and y = 0 in 3D), the lowest one held at its base, those between held
+vertically at their outer side faces (their rims, as bolts hold a flange: each body of the
+method has its own factorization, so each must be held), the top face of the highest pressed
+down by ``press`` with its lateral motion held (a clamped press). The middle plates bend
+between their rims and what presses on them, so their contact zones have edges inside the
+faces where they end. Meshes do not
+match across any interface: plate k has ``divisions + k % 2`` elements across (and its own
+width). Every node of every upper face is in contact, so the contact zone grows as
+``divisions**(dim - 1)``: ``divisions = 100`` in 3D is a flat-on-flat interface of
+101 x 101 contact nodes (some 30,000 contact dofs), the size at which the dense contact blocks
+stop fitting (``contact.flexibility``, :mod:`vfem.contact.matrix_free`). ``blocks = 2`` with a
+thin ``thickness`` is a flange-like pair of plates.
+
+No closed form; the checks are those every contact solution must meet (every invariant at
+every converged step: the forces balance, no body inside another, no tension), the contact
+forces equal and opposite across each interface, the press's force equal to the reactions of
+the base and the rims, and the same answer from either route to the flexibility and either
+body order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..bodies import PrescribedDisplacement, Support
+from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from ..contact.settings import FLEXIBILITY_ROUTES, ContactSettings
+from ..errors import InputError
+from ..io.runner import run_headline
+from ..materials import LinearElastic
+from ..solver import AnalysisResult, Model
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """Parameters of the stack example (see the module docstring)."""
+
+    dim: int = 3  # 2: plane strain; 3: a quarter model
+    blocks: int = 3
+    divisions: int = 8  # elements across the lowest plate (plate k: divisions + k % 2)
+    layers: int = 2  # elements through each plate's thickness
+    width: float = 1.0  # the lowest plate's half width
+    thickness: float = 0.25
+    shrink: float = 0.1  # each plate this fraction narrower than the one below
+    stiff_modulus: float = 200e3  # plates 0, 2, 4, ...
+    soft_modulus: float = 70e3  # plates 1, 3, 5, ...
+    poissons_ratio: float = 0.3
+    press: float = 0.001  # the highest plate's top face, downwards
+    steps: int = 1
+    tetrahedra: bool = False  # 3D: tetrahedra instead of hexahedra (2D: triangles)
+    flexibility: str = "auto"  # contact.flexibility: auto, dense or matrix_free
+    reverse_bodies: bool = False  # list the plates from the top down
+
+
+def validate(p: Parameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    if p.dim not in (2, 3):
+        raise InputError(f"stack: dim must be 2 or 3, got {p.dim!r}")
+    for name, low in (("blocks", 2), ("divisions", 1), ("layers", 1), ("steps", 1)):
+        v = getattr(p, name)
+        if not isinstance(v, int) or isinstance(v, bool) or v < low:
+            raise InputError(f"stack: {name} must be a whole number >= {low}, got {v!r}")
+    if p.blocks > 64:
+        raise InputError(f"stack: blocks must be at most 64, got {p.blocks}")
+    for name in ("width", "thickness", "stiff_modulus", "soft_modulus", "press"):
+        v = getattr(p, name)
+        if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
+            raise InputError(f"stack: {name} must be a number > 0, got {v!r}")
+    if not (0.0 <= p.shrink < 1.0 / p.blocks):
+        raise InputError(f"stack: shrink must be >= 0 and below 1 / blocks "
+                         f"({1.0 / p.blocks:.3g}), got {p.shrink!r}")
+    if not (-1.0 < p.poissons_ratio < 0.5):
+        raise InputError(f"stack: poissons_ratio must lie in (-1, 0.5), got "
+                         f"{p.poissons_ratio!r}")
+    if p.press >= 0.1 * p.thickness:
+        raise InputError(f"stack: press ({p.press:g}) must be below a tenth of the thickness "
+                         f"({p.thickness:g}): small kinematics")
+    if p.flexibility not in FLEXIBILITY_ROUTES:
+        raise InputError(f"stack: flexibility must be one of {FLEXIBILITY_ROUTES}, got "
+                         f"{p.flexibility!r}")
+    build(p).validate()
+
+
+def plate_width(p: Parameters, k: int) -> float:
+    """Plate k's half width (k = 0: the lowest)."""
+    return p.width * (1.0 - k * p.shrink)
+
+
+def config(p: Parameters | None = None) -> ModelConfig:
+    """The model as data (``vfem export stack`` writes it as ``examples/stack.toml``)."""
+    p = p or Parameters()
+    rollers = (Support("left", ("x",)),) + ((Support("front", ("y",)),) if p.dim == 3 else ())
+    lateral = ("x", "y") if p.dim == 3 else ("x",)
+    vertical = "z" if p.dim == 3 else "y"
+    rims = ("right", "back") if p.dim == 3 else ("right",)
+    bodies = []
+    for k in range(p.blocks):
+        w, n = plate_width(p, k), p.divisions + k % 2
+        if p.dim == 3:
+            mesh = MeshSpec(shape="box", parameters=as_parameters(
+                x0=0.0, y0=0.0, z0=k * p.thickness, width=w, depth=w, height=p.thickness,
+                nx=n, ny=n, nz=p.layers, tetrahedra=p.tetrahedra))
+        else:
+            mesh = MeshSpec(shape="rectangle", parameters=as_parameters(
+                x0=0.0, y0=k * p.thickness, width=w, height=p.thickness, nx=n, ny=p.layers,
+                triangles=p.tetrahedra))
+        mat = LinearElastic(p.stiff_modulus if k % 2 == 0 else p.soft_modulus,
+                            p.poissons_ratio)
+        supports = rollers
+        prescribed = ()
+        if k == 0:
+            supports = supports + (Support("bottom", (vertical,)),)
+        elif k < p.blocks - 1:  # held at its rim, as bolts hold a flange's
+            supports = supports + tuple(Support(face, (vertical,)) for face in rims)
+        if k == p.blocks - 1:
+            prescribed = (PrescribedDisplacement("top", vertical, -p.press),) + tuple(
+                PrescribedDisplacement("top", c, 0.0) for c in lateral)
+        faces = (("top",) if k < p.blocks - 1 else ()) + (("bottom",) if k > 0 else ())
+        bodies.append(BodyConfig(f"plate{k}", mesh, mat, supports=supports,
+                                 prescribed=prescribed, contact_boundaries=faces))
+    if p.reverse_bodies:
+        bodies.reverse()
+    return ModelConfig("stack", tuple(bodies), ContactSettings(flexibility=p.flexibility),
+                       Steps(count=p.steps))
+
+
+def build(p: Parameters | None = None) -> Model:
+    return config(p).build()
+
+
+def evaluate(result: AnalysisResult, p: Parameters) -> dict:
+    """The press's force, the base's and the rims' reactions (their sum the press's: nothing
+    else holds the stack vertically) and per interface the total vertical contact force on the
+    upper plate's bottom and on the lower plate's top (equal and opposite)."""
+    last = result.steps[-1]
+    axis = p.dim - 1
+    component = "zy"[p.dim == 2]
+    bodies = {b.name: b for b in result.model.bodies}
+    surfaces = {s.body.name: s for s in result.surfaces}
+
+    def reaction(name: str, face: str | None = None) -> float:
+        """The vertical force the constraints on ``face`` (every constraint of the body:
+        each constrained dof once) apply to body ``name``."""
+        body, r = bodies[name], last.bodies[name]
+        s = surfaces[name]
+        f = np.zeros(body.ndofs)
+        f[s.candidate_dofs] = r.contact_force[s.nodes[: s.nc]].ravel()
+        u = r.displacement.ravel()
+        if face is not None:
+            return body.reaction(u, face, component, last.load_factor, f)
+        return float(body.nodal_reaction(u, last.load_factor, f)[axis::p.dim].sum())
+
+    def face_force(name: str, face: str) -> float:
+        body = bodies[name]
+        nodes = np.unique(body.facet_points(body.mesh.boundaries[face]))
+        return float(last.bodies[name].contact_force[nodes, axis].sum())
+
+    press = -reaction(f"plate{p.blocks - 1}", "top")
+    held = sum(reaction(f"plate{k}") for k in range(p.blocks - 1))
+    interfaces = []
+    for k in range(p.blocks - 1):
+        up, down = face_force(f"plate{k + 1}", "bottom"), face_force(f"plate{k}", "top")
+        interfaces.append({"force": up, "equal_and_opposite_error":
+                           abs(up + down) / max(abs(up), 1e-300)})
+    return {"press_force": press, "held_force": held,
+            "balance_error": abs(press - held) / abs(press), "interfaces": interfaces,
+            "contact_dofs": int(sum(p.dim * s.nc for s in result.surfaces)),
+            "matrix_free": result.flexibility == "matrix_free"}
+
+
+def summarize(result: AnalysisResult, p: Parameters) -> dict:
+    """The ``summary.json`` dictionary of a stack run."""
+    from ..io.results import solid_summary
+
+    return solid_summary("stack", result, p, "stack", evaluate)
+
+
+def run(p: Parameters, out, on_step=None, figures: bool = True, resume: bool = False) -> dict:
+    """Run the example, writing VTU/PVD per step and ``summary.json`` to ``out``."""
+    from ..io.results import run_example
+
+    return run_example(build(p), out, lambda r: summarize(r, p), None, on_step, resume)
+
+
+def report(s: dict) -> list[str]:
+    """The closing lines of a stack run."""
+    lines = [run_headline(s, contact_dofs=True)]
+    if "stack" in s:
+        m = s["stack"]
+        worst = max(i["equal_and_opposite_error"] for i in m["interfaces"])
+        lines.append(f"  press force {m['press_force']:.6g}, base and rims {m['held_force']:.6g} "
+                     f"({m['balance_error']:.1e} apart); interfaces equal and opposite within "
+                     f"{worst:.1e}; {m['contact_dofs']} contact dofs, flexibility "
+                     f"{'matrix-free' if m['matrix_free'] else 'dense'}")
+    return lines
