@@ -13,6 +13,7 @@ import difflib
 import inspect
 import json
 import logging
+import os
 import shlex
 import shutil
 import signal
@@ -20,7 +21,7 @@ import sys
 import textwrap
 from pathlib import Path
 
-from . import linalg, threads
+from . import linalg, parallel, threads
 from .contact.settings import ContactSettings
 from .errors import InputError, VfemError
 from .examples import EXAMPLES, load
@@ -224,7 +225,7 @@ def _writable_folder(out: Path, what: str) -> None:
         raise InputError(f"{what} {out}: a file, not a folder; name a folder for the results")
     try:
         out.mkdir(parents=True, exist_ok=True)
-        probe = out / ".vfem-write-test"
+        probe = out / f".vfem-write-test-{os.getpid()}"  # several processes (MPI ranks)
         probe.write_bytes(b"")
         probe.unlink()
     except OSError as exc:
@@ -236,6 +237,7 @@ def _results_directory(args, default: Path) -> Path:
     else ``default``; made ready for the run (:class:`vfem.io.folders.ResultsFolder`: an
     earlier run's files cleared, another model's refused without ``--overwrite``)."""
     out = _results_location(args, default)
+    out = parallel.scratch_folder(out, bool(args.resume))  # rank 0's alone under MPI
     target = args.example if not _is_input_file(args.example) else str(
         Path(args.example).resolve())
     args.folder = ResultsFolder(out, run_description(args.command_line, target, args.set or []))
@@ -611,6 +613,10 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--resume", metavar="RESULTS_DIR",
                      help="continue an interrupted run of the same model from the last step "
                           "completed in RESULTS_DIR (its results directory)")
+    run.add_argument("--ranks", type=int, metavar="N",
+                     help="spread the bodies over N MPI processes: launches mpiexec -n N with "
+                          "this command (needs the mpi extra: pip install -e \".[mpi]\"; "
+                          "docs/scaling.md)")
     check = sub.add_parser("check", help="check an input file without solving")
     check.add_argument("file", help="the input file (.toml)")
     check.add_argument("--set", action="append", metavar="KEY=VALUE",
@@ -661,10 +667,86 @@ def main(argv: list[str] | None = None) -> int:
     study.add_argument("--quadratic-levels", type=int, nargs="+", default=[0, 1, 2, 3],
                        help="refinement levels with quadratic elements")
     study.add_argument("--out", help="results directory (default results/hertz_study)")
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
-    args.command_line = "vfem " + " ".join(
-        shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
+    args.command_line = "vfem " + " ".join(shlex.quote(a) for a in argv)
+    if getattr(args, "ranks", None) is not None:
+        return _launch_ranks(args, argv)
+    ranks = _join_ranks(args)
+    if ranks is None:
+        return 2
+    if ranks.parallel:
+        status = 1
+        try:
+            status = _main(args)
+        finally:
+            ranks.finish(status)
+        return status
+    return _main(args)
 
+
+def _launch_ranks(args, argv: list[str]) -> int:
+    """``vfem run --ranks N ...``: the same command under ``mpiexec -n N`` (vfem.parallel);
+    one rank runs in this process."""
+    n = args.ranks
+    if n < 1:
+        print(f"vfem: error: --ranks must be a whole number >= 1, got {n}", file=sys.stderr)
+        return 2
+    rest = _without_ranks(argv)
+    if n == 1:
+        return main(rest)
+    if parallel.launched_size() > 1:
+        print("vfem: error: --ranks inside an MPI launch (mpiexec already started "
+              f"{parallel.launched_size()} ranks): leave out --ranks", file=sys.stderr)
+        return 2
+    launcher = parallel.launcher()
+    if launcher is None:
+        print("vfem: error: --ranks needs MPI: mpi4py and an mpiexec (pip install -e "
+              "\".[mpi]\", which brings Open MPI's); or run one process without --ranks",
+              file=sys.stderr)
+        return 2
+    command, env = parallel.launch_command(launcher, n, [sys.executable, "-m", "vfem", *rest])
+    import subprocess
+
+    try:
+        return subprocess.call(command, env=env)
+    except KeyboardInterrupt:
+        return 130
+
+
+def _without_ranks(argv: list[str]) -> list[str]:
+    """``argv`` without its ``--ranks N`` (or ``--ranks=N``)."""
+    out, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+        elif a == "--ranks":
+            skip = True
+        elif not a.startswith("--ranks="):
+            out.append(a)
+    return out
+
+
+def _join_ranks(args):
+    """Join the MPI run this process was launched in (``mpiexec -n N vfem ...``), if any:
+    the threads split between the ranks on a machine, and every rank but 0 silent (it writes
+    its results to a scratch folder of its own and prints nothing). None: refused (printed)."""
+    try:
+        ranks = parallel.start()
+    except ImportError as exc:
+        print(f"vfem: error: {exc}", file=sys.stderr)
+        return None
+    if ranks.parallel:
+        if args.threads is None and not os.environ.get("VFEM_THREADS"):
+            args.threads = str(max(1, threads.default_threads() // ranks.size))
+        if not ranks.root:
+            sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - for the life of the process
+            sys.stderr = sys.stdout
+    return ranks
+
+
+def _main(args) -> int:
+    """The command ``args`` names, its errors turned into one line and an exit status."""
     level = (logging.WARNING if args.verbose == 0 else
              logging.INFO if args.verbose == 1 else logging.DEBUG)
     logging.basicConfig(level=logging.ERROR if args.quiet else level,

@@ -64,6 +64,8 @@ from .errors import (
 )
 from .linalg import resolve as resolve_backend
 from .memory import available_memory, check_memory, estimate, memory_guard
+from .parallel import current as current_ranks
+from .parallel import set_up_bodies
 from .result_types import (  # the result types, here too for those who import them from here
     AnalysisResult,
     BodyStepResult,
@@ -316,9 +318,19 @@ class Analysis:
         self.matrix_free = self._matrix_free(pairs)
         check_memory(self.surfaces, pairs, self.backend, matrix_free=self.matrix_free)
         with memory_guard("factorizing the bodies and computing their flexibility"):
-            for b, s in zip(bodies, self.surfaces):
-                b.setup(self.backend,
-                        condensed_dofs=None if self.matrix_free else s.condensed_dofs)
+            ranks = current_ranks()
+            if ranks.parallel:  # each body on its own rank (vfem.parallel, issue 22)
+                if any(b.large for b in bodies):
+                    raise InputError("a run over MPI ranks serves small kinematics; body "
+                                     f"{next(b.name for b in bodies if b.large)!r} has large "
+                                     "kinematics: run it in one process")
+                set_up_bodies(ranks, bodies, lambda i: bodies[i].setup(
+                    self.backend, condensed_dofs=None if self.matrix_free
+                    else self.surfaces[i].condensed_dofs))
+            else:
+                for b, s in zip(bodies, self.surfaces):
+                    b.setup(self.backend,
+                            condensed_dofs=None if self.matrix_free else s.condensed_dofs)
             t2 = time.perf_counter()
             for s in self.surfaces:
                 s.compute_flexibility(matrix_free=self.matrix_free)

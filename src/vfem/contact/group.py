@@ -14,6 +14,7 @@ import warnings
 import numpy as np
 import scipy.linalg as sla
 
+from ..parallel import current as current_ranks
 from ..result_types import BodyStepResult, add_reactions
 from ..threads import dense_threads
 from .bordered import bordered_matrix, bordered_solve  # noqa: F401 - here too, as before
@@ -117,12 +118,15 @@ class SurfaceGroup:
         """Current coordinates of every body's condensed nodes (the rows of its flexibility:
         the tracked nodes, or the candidates alone, :attr:`ContactSurface.rind_rows`):
         X + u(load, platen, forces), the bodies' linear response (superposition)."""
+        # the contact forces' share: each body on the rank that owns it (vfem.parallel)
+        moved = current_ranks().map(range(len(self.surfaces)), lambda i: self.surfaces[
+            i].motion(state.forces[i].ravel()))
         out = []
-        for s, F in zip(self.surfaces, state.forces):
+        for i, s in enumerate(self.surfaces):
             b = s.body
             dofs = s.condensed_dofs
             u = (b.load_displacement(state.load_factor, dofs) + state.platen_displacement
-                 * b.u_platen[dofs] + s.motion(F.ravel()))
+                 * b.u_platen[dofs] + moved[i])
             out.append(s.X[: len(dofs) // s.dim] + u.reshape(-1, s.dim))
         return out
 
@@ -148,12 +152,18 @@ class SurfaceGroup:
         displacements under the state's loads, platen motion and contact forces, the contact
         forces, pressure (nodal force over tributary length), the formulation's traction where
         it has one, contact status and penetration (``result.pairings``), and the reactions."""
+        def displacement(i: int) -> np.ndarray:
+            s = self.surfaces[i]
+            f = np.zeros(s.body.ndofs)
+            f[s.candidate_dofs] = state.forces[i].ravel()
+            return s.body.displacement(state.load_factor, state.platen_displacement, f)
+
+        # each body's back-substitution on the rank that owns it (vfem.parallel)
+        displacements = current_ranks().map(range(len(self.surfaces)), displacement)
         out = {}
-        for s, F, p in zip(self.surfaces, state.forces, result.pairings):
+        for i, (s, F, p) in enumerate(zip(self.surfaces, state.forces, result.pairings)):
             b = s.body
-            f = np.zeros(b.ndofs)
-            f[s.candidate_dofs] = F.ravel()
-            u = b.displacement(state.load_factor, state.platen_displacement, f)
+            u = displacements[i]
             nv = b.npoints
             cand = s.nodes[: s.nc]
             force = np.zeros((nv, s.dim))

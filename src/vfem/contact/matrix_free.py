@@ -33,6 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator, gmres
 
+from ..parallel import current as current_ranks
 from .bordered import bordered_solve
 
 log = logging.getLogger(__name__)
@@ -158,13 +159,16 @@ class PairOperator:
         X = x[:, None] if vector else x
         k = X.shape[1]
         self.applications += k
-        motion = {}
-        for b in self.bodies:
+
+        def move(b: int) -> np.ndarray:
             s = self.surfaces[b]
             f = self.dF[b] @ X  # (dim nc, k)
             u = self.flex[b].apply(np.asarray(f), rows=s.dim * s.nc) if f.any() else \
                 np.zeros((s.dim * s.nc, k))
-            motion[b] = u.reshape(s.nc, s.dim, k)
+            return u.reshape(s.nc, s.dim, k)
+
+        # each body on the rank that owns it, all at once (vfem.parallel; in order in serial)
+        motion = current_ranks().map(self.bodies, move)
         out = np.zeros((self.m, k))
         for i, pair in enumerate(self.pairs):
             n = len(pair.nodes)

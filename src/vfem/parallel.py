@@ -1,0 +1,313 @@
+"""Bodies spread over MPI ranks (issue 22): each rank factorizes and solves only its own bodies.
+
+vfem's structure is made for it: every body has its own stiffness and factorization, and the
+bodies meet only through their contact data. Under ``mpiexec -n N vfem run MODEL`` (or
+``vfem run --ranks N MODEL``, which launches it) every rank runs the same analysis on the same
+model, step by step and iteration by iteration, with one difference: a body's factorization and
+every back-substitution through it happen on the rank that owns the body
+(:meth:`Ranks.place`: largest bodies first, each to the least loaded rank), and what the others
+need of it comes to them by broadcast. So every rank holds the same contact state, the same
+numbers, and takes the same decisions (step cuts, invariants, the end), and the answers are the
+serial run's (the owner computes exactly what the serial run computes; only threads per
+process differ: 1e-12 and below, tests/test_mpi.py).
+
+What crosses between ranks:
+
+* at set-up, per body, what the contact iteration reads of it: its displacement under each load
+  case and under a unit platen motion, the platen's reactions and stiffness, and on the dense
+  route its flexibility on its contact dofs (:meth:`Ranks.share`);
+* per contact iteration on the matrix-free route, each body's motion under its contact forces
+  at its condensed dofs (:meth:`Ranks.map`: every owner solves its own bodies at once, then they
+  are exchanged);
+* per converged step, each body's displacement (the invariants and the results read them all).
+
+Rank 0 writes the results and prints; the others write nothing. Serial runs never import
+mpi4py (:func:`current` is a one-rank :class:`Ranks` unless the process was started by an MPI
+launcher with more than one rank).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Callable, Iterable
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+#: the environment variables MPI launchers set to the number of ranks (Open MPI, MPICH/Hydra)
+SIZE_VARIABLES = ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS")
+
+
+class Ranks:
+    """The ranks of a run and which body each owns; one rank (``comm`` None) is the serial
+    run, where every body is its own and nothing is sent."""
+
+    def __init__(self, comm=None):
+        self.comm = comm
+        self.rank = 0 if comm is None else comm.Get_rank()
+        self.size = 1 if comm is None else comm.Get_size()
+        self.owner: list[int] = []
+        #: while set (:meth:`map`), a shared factorization solves on its owner only
+        self.local = False
+
+    @property
+    def parallel(self) -> bool:
+        return self.size > 1
+
+    @property
+    def root(self) -> bool:
+        """Whether this is rank 0 (the one that writes and prints)."""
+        return self.rank == 0
+
+    def place(self, sizes: Iterable[int]) -> list[int]:
+        """Each body's rank, balanced by its size (dofs): the largest first, each to the rank
+        with the least so far (ties: the lower rank). The same on every rank."""
+        sizes = list(sizes)
+        load = [0] * self.size
+        owner = [0] * len(sizes)
+        for i in sorted(range(len(sizes)), key=lambda i: (-sizes[i], i)):
+            r = min(range(self.size), key=lambda r: (load[r], r))
+            owner[i] = r
+            load[r] += sizes[i]
+        self.owner = owner
+        return owner
+
+    def mine(self, i: int) -> bool:
+        """Whether body ``i`` is this rank's."""
+        return not self.owner or self.owner[i] == self.rank
+
+    def share(self, i: int, make: Callable[[], object]) -> object:
+        """``make()`` on body ``i``'s owner, its value on every rank; an error raised there is
+        raised on every rank (the same type and message where it can be rebuilt)."""
+        if not self.parallel:
+            return make()
+        value = error = None
+        if self.mine(i):
+            try:
+                value = make()
+            except Exception as e:  # noqa: BLE001 - carried to every rank, raised there
+                error = e
+        value, error = self.comm.bcast((value, error), root=self.owner[i])
+        if error is not None:
+            raise error
+        return value
+
+    def map(self, indices: Iterable[int], compute: Callable[[int], object]) -> dict:
+        """``compute(i)`` for every body ``i`` of ``indices``, each on its owner, all owners at
+        once; every rank gets every value. In serial, simply in order."""
+        indices = list(indices)
+        if not self.parallel:
+            return {i: compute(i) for i in indices}
+        out, errors = {}, {}
+        self.local = True
+        try:
+            for i in indices:
+                if self.mine(i):
+                    try:
+                        out[i] = compute(i)
+                    except Exception as e:  # noqa: BLE001 - carried to every rank
+                        errors[i] = e
+        finally:
+            self.local = False
+        for i in indices:
+            value, error = self.comm.bcast((out.get(i), errors.get(i)), root=self.owner[i])
+            if error is not None:
+                raise error
+            out[i] = value
+        return out
+
+    def finish(self, status: int) -> None:
+        """The end of a rank's command with exit status ``status``: a rank that failed while
+        others may still wait for it stops them all (``MPI_Abort``: a failure on one rank
+        alone, writing its results say, must not leave the others waiting for ever); a rank
+        that succeeded waits for the others."""
+        if not self.parallel:
+            return
+        if status != 0:
+            import sys
+
+            sys.stdout.flush()
+            sys.stderr.flush()
+            self.comm.Abort(status)
+        self.comm.Barrier()
+
+    def agree(self, value: object) -> object:
+        """Rank 0's ``value`` on every rank (what must be the same everywhere: a time, a
+        choice made from a measurement)."""
+        return value if not self.parallel else self.comm.bcast(value, root=0)
+
+
+class SharedFactor:
+    """A body's factorization on its owner, as every rank sees it: ``solve`` runs on the owner
+    and its answer is broadcast (every rank calls it at the same point of the same analysis),
+    or, inside :meth:`Ranks.map`, runs on the owner alone."""
+
+    def __init__(self, factor, ranks: Ranks, index: int):
+        self.factor = factor  # the owner's; None elsewhere
+        self.ranks = ranks
+        self.index = index
+        self.name = getattr(factor, "name", None)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        if self.ranks.local:
+            return self.factor.solve(b)
+        return self.ranks.share(self.index, lambda: self.factor.solve(b))
+
+
+def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None]) -> None:
+    """Set every body up on its owner (``setup(i)``: assemble, factorize, solve its load
+    cases), all owners at once; on the other ranks only assemble it (the invariants and the
+    results read its stiffness), then hand them what the contact iteration reads of it and a
+    :class:`SharedFactor` in place of its factorization."""
+    from .bodies.mechanics import LinearMechanics
+
+    ranks.place([b.dim * b.npoints for b in bodies])
+    log.info("MPI: %d ranks; rank %d sets up %s", ranks.size, ranks.rank,
+             ", ".join(repr(b.name) for i, b in enumerate(bodies) if ranks.mine(i)) or "nothing")
+    for i, b in enumerate(bodies):
+        if ranks.mine(i):
+            try:
+                setup(i)
+            except Exception as e:  # noqa: BLE001 - raised on every rank by share, below
+                b._setup_error = e
+        else:
+            b.assemble()
+    for i, b in enumerate(bodies):
+        def payload(b=b):
+            error = b.__dict__.pop("_setup_error", None)
+            if error is not None:
+                raise error
+            return {"cases": [(c.displacement, getattr(c, "platen_reaction", 0.0))
+                              for c in b.load_cases],
+                    "u_platen": b.u_platen, "platen_load_reaction": b.platen_load_reaction,
+                    "platen_stiffness": b.platen_stiffness,
+                    "condensed_flexibility": b.condensed_flexibility, "timings": b.timings}
+
+        data = ranks.share(i, payload)
+        if ranks.mine(i):
+            b.factor = SharedFactor(b.factor, ranks, i)
+            continue
+        for case, (u, reaction) in zip(b.load_cases, data["cases"], strict=True):
+            case.displacement, case.platen_reaction = u, reaction
+        b.u_load = (b.load_cases[0].displacement if len(b.load_cases) == 1
+                    else sum(c.displacement for c in b.load_cases))
+        b.u_platen = data["u_platen"]
+        b.platen_load_reaction = data["platen_load_reaction"]
+        b.platen_stiffness = data["platen_stiffness"]
+        b.condensed_flexibility = data["condensed_flexibility"]
+        b.timings = data["timings"]
+        b.factor = SharedFactor(None, ranks, i)
+        b.mechanics = LinearMechanics(b)
+
+
+_current = Ranks()
+
+
+def current() -> Ranks:
+    """The ranks of this process's run (one, unless :func:`start` found an MPI launch)."""
+    return _current
+
+
+def launched_size() -> int:
+    """The number of ranks an MPI launcher started this process among (1 if none)."""
+    for name in SIZE_VARIABLES:
+        value = os.environ.get(name, "")
+        if value.isdigit():
+            return int(value)
+    return 1
+
+
+def start() -> Ranks:
+    """Join the MPI run this process was launched in (mpi4py), if it was launched by an MPI
+    launcher with more than one rank; else stay serial. Raises ImportError with what to
+    install when mpi4py is missing under a parallel launch."""
+    global _current
+    if launched_size() <= 1 or _current.parallel:
+        return _current
+    try:
+        from mpi4py import MPI
+    except ImportError as e:
+        raise ImportError("this run was started by an MPI launcher with "
+                          f"{launched_size()} ranks, but mpi4py is not installed: "
+                          "pip install -e \".[mpi]\" (mpi4py and Open MPI)") from e
+    _current = Ranks(MPI.COMM_WORLD)
+    log.info("MPI: rank %d of %d", _current.rank, _current.size)
+    return _current
+
+
+def scratch_folder(out, resume: bool):
+    """Where this rank writes a run's results: ``out`` on rank 0 (and in serial); on the other
+    ranks a scratch folder of their own (with ``resume``, a copy of ``out``'s checkpoints,
+    taken before rank 0 goes on writing there), removed when the process ends."""
+    ranks = current()
+    if not ranks.parallel:
+        return out
+    from pathlib import Path
+
+    if not ranks.root:
+        import atexit
+        import shutil
+        import tempfile
+
+        scratch = Path(tempfile.mkdtemp(prefix=f"vfem-rank{ranks.rank}-"))
+        atexit.register(shutil.rmtree, scratch, ignore_errors=True)
+        if resume:
+            shutil.copytree(out, scratch, dirs_exist_ok=True)
+        out = scratch
+    ranks.comm.Barrier()  # every copy taken before rank 0 writes
+    return Path(out)
+
+
+def launcher() -> str | None:
+    """The ``mpiexec`` to launch ranks with: beside this Python (the Open MPI wheel puts it
+    in the environment's ``bin``), else on the PATH; None without mpi4py or an mpiexec."""
+    import importlib.util
+    import shutil
+    import sys
+    from pathlib import Path
+
+    if importlib.util.find_spec("mpi4py") is None:
+        return None
+    beside = Path(sys.executable).parent / "mpiexec"
+    if beside.exists():
+        return str(beside)
+    return shutil.which("mpiexec")
+
+
+def launch_command(mpiexec: str, n: int, command: list[str]) -> tuple[list[str], dict]:
+    """The command line and environment that run ``command`` on ``n`` ranks: Open MPI's
+    ``--oversubscribe`` where ``n`` exceeds the cores, and its consent to run as root where
+    this user is root (containers, CI)."""
+    env = dict(os.environ)
+    out = [mpiexec, "-n", str(n)]
+    open_mpi = _is_open_mpi(mpiexec)
+    if open_mpi and n > (os.cpu_count() or 1):
+        out.append("--oversubscribe")
+    if open_mpi and hasattr(os, "geteuid") and os.geteuid() == 0:
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    return out + command, env
+
+
+def _is_open_mpi(mpiexec: str) -> bool:
+    import subprocess
+
+    try:
+        text = subprocess.run([mpiexec, "--version"], capture_output=True, text=True,
+                              timeout=30).stdout
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return "Open MPI" in text or "OpenRTE" in text
+
+
+def use(ranks: Ranks) -> Ranks:
+    """Make ``ranks`` the current ones (tests; :func:`start` for a run)."""
+    global _current
+    _current = ranks
+    return ranks
+
+
+__all__ = ["Ranks", "SharedFactor", "current", "launch_command", "launched_size", "launcher",
+           "scratch_folder", "set_up_bodies", "start", "use"]

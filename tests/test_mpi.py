@@ -1,0 +1,132 @@
+"""Bodies over MPI ranks (issue 22, :mod:`vfem.parallel`): the serial answers from N processes.
+
+Each test launches ``mpiexec -n N python -m vfem run ...`` (Open MPI's ``--oversubscribe``
+where N exceeds the cores; its consent to run as root where the user is root) and compares
+every field of every body's VTU files with the serial run's: equal to 1e-10 of each field's
+largest value (measured 2026-11-28: to the bit on these models; the owner of a body computes
+what the serial run computes). Skipped where mpi4py or an mpiexec is missing (the ``mpi``
+extra, which the test extra installs).
+"""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from vfem import parallel
+
+MPIEXEC = parallel.launcher()
+pytestmark = pytest.mark.skipif(MPIEXEC is None, reason="needs mpi4py and an mpiexec "
+                                "(pip install -e \".[mpi]\")")
+RTOL = 1e-10
+
+
+def vfem(args: list[str], ranks: int = 1, **kwargs) -> subprocess.CompletedProcess:
+    command = [sys.executable, "-m", "vfem", *args]
+    env = None
+    if ranks > 1:
+        command, env = parallel.launch_command(MPIEXEC, ranks, command)
+    env = dict(env or os.environ)
+    env.pop("VFEM_THREADS", None)
+    return subprocess.run(command, capture_output=True, text=True, env=env, timeout=600,
+                          **kwargs)
+
+
+def same_results(a: Path, b: Path, rtol: float = RTOL) -> int:
+    """Every VTU field of ``a`` equal to ``b``'s within ``rtol`` of its largest value; the
+    number of files compared."""
+    files = sorted(a.glob("*.vtu"))
+    assert files
+    for f in files:
+        ma, mb = meshio.read(f), meshio.read(b / f.name)
+        assert set(ma.point_data) == set(mb.point_data)
+        for key, va in ma.point_data.items():
+            vb = mb.point_data[key]
+            scale = max(float(np.abs(va).max()), 1e-300)
+            assert np.abs(va - vb).max() <= rtol * scale, (f.name, key)
+    return len(files)
+
+
+def run_both(tmp_path: Path, args: list[str], ranks: int) -> tuple[Path, Path]:
+    serial, spread = tmp_path / "serial", tmp_path / f"ranks{ranks}"
+    done = vfem(["run", *args, "--out", str(serial), "--no-figures"])
+    assert done.returncode == 0, done.stderr
+    done = vfem(["run", *args, "--out", str(spread), "--no-figures"], ranks=ranks)
+    assert done.returncode == 0, done.stderr + done.stdout
+    assert "Traceback" not in done.stderr
+    return serial, spread
+
+
+@pytest.mark.parametrize("ranks,args", [
+    (2, ["stack", "--set", "dim=2", "--set", "blocks=5", "--set", "divisions=12"]),
+    (4, ["stack", "--set", "dim=2", "--set", "blocks=5", "--set", "divisions=12"]),
+    (2, ["stack"]),
+    (2, ["stack", "--set", "flexibility=matrix_free", "--set", "steps=2"]),
+    (2, ["sphere", "--set", "steps=1"]),
+], ids=["2d-5-plates-n2", "2d-5-plates-n4", "3d-3-plates-n2", "3d-matrix-free-n2",
+        "sphere-n2"])
+def test_ranks_give_the_serial_answers(tmp_path, ranks, args):
+    serial, spread = run_both(tmp_path, args, ranks)
+    assert same_results(serial, spread) >= 2
+    a = json.loads((serial / "summary.json").read_text())
+    b = json.loads((spread / "summary.json").read_text())
+    assert b["converged"] and [s["iterations"] for s in a["steps"]] == [
+        s["iterations"] for s in b["steps"]]
+    assert all(s["invariants"]["passed"] for s in b["steps"])
+    # rank 0 alone wrote and printed
+    assert not any(Path(p).name.startswith("vfem-rank") for p in os.listdir(tmp_path))
+
+
+def test_the_ranks_launcher_runs_the_same_command(tmp_path):
+    """``vfem run --ranks 2`` is ``mpiexec -n 2 vfem run``."""
+    out = tmp_path / "launched"
+    done = vfem(["run", "--ranks", "2", "stack", "--set", "dim=2", "--out", str(out),
+                 "--no-figures"])
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count("vfem: stack, results in") == 1  # one rank prints
+    serial = tmp_path / "serial"
+    assert vfem(["run", "stack", "--set", "dim=2", "--out", str(serial),
+                 "--no-figures"]).returncode == 0
+    same_results(serial, out)
+
+
+def test_resume_after_a_kill_under_mpi_is_the_uninterrupted_run(tmp_path):
+    args = ["stack", "--set", "divisions=14", "--set", "steps=8", "--set",
+            "flexibility=matrix_free", "--no-figures"]
+    whole = tmp_path / "whole"
+    assert vfem(["run", *args, "--out", str(whole)]).returncode == 0
+    out = tmp_path / "killed"
+    command, env = parallel.launch_command(
+        MPIEXEC, 2, [sys.executable, "-m", "vfem", "run", *args, "--out", str(out)])
+    proc = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.time() + 300
+    while time.time() < deadline and proc.poll() is None:
+        if len(list(out.glob("**/checkpoint/step*.npz"))) >= 3:
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the run ended before it could be killed: make it longer"
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    steps_before = len(list(out.glob("**/checkpoint/step*.npz")))
+    assert 1 <= steps_before < 8
+    done = vfem(["run", *args, "--resume", str(out)], ranks=2)
+    assert done.returncode == 0, done.stderr + done.stdout
+    same_results(whole, out)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] and len(summary["steps"]) == 8
+
+
+def test_a_failure_on_every_rank_is_one_message_and_no_hang(tmp_path):
+    done = vfem(["run", "stack", "--set", "flexibility=matrix_free", "--set", "dim=2",
+                 "--set", "press=1.0", "--out", str(tmp_path / "x")], ranks=2)
+    assert done.returncode != 0
+    assert "stack: press (1) must be below a tenth of the thickness" in done.stderr
+    assert "Traceback" not in done.stderr
