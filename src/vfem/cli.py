@@ -730,18 +730,19 @@ def _without_ranks(argv: list[str]) -> list[str]:
 def _join_ranks(args):
     """Join the MPI run this process was launched in (``mpiexec -n N vfem ...``), if any:
     the threads split between the ranks on a machine, and every rank but 0 silent (it writes
-    its results to a scratch folder of its own and prints nothing). None: refused (printed)."""
+    its results to a scratch folder of its own and prints nothing unless it fails alone). None:
+    refused (printed)."""
     try:
         ranks = parallel.start()
     except ImportError as exc:
         print(f"vfem: error: {exc}", file=sys.stderr)
         return None
-    if ranks.parallel:
-        if args.threads is None and not os.environ.get("VFEM_THREADS"):
-            args.threads = str(max(1, threads.default_threads() // ranks.size))
+    if ranks.parallel:  # (the threads: split between a machine's ranks, parallel.start)
         if not ranks.root:
+            import io
+
             sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - for the life of the process
-            sys.stderr = sys.stdout
+            sys.stderr = io.StringIO()  # told only if this rank alone fails (Ranks.finish)
     return ranks
 
 

@@ -36,6 +36,10 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
+#: seconds a failed rank other than 0 waits before stopping the run, for rank 0 to report a
+#: failure they share (:meth:`Ranks.finish`)
+ABORT_GRACE_S = 3.0
+
 #: the environment variables MPI launchers set to the number of ranks (Open MPI, MPICH/Hydra)
 SIZE_VARIABLES = ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS")
 
@@ -94,17 +98,23 @@ class Ranks:
             raise error
         return value
 
-    def map(self, indices: Iterable[int], compute: Callable[[int], object]) -> dict:
-        """``compute(i)`` for every body ``i`` of ``indices``, each on its owner, all owners at
-        once; every rank gets every value. In serial, simply in order."""
+    def map(self, indices: Iterable[int], compute: Callable[[int], object],
+            owners: list[int] | None = None) -> dict:
+        """``compute(i)`` for every body ``i`` of ``indices``, each on its owner (or on rank
+        ``owners[i]``: work that is no body's, spread), all owners at once; every rank gets
+        every value. In serial, simply in order."""
         indices = list(indices)
         if not self.parallel:
             return {i: compute(i) for i in indices}
+
+        def owner(i: int) -> int:
+            return owners[i] if owners is not None else self.owner[i]
+
         out, errors = {}, {}
         self.local = True
         try:
             for i in indices:
-                if self.mine(i):
+                if owner(i) == self.rank:
                     try:
                         out[i] = compute(i)
                     except Exception as e:  # noqa: BLE001 - carried to every rank
@@ -112,7 +122,7 @@ class Ranks:
         finally:
             self.local = False
         for i in indices:
-            value, error = self.comm.bcast((out.get(i), errors.get(i)), root=self.owner[i])
+            value, error = self.comm.bcast((out.get(i), errors.get(i)), root=owner(i))
             if error is not None:
                 raise error
             out[i] = value
@@ -127,8 +137,16 @@ class Ranks:
             return
         if status != 0:
             import sys
+            import time
 
             sys.stdout.flush()
+            if not self.root:
+                # rank 0 reports a failure every rank shares (and stops them all): give it
+                # the time; a failure of this rank alone is told here, on the real stderr
+                time.sleep(ABORT_GRACE_S)
+                said = sys.stderr.getvalue() if hasattr(sys.stderr, "getvalue") else ""
+                for line in said.splitlines():
+                    print(f"vfem (rank {self.rank}): {line}", file=sys.__stderr__, flush=True)
             sys.stderr.flush()
             self.comm.Abort(status)
         self.comm.Barrier()
@@ -156,11 +174,14 @@ class SharedFactor:
         return self.ranks.share(self.index, lambda: self.factor.solve(b))
 
 
-def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None]) -> None:
+def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None],
+                  share_flexibility: bool = False) -> None:
     """Set every body up on its owner (``setup(i)``: assemble, factorize, solve its load
     cases), all owners at once; on the other ranks only assemble it (the invariants and the
     results read its stiffness), then hand them what the contact iteration reads of it and a
-    :class:`SharedFactor` in place of its factorization."""
+    :class:`SharedFactor` in place of its factorization. ``share_flexibility``: also its dense
+    flexibility on its contact dofs (a formulation that reads it on every rank: the thesis
+    variant); the paired variant reads it on the owner only (:meth:`Ranks.map`)."""
     from .bodies.mechanics import LinearMechanics
 
     ranks.place([b.dim * b.npoints for b in bodies])
@@ -183,7 +204,8 @@ def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None]) -> None:
                               for c in b.load_cases],
                     "u_platen": b.u_platen, "platen_load_reaction": b.platen_load_reaction,
                     "platen_stiffness": b.platen_stiffness,
-                    "condensed_flexibility": b.condensed_flexibility, "timings": b.timings}
+                    "condensed_flexibility": b.condensed_flexibility if share_flexibility
+                    else None, "timings": b.timings}
 
         data = ranks.share(i, payload)
         if ranks.mine(i):
@@ -233,6 +255,11 @@ def start() -> Ranks:
                           f"{launched_size()} ranks, but mpi4py is not installed: "
                           "pip install -e \".[mpi]\" (mpi4py and Open MPI)") from e
     _current = Ranks(MPI.COMM_WORLD)
+    # the cores of a machine shared between its ranks (unless VFEM_THREADS says otherwise):
+    # two ranks each factorizing on every core would only slow each other down
+    local = os.environ.get("OMPI_COMM_WORLD_LOCAL_SIZE", "")
+    per_machine = int(local) if local.isdigit() else _current.size
+    os.environ.setdefault("VFEM_THREADS", str(max(1, (os.cpu_count() or 1) // per_machine)))
     log.info("MPI: rank %d of %d", _current.rank, _current.size)
     return _current
 

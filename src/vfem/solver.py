@@ -319,6 +319,9 @@ class Analysis:
         check_memory(self.surfaces, pairs, self.backend, matrix_free=self.matrix_free)
         with memory_guard("factorizing the bodies and computing their flexibility"):
             ranks = current_ranks()
+            # the thesis variant reads every body's flexibility on every rank; the paired
+            # variant on its owner only (vfem.parallel)
+            shared = self.model.contact.variant != "paired"
             if ranks.parallel:  # each body on its own rank (vfem.parallel, issue 22)
                 if any(b.large for b in bodies):
                     raise InputError("a run over MPI ranks serves small kinematics; body "
@@ -326,14 +329,15 @@ class Analysis:
                                      "kinematics: run it in one process")
                 set_up_bodies(ranks, bodies, lambda i: bodies[i].setup(
                     self.backend, condensed_dofs=None if self.matrix_free
-                    else self.surfaces[i].condensed_dofs))
+                    else self.surfaces[i].condensed_dofs), shared)
             else:
                 for b, s in zip(bodies, self.surfaces):
                     b.setup(self.backend,
                             condensed_dofs=None if self.matrix_free else s.condensed_dofs)
             t2 = time.perf_counter()
-            for s in self.surfaces:
-                s.compute_flexibility(matrix_free=self.matrix_free)
+            for i, s in enumerate(self.surfaces):
+                s.compute_flexibility(matrix_free=self.matrix_free,
+                                      remote=not (shared or ranks.mine(i)))
                 log.info("body %s: %d contact candidate nodes", s.body.name, s.nc)
             self.contact = self._contact(pairs)
         self.invariant_check = self._invariant_check()

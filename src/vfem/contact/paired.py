@@ -42,6 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import PlatenUnheld, RindViolation
+from ..parallel import current as current_ranks
 from .capabilities import Capabilities
 from .complementarity import linear_complementarity
 from .corrections import relaxation, release_tension
@@ -89,8 +90,20 @@ class PairSet(SurfaceGroup):
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
                  backend: str | None = None):
         super().__init__(surfaces, pairs, settings, backend)
-        self.contact_pairs = [p for p in (self._make_pair(*sorted(pp)) for pp in sorted(
-            pairs, key=sorted)) if p is not None]
+        keys = [tuple(sorted(pp)) for pp in sorted(pairs, key=sorted)]
+        keys = [(i, j) for i, j in keys if len(surfaces[i].facets) and len(surfaces[j].facets)]
+        # each body's compliance densities against the bodies it may touch on the rank that
+        # owns it (its flexibility), then each pair's geometry on a rank of its own, all at
+        # once (vfem.parallel; in serial in order, as before)
+        ranks = current_ranks()
+        partners = {b: [j if i == b else i for i, j in keys if b in (i, j)]
+                    for b in range(len(surfaces))}
+        density = ranks.map(range(len(surfaces)), lambda b: {
+            j: self._compliance_density(b, j) for j in partners[b]})
+        made = ranks.map(range(len(keys)), lambda k: self._make_pair(
+            *keys[k], density[keys[k][0]][keys[k][1]], density[keys[k][1]][keys[k][0]]),
+            owners=[k % ranks.size for k in range(len(keys))])
+        self.contact_pairs = [made[k] for k in range(len(keys)) if made[k] is not None]
         # penetration p = -(gap0 + n.(u_fine - u_coarse)): its change per unit platen motion
         v = self.platen_motion
         for pair in self.contact_pairs:
@@ -106,11 +119,13 @@ class PairSet(SurfaceGroup):
     #: which nodes overlap the other surface changes as the bodies slide)
     keep_all_nodes = False
 
-    def _make_pair(self, i: int, j: int) -> ContactPair | None:
+    def _make_pair(self, i: int, j: int, density_i: tuple[float, bool],
+                   density_j: tuple[float, bool]) -> ContactPair | None:
+        """The pair of bodies i < j (both with candidate facets), from their compliance
+        densities against each other (:meth:`_compliance_density`), or None where they do not
+        face each other."""
         si, sj = self.surfaces[i], self.surfaces[j]
-        if len(si.facets) == 0 or len(sj.facets) == 0:
-            return None
-        (ci, ei), (cj, ej) = self._compliance_density(i, j), self._compliance_density(j, i)
+        (ci, ei), (cj, ej) = density_i, density_j
         if ci == 0.0 and cj == 0.0:
             return None  # no facet of either faces the other
         if ei != ej and (ci if ei else cj) * EDGE_RATIO >= max(ci, cj):
@@ -574,8 +589,12 @@ class PairedContact(PairSet):
                  for k, pair in enumerate(self.contact_pairs)
                  for j, direction in enumerate(directions[k])] or [np.zeros(0)])
             return W, dp_dplaten, self._platen_rows(dF, m), offsets
-        du = [np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T).reshape(
-            s.nc, s.dim, m) for s, f in zip(self.surfaces, dF)]
+        def motion(b: int) -> np.ndarray:  # C f as (f^T C^T)^T, on the body's owner
+            s, f = self.surfaces[b], dF[b]
+            return np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T).reshape(
+                s.nc, s.dim, m)
+
+        du = current_ranks().map(range(len(self.surfaces)), motion)
         W = np.zeros((m, m))
         dp_dplaten = np.zeros(m)
         for k, pair in enumerate(self.contact_pairs):

@@ -217,7 +217,7 @@ class ContactSurface:
         tracked nodes' with :attr:`rind_rows`, else the candidate nodes' alone."""
         return self.tracked_dofs if self.rind_rows else self.candidate_dofs
 
-    def compute_flexibility(self, matrix_free: bool = False) -> None:
+    def compute_flexibility(self, matrix_free: bool = False, remote: bool = False) -> None:
         """The flexibility rows of the condensed dofs for the candidate dofs, and the platen row.
 
         Taken from the body's factorization (condensed dofs ordered last, see ``vfem.linalg``),
@@ -225,7 +225,8 @@ class ContactSurface:
         a candidate dof is, by reciprocity, minus that dof's motion under a unit platen motion.
         ``matrix_free`` (issue 22): no dense block at all; the flexibility is applied through
         the body's factorization when asked (:attr:`flexibility`,
-        :class:`~vfem.contact.matrix_free.SurfaceFlexibility`).
+        :class:`~vfem.contact.matrix_free.SurfaceFlexibility`). ``remote``: the body is another
+        MPI rank's, which alone reads its dense flexibility (:mod:`vfem.parallel`): none here.
         """
         body = self.body
         nc2 = self.dim * self.nc
@@ -237,6 +238,9 @@ class ContactSurface:
             self.G = None
             self.flexibility = SurfaceFlexibility(self)
             self.exactly_symmetric = False
+            return
+        if remote:
+            self.G = None
             return
         if getattr(body, "condensed_flexibility", None) is not None and \
                 len(body.condensed_flexibility) == len(rows):
