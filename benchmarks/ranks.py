@@ -9,11 +9,13 @@ the sparse factorization on every core), in one process on one thread, and under
 compared with the serial run's, and beside each the prediction of the scaling model of
 docs/scaling.md from the serial run's own timings:
 
-    T(P) = T(1) - sum_b w_b + max_r sum_{b on r} w_b - S + S / min(P, pairs)
+    T(P) = T(1) - sum_b w_b + max_r sum_{b on r} w_b - S + S / min(P, pairs) - C + C s_max
 
 with w_b body b's work that its owner alone does (its factorization and its load cases'
-back-substitutions, ``Body.timings``) and S the pairs' set-up (their geometry, spread over the
-ranks), both from the serial run on one thread.
+back-substitutions, ``Body.timings``), S the pairs' set-up (their geometry, spread over the
+ranks) and, matrix-free, C the contact iterations (the products of W: a back-substitution per
+body, all owners at once; s_max the largest rank's share of the dofs), all from the serial run
+on one thread.
 
     python3 benchmarks/ranks.py                                  # 4 plates, 2 ranks
     python3 benchmarks/ranks.py --blocks 4 --divisions 30 --layers 8 --ranks 2 4
@@ -85,7 +87,42 @@ def predicted(serial: dict, n: int) -> float:
     per_rank = [sum(w for w, o in zip(work, owner) if o == r) for r in range(n)]
     pairs = serial["timings"].get("flexibility_s", 0.0)
     spread = min(n, max(1, len(serial["bodies"]) - 1))
-    return serial["wall_s"] - sum(work) + max(per_rank) - pairs + pairs / spread
+    # matrix-free: the contact iteration is the products of W, one back-substitution per body,
+    # all owners at once: its share of the largest rank (by dofs)
+    contact = serial["timings"].get("contact_s", 0.0) if serial["flexibility"] == \
+        "matrix_free" else 0.0
+    dofs = [b["dofs"] for b in serial["bodies"]]
+    share = max(sum(d for d, o in zip(dofs, owner) if o == r) for r in range(n)) / sum(dofs)
+    return (serial["wall_s"] - sum(work) + max(per_rank) - pairs + pairs / spread
+            - contact + contact * share)
+
+
+#: the broadcast bandwidth assumed for the extrapolation (bytes/s: a cluster's interconnect,
+#: or shared memory between a machine's ranks), and each message's latency (s)
+BANDWIDTH, LATENCY = 5e9, 5e-6
+
+
+def extrapolate(serial: dict, sizes=(2, 4, 16, 64, 256, 1024)) -> list[dict]:
+    """The scaling model for P ranks with one body each (a stack of P plates like the serial
+    run's, P - 1 pairs): each rank's own work w (the mean of the serial run's bodies), the
+    replicated work r per body (T(1) - sum w - S, over the bodies) done for all P bodies on
+    every rank, one pair's set-up s on each rank, and each step's broadcast of every body's
+    displacement (P n 8 bytes, log2 P stages, :data:`BANDWIDTH`, :data:`LATENCY`)."""
+    bodies = serial["bodies"]
+    w = sum(b["own_s"] for b in bodies) / len(bodies)
+    pairs = serial["timings"].get("flexibility_s", 0.0)
+    s = pairs / max(1, len(bodies) - 1)
+    r = (serial["wall_s"] - sum(b["own_s"] for b in bodies) - pairs) / len(bodies)
+    n = sum(b["dofs"] for b in bodies) / len(bodies)
+    ideal = w + r + s
+    out = []
+    for p in sizes:
+        stages = max(1.0, float(np.log2(p)))
+        comm = p * (n * 8 / BANDWIDTH + LATENCY) * stages
+        t = w + p * r + s + comm
+        out.append({"ranks": p, "bodies": p, "time_s": t, "efficiency": ideal / t,
+                    "own_s": w, "replicated_s": p * r, "broadcast_s": comm})
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -98,6 +135,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--flexibility", default="dense", choices=["dense", "matrix_free"])
     ap.add_argument("--ranks", type=int, nargs="+", default=[2])
     ap.add_argument("--json", help="write the rows to this file")
+    ap.add_argument("--extrapolate", action="store_true",
+                    help="also the scaling model for 2 to 1,024 ranks, one body each")
     ap.add_argument("--one", help=argparse.SUPPRESS)  # the output stem: run in this process
     args = ap.parse_args(argv)
     if args.one:
@@ -149,6 +188,15 @@ def main(argv: list[str] | None = None) -> int:
                   f"{serial['wall_s'] / row['wall_s']:>9.2f} {pred:>12.2f} {diff:>10.1e}{ok}")
             row["difference"], row["predicted_s"] = diff, pred
             del row["answers"]
+    if args.extrapolate:
+        size = serial["dofs"] // len(serial["bodies"])
+        print(f"\nscaling model, one body a rank (bodies of {size:,} dofs; from the serial run "
+              "on one thread):")
+        print(f"{'ranks':>6} {'own s':>7} {'replicated s':>13} {'broadcast s':>12} {'T s':>8} "
+              f"{'efficiency':>11}")
+        for e in extrapolate(one_thread):
+            print(f"{e['ranks']:>6} {e['own_s']:>7.2f} {e['replicated_s']:>13.2f} "
+                  f"{e['broadcast_s']:>12.4f} {e['time_s']:>8.2f} {e['efficiency']:>11.2f}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)

@@ -370,7 +370,8 @@ class Analysis:
         else:
             available = available_memory()
             limit = None if available is None else 0.5 * available
-        chosen = limit is not None and dense > limit
+        # one choice for every MPI rank (the memory available differs from rank to rank)
+        chosen = current_ranks().agree(limit is not None and dense > limit)
         log.info("contact flexibility: %s (dense blocks about %.0f MiB, limit %s)",
                  "matrix-free" if chosen else "dense", dense / 2**20,
                  "none" if limit is None else f"{limit / 2**20:.0f} MiB")

@@ -331,15 +331,14 @@ class ContactSurface:
         """
         if self.matrix_free:  # one back-substitution a node (issue 22)
             c = self.flexibility.normal_compliance(nodes, normal)
-            with np.errstate(divide="ignore"):
-                return np.where(c > 0, 1.0 / np.maximum(c, 1e-300), np.inf)
-        C, k = self.C, self.dim
-        c = 0.0
-        for d in range(k):  # the symmetric form, its off-diagonal terms once, doubled
-            for e in range(d, k):
-                cde = C[k * nodes + d, k * nodes + e]
-                c = c + (cde * normal[:, d] * normal[:, e] if d == e
-                         else 2 * cde * normal[:, d] * normal[:, e])
+        else:
+            C, k = self.C, self.dim
+            c = 0.0
+            for d in range(k):  # the symmetric form, its off-diagonal terms once, doubled
+                for e in range(d, k):
+                    cde = C[k * nodes + d, k * nodes + e]
+                    c = c + (cde * normal[:, d] * normal[:, e] if d == e
+                             else 2 * cde * normal[:, d] * normal[:, e])
         with np.errstate(divide="ignore"):
             return np.where(c > 0, 1.0 / np.maximum(c, 1e-300), np.inf)
 
