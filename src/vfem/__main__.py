@@ -1,5 +1,8 @@
+"""``python -m vfem``: the ``vfem`` command (what ``vfem run --ranks N`` launches on each rank)."""
+
 import sys
 
 from .cli import main
 
-sys.exit(main())
+if __name__ == "__main__":
+    sys.exit(main())
