@@ -83,6 +83,7 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
         "contact_settings": contact_settings(result.model),
         "timings": result.timings,
         "linear_solver": result.backend,
+        "contact_flexibility": result.flexibility,
         **friction,
     }
 
