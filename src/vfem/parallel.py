@@ -55,6 +55,8 @@ class Ranks:
         self.owner: list[int] = []
         #: while set (:meth:`map`), a shared factorization solves on its owner only
         self.local = False
+        #: this rank's scratch results folder (ranks other than 0, :func:`scratch_folder`)
+        self.scratch = None
 
     @property
     def parallel(self) -> bool:
@@ -135,6 +137,10 @@ class Ranks:
         that succeeded waits for the others."""
         if not self.parallel:
             return
+        if self.scratch is not None:
+            import shutil
+
+            shutil.rmtree(self.scratch, ignore_errors=True)
         if status != 0:
             import sys
             import time
@@ -280,6 +286,7 @@ def scratch_folder(out, resume: bool):
 
         scratch = Path(tempfile.mkdtemp(prefix=f"vfem-rank{ranks.rank}-"))
         atexit.register(shutil.rmtree, scratch, ignore_errors=True)
+        ranks.scratch = scratch  # removed by Ranks.finish too (MPI_Abort skips atexit)
         if resume:
             shutil.copytree(out, scratch, dirs_exist_ok=True)
         out = scratch

@@ -406,6 +406,15 @@ def run_example(model: Model, out: Path, summarize, draw=None, on_step=None,
     return summary
 
 
+def mpi_ranks() -> dict:
+    """``{"mpi_ranks": N}`` for a run over N > 1 MPI ranks (vfem.parallel); nothing for a
+    serial run (its summary as before)."""
+    from ..parallel import current
+
+    size = current().size
+    return {"mpi_ranks": size} if size > 1 else {}
+
+
 def finish_summary(out: Path, summary: dict) -> None:
     """Add the phase table of the run (:func:`vfem.result_types.phase_table`: seconds per
     phase, from its ``timings``) to ``summary``, log it (``vfem -v``) and write
@@ -546,6 +555,7 @@ def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
            "dofs": int(sum(b.ndofs for b in result.model.bodies)),
            "parameters": dataclasses.asdict(parameters), "timings": result.timings,
            "linear_solver": result.backend, "contact_flexibility": result.flexibility,
+           **mpi_ranks(),
            "contact_settings": contact_settings(result.model)}
     out.update(friction_summary(result, out["steps"]))
     return out

@@ -24,6 +24,7 @@ from .results import (
     finish_summary,
     force_record,
     friction_summary,
+    mpi_ranks,
     run_writing,
     step_record,
     total,
@@ -84,6 +85,7 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
         "timings": result.timings,
         "linear_solver": result.backend,
         "contact_flexibility": result.flexibility,
+        **mpi_ranks(),
         **friction,
     }
 
