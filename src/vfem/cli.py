@@ -680,9 +680,22 @@ def main(argv: list[str] | None = None) -> int:
         try:
             status = _main(args)
         finally:
+            if status != 0 and not ranks.root:
+                _tell_rank_failure(ranks)
             ranks.finish(status)
         return status
     return _main(args)
+
+
+def _tell_rank_failure(ranks) -> None:
+    """A rank other than 0 failed: give rank 0 the time to report a failure every rank shares
+    (it then stops them all), else tell this rank's own message on the real stderr."""
+    import time
+
+    time.sleep(parallel.ABORT_GRACE_S)
+    said = sys.stderr.getvalue() if hasattr(sys.stderr, "getvalue") else ""
+    for line in said.splitlines():
+        print(f"vfem (rank {ranks.rank}): {line}", file=sys.__stderr__, flush=True)
 
 
 def _launch_ranks(args, argv: list[str]) -> int:

@@ -37,7 +37,7 @@ import numpy as np
 log = logging.getLogger(__name__)
 
 #: seconds a failed rank other than 0 waits before stopping the run, for rank 0 to report a
-#: failure they share (:meth:`Ranks.finish`)
+#: failure they share (``vfem.cli``, before :meth:`Ranks.finish`)
 ABORT_GRACE_S = 3.0
 
 #: the environment variables MPI launchers set to the number of ranks (Open MPI, MPICH/Hydra)
@@ -131,10 +131,11 @@ class Ranks:
         return out
 
     def finish(self, status: int) -> None:
-        """The end of a rank's command with exit status ``status``: a rank that failed while
-        others may still wait for it stops them all (``MPI_Abort``: a failure on one rank
-        alone, writing its results say, must not leave the others waiting for ever); a rank
-        that succeeded waits for the others."""
+        """The end of a rank's command with exit status ``status``: its scratch folder
+        removed; a rank that failed while others may still wait for it stops them all
+        (``MPI_Abort``: a failure on one rank alone, writing its results say, must not leave
+        the others waiting for ever); a rank that succeeded waits for the others. (The CLI
+        lets rank 0 tell a failure every rank shares first, :data:`ABORT_GRACE_S`.)"""
         if not self.parallel:
             return
         if self.scratch is not None:
@@ -143,16 +144,8 @@ class Ranks:
             shutil.rmtree(self.scratch, ignore_errors=True)
         if status != 0:
             import sys
-            import time
 
             sys.stdout.flush()
-            if not self.root:
-                # rank 0 reports a failure every rank shares (and stops them all): give it
-                # the time; a failure of this rank alone is told here, on the real stderr
-                time.sleep(ABORT_GRACE_S)
-                said = sys.stderr.getvalue() if hasattr(sys.stderr, "getvalue") else ""
-                for line in said.splitlines():
-                    print(f"vfem (rank {self.rank}): {line}", file=sys.__stderr__, flush=True)
             sys.stderr.flush()
             self.comm.Abort(status)
         self.comm.Barrier()

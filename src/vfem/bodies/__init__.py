@@ -431,8 +431,7 @@ class Body:
         trailing = None
         if condensed_dofs is not None:
             condensed_dofs = np.asarray(condensed_dofs, dtype=int)
-            pos = np.searchsorted(self.free_dofs, condensed_dofs)
-            free = self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == condensed_dofs
+            pos, free = self.free_positions(condensed_dofs)
             trailing = pos[free]
         t2 = time.perf_counter()
         self.factor = factorize(K_ff, backend, trailing=trailing,
@@ -878,6 +877,15 @@ class Body:
         """Displacement due to nodal forces (ndofs), supports kept at zero: K^-1 f."""
         return self._solve_with(np.asarray(nodal_force, dtype=float), np.zeros(self.ndofs))
 
+    def free_positions(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where body dofs ``dofs`` stand among the free dofs (the rows of the factorized
+        block), and which of them are free at all (a constrained dof has no row)."""
+        dofs = np.asarray(dofs, dtype=int)
+        pos = np.searchsorted(self.free_dofs, dofs)
+        is_free = (pos < len(self.free_dofs)) & (
+            self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == dofs)
+        return pos, is_free
+
     def flexibility_columns(self, dofs: np.ndarray, chunk: int = 256) -> np.ndarray:
         """Columns of K^-1 (supports kept) for the given dofs, shape (ndofs, len(dofs)).
 
@@ -885,9 +893,7 @@ class Body:
         """
         dofs = np.asarray(dofs, dtype=int)
         out = np.zeros((self.ndofs, len(dofs)))
-        pos = np.searchsorted(self.free_dofs, dofs)
-        is_free = (pos < len(self.free_dofs)) & (
-            self.free_dofs[np.minimum(pos, len(self.free_dofs) - 1)] == dofs)
+        pos, is_free = self.free_positions(dofs)
         cols = np.flatnonzero(is_free)
         for start in range(0, len(cols), chunk):
             c = cols[start:start + chunk]

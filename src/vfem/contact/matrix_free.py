@@ -58,21 +58,12 @@ class SurfaceFlexibility:
         body = surface.body
         self.body = body
         self.dim = surface.dim
-        free = body.free_dofs
-        self.n_free = len(free)
-
-        def positions(dofs):
-            pos = np.searchsorted(free, dofs)
-            ok = (pos < len(free)) & (free[np.minimum(pos, len(free) - 1)] == dofs)
-            return pos, ok
-
-        self._col_pos, self._col_free = positions(surface.candidate_dofs)
-        self._row_pos, self._row_free = positions(surface.condensed_dofs)
+        self.n_free = len(body.free_dofs)
+        self._col_pos, self._col_free = body.free_positions(surface.candidate_dofs)
+        self._row_pos, self._row_free = body.free_positions(surface.condensed_dofs)
         self.n_cols = len(surface.candidate_dofs)
         self._cand_dofs = surface.candidate_dofs.reshape(-1, self.dim)
         self.n_rows = len(surface.condensed_dofs)
-        #: back-substitutions made (columns), for the log and the benchmark
-        self.solves = 0
 
     def apply(self, F: np.ndarray, rows: int | None = None) -> np.ndarray:
         """The condensed dofs' motion (their first ``rows``, default all) under candidate-dof
@@ -85,7 +76,6 @@ class SurfaceFlexibility:
         rhs[self._col_pos[self._col_free]] = F2[self._col_free]
         x = self.body.factor.solve(rhs if k > 1 else rhs[:, 0])
         x = x.reshape(self.n_free, k)
-        self.solves += k
         n = self.n_rows if rows is None else rows
         out = np.zeros((n, k))
         ok = self._row_free[:n]
