@@ -115,11 +115,20 @@ def test_bench_times_the_whole_run_against_a_plain_run_writing_the_same_files(tm
 
 
 def test_the_thesis_variant_from_the_command_line(tmp_path, capsys):
-    assert main(["run", "hertz", "--set", "variant=thesis", "--out", str(tmp_path)]) == 0
+    """Every step stops at the thesis variant's fixed point outside its tolerance: the run goes
+    to its end and writes everything, but is not converged (issue 37): exit status 1, as any
+    analysis that does not converge, and the message names what to change."""
+    assert main(["run", "hertz", "--set", "variant=thesis", "--out", str(tmp_path)]) == 1
     s = json.loads((tmp_path / "summary.json").read_text())
     assert s["parameters"]["variant"] == "thesis"
-    assert all(x["stopped_at_fixed_point"] for x in s["steps"])
-    assert "note: 5 of 5 steps stopped where" in capsys.readouterr().out
+    assert all(x["stopped_at_fixed_point"] and not x["converged"] for x in s["steps"])
+    assert not s["converged"] and "hertz" in s  # the evaluation, for comparison
+    out, err = capsys.readouterr()
+    assert "note: 5 of 5 steps stopped where" in out
+    assert "NOT converged (stopped at the thesis variant's fixed point OUTSIDE" in out
+    assert "vfem: the analysis did not converge: 5 of 5 steps stopped" in err
+    assert "contact.variant = \"paired\"" in err
+    assert (tmp_path / "pressure.png").exists() and len(list(tmp_path.glob("*.vtu"))) == 10
 
 
 def test_study_writes_the_table_and_the_convergence_plot(tmp_path):

@@ -11,8 +11,8 @@ a message for the user is found:
   ``mesh shape '<shape>': ...``) and internal guards;
 * ``SolveResult(False, ..., message)``: a contact solve that failed (shown through
   ``diagnosis()`` when the analysis stops);
-* the text returned by ``diagnosis()`` (solver.py) and by ``CycleWatch`` (contact/algorithm.py),
-  and what the CLI prints on stderr.
+* the text returned by ``diagnosis()``, ``fixed_point_message()`` and ``_platen_off()``
+  (solver.py) and by ``CycleWatch`` (contact/algorithm.py), and what the CLI prints on stderr.
 
 From each message the first literal fragment of at least 12 characters (ends trimmed of spaces
 and punctuation, whitespace normalised) must occur in ``docs/errors.md``; a message with no
@@ -38,12 +38,14 @@ CATALOGUE = ROOT / "docs" / "errors.md"
 MESSAGE_ARGUMENT = {"failure": 0, "InputError": 0, "AnalysisError": 0, "RindViolation": 0,
                     "VfemError": 0, "_Inverted": 0, "_Problem": 1, "need": 1, "ContactCycling": 0,
                     "ContactNotConverged": 0, "ElementInverted": 0, "NewtonNotConverged": 0,
-                    "PlatenUnheld": 0, "SingularSystem": 0, "ActiveSetNotSettled": 0}
+                    "PlatenUnheld": 0, "SingularSystem": 0, "ActiveSetNotSettled": 0,
+                    "PlatenOffForce": 0}
 #: exceptions whose message counts only where they are raised (they are common names)
 RAISED = {"ValueError", "RuntimeError"}
 #: functions whose every string is user-facing text (module relative to src/vfem, name):
 #: the stop message and its remedies, and CycleWatch.__call__'s message
-MESSAGE_FUNCTIONS = {("solver.py", "diagnosis"), ("contact/state.py", "__call__")}
+MESSAGE_FUNCTIONS = {("solver.py", "diagnosis"), ("contact/state.py", "__call__"),
+                     ("solver.py", "fixed_point_message"), ("solver.py", "_platen_off")}
 
 FRAGMENT = 12  # characters a fragment must have
 SHORT_FRAGMENT = 8  # ... or, failing that, the longest fragment of the message
@@ -67,9 +69,9 @@ _WRAPPERS_AS_WRITTEN = {
         "prefixes 'wedge: ' to the need(...) messages of wedge.validate (catalogued there)",
     ("examples/wedge.py", 'f"wedge: {exc}"'):
         "prefixes 'wedge: ' to a mesh shape's ValueError (catalogued in mesh/shapes.py)",
-    ("solver.py", "res.message"):
-        "res.failure(res.message): a failed contact solve's SolveResult message, raised as "
-        "its failure kind",
+    ("solver.py", "message"):
+        "failure(message): a failed contact solve's SolveResult message (with the platen's "
+        "clause where it ends off its force, _platen_off), raised as its failure kind",
     ("contact/iteration.py", "cycling"):
         "SolveResult(False, ..., cycling): the CycleWatch message (catalogued from CycleWatch)",
     ("contact/iteration.py", "c.unconverged()"):

@@ -100,7 +100,10 @@ def test_thesis_variant_meets_the_core_acceptance_too(hertz_level0):
     p, result, h = hertz_level0
     tp = dataclasses.replace(p, variant="thesis")
     r = Analysis(build(tp)).run()
-    assert r.converged
+    # every step stops at its fixed point outside its tolerance: run to the end, not converged
+    # (issue 37), and its answer still meets the core acceptance
+    assert r.complete and not r.converged and all(s.fixed_point for s in r.steps)
+    assert "contact.variant = \"paired\"" in r.message
     ht = evaluate(r, tp)
     assert ht["p_max"] == pytest.approx(31848, rel=0.03)
     assert abs(ht["a_estimate"] - 0.06117) <= ht["contact_facet_length"]

@@ -69,7 +69,9 @@ def test_the_flat_carries_exactly_what_the_punches_apply(results):
 def test_thesis_variant_balances_only_to_a_few_percent(thesis_result):
     """The plain reading meets the balance only to a few percent at sharp corners
     (docs/method.md §5)."""
-    assert thesis_result.converged
+    # (it stops at its fixed point outside its tolerance: every step run, not converged,
+    # issue 37)
+    assert thesis_result.complete and not thesis_result.converged
     b = thesis_result.steps[-1].bodies
     punches = b["left"].contact_force[:, 1].sum() + b["right"].contact_force[:, 1].sum()
     assert -b["flat"].contact_force[:, 1].sum() == pytest.approx(punches, rel=0.03)

@@ -26,7 +26,9 @@ def test_other_settings_reach_the_same_hertz_answer(hertz_level0, changes):
     model = build(p)
     model.contact = dataclasses.replace(model.contact, **changes)
     r = Analysis(model).run()
-    assert r.converged
+    # every step run; the thesis variant's steps that stop at its fixed point outside its
+    # tolerance make the analysis not converged (issue 37)
+    assert r.complete and r.converged is not any(s.fixed_point for s in r.steps)
     assert evaluate(r, p)["p_max"] == pytest.approx(h["p_max"], rel=0.01)
 
 

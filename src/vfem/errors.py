@@ -47,6 +47,11 @@ class ContactNotConverged(AnalysisError):
     """The contact iteration reached ``contact.max_iterations`` without meeting its tolerances."""
 
 
+class PlatenOffForce(ContactNotConverged):
+    """The contact iteration reached ``contact.max_iterations`` with a force-controlled
+    platen's reaction still off its force (its other errors may be within their tolerances)."""
+
+
 class ElementInverted(AnalysisError):
     """An iterate would turn an element inside out (det F <= 0); the step is cut."""
 

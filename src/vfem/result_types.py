@@ -122,6 +122,10 @@ class AnalysisResult:
     backend: str = ""  # the linear-algebra backend that factorized the bodies (vfem.linalg)
     #: how the contact correction read the flexibility: "dense" or "matrix_free" (issue 22)
     flexibility: str = "dense"
+    #: every scheduled load factor was reached: true where ``converged`` is, and where the
+    #: thesis variant ran every step but stopped some at its fixed point outside its tolerance
+    #: (``StepResult.fixed_point``; not converged, its answers there for comparison)
+    complete: bool = False
 
 
 @dataclass

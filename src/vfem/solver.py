@@ -40,6 +40,7 @@ from .bodies import Body, multiplier
 from .bodies.stresses import max_strain
 from .contact.check import InvariantCheck, Invariants
 from .contact.formulation import check_capabilities, formulation_class
+from .contact.group import SurfaceGroup
 from .contact.matrix_free import matrix_free_refusal
 from .contact.search import project_points
 from .contact.settings import ContactSettings
@@ -54,10 +55,12 @@ from .errors import (
     ActiveSetNotSettled,
     AnalysisError,
     ContactCycling,
+    ContactNotConverged,
     ElementInverted,
     InputError,
     InvariantViolation,
     NewtonNotConverged,
+    PlatenOffForce,
     PlatenUnheld,
     RindViolation,
     SingularSystem,
@@ -219,6 +222,45 @@ def idle_load_curves(model: Model) -> list[str]:
     return notes
 
 
+#: what to change where a platen's reaction stays off its force (measured, docs/errors.md)
+PLATEN_REMEDY = (
+    "a body that only the platen and contact hold along the platen's direction is free there "
+    "where the platen's force is zero, or where the contact cannot push along it (frictionless, "
+    "sideways): end the platen's load curve at a small force instead of zero, or hold the body "
+    "with a support; where other loads press the bodies together before the platen's body "
+    "touches, start the platen's force first (a load curve on the other loads)")
+
+#: what to change where the thesis variant stopped at its fixed point outside its tolerance
+#: (measured: the paired variant solves every model that showed it, docs/errors.md)
+FIXED_POINT_REMEDY = (
+    "analyse the model with the paired variant (contact.variant = \"paired\", the default), "
+    "whose exact discrete state is the fixed point of its iteration; smaller steps, more "
+    "iterations or a looser contact.equilibrium_tolerance do not move the thesis variant's "
+    "fixed point (docs/method.md §5)")
+
+
+def fixed_point_message(steps: list[StepResult], penetration_tolerance: float) -> str:
+    """The message of an analysis of the thesis variant that ran every step but stopped some
+    at the fixed point of its iteration with errors above its tolerance (``fixed_point``): how
+    many, the first and the worst, and what to change (:data:`FIXED_POINT_REMEDY`)."""
+    outside = [s for s in steps if s.fixed_point]
+
+    def errors(s: StepResult) -> str:
+        last = s.history[-1]
+        return (f"step {s.step} (load factor {s.load_factor:.6g}): penetration "
+                f"{last.max_penetration:.3g} against a tolerance of {penetration_tolerance:.3g}, "
+                f"equilibrium error {last.max_equilibrium_error:.3g}")
+
+    first = outside[0]
+    worst = max(outside, key=lambda s: s.history[-1].max_penetration)
+    where = errors(first) + ("" if worst is first else f"; the deepest, {errors(worst)}")
+    return (f"{len(outside)} of {len(steps)} steps stopped at the thesis variant's fixed point "
+            f"OUTSIDE its tolerance, where its compatibility and equilibrium corrections cancel "
+            f"({where}); every step's results are written, its residuals in summary.json "
+            f"(steps[].max_penetration, max_equilibrium_error). What to change: "
+            f"{FIXED_POINT_REMEDY}")
+
+
 def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
               settings: ContactSettings, unreachable: list[str] = ()) -> str:
     """The message of an analysis that stops: which step, what failed (the error names the
@@ -241,6 +283,9 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
     elif isinstance(exc, RindViolation):
         remedy = ("take smaller steps ([steps] count), or give the bodies deeper surface "
                   "elements so a step's overlap stays inside them")
+    elif isinstance(exc, PlatenOffForce):
+        remedy = (f"{PLATEN_REMEDY}; else allow more iterations (contact.max_iterations = "
+                  f"{settings.max_iterations}) or smaller steps")
     elif isinstance(exc, PlatenUnheld):
         remedy = ("give the platen's force the sign that pushes the body onto the other (or "
                   "hold the body otherwise); no step size or iteration count can help")
@@ -465,8 +510,32 @@ class Analysis:
         res = self.contact.solve(state, self.on_iteration)
         history_out.extend(res.history)
         if not res.converged:
-            raise res.failure(res.message)  # its kind: what the diagnosis reads
+            failure, message = res.failure, res.message
+            off = self._platen_off(state, res) if failure is ContactNotConverged else ""
+            if off:
+                message = f"{message}; {off}"
+                last = res.history[-1]
+                if (last.max_penetration <= self.contact.penetration_tolerance
+                        and last.tension_nodes == 0):
+                    failure = PlatenOffForce  # what is left: the platen (its own remedy)
+            raise failure(message)  # its kind: what the diagnosis reads
         return state, res
+
+    def _platen_off(self, state: ContactState, res: SolveResult) -> str:
+        """Where a solve ended with a force-controlled platen's reaction off its force (the
+        last iteration's ``platen_error`` beyond the formulation's allowance, issue 37), what
+        the message adds: by how much, and the force; "" otherwise."""
+        contact = self.contact
+        if not isinstance(contact, SurfaceGroup) or contact.platen_body is None \
+                or not res.history:
+            return ""  # (a baseline's global system: its own failure kinds)
+        error = res.history[-1].platen_error
+        allowed = contact.platen_allowance(state)
+        if abs(error) <= allowed:
+            return ""
+        name = contact.surfaces[contact.platen_body].body.name
+        return (f"the platen on body {name!r} is {abs(error):.3g} off its force "
+                f"{state.platen_force + 0.0:.6g} (allowed {allowed:.3g})")
 
     # -- the steps ------------------------------------------------------------------------------
 
@@ -558,8 +627,14 @@ class Analysis:
                 b.commit_step()
             state = self.state = new
             iterations = sum(1 for h in history if h.iteration > 0) or 0
+            if res.fixed_point:  # the thesis variant's: not converged (issue 37)
+                last = history[-1]
+                log.warning("step to load factor %.6g: stopped at the thesis variant's fixed "
+                            "point OUTSIDE its tolerance (penetration %.3g, tolerance %.3g; "
+                            "equilibrium error %.3g): not converged", lf, last.max_penetration,
+                            self.contact.penetration_tolerance, last.max_equilibrium_error)
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=iterations,
-                              converged=True, history=history,
+                              converged=not res.fixed_point, history=history,
                               platen_displacement=state.platen_displacement, cuts=self.level,
                               fixed_point=res.fixed_point, invariants=invariants.record())
             step.bodies = fields
@@ -578,6 +653,13 @@ class Analysis:
                 t0 = time.perf_counter()
                 on_step(step)  # (the results of the step written, by the caller)
                 self._add_time("output_s", time.perf_counter() - t0)
+        complete = self.target >= len(schedule)  # every scheduled load factor reached
+        if converged and any(s.fixed_point for s in steps):
+            # the thesis variant ran every step, but stopped some outside its tolerance: not
+            # converged (the CLI's exit status 1), its results written for comparison
+            converged = False
+            message = fixed_point_message(steps, self.contact.penetration_tolerance)
+            log.info(message)
         # a formulation's own timings (a baseline's factorizations and solves)
         self.timings.update(getattr(self.contact, "timings", {}))
         self.timings["steps_s"] = time.perf_counter() - t_setup
@@ -587,7 +669,8 @@ class Analysis:
                                        "steps_s"))
         return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
                               self.surfaces, self.contact.penetration_tolerance, self.backend,
-                              "matrix_free" if getattr(self, "matrix_free", False) else "dense")
+                              "matrix_free" if getattr(self, "matrix_free", False) else "dense",
+                              complete)
 
     def _add_time(self, key: str, seconds: float) -> None:
         self.timings[key] = self.timings.get(key, 0.0) + seconds

@@ -284,7 +284,7 @@ class VirtualElementContact(SurfaceGroup):
         r_platen = b.platen_stiffness
         need = (state.platen_force - self.platen_reaction(state)
                 - float(s.platen_row @ dF_other.ravel()))
-        off = abs(need) > self.settings.platen_tolerance * max(abs(state.platen_force), 1e-300)
+        off = abs(need) > self.platen_allowance(state)  # (a zero force: issue 37)
         sel = comp.copy()
         if off:
             sel |= p.participating & (p.force >= 0) & (p.penetration > -self.penetration_tolerance)

@@ -263,7 +263,11 @@ class FrictionHistory:
             if on.any() and s.ndim == 1:
                 sigma = -np.sign(s[on])
                 err = max(err, float(np.maximum(-sigma * dw[on], 0.0).max()))
-            elif on.any():  # 3D: the slip along sigma, and none across it
+            # 3D: the slip along sigma, and none across it. A node that slips with no traction
+            # (a frictionless pair's) has no direction to measure its slip against: it is free
+            # (in 2D sigma is then 0); dividing by its |s| = 0 made NaN errors (issue 37)
+            on &= magnitudes(s) > 0
+            if on.any() and s.ndim > 1:
                 sigma = -s[on] / magnitudes(s[on])[:, None]
                 along = np.einsum("ij,ij->i", sigma, dw[on])
                 across = magnitudes(dw[on] - along[:, None] * sigma)
@@ -521,6 +525,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         out = 0.0
         for k, w in enumerate(dw):
             s, on = columns(self.shear(state, k)), self.status(state, k) == 2
+            on &= magnitudes(s) > 0  # (no direction without a traction: friction_errors)
             if on.any():
                 sigma = -s[on] / magnitudes(s[on])[:, None]
                 along = np.einsum("ij,ij->i", sigma, w[on])
@@ -708,7 +713,10 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             A[len(rows) + np.arange(turning), len(cols) + np.arange(turning)] += \
                 np.concatenate(perp_c)
             b = np.concatenate([b, np.concatenate(perp_rhs) - Gr[len(rows):] @ jump])
-        if self.platen_body is not None and state.platen_force != 0.0:
+        # the platen's motion solved for where it has a force to meet, or (a zero force: a
+        # platen holding the body sideways while it is pressed) where its reaction is off it
+        if self.platen_body is not None and (state.platen_force != 0.0
+                                             or not self.platen_met(state)):
             body = self.surfaces[self.platen_body].body
             row = dR[cols].copy()
             for tq, ts, t in zip(tie_q, tie_s, ties):

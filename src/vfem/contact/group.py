@@ -145,7 +145,34 @@ class SurfaceGroup:
         if self.platen_body is None:
             return True
         error = self.platen_reaction(state) - state.platen_force
-        return abs(error) <= self.settings.platen_tolerance * max(abs(state.platen_force), 1e-300)
+        return abs(error) <= self.platen_allowance(state)
+
+    def platen_allowance(self, state: ContactState) -> float:
+        """How far the platen's reaction may be from its force and count as on it:
+        ``platen_tolerance`` times the force; where the force is zero (a load curve at zero, a
+        platen that holds a body sideways while it is pressed), times the force scale of the
+        reaction instead (issue 37, :meth:`platen_force_scale`). Relative to the zero force
+        itself only an exactly zero reaction would do: a model whose every error was 1e-17
+        stopped after ``max_iterations``."""
+        cfg = self.settings
+        if state.platen_force != 0.0:
+            return cfg.platen_tolerance * abs(state.platen_force)
+        return cfg.platen_tolerance * self.platen_force_scale(state)
+
+    def platen_force_scale(self, state: ContactState) -> float:
+        """The forces the platen's reaction sums (:meth:`platen_reaction`), in magnitude: the
+        loads' share, the platen's motion times its stiffness, and every contact force of its
+        body (the whole force, not its component along the platen: the round-off of a sideways
+        reaction is the normal forces') times the reaction it makes per unit force. Zero only
+        where every one of them is, the reaction then exactly zero."""
+        if self.platen_body is None:
+            return 0.0
+        s = self.surfaces[self.platen_body]
+        b = s.body
+        row = np.linalg.norm(s.platen_row.reshape(-1, s.dim), axis=1)
+        force = np.linalg.norm(state.forces[self.platen_body], axis=1)
+        return (abs(b.platen_load_reaction_at(state.load_factor))
+                + abs(state.platen_displacement * b.platen_stiffness) + float(row @ force))
 
     def fields(self, state: ContactState, result: SolveResult) -> dict[str, BodyStepResult]:
         """Full-mesh results of a converged state, per body (one back-substitution each): the

@@ -207,8 +207,7 @@ class LargeDeformationContact(PairSet):
             # first iteration of a step) is not in equilibrium, whatever its residual
             settled = all(lin.prescribed_met for lin in lins if lin is not None)
             need, _, _ = self._platen_terms(state, lins)
-            platen_ok = (self.platen_body is None or abs(need) <= cfg.platen_tolerance
-                         * max(abs(state.platen_force), 1e-300))
+            platen_ok = self._platen_on_force(state, need)
             other_err, other_ok, other_what = self._further_errors(state)
             return Check(
                 IterationRecord(it, max(pen_err, other_err), body_err, contact, tension,
@@ -259,6 +258,12 @@ class LargeDeformationContact(PairSet):
             if s.body.large:
                 s.body.equilibrate(state.load_factor, state.platen_displacement,
                                    self._full_force(i, F))
+
+    def _platen_on_force(self, state: ContactState, need: float) -> bool:
+        """Whether the platen's reaction is on its force: ``need`` (:meth:`_platen_terms`)
+        within :meth:`~vfem.contact.group.SurfaceGroup.platen_allowance` (a zero force: of the
+        forces its reaction sums, issue 37)."""
+        return self.platen_body is None or abs(need) <= self.platen_allowance(state)
 
     def _platen_terms(self, state: ContactState, lins: list) -> tuple[float, float, np.ndarray]:
         """The platen's missing force after the bodies' corrections with the contact forces

@@ -433,7 +433,10 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             # the nodes whose sigma turns: slipping along both tangents, with a traction and a
             # slip along sigma to turn it by
             q_now = x[nrm]
-            turning = slide & both & (q_now > 0) & (np.einsum("ij,ij->i", sigma, slip) > 0)
+            # (and a dynamic coefficient: with mu = 0 its traction is zero, and the compliance
+            # below would divide by it)
+            turning = (slide & both & (q_now > 0) & (mu > 0)
+                       & (np.einsum("ij,ij->i", sigma, slip) > 0))
             turn = np.flatnonzero(turning)
             across_dir = np.column_stack([-sigma[turn, 1], sigma[turn, 0]])
             cols = np.concatenate([nrm[contact]] + [tng[stick & free[:, j], j]

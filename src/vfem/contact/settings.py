@@ -124,7 +124,9 @@ class ContactSettings:
             tolerance (largest penetration, largest equilibrium error, no node in tension).
             ``"stationary"`` (default) — also when the net corrective force on every node is
             within the equilibrium tolerance and the displacement it causes within the
-            penetration tolerance (the fixed point of the iteration); ``"physical"`` — only on
+            penetration tolerance (the fixed point of the iteration; a step that stops there
+            with the physical errors above tolerance is not converged, and neither is the
+            analysis, which still runs and writes every step); ``"physical"`` — only on
             the physical errors; ``"thesis"`` — also when the corrective forces of an iteration
             fall below ``thesis_fraction`` of the largest of the solve, or the displacements they
             cause below that fraction of the largest (thesis §5.6).
@@ -141,7 +143,9 @@ class ContactSettings:
         size_ratio_limit: when a facet is longer than this many times the opposing facets, the
             quadrature order is raised in proportion (thesis §5.6: 3:1 is easily tolerated).
         max_step_cuts: how many times a step is halved after a failure before the analysis stops.
-        platen_tolerance: relative mismatch allowed between a platen's reaction and its force.
+        platen_tolerance: relative mismatch allowed between a platen's reaction and its force;
+            where the force is zero, relative to the forces the reaction sums (its body's
+            contact forces, the loads' share).
         penalty: the baselines' penalty stiffness per unit contact length (``method``
             ``"penalty"`` or ``"augmented"``): contact pressure per unit penetration (a slave
             node's force is penalty x penetration x its tributary length). Default (None):

@@ -135,7 +135,7 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
     from ..io.results import example_summary
 
     summary = example_summary("block", result, p)
-    if result.converged:
+    if result.complete:  # (also the thesis variant's run, not converged: issue 37)
         summary["block"] = evaluate(result, p)
     return summary
 
