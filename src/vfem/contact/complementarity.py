@@ -25,8 +25,9 @@ log = logging.getLogger(__name__)
 def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
                            dp_dplaten: np.ndarray | None = None, dR: np.ndarray | None = None,
                            stiffness: float = 0.0, need: float = 0.0,
-                           max_pivots: int | None = None, factor: ReusedFactor | None = None
-                           ) -> tuple[np.ndarray, float]:
+                           max_pivots: int | None = None, factor: ReusedFactor | None = None,
+                           reserve: np.ndarray | None = None, guard: np.ndarray | None = None,
+                           rounds: int | None = None) -> tuple[np.ndarray, float]:
     """The traction values q >= 0 of the linearised contact problem, and the platen motion.
 
     From traction values ``q0`` with (linearised) penetrations ``p``, the penetrations after the
@@ -47,6 +48,20 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
     keep the LU factors of the last set's matrix (:class:`ReusedFactor`; a step whose set is
     the last step's solves with the same factors); without it, every set's bordered system is
     solved by least squares.
+
+    ``reserve`` (bool over the nodes): nodes held back until the others' set is found — the
+    held nodes (issue 37, :func:`~vfem.contact.pairing.held_nodes`), even those that carried
+    force before. Only if one of them then penetrates do they take part in the pivoting, so where
+    none would (a flat interface, a convex compatibility side) the answer is the
+    compatibility side's set alone, unchanged; a held node that only touches within
+    round-off, whose condition repeats its neighbours', never makes a set's matrix singular.
+    ``rounds``: of held nodes joining (default :data:`STAGES`; 0: the reserve nodes never
+    join). ``guard`` ((nodes, k) indices, -1 for none, -2 for one always in the set, so that the
+    node is never held): a reserve node is in the set only while not
+    all of its guard's nodes are — the compatibility side's nodes around its virtual
+    node: between nodes in contact a node of the other surface protrudes by the faceting
+    of the compatibility side (a mesh that resolves the surface between its nodes only as
+    they lie), not by a contact missed.
     """
     n = len(q0)
     max_pivots = max_pivots or 10 * n + 10
@@ -68,26 +83,84 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
         pen = p - system.matvec(q - q0) + (d * dp_dplaten if platen else 0.0)
         return q, d, pen
 
-    active = (q0 > 0) | (p > tol)
-    seen = set()
-    single = False
-    q, d = np.zeros(n), 0.0
-    for pivot in range(max_pivots):
-        q, d, pen = on(active)
-        wrong = (active & (q < 0)) | (~active & (pen > tol))
-        if platen and abs(float(dR @ (q - q0)) + stiffness * d - need) > 1e-9 * abs(need):
-            wrong |= ~active & (pen > -tol)  # the platen needs the nodes touching it to push
-        if not wrong.any():
-            log.debug("complementarity: the contact set in %d solves", pivot + 1)
-            return q, d
-        key = active.tobytes()
-        single = single or key in seen
-        seen.add(key)
-        if single:
-            wrong[np.flatnonzero(wrong)[0] + 1:] = False
-        active = active ^ wrong
-    log.debug("linearised contact: no complementary set in %d solves", max_pivots)
-    return np.maximum(q, 0.0), d
+    reserve = np.zeros(n, dtype=bool) if reserve is None else reserve
+
+    def excused(active):
+        """The reserve nodes whose guard is wholly in the set."""
+        if guard is None:
+            return np.zeros(n, dtype=bool)
+        # index -1: never in the set; -2: always (a node that is never held)
+        on_set = np.concatenate([active, [True, False]])
+        return reserve & on_set[guard].all(axis=1) & (guard != -1).any(axis=1)
+
+    def off(q, d):
+        """Whether the platen's equilibrium does not hold."""
+        return platen and abs(float(dR @ (q - q0)) + stiffness * d - need) > 1e-9 * abs(need)
+
+    def pivoting(active, eligible, limit):
+        """Block principal pivoting over the ``eligible`` nodes from the set ``active``:
+        (q, d, penetrations, set, whether it is complementary)."""
+        seen = set()
+        single = False
+        for pivot in range(limit):
+            q, d, pen = on(active)
+            wrong = (active & (q < 0)) | (~active & eligible & (pen > tol))
+            if off(q, d):  # the platen needs the nodes touching it to push
+                wrong |= ~active & eligible & (pen > -tol)
+            if not wrong.any():
+                log.debug("complementarity: the contact set in %d solves", pivot + 1)
+                return q, d, pen, active, True
+            key = active.tobytes()
+            single = single or key in seen
+            seen.add(key)
+            if single:
+                wrong[np.flatnonzero(wrong)[0] + 1:] = False
+            active = active ^ wrong
+        return q, d, pen, active, False
+
+    # the compatibility sides' set first, the held nodes waiting
+    eligible = ~reserve
+    q, d, pen, active, ok = pivoting(((q0 > 0) | (p > tol)) & eligible, eligible, max_pivots)
+    if not ok:
+        log.debug("linearised contact: no complementary set in %d solves", max_pivots)
+        return np.maximum(q, 0.0), d
+    # then the held nodes that penetrate where the compatibility side's nodes around them do
+    # not all touch, until none is left (each stage a complementarity problem of its own)
+    for _ in range(STAGES if rounds is None else rounds):
+        # (and, where the platen finds no node of the compatibility side to push, the held
+        # nodes that touch: a body that lands on its corner)
+        new = reserve & ~eligible & ~excused(active) & (pen > tol)
+        if platen and off(q, d):
+            # the platen short of its force: the held nodes that touch, where its force
+            # presses them in (a body landing on its corner; not one pulled away)
+            short = need - float(dR @ (q - q0)) - stiffness * d
+            scale = 1e-9 * float(np.abs(dp_dplaten).max(initial=0.0))
+            new |= reserve & ~eligible & (pen > -tol) & (np.sign(short) * dp_dplaten > scale)
+        if not new.any():
+            break
+        eligible = eligible | new
+        try:
+            q2, d2, pen2, active2, ok = pivoting(active | new, eligible, min(max_pivots, 20 + n))
+        except np.linalg.LinAlgError:  # a set whose conditions repeat one another
+            ok = False
+        if not ok:
+            raise HeldUnsettled(np.flatnonzero(new))
+        q, d, pen, active = q2, d2, pen2, active2
+    return q, d
+
+
+#: at most this many rounds of held nodes joining the contact set
+#: (:func:`linear_complementarity`)
+STAGES = 10
+
+
+class HeldUnsettled(Exception):
+    """The held nodes (``reserve``) found no complementary set: ``nodes``, the indices of
+    those that had joined in the last round."""
+
+    def __init__(self, nodes: np.ndarray):
+        super().__init__(f"{len(nodes)} held nodes found no complementary set")
+        self.nodes = nodes
 
 
 class DenseSystem:
@@ -123,4 +196,4 @@ class DenseSystem:
         return (np.linalg.solve(W[np.ix_(a, a)], rhs) if x is None else x), 0.0
 
 
-__all__ = ["DenseSystem", "linear_complementarity"]
+__all__ = ["DenseSystem", "HeldUnsettled", "linear_complementarity"]

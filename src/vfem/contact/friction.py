@@ -348,6 +348,8 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
                                        friction=("frictionless", "coulomb"), orders_3d=(1,))
     state_type = FrictionState
+    #: the equilibrium side's nodes are not held (issue 37): not yet with friction
+    both_surfaces = False
 
     def __init__(self, surfaces, pairs, settings, backend: str | None = None):
         super().__init__(surfaces, pairs, settings, backend)

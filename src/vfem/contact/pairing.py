@@ -38,6 +38,16 @@ class ContactPair:
     carries: np.ndarray  # (m,) whose traction reaches the other surface
     patches: tuple[np.ndarray, np.ndarray] | None  # each side's facets facing the other
     platen_rate: np.ndarray | None = None  # (m,) penetration change per unit platen motion
+    #: the equilibrium side's nodes held against the compatibility side (both surfaces
+    #: enforced, issue 37): ``fine`` is then the equilibrium body, each unknown a point force
+    #: at its node (``mass`` the identity there) that reaches the compatibility side through
+    #: the shape functions at its virtual node (``transfer`` = ``interp`` transposed); they
+    #: join the contact set only where the node would penetrate
+    point: bool = False
+    #: (m, k) per held node, the other surface's nodes around its virtual node (the nodes of
+    #: the facet it lies on; -1 beyond the other patch): while they all touch, the held node
+    #: is not held (:func:`~vfem.contact.complementarity.linear_complementarity`'s ``guard``)
+    guard: np.ndarray | None = None
 
 
 #: A facet faces the other body when its outward normal and the other surface's normal where
@@ -149,6 +159,51 @@ def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: 
     d = sf.X[geo.nodes] - geo.interp @ sc.X[: sc.nc]  # from the virtual node to the node
     geo.normal = n
     geo.gap = np.einsum("ij,ij->i", d, n)
+
+
+def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch: np.ndarray,
+               nodes: np.ndarray | None = None
+               ) -> tuple[Overlap, np.ndarray] | None:
+    """Nodes of ``s`` held against the patch ``opatch`` of ``so`` by point forces (issue 37:
+    both surfaces enforced), undeformed: by default every node of ``s``'s patch ``patch``
+    (the equilibrium side's), else ``nodes``. Each has its virtual node on the other patch
+    (the thesis's device, §4.3, the other way round), or, beyond the patch's end, the end
+    itself with the direction to it as normal, if it lies within two facets of it; the gap
+    along the other surface's normal there, the surface the node must not cross (not the
+    pair's common normal, :func:`common_normal`: at a stiff body's corner that is its own
+    nodal normal, the bisector of its two faces, along which the corner could still slide
+    into the other surface: measured 4 % of the push on a turned square); and as transfer a point
+    force: ``mass`` the identity at the node, ``transfer`` the other side's shape functions at
+    the virtual node (so the two forces balance exactly). Returned with each node's guard:
+    the nodes of the facet its virtual node lies on (-1 beyond the patch).
+
+    **Why**: the compatibility side's nodes over the other surface leave that surface free
+    between them and past their ends: a stiff body's corner or edge (a node of the equilibrium
+    side) then sinks into a softer, finer surface between its nodes, and a node of the
+    softer surface just past the stiff body's edge slides under it (the tilted cube of issue
+    37: a corner 9.2e-3 inside, half the force). Held only where it would penetrate
+    (:func:`~vfem.contact.complementarity.linear_complementarity`'s ``reserve``), such a node
+    changes nothing where the two surfaces fit (a flat interface, a convex compatibility
+    side) and gives the force where they do not.
+    """
+    if nodes is None:
+        nodes = np.unique(s.facets[patch])
+    if not len(nodes):
+        return None
+    normal, gap, interp, seg, past = virtual_nodes(s, so, s.X, so.X, nodes, patch, opatch)
+    reach = 2.0 * (float(s.sizes[patch].max()) + float(so.sizes[opatch].max()))
+    keep = ~past | (np.abs(gap) <= reach)
+    if not keep.any():
+        return None
+    nodes, interp = nodes[keep], interp[keep]
+    mass = np.zeros((s.nc, s.nc))
+    mass[nodes, nodes] = 1.0
+    transfer = np.zeros((so.nc, s.nc))
+    transfer[:, nodes] = interp.T
+    geo = Overlap(nodes, normal[keep], gap[keep], interp, so.rind_depth[seg[keep]],
+                  past[keep], np.ones(len(nodes), dtype=bool), mass, transfer, patch, opatch)
+    guard = np.where(past[keep][:, None], -1, so.facets[seg[keep]])
+    return geo, guard
 
 
 @dataclass
