@@ -132,13 +132,15 @@ def test_the_3d_slide_turns_with_its_direction(degrees):
 
 def test_the_3d_slide_turned_about_the_vertical_gives_the_turned_forces():
     """The whole model (meshes, slide) turned by 37 degrees about the vertical: the tangents
-    are measured from other axes, the answer is the same turned (measured: 9e-13 of the
-    largest force)."""
+    are measured from other axes, the answer is the same turned. Each answer is its Newton
+    iteration's to a residual of 1e-10 of the forces (``NonlinearBody.solve``), so the two
+    agree to that, not to round-off: 1e-9 of the largest force (measured 9e-13 on one machine,
+    3.3e-11 on another, where 1e-11 failed: issue 39)."""
     base = resultant(run(slide(factors=FACTORS[:4])))
     other = resultant(run(slide(factors=FACTORS[:4], turn=37.0)))
     a = np.radians(37.0)
     R = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
-    np.testing.assert_allclose(other, base @ R.T, rtol=0, atol=1e-11 * np.abs(base).max())
+    np.testing.assert_allclose(other, base @ R.T, rtol=0, atol=1e-9 * np.abs(base).max())
 
 
 def test_a_small_push_in_3d_is_the_small_kinematics_one_to_the_strain():
