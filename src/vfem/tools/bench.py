@@ -354,7 +354,7 @@ def run_isolated(kind: str, **kwargs) -> dict:
         out = subprocess.run([sys.executable, "-m", "vfem.tools.bench", json.dumps([kind, kwargs]),
                               str(row)], capture_output=True, text=True, check=False)
         if out.returncode != 0 or not row.exists():
-            from .errors import AnalysisError
+            from ..errors import AnalysisError
 
             tail = (out.stderr or out.stdout).strip().splitlines()[-3:]
             raise AnalysisError(f"benchmark case {kind} {kwargs} failed: {' | '.join(tail)}")
