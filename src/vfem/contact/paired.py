@@ -311,14 +311,19 @@ class PairSet(SurfaceGroup):
             if pair.point and self._given_up:
                 e = np.ones(len(q), dtype=bool)
             elif pair.point and pair.guard is not None and len(q):
-                forward = next((j for j, f in enumerate(self.contact_pairs) if not f.point
-                                and f.fine == pair.coarse and f.coarse == pair.fine), None)
+                forward = self._guarding_pair(pair)
                 if forward is not None:
                     inside = np.zeros(self.surfaces[pair.coarse].nc + 1, dtype=bool)
                     inside[self.contact_pairs[forward].nodes] = True
                     e = (q[: len(pair.nodes)] <= 0) & inside[pair.guard].all(axis=1)
             out.append(e)
         return out
+
+    def _guarding_pair(self, held: ContactPair) -> int | None:
+        """The index of the compatibility pair of the same two bodies as the ``point`` pair
+        ``held``, whose nodes guard its nodes; None if there is none."""
+        return next((j for j, f in enumerate(self.contact_pairs) if not f.point
+                     and f.fine == held.coarse and f.coarse == held.fine), None)
 
     def worst_node(self, errs: list[np.ndarray]) -> str:
         """Where the largest of ``errs`` (per pair, over its nodes) is, for messages:
@@ -650,8 +655,7 @@ class PairedContact(PairSet):
             if not pair.point:
                 continue
             # the compatibility pair of the same two bodies, whose nodes guard this one's
-            forward = next((j for j, f in enumerate(pairs) if not f.point
-                            and f.fine == pair.coarse and f.coarse == pair.fine), None)
+            forward = self._guarding_pair(pair)
             if forward is None:
                 continue
             where = np.full(self.surfaces[pair.coarse].nc + 1, -1)
