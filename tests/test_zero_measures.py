@@ -177,12 +177,15 @@ def check_press_then_push(result, platen_force: float, normal: int):
 
 
 def check_continuous_at_zero(result, reference):
-    """Every nodal contact force of every step as with a force of 1e-9 instead of zero."""
+    """Every nodal contact force of every step as with a force of 1e-9 instead of zero, to the
+    platen's own tolerance: a zero force is met within 1e-5 of the forces its reaction sums
+    (``SurfaceGroup.platen_allowance``), so the two answers differ by up to that (1.8e-7 of
+    the largest with SuperLU, where 1e-6 was fitted to PARDISO's)."""
     for step, ref in zip(result.steps, reference.steps, strict=True):
         for name, r in ref.bodies.items():
             scale = np.abs(r.contact_force).max()
             np.testing.assert_allclose(step.bodies[name].contact_force, r.contact_force,
-                                       rtol=0, atol=1e-6 * scale)
+                                       rtol=0, atol=1e-5 * scale)
 
 
 def test_a_frictional_press_with_a_zero_sideways_force_2d():
