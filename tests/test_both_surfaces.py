@@ -108,3 +108,70 @@ def test_a_held_node_joins_only_where_it_would_penetrate():
     # without a guard it is held too
     q, _ = linear_complementarity(W, q0, np.array([1.0, 2.0]), 1e-12, reserve=reserve)
     np.testing.assert_allclose(q, [1.0, 2.0])
+
+
+# -- a stiff block's corner under a soft body's face whose nodes lie far off ---------------------
+
+CORNER_PUSH = 0.002
+
+
+def soft_square_over_block_corner(swap: bool = False) -> tuple[vfem.Model, float]:
+    """A soft one-element square turned 10 degrees, its lowest corner 0.05 left of a stiff
+    block's corner, so that its bottom face passes over that corner with its other node 0.44
+    to the right and 0.08 up: no node of the square touches; the block's corner lands on its
+    face. Pushed down by the gap over the corner plus CORNER_PUSH. Returns the model and the
+    gap (vertical, over the corner)."""
+    c, s = np.cos(np.radians(10.0)), np.sin(np.radians(10.0))
+    sq = rectangle(x0=0.0, y0=0.0, width=0.5, height=0.5, nx=1, ny=1)
+    sq = type(sq)(np.array([[c, -s], [s, c]]) @ sq.p, sq.t, _boundaries=sq.boundaries)
+    low = np.argmin(sq.p[1])
+    sq = sq.translated((-0.65 - sq.p[0, low], 0.01 - sq.p[1, low]))
+    # the bottom face's height over the block's corner (x = -0.6)
+    right = np.argmin(np.where(np.arange(sq.p.shape[1]) == low, np.inf, sq.p[1]))
+    (x0, y0), (x1, y1) = sq.p[:, low], sq.p[:, right]
+    gap = y0 + (y1 - y0) * (-0.6 - x0) / (x1 - x0)
+    square = vfem.Body(name="square", mesh=sq, material=vfem.LinearElastic(1e8, 0.3),
+                       supports=(vfem.Support("top", ("x",)),),
+                       prescribed=(vfem.PrescribedDisplacement("top", "y",
+                                                               -(gap + CORNER_PUSH)),))
+    block = vfem.Body(name="block", mesh=rectangle(x0=-0.6, y0=-0.6, width=1.2, height=0.6,
+                                                   nx=24, ny=12),
+                      material=vfem.LinearElastic(2e11, 0.3),
+                      supports=(vfem.Support("bottom", ("x", "y")),),
+                      contact_boundaries=("top",))
+    return vfem.Model(name="corner under a face",
+                      bodies=[block, square] if swap else [square, block],
+                      load_factors=(0.5, 1.0)), gap
+
+
+def corner_depth(result, model) -> float:
+    """How far the block's corner (-0.6, 0) lies inside the square (> 0 inside): below the
+    line through the square's two deformed bottom nodes."""
+    last = result.steps[-1]
+    bodies = {b.name: b for b in model.bodies}
+    X = bodies["block"].mesh.p.T
+    k = int(np.argmin(np.hypot(X[:, 0] + 0.6, X[:, 1])))
+    corner = X[k] + last.bodies["block"].displacement[k]
+    P = bodies["square"].mesh.p.T
+    x = P + last.bodies["square"].displacement
+    a, b = np.argsort(P[:, 1])[:2]
+    t = (x[b] - x[a]) / np.linalg.norm(x[b] - x[a])
+    n = np.array([t[1], -t[0]])
+    n = n if n[1] < 0 else -n  # out of the square, downwards
+    return float(-n @ (corner - x[a]))
+
+
+@pytest.mark.parametrize("swap", [False, True])
+def test_a_stiff_corner_under_a_soft_face_is_held(swap):
+    """Before, no pair was made (the square's only node over the block lies 0.08 up) and the
+    corner went through the face by all of the push, "converged" with no force; read along
+    the facet's normal interpolated between its nodes, it still went through."""
+    model, gap = soft_square_over_block_corner(swap)
+    result = vfem.solve(model)
+    assert result.converged, result.message
+    fy = result.steps[-1].bodies["square"].contact_force[:, 1].sum()
+    assert fy > 0  # the block pushes the square up
+    # the linearised gap of a point against a straight facet is its distance to first order;
+    # what is left is second order (the face's turn, strain ~ 1e-3, times the slide along it,
+    # about gap sin 10 deg): 2 % of the push bounds it
+    assert corner_depth(result, model) <= 0.02 * CORNER_PUSH

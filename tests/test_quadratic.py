@@ -95,3 +95,78 @@ def test_thesis_variant_refuses_quadratic_elements():
 def test_order_must_be_one_or_two():
     with pytest.raises(InputError, match="order must be 1"):
         build(HertzParameters(order=3)).validate()
+
+
+def test_the_traction_on_a_three_node_facet_is_linear_on_each_half():
+    """Issue 37, item 3: values >= 0 give a traction >= 0 everywhere (a quadratic interpolant
+    of (1, 0, 0) dips to -1/8), and a uniform one is represented exactly."""
+    from vfem.contact.facets import Segment
+
+    t = np.linspace(0.0, 1.0, 201)
+    psi = Segment(2).traction_shape(t)
+    assert np.allclose(psi.sum(axis=1), 1.0, atol=1e-15)
+    assert psi.min() >= 0.0
+    assert np.allclose(psi[[0, 100, 200]], [[1, 0, 0], [0, 0, 1], [0, 1, 0]])
+    assert Segment(2).shape(t)[:, 0].min() < -0.1  # what it replaces
+
+
+FIRST_TOUCH = """
+name = "first touch"
+
+[[bodies]]
+name = "upper"
+order = 2
+[bodies.mesh]
+shape = "graded_quarter_disk"
+growth = 1.877699212077418
+h_contact = 0.04372436006048939
+h_max = 0.26234616036293634
+radius = 1.0
+translate = [-0.1708265941656228, 0.1060511622993913]
+[bodies.material]
+youngs_modulus = 1.8114553765280772
+poissons_ratio = 0.21053021531223978
+[[bodies.supports]]
+boundary = "top"
+components = ["x"]
+[bodies.platen]
+boundary = "top"
+component = "y"
+force = -0.0001398393751266381
+
+[[bodies]]
+name = "block"
+order = 2
+[bodies.mesh]
+shape = "rectangle"
+height = 0.7032566960060398
+nx = 27
+ny = 5
+triangles = true
+width = 2.455175479501359
+x0 = 0.0
+y0 = -0.7032566960060398
+[bodies.material]
+youngs_modulus = 1.4799400570558947
+poissons_ratio = 0.16806609940323092
+[[bodies.supports]]
+boundary = "bottom"
+
+[steps]
+load_factors = [0.16666666666666666, 0.3333333333333333, 0.5, 1.0]
+"""
+
+
+def test_a_quadratic_body_landing_on_one_node_is_not_in_tension():
+    """A quadratic quarter disk on a platen lands on one node of a quadratic block (the
+    random-model study's 2d-236, benchmarks/random_models.py): before, its first step stopped
+    on invariant (c) (a tensile nodal force 7.8 % of the largest, from the quadratic traction's
+    dip past the one node touching). Now every step converges with the invariants, and the
+    platen's force is carried."""
+    from vfem.io.input import loads
+
+    result = Analysis(loads(FIRST_TOUCH).build()).run()
+    assert result.converged, result.message
+    fy = result.steps[-1].bodies["block"].contact_force[:, 1].sum()
+    # the platen's force, to its own tolerance (contact.platen_tolerance, 1e-5 of it)
+    assert fy == pytest.approx(-0.0001398393751266381, rel=1e-5)

@@ -27,7 +27,8 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
                            stiffness: float = 0.0, need: float = 0.0,
                            max_pivots: int | None = None, factor: ReusedFactor | None = None,
                            reserve: np.ndarray | None = None, guard: np.ndarray | None = None,
-                           rounds: int | None = None) -> tuple[np.ndarray, float]:
+                           rounds: int | None = None, zone: np.ndarray | None = None,
+                           refused: np.ndarray | None = None) -> tuple[np.ndarray, float]:
     """The traction values q >= 0 of the linearised contact problem, and the platen motion.
 
     From traction values ``q0`` with (linearised) penetrations ``p``, the penetrations after the
@@ -56,12 +57,19 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
     compatibility side's set alone, unchanged; a held node that only touches within
     round-off, whose condition repeats its neighbours', never makes a set's matrix singular.
     ``rounds``: of held nodes joining (default :data:`STAGES`; 0: the reserve nodes never
-    join). ``guard`` ((nodes, k) indices, -1 for none, -2 for one always in the set, so that the
-    node is never held): a reserve node is in the set only while not
-    all of its guard's nodes are — the compatibility side's nodes around its virtual
-    node: between nodes in contact a node of the other surface protrudes by the faceting
-    of the compatibility side (a mesh that resolves the surface between its nodes only as
-    they lie), not by a contact missed.
+    join). ``guard`` ((nodes, k) indices, -1 for none): a reserve node is in the set only
+    while not all of its guard's nodes are — the compatibility side's nodes around its
+    virtual node: between nodes in contact a node of the other surface protrudes by the
+    faceting of the compatibility side (a mesh that resolves the surface between its nodes
+    only as they lie), not by a contact missed. ``zone`` (bool over the nodes): reserve nodes
+    inside the compatibility side's zone (every guard node a node of its pair), never in the
+    set (:meth:`~vfem.contact.paired.PairedContact._reserve`).
+    ``refused`` (bool over the nodes, written): the reserve nodes that could not join —
+    where the nodes of a round find no complementary set together (two conditions of
+    nearly one: a held node beside a compatibility node of the other side at almost the
+    same point, or conforming curved surfaces whose facets do not match), they join one at
+    a time, the deepest first, and each that still finds none is refused, its penetration
+    left to invariant (b).
     """
     n = len(q0)
     max_pivots = max_pivots or 10 * n + 10
@@ -86,12 +94,14 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
     reserve = np.zeros(n, dtype=bool) if reserve is None else reserve
 
     def excused(active):
-        """The reserve nodes whose guard is wholly in the set."""
+        """The reserve nodes whose guard is wholly in the set, and those inside the zone."""
         if guard is None:
             return np.zeros(n, dtype=bool)
-        # index -1: never in the set; -2: always (a node that is never held)
-        on_set = np.concatenate([active, [True, False]])
-        return reserve & on_set[guard].all(axis=1) & (guard != -1).any(axis=1)
+        on_set = np.concatenate([active, [False]])  # index -1: never in the set
+        wholly = on_set[guard].all(axis=1) & (guard != -1).any(axis=1)
+        if zone is not None:
+            wholly |= zone
+        return reserve & wholly
 
     def off(q, d):
         """Whether the platen's equilibrium does not hold."""
@@ -118,6 +128,15 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
             active = active ^ wrong
         return q, d, pen, active, False
 
+    def join(active, eligible, new, limit):
+        """The set with the nodes ``new`` joined, (q, d, penetrations, set), or None where
+        pivoting finds no complementary one."""
+        try:
+            q, d, pen, active, ok = pivoting(active | new, eligible, limit)
+        except np.linalg.LinAlgError:  # a set whose conditions repeat one another
+            return None
+        return (q, d, pen, active) if ok else None
+
     # the compatibility sides' set first, the held nodes waiting
     eligible = ~reserve
     q, d, pen, active, ok = pivoting(((q0 > 0) | (p > tol)) & eligible, eligible, max_pivots)
@@ -126,6 +145,7 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
         return np.maximum(q, 0.0), d
     # then the held nodes that penetrate where the compatibility side's nodes around them do
     # not all touch, until none is left (each stage a complementarity problem of its own)
+    refused = np.zeros(n, dtype=bool) if refused is None else refused
     for _ in range(STAGES if rounds is None else rounds):
         # (and, where the platen finds no node of the compatibility side to push, the held
         # nodes that touch: a body that lands on its corner)
@@ -136,31 +156,30 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
             short = need - float(dR @ (q - q0)) - stiffness * d
             scale = 1e-9 * float(np.abs(dp_dplaten).max(initial=0.0))
             new |= reserve & ~eligible & (pen > -tol) & (np.sign(short) * dp_dplaten > scale)
+        new &= ~refused
         if not new.any():
             break
+        limit = min(max_pivots, 20 + n)
+        found = join(active, eligible | new, new, limit)
+        if found is None:  # one at a time, the deepest first
+            for i in np.flatnonzero(new)[np.argsort(-pen[new], kind="stable")]:
+                one = np.zeros(n, dtype=bool)
+                one[i] = True
+                found = join(active, eligible | one, one, limit)
+                if found is None:
+                    refused[i] = True
+                else:
+                    q, d, pen, active = found
+                    eligible = eligible | one
+            continue
+        q, d, pen, active = found
         eligible = eligible | new
-        try:
-            q2, d2, pen2, active2, ok = pivoting(active | new, eligible, min(max_pivots, 20 + n))
-        except np.linalg.LinAlgError:  # a set whose conditions repeat one another
-            ok = False
-        if not ok:
-            raise HeldUnsettled(np.flatnonzero(new))
-        q, d, pen, active = q2, d2, pen2, active2
     return q, d
 
 
 #: at most this many rounds of held nodes joining the contact set
 #: (:func:`linear_complementarity`)
 STAGES = 10
-
-
-class HeldUnsettled(Exception):
-    """The held nodes (``reserve``) found no complementary set: ``nodes``, the indices of
-    those that had joined in the last round."""
-
-    def __init__(self, nodes: np.ndarray):
-        super().__init__(f"{len(nodes)} held nodes found no complementary set")
-        self.nodes = nodes
 
 
 class DenseSystem:
@@ -196,4 +215,4 @@ class DenseSystem:
         return (np.linalg.solve(W[np.ix_(a, a)], rhs) if x is None else x), 0.0
 
 
-__all__ = ["DenseSystem", "HeldUnsettled", "linear_complementarity"]
+__all__ = ["DenseSystem", "linear_complementarity"]

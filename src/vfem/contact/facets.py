@@ -67,6 +67,12 @@ class FacetKind:
         """Derivatives of :meth:`shape` with respect to ``xi``."""
         raise NotImplementedError
 
+    def traction_shape(self, xi: np.ndarray) -> np.ndarray:
+        """(n, nodes) the functions that interpolate a contact traction from its nodal values
+        (the paired variant's unknowns, thesis §4.4: the traction varies between the contact
+        nodes): by default the facet's own shape functions."""
+        return self.shape(xi)
+
     def orient(self, p: np.ndarray, fn: np.ndarray, centroid: np.ndarray) -> None:
         """Reorder, in place, the rows of ``fn`` (point numbers of ``p`` (dim, np)) whose
         normal points into their element (``centroid`` (nf, dim)), so every normal is outward."""
@@ -182,6 +188,26 @@ class Segment(FacetKind):
     def shape(self, xi: np.ndarray) -> np.ndarray:
         return facet_shape(np.asarray(xi, dtype=float), self.order)
 
+    def traction_shape(self, xi: np.ndarray) -> np.ndarray:
+        """On a 3-node facet, linear between consecutive nodes (end, midpoint, end: the
+        facet's two halves), not the quadratic shape functions (issue 37, item 3).
+
+        **Why**: a quadratic interpolant of nodal values >= 0 dips below zero between them,
+        by up to 1/8 of a neighbour's value where a contact zone ends (one node touching at
+        first contact: the whole zone ends there), and the nodal forces it gives both bodies
+        are then tensile; measured: 26 of 67 quadratic random models stopped on invariant
+        (c), "no tension", several at first touch. Piecewise-linear values >= 0 are >= 0
+        everywhere, so each vertex's share of the forces (its own plus half of each adjacent
+        midpoint's, the integral of the traction against the linear hat) is never tensile. A
+        uniform traction is still represented exactly (the hats sum to one), so the patch
+        test holds. The same choice as the piecewise-linear multipliers on subdivided
+        quadratic facets of the mortar literature (Puso, Laursen and Solberg 2008)."""
+        if self.order == 1:
+            return self.shape(xi)
+        t = np.asarray(xi, dtype=float)
+        return np.column_stack([np.maximum(0.0, 1.0 - 2.0 * t), np.maximum(0.0, 2.0 * t - 1.0),
+                                1.0 - np.abs(2.0 * t - 1.0)])
+
     def derivatives(self, xi: np.ndarray) -> np.ndarray:
         return facet_shape_derivative(xi, self.order)
 
@@ -248,11 +274,12 @@ class Segment(FacetKind):
 
     def overlap_quadrature(self, sf, fpatch, sc, cpatch, cnormals, reach, xf, xc):
         """The fine facets split where the projection onto the coarse patch passes one of its
-        vertices (seen along its nodal normal), with a Gauss rule exact to degree 5 on each
-        piece: exact for the piecewise polynomial integrand (degree 4 at most, with quadratic
-        elements) on straight facets. On curved (quadratic) facets the points and weights
-        follow the curve; the splits are found on the chords. The weights are times the fine
-        side's undeformed length (the traction is nominal)."""
+        vertices (seen along its nodal normal), and 3-node ones at their midpoints, with a
+        Gauss rule exact to degree 5 on each piece: exact for the piecewise polynomial
+        integrand (degree 4 at most, with quadratic elements) on straight facets. On curved
+        (quadratic) facets the points and weights follow the curve; the splits are found on
+        the chords. The weights are times the fine side's undeformed length (the traction is
+        nominal)."""
         fa, fb = xf[sf.facets[:, 0]], xf[sf.facets[:, 1]]
         fa, fb = fa[fpatch], fb[fpatch]
         d = fb - fa
@@ -273,7 +300,10 @@ class Segment(FacetKind):
         # each fine facet's pieces between its ends and its cuts, in order along it (all
         # facets at once: the cuts sorted per row, repeated cuts giving empty pieces that are
         # dropped)
-        cuts = np.sort(np.hstack([np.zeros((len(fpatch), 1)), np.ones((len(fpatch), 1)),
+        # (a 3-node facet is also cut at its midpoint, where its traction's slope changes:
+        # :meth:`traction_shape`)
+        mids = np.full((len(fpatch), self.order - 1), 0.5)
+        cuts = np.sort(np.hstack([np.zeros((len(fpatch), 1)), np.ones((len(fpatch), 1)), mids,
                                   np.where(ok, s, np.nan)]), axis=1)  # NaN (no cut) last
         lo, hi = cuts[:, :-1], cuts[:, 1:]
         piece = hi > lo  # False where either is NaN

@@ -109,21 +109,22 @@ def read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
 
 def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np.ndarray,
                   nodes: np.ndarray, fpatch: np.ndarray, cpatch: np.ndarray,
-                  beyond_normal: bool = True):
+                  beyond_normal: bool = True, facet_normal: bool = False):
     """The virtual nodes of ``nodes`` of ``sf`` on the patch ``cpatch`` of ``sc`` (positions
     ``xf``, ``xc``): (normal, gap, interp, facet, beyond) — see :func:`overlap`.
     ``beyond_normal=False``: a node beyond the patch keeps the normal interpolated at its
     virtual node instead of the direction to it (the large-kinematics follower term's
     differences, :meth:`~vfem.contact.large.LargeDeformationContact._normals_at`: a loaded
     node on the patch's edge that a perturbation moves past it would otherwise turn its
-    normal by 90 degrees over the perturbation).
+    normal by 90 degrees over the perturbation). ``facet_normal``: the normal of the facet
+    at the virtual node instead of the interpolated one (:func:`held_nodes`).
     """
     pts = xf[nodes]
-    seg, t, _, _, tf = sc.closest(pts, xc, cpatch, sf.node_normals(xf, fpatch)[nodes])
+    seg, t, _, m, tf = sc.closest(pts, xc, cpatch, sf.node_normals(xf, fpatch)[nodes])
     closest, _ = sc.surface_map(seg, t, xc)
     past = sc.beyond(seg, tf, sc.patch_boundary(cpatch))
     interp = sc.interpolation(seg, t)
-    normal = interp @ sc.node_normals(xc, cpatch)
+    normal = m.copy() if facet_normal else interp @ sc.node_normals(xc, cpatch)
     d = pts - closest
     dn = np.linalg.norm(d, axis=1)
     if beyond_normal:
@@ -169,10 +170,14 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     (the equilibrium side's), else ``nodes``. Each has its virtual node on the other patch
     (the thesis's device, §4.3, the other way round), or, beyond the patch's end, the end
     itself with the direction to it as normal, if it lies within two facets of it; the gap
-    along the other surface's normal there, the surface the node must not cross (not the
-    pair's common normal, :func:`common_normal`: at a stiff body's corner that is its own
-    nodal normal, the bisector of its two faces, along which the corner could still slide
-    into the other surface: measured 4 % of the push on a turned square); and as transfer a point
+    along the normal of the other surface's facet there, the line the node must not cross
+    (not the pair's common normal, :func:`common_normal`: at a stiff body's corner that is
+    its own nodal normal, the bisector of its two faces, along which the corner could still
+    slide into the other surface: measured 4 % of the push on a turned square; nor the
+    normal interpolated between the facet's nodal normals: a node held along a direction
+    turned from the facet's by an angle a reads the facet's motion d across it as n.d, short
+    of the true approach by about |d| sin(a) — the block's corner under a coarse quarter disk
+    faceted at 5 degrees sank 1e-3 (all of the push) through a gap of 0.13); and as transfer a point
     force: ``mass`` the identity at the node, ``transfer`` the other side's shape functions at
     the virtual node (so the two forces balance exactly). Returned with each node's guard:
     the nodes of the facet its virtual node lies on (-1 beyond the patch).
@@ -190,7 +195,8 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
         nodes = np.unique(s.facets[patch])
     if not len(nodes):
         return None
-    normal, gap, interp, seg, past = virtual_nodes(s, so, s.X, so.X, nodes, patch, opatch)
+    normal, gap, interp, seg, past = virtual_nodes(s, so, s.X, so.X, nodes, patch, opatch,
+                                                   facet_normal=True)
     reach = 2.0 * (float(s.sizes[patch].max()) + float(so.sizes[opatch].max()))
     keep = ~past | (np.abs(gap) <= reach)
     if not keep.any():

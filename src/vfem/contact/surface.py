@@ -178,9 +178,17 @@ class ContactSurface:
     def interpolation(self, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
         """(len(seg), nc) the values of the candidate nodes' shape functions at local
         coordinates ``t`` of facets ``seg``: row k @ nodal values = the value at point k."""
+        return self._rows(seg, self.shape(t))
+
+    def traction_interpolation(self, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """As :meth:`interpolation` for a contact traction's nodal values
+        (:meth:`~vfem.contact.facets.FacetKind.traction_shape`)."""
+        return self._rows(seg, self.kind.traction_shape(t))
+
+    def _rows(self, seg: np.ndarray, values: np.ndarray) -> np.ndarray:
         out = np.zeros((len(seg), self.nc))
         rows = np.arange(len(seg))
-        for col, phi in zip(self.facets[seg].T, self.shape(t).T):
+        for col, phi in zip(self.facets[seg].T, values.T):
             out[rows, col] += phi
         return out
 

@@ -21,9 +21,11 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
               xf: np.ndarray, xc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Both sides' nodal forces per unit traction value, from one integral over the overlap.
 
-    ``N[i, k] = int phi_i(y) phi_k(y) dy`` (the compatibility side, eq. 4.4.11) and
-    ``T[c, k] = int phi_c(proj(y)) phi_k(y) dy`` (the equilibrium side: the same traction
-    re-integrated with its shape functions), both over the part of the patch ``fpatch`` of
+    ``N[i, k] = int phi_i(y) psi_k(y) dy`` (the compatibility side, eq. 4.4.11) and
+    ``T[c, k] = int phi_c(proj(y)) psi_k(y) dy`` (the equilibrium side: the same traction
+    re-integrated with its shape functions), ``psi_k`` the traction's interpolation
+    (:meth:`~vfem.contact.facets.FacetKind.traction_shape`: the shape functions, piecewise
+    linear on 3-node segments), both over the part of the patch ``fpatch`` of
     ``sf`` that lies over the patch ``cpatch`` of ``sc`` (points beyond its ends count
     nothing). Since the shape functions of each side sum to one, the two sides' forces are
     equal and opposite for any traction, to round-off, and force reaches only nodes whose
@@ -52,8 +54,8 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
     N = np.zeros((sf.nc, sf.nc))
     T = np.zeros((sc.nc, sf.nc))
     fend, cend = sf.facets[fac], sc.facets[seg]
-    fshape = sf.shape(sloc).T
-    for fi, fw in zip(fend.T, fshape):
+    fshape, tshape = sf.shape(sloc).T, sf.kind.traction_shape(sloc).T
+    for fi, fw in zip(fend.T, tshape):  # the traction's interpolation (piecewise linear)
         for ci, cw in zip(cend.T, sc.shape(tt).T):
             np.add.at(T, (ci, fi), wts * cw * fw)
         for gi, gw in zip(fend.T, fshape):

@@ -336,7 +336,9 @@ def _value(v) -> str:
     if isinstance(v, (int, float)):
         if not math.isfinite(v):
             raise InputError(f"cannot write the non-finite number {v!r}")
-        return repr(v)  # the shortest text that reads back as the same float
+        # the shortest text that reads back as the same number (a NumPy scalar, a float or
+        # int subclass, reprs as "np.float64(...)")
+        return repr(float(v) if isinstance(v, float) else int(v))
     if isinstance(v, str):
         return json.dumps(v)  # a TOML basic string
     if isinstance(v, list):
