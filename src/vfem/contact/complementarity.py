@@ -27,8 +27,8 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
                            stiffness: float = 0.0, need: float = 0.0,
                            max_pivots: int | None = None, factor: ReusedFactor | None = None,
                            reserve: np.ndarray | None = None, guard: np.ndarray | None = None,
-                           rounds: int | None = None, zone: np.ndarray | None = None,
-                           refused: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+                           rounds: int | None = None, refused: np.ndarray | None = None
+                           ) -> tuple[np.ndarray, float]:
     """The traction values q >= 0 of the linearised contact problem, and the platen motion.
 
     From traction values ``q0`` with (linearised) penetrations ``p``, the penetrations after the
@@ -61,10 +61,10 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
     while not all of its guard's nodes are — the compatibility side's nodes around its
     virtual node: between nodes in contact a node of the other surface protrudes by the
     faceting of the compatibility side (a mesh that resolves the surface between its nodes
-    only as they lie), not by a contact missed. ``zone`` (bool over the nodes): reserve nodes
-    inside the compatibility side's zone (every guard node a node of its pair), never in the
-    set (:meth:`~vfem.contact.paired.PairedContact._reserve`).
-    ``refused`` (bool over the nodes, written): the reserve nodes that could not join —
+    only as they lie), not by a contact missed; where one of them is open, the node of the
+    other surface between them is a contact of its own (a convex punch's lowest node first
+    touching between a flat block's nodes). ``refused`` (bool over the nodes, read and
+    written): the reserve nodes that may not join (given), and those that could not —
     where the nodes of a round find no complementary set together (two conditions of
     nearly one: a held node beside a compatibility node of the other side at almost the
     same point, or conforming curved surfaces whose facets do not match), they join one at
@@ -94,13 +94,11 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
     reserve = np.zeros(n, dtype=bool) if reserve is None else reserve
 
     def excused(active):
-        """The reserve nodes whose guard is wholly in the set, and those inside the zone."""
+        """The reserve nodes whose guard is wholly in the set."""
         if guard is None:
             return np.zeros(n, dtype=bool)
         on_set = np.concatenate([active, [False]])  # index -1: never in the set
         wholly = on_set[guard].all(axis=1) & (guard != -1).any(axis=1)
-        if zone is not None:
-            wholly |= zone
         return reserve & wholly
 
     def off(q, d):
@@ -139,7 +137,11 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
 
     # the compatibility sides' set first, the held nodes waiting
     eligible = ~reserve
-    q, d, pen, active, ok = pivoting(((q0 > 0) | (p > tol)) & eligible, eligible, max_pivots)
+    # (with held nodes, from the nodes that penetrate with no contact force at all: with them
+    # the problem need not have one solution, and starting from the last step's set would
+    # make the answer depend on the path — unloading would not mirror loading)
+    start = (p + Wq0 > tol) if reserve.any() else ((q0 > 0) | (p > tol))
+    q, d, pen, active, ok = pivoting(start & eligible, eligible, max_pivots)
     if not ok:
         log.debug("linearised contact: no complementary set in %d solves", max_pivots)
         return np.maximum(q, 0.0), d
@@ -174,6 +176,8 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
             continue
         q, d, pen, active = found
         eligible = eligible | new
+    else:  # the rounds spent: those still waiting to join are refused (invariant (b) judges)
+        refused |= reserve & ~eligible & ~excused(active) & (pen > tol)
     return q, d
 
 

@@ -167,7 +167,7 @@ class PairOperator:
             uc = (self.interp[i] @ uc_flat).reshape(uf.shape)
             for j, direction in enumerate(self.directions[i]):
                 rows = slice(self.offsets[i] + j * n, self.offsets[i] + (j + 1) * n)
-                out[rows] = np.einsum("id,idk->ik", direction, uf - uc)
+                out[rows] = np.einsum("id,idk->ik", pair.reading(j, direction), uf - uc)
         return out[:, 0] if vector else out
 
     def _diagonal(self) -> np.ndarray:
@@ -206,7 +206,8 @@ class PairOperator:
                         weight = at.astype(float)
                     else:  # read at the virtual node: interp's weight of the forced node
                         weight = np.asarray(read[f.col, node]).ravel()
-                    contrib = np.einsum("ed,ed->e", u, direction[f.col]) * weight
+                    contrib = np.einsum("ed,ed->e", u, pair.reading(j, direction)[f.col]) \
+                        * weight
                     np.add.at(value, f.col, contrib if read is None else -contrib)
                 diag[cols] = value
         return diag

@@ -57,6 +57,7 @@ from .pairing import (  # noqa: F401 - the pairing's parts, here too for those w
     beyond,
     common_normal,
     facing,
+    held_force_directions,
     held_nodes,
     overlap,
     patch_ends,
@@ -80,6 +81,10 @@ log = logging.getLogger(__name__)
 #: Above every model measured before issue 22 (the 981k-dof sphere reads 3,061), so none of
 #: their answers moved.
 SIDE_SAMPLE = 4096
+
+#: changes of the stale held nodes (:meth:`PairedContact._update_stale`) in one solve after
+#: which they only accumulate
+STALE_CHANGES = 5
 
 
 class PairSet(SurfaceGroup):
@@ -113,8 +118,8 @@ class PairSet(SurfaceGroup):
         # penetration p = -(gap0 + n.(u_fine - u_coarse)): its change per unit platen motion
         v = self.platen_motion
         for pair in self.contact_pairs:
-            pair.platen_rate = np.einsum("id,id->i", pair.normal, pair.interp @ v[pair.coarse]
-                                         - v[pair.fine][pair.nodes])
+            pair.platen_rate = np.einsum("id,id->i", pair.reading(0, pair.normal),
+                                         pair.interp @ v[pair.coarse] - v[pair.fine][pair.nodes])
 
     #: the unknowns are the pairs' traction values
     state_type = TractionState
@@ -128,6 +133,8 @@ class PairSet(SurfaceGroup):
     #: (unknowns,) the held nodes that found no contact set with the others in the last
     #: correction (:meth:`_correct_complementarity`), or None
     _refused = None
+    _stale_mask = None
+    _stale_changes = 0
 
     #: whether the equilibrium side's nodes are held too, where they would penetrate the
     #: compatibility side (issue 37, :func:`~vfem.contact.pairing.held_nodes`): the
@@ -196,14 +203,17 @@ class PairSet(SurfaceGroup):
             made = held_nodes(self.surfaces[own], self.surfaces[other], *patches, which)
             if made is None:
                 continue
-            h, guard = made
+            h, guard, reach = made
             if own == fine:  # beyond the other patch: nothing of the compatibility side's
                 guard = np.full_like(guard, -1)
             log.info("contact pair: %d nodes of %s held against %s", len(h.nodes),
                      self.surfaces[own].body.name, self.surfaces[other].body.name)
-            held.append(ContactPair(own, other, h.nodes, h.normal, h.gap, h.interp,
+            c_own, c_other = (c_coarse, c_fine) if own == coarse else (c_fine, c_coarse)
+            force = held_force_directions(self.surfaces[own], patches[0], h, c_own, c_other)
+            held.append(ContactPair(own, other, h.nodes, force, h.gap, h.interp,
                                     h.transfer, h.mass, h.rind_depth, h.carries,
-                                    (h.fpatch, h.cpatch), point=True, guard=guard))
+                                    (h.fpatch, h.cpatch), point=True, guard=guard,
+                                    gap_normal=h.normal, reach=reach))
         return pair, held
 
     def _compliance_density(self, i: int, j: int) -> tuple[float, bool]:
@@ -299,17 +309,16 @@ class PairSet(SurfaceGroup):
     def _excused(self, traction_values: list[np.ndarray]) -> list[np.ndarray]:
         """Per pair, its nodes that may lie inside the other surface: held nodes (``point``
         pairs) not held whose virtual node lies on a facet all of whose nodes are the
-        compatibility side's pair nodes — inside the zone the compatibility side holds, where
-        a node of the other surface protrudes by the faceting of the compatibility side, and
-        holding it too would make two conditions of nearly one (measured on a press fit with
-        facets at other angles: the held shaft nodes took the load from the hub's and its
-        mean pressure moved 1.4 %; holding it where none of those nodes touches moved the
-        quadratic gasket's largest force by 12.7 %, its forces 20 degrees off the face
-        normal); every held node refused in the last correction, where it found no
-        contact set with the others (:meth:`_correct_complementarity`). Held, then: the
-        equilibrium side's nodes at the ends of the compatibility side's zone and past them
-        (a stiff corner or edge), and the compatibility side's past the other patch's
-        ends."""
+        compatibility side's pair nodes carrying force — between them a node of the other
+        surface protrudes by the faceting of the compatibility side, and holding it too would
+        make two conditions of nearly one (measured on a press fit with facets at other
+        angles, when every such node was left out: the held shaft nodes took the load from
+        the hub's and its mean pressure moved 1.4 %); and every held node refused in the
+        last correction: stale (slid off its facet, :meth:`_stale`) or finding no contact set
+        with the others (:meth:`_correct_complementarity`). Held, then: the equilibrium
+        side's nodes where the compatibility side's around them do not all touch (a stiff
+        corner or edge, a convex body's first touch between the other's nodes), and the
+        compatibility side's past the other patch's ends."""
         out = []
         pos = 0
         for pair, q in zip(self.contact_pairs, traction_values):
@@ -320,9 +329,10 @@ class PairSet(SurfaceGroup):
             if pair.point and pair.guard is not None and len(q):
                 forward = self._guarding_pair(pair)
                 if forward is not None:
-                    inside = np.zeros(self.surfaces[pair.coarse].nc + 1, dtype=bool)
-                    inside[self.contact_pairs[forward].nodes] = True  # (-1 reads the last)
-                    e |= (q[: len(pair.nodes)] <= 0) & inside[pair.guard].all(axis=1)
+                    touching = np.zeros(self.surfaces[pair.coarse].nc + 1, dtype=bool)
+                    touching[self.contact_pairs[forward].nodes] = traction_values[forward] > 0
+                    # (-1, beyond the other patch, reads the last entry: never touching)
+                    e |= (q[: len(pair.nodes)] <= 0) & touching[pair.guard].all(axis=1)
             out.append(e)
         return out
 
@@ -493,7 +503,7 @@ class PairedContact(PairSet):
         """Penetration (> 0 overlap) of every pair's fine nodes, linear kinematics (from
         ``relative``, :meth:`relative_displacements`, when given)."""
         relative = self.relative_displacements(state) if relative is None else relative
-        return [-(pair.gap0 + np.einsum("ij,ij->i", d, pair.normal))
+        return [-(pair.gap0 + np.einsum("ij,ij->i", d, pair.reading(0, pair.normal)))
                 for pair, d in zip(self.contact_pairs, relative, strict=True)]
 
     def _release_and_hold(self, state: ContactState, k: int, p: np.ndarray, platen_ok: bool
@@ -523,17 +533,19 @@ class PairedContact(PairSet):
         cfg = self.settings
         tol = self.penetration_tolerance
         self._refused = None
+        self._stale_mask, self._stale_changes = None, 0
         self.assemble_forces(state)
 
         def check(it: int) -> Check:
             pens = self.penetrations(state)
             traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
             self._check_rind(pens)
+            stale_moved = self._update_stale(state, traction_values)
             errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
             platen_ok = self.platen_met(state)
             rec = IterationRecord(it, pen_err, 0.0, contact, tension,
                                   platen_error=self.platen_reaction(state) - state.platen_force)
-            return Check(rec, pen_err <= tol and tension == 0 and platen_ok,
+            return Check(rec, pen_err <= tol and tension == 0 and platen_ok and not stale_moved,
                          lambda: self.contact_sets(traction_values), pen_err,
                          lambda: self.pairings(state, pens),
                          lambda: (f"no convergence in {cfg.max_iterations} iterations "
@@ -599,13 +611,14 @@ class PairedContact(PairSet):
         q0 = np.concatenate([self.tractions(state, k) for k in range(len(self.contact_pairs))]
                             or [np.zeros(0)])
         p = np.concatenate(pens or [np.zeros(0)])
-        reserve, guard, zone = self._reserve()
+        reserve, guard = self._reserve()
         # held nodes whose conditions and the compatibility side's cross (two of nearly one,
         # or conforming curved surfaces whose facets do not match) are refused: the rest of
         # the answer stands, and invariant (b) judges what they leave
-        self._refused = np.zeros(len(reserve), dtype=bool)
+        self._refused = (self._stale_mask.copy() if self._stale_mask is not None
+                         else np.zeros(len(reserve), dtype=bool))
         q, dplaten = self._complementarity_with(state, pens, W, rate, dR, q0, p, reserve,
-                                                (guard, zone, self._refused))
+                                                (guard, self._refused))
         if self._refused.any():
             log.info("%d held nodes found no contact set with the others: left out",
                      int(self._refused.sum()))
@@ -619,9 +632,9 @@ class PairedContact(PairSet):
 
     def _complementarity_with(self, state, pens, W, rate, dR, q0, p, reserve, guards):
         """:meth:`_correct_complementarity`'s solve: (q, platen motion), or (None, 0) where
-        the platen first closed a gap. ``guards``: (guard, zone) of :meth:`_reserve` and the
-        held nodes refused (written)."""
-        guard, zone, refused = guards
+        the platen first closed a gap. ``guards``: the guard of :meth:`_reserve` and the
+        held nodes refused (read and written)."""
+        guard, refused = guards
         tol = self.penetration_tolerance
         platen = self.platen_body is not None and state.platen_force != 0.0
         if platen:
@@ -638,28 +651,77 @@ class PairedContact(PairSet):
             return linear_complementarity(
                 W, q0, p, tol, rate, dR, body.platen_stiffness,
                 state.platen_force - self.platen_reaction(state), factor=self._factor,
-                reserve=reserve, guard=guard, zone=zone, refused=refused)
+                reserve=reserve, guard=guard, refused=refused)
         return linear_complementarity(W, q0, p, tol, factor=self._factor, reserve=reserve,
-                                      guard=guard, zone=zone, refused=refused)
+                                      guard=guard, refused=refused)
 
-    def _reserve(self) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+    def _update_stale(self, state: ContactState, traction_values: list[np.ndarray]) -> bool:
+        """Read which held nodes are stale (:meth:`_stale`) in this state; whether the last
+        correction held a node that is stale now, or left out as stale one that is not and
+        penetrates, so that the contact set must be found again (the answer is then the stale
+        nodes' own fixed point, however the step was reached).
+        After :data:`STALE_CHANGES` such changes in one solve the set only grows (no cycle)."""
+        reserve = np.concatenate([np.full(len(p.nodes) * len(self.directions(k)), p.point)
+                                  for k, p in enumerate(self.contact_pairs)]
+                                 or [np.zeros(0, dtype=bool)])
+        if not reserve.any():
+            return False
+        stale = self._stale(state, reserve)
+        before = self._stale_mask if self._stale_mask is not None else np.zeros_like(stale)
+        if self._stale_changes >= STALE_CHANGES:
+            stale |= before
+        q = np.concatenate(traction_values or [np.zeros(0)])
+        p = np.concatenate(self.penetrations(state) or [np.zeros(0)])
+        # (the last correction read other stale nodes than this state has where it matters:
+        # a node held that is stale now, or one left out as stale that is not and penetrates)
+        moved = bool(((stale & ~before & (q > 0))
+                      | (~stale & before & (p > self.penetration_tolerance))).any())
+        self._stale_changes += int(moved)
+        self._stale_mask = stale
+        # (a stale node is excused where it is not held: :meth:`_excused`)
+        self._refused = stale if self._refused is None else (self._refused | stale)
+        return moved
+
+    def _stale(self, state: ContactState, reserve: np.ndarray) -> np.ndarray:
+        """(unknowns,) bool: the held nodes over the other surface that have slid along it,
+        relative to it, by more than the facet their virtual node lies on (``reach``): small
+        kinematics pairs once, undeformed, so such a node's condition holds it off a facet
+        that is no longer under it (the quadratic gasket, whose faces slide 0.5 past each
+        other, 20 facets: held there, its stiff nodes bridged gaps of 0.046 in the deformed
+        configuration). They are left out; the compatibility side's nodes, and invariant (b),
+        judge what is left."""
+        out = np.zeros(len(reserve), dtype=bool)
+        if not reserve.any():
+            return out
+        relative = self.relative_displacements(state)
+        pos = 0
+        for k, pair in enumerate(self.contact_pairs):
+            m = len(pair.nodes) * len(self.directions(k))
+            if pair.point and pair.reach is not None and pair.gap_normal is not None:
+                d = relative[k]
+                n = pair.gap_normal
+                slide = d - np.einsum("ij,ij->i", d, n)[:, None] * n
+                over = pair.guard[:, 0] >= 0  # (beyond the other patch: read to its end)
+                out[pos:pos + len(pair.nodes)] = over & (
+                    np.linalg.norm(slide, axis=1) > pair.reach)
+            pos += m
+        return out
+
+    def _reserve(self) -> tuple[np.ndarray, np.ndarray | None]:
         """(unknowns,) bool: the held nodes (``point`` pairs), which join the contact set
-        only where they would penetrate; (unknowns, k) the unknowns of each one's guard
+        only where they would penetrate; and (unknowns, k) the unknowns of each one's guard
         (the compatibility side's nodes around its virtual node, -1 for none), or None
-        without held nodes; and (unknowns,) bool, the held nodes inside the compatibility
-        side's zone (every guard node one of its pair's), never held (:meth:`_excused`), or
-        None."""
+        without held nodes."""
         pairs = self.contact_pairs
         reserve = np.concatenate([np.full(len(pair.nodes) * len(self.directions(k)),
                                           pair.point) for k, pair in enumerate(pairs)]
                                  or [np.zeros(0, dtype=bool)])
         if not reserve.any():
-            return reserve, None, None
+            return reserve, None
         offsets = np.cumsum([0] + [len(p.nodes) * len(self.directions(k))
                                    for k, p in enumerate(pairs)])
         width = max(p.guard.shape[1] for p in pairs if p.point)
         guard = np.full((len(reserve), width), -1)
-        zone = np.zeros(len(reserve), dtype=bool)
         for k, pair in enumerate(pairs):
             if not pair.point:
                 continue
@@ -672,10 +734,7 @@ class PairedContact(PairSet):
                 len(pairs[forward].nodes))
             g = where[pair.guard]  # -1 (beyond) reads the last entry, -1
             guard[offsets[k]:offsets[k] + len(pair.nodes), : g.shape[1]] = g
-            # a node whose facet's nodes are all the compatibility side's pair nodes lies
-            # inside its zone (:meth:`_excused`)
-            zone[offsets[k]:offsets[k] + len(pair.nodes)] = (g >= 0).all(axis=1)
-        return reserve, guard, zone
+        return reserve, guard
 
     def _solve_pairs(self, state: ContactState, active: list[np.ndarray], rhs: np.ndarray
                      ) -> tuple[np.ndarray, float]:
@@ -763,7 +822,7 @@ class PairedContact(PairSet):
                 rows = slice(offsets[k] + j * n, offsets[k] + (j + 1) * n)
                 # along the normal: penetration p = -(gap0 + n.(u_f - u_c)), W = -dp/dq; along
                 # a tangent t: the relative displacement t.(u_f - u_c) per unit traction
-                W[rows] = np.einsum("id,idm->im", direction, uf - uc)
+                W[rows] = np.einsum("id,idm->im", pair.reading(j, direction), uf - uc)
                 dp_dplaten[rows] = pair.platen_rate if j == 0 else self._tangent_platen_rate(
                     k, direction)
         return W, dp_dplaten, self._platen_rows(dF, m), offsets

@@ -48,6 +48,19 @@ class ContactPair:
     #: the facet it lies on; -1 beyond the other patch): while they all touch, the held node
     #: is not held (:func:`~vfem.contact.complementarity.linear_complementarity`'s ``guard``)
     guard: np.ndarray | None = None
+    #: (m, dim) where the gap is read along another direction than the force acts (held
+    #: nodes, :func:`held_nodes`): the penetration is ``-(gap0 + gap_normal . (u_f - u_c))``
+    #: while the force acts along ``normal``; None: along ``normal``
+    gap_normal: np.ndarray | None = None
+    #: (m,) per held node, the size of the facet its virtual node lies on: a node that has
+    #: slid along it by more is no longer over it, and is not held (small kinematics pairs
+    #: once; :meth:`~vfem.contact.paired.PairedContact._stale`)
+    reach: np.ndarray | None = None
+
+    def reading(self, j: int, direction: np.ndarray) -> np.ndarray:
+        """The direction along which the unknowns ``j`` (0 the normal ones) read the relative
+        displacement, whose forces act along ``direction``."""
+        return self.gap_normal if j == 0 and self.gap_normal is not None else direction
 
 
 #: A facet faces the other body when its outward normal and the other surface's normal where
@@ -164,7 +177,7 @@ def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: 
 
 def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch: np.ndarray,
                nodes: np.ndarray | None = None
-               ) -> tuple[Overlap, np.ndarray] | None:
+               ) -> tuple[Overlap, np.ndarray, np.ndarray] | None:
     """Nodes of ``s`` held against the patch ``opatch`` of ``so`` by point forces (issue 37:
     both surfaces enforced), undeformed: by default every node of ``s``'s patch ``patch``
     (the equilibrium side's), else ``nodes``. Each has its virtual node on the other patch
@@ -180,7 +193,8 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     faceted at 5 degrees sank 1e-3 (all of the push) through a gap of 0.13); and as transfer a point
     force: ``mass`` the identity at the node, ``transfer`` the other side's shape functions at
     the virtual node (so the two forces balance exactly). Returned with each node's guard:
-    the nodes of the facet its virtual node lies on (-1 beyond the patch).
+    the nodes of the facet its virtual node lies on (-1 beyond the patch), and that facet's
+    size (how far the node may slide along it before its pairing is stale).
 
     **Why**: the compatibility side's nodes over the other surface leave that surface free
     between them and past their ends: a stiff body's corner or edge (a node of the equilibrium
@@ -209,7 +223,31 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     geo = Overlap(nodes, normal[keep], gap[keep], interp, so.rind_depth[seg[keep]],
                   past[keep], np.ones(len(nodes), dtype=bool), mass, transfer, patch, opatch)
     guard = np.where(past[keep][:, None], -1, so.facets[seg[keep]])
-    return geo, guard
+    return geo, guard, so.sizes[seg[keep]]
+
+
+def held_force_directions(s: ContactSurface, patch: np.ndarray, held: Overlap, c_own: float,
+                          c_other: float) -> np.ndarray:
+    """The directions of the held nodes' point forces (:func:`held_nodes`; their gaps read
+    along ``held.normal``, the other facet's normal): over the other surface, the pair's
+    common normal (:func:`common_normal`: the other facet's normal blended with minus the
+    node's own, each weighted by its body's stiffness per unit length, ``c`` the compliance
+    densities), so that a stiff body's node pushes along its own face as the compatibility
+    side's nodes around it do; beyond the other patch's end, the direction to it.
+
+    **Why**: the force along the other facet's normal turned a stiff gasket's held nodes'
+    forces 20 degrees off its face's normal when the gaskets had slid by several elements.
+    The gap stays read along the facet's normal, the line the node must not cross: a
+    positive scale of a gap changes nothing of where it closes."""
+    total = c_own + c_other
+    w_other = c_own / total if total > 0 else 0.5  # the stiffer surface weighs more
+    own = s.node_normals(None, patch)[held.nodes]
+    n = w_other * held.normal - (1.0 - w_other) * own
+    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+    # (a blend that turns more than 60 degrees from the facet's normal — a node facing away —
+    # keeps the facet's)
+    keep = held.beyond | (np.einsum("ij,ij->i", n, held.normal) < 0.5)
+    return np.where(keep[:, None], held.normal, n)
 
 
 @dataclass
