@@ -81,3 +81,14 @@ def test_run_writes_summary_and_figures(tmp_path):
     for name in ("summary.json", "results.pvd", "initial.png", "prediction.png", "final.png",
                  "corner.png", "pressure.png"):
         assert (tmp_path / name).stat().st_size > 0
+
+
+def test_figures_are_drawn_after_a_no_figures_run_in_the_same_process(tmp_path):
+    """`vfem run --no-figures` defers the figures for its own run only: a library run after it
+    in the same process draws them (a test order that ran the CLI first left them deferred,
+    and test_run_writes_summary_and_figures failed on one worker)."""
+    from vfem.cli import main
+
+    assert main(["run", "springs", "--no-figures", "--out", str(tmp_path / "cli")]) == 0
+    block.run(block.Parameters(), tmp_path / "lib")
+    assert (tmp_path / "lib" / "initial.png").stat().st_size > 0

@@ -181,10 +181,20 @@ SOLVER_HELP = ("linear-algebra backend: auto (the fastest installed), superlu, p
 
 
 def cmd_run(args) -> int:
-    chosen = linalg.use(args.solver)
     from .io.replot import defer
 
-    defer(args.no_figures)  # for this run (main() may run several in one process)
+    # for this run only: main() may run several in one process, and a library call after it
+    # (an example's run()) must draw its figures again (a test that ran `vfem run
+    # --no-figures` in the same process left them deferred)
+    defer(args.no_figures)
+    try:
+        return _cmd_run(args)
+    finally:
+        defer(False)
+
+
+def _cmd_run(args) -> int:
+    chosen = linalg.use(args.solver)
     log.info("linear solver %s -> %s", args.solver, chosen)
     if _is_input_file(args.example):
         return run_input_file(args)
