@@ -88,6 +88,8 @@ traction unknowns, tolerances' readings), and neither ``vfem.contact.check`` nor
     python3 benchmarks/random_models.py --json out.json      # every model's parameters, checks
     python3 benchmarks/random_models.py --dump 2d-17 /tmp/m17    # as an input file:
     vfem run /tmp/m17/random_2d-17.toml    # (add --set contact.method=lagrange for the baseline)
+    python3 benchmarks/random_models.py --remedies   # then each stop again: the other
+                                          # compatibility side, 4x the steps, large kinematics
 
 One line at the end sums it up per class (2D linear, 2D quadratic, 3D) and for the baseline
 (the baselines need linear elements: run on the 2D linear models only; its answers get the same
@@ -870,8 +872,7 @@ def solve_one(p: dict, method: str) -> dict:
     with tempfile.TemporaryDirectory(prefix="vfem-random-") as tmp:
         try:
             config, info = build(p, Path(tmp))
-            if method == "lagrange":
-                config = dataclasses.replace(config, contact=vfem.Contact(method="lagrange"))
+            config = _variant(config, method)
             model = config.build(Path(tmp))
         except Exception as exc:  # the generator's fault, not the solver's
             return {**rec, "status": "invalid", "message": _first(exc)}
@@ -904,6 +905,43 @@ def solve_one(p: dict, method: str) -> dict:
         if checks["failed"]:
             return {**rec, "status": "wrong", "message": ", ".join(checks["failed"])}
         return {**rec, "status": "solved", "message": ""}
+
+
+#: the remedies tried on each stopped model (``--remedies``): the other body on the
+#: compatibility side (each of the two forced), four times the steps, large kinematics
+REMEDIES = ("side=upper", "side=block", "steps x4", "total")
+
+
+def _variant(config: ModelConfig, method: str) -> ModelConfig:
+    """The model as ``method`` solves it: "vfem" as drawn, "lagrange" the baseline, or one of
+    :data:`REMEDIES`."""
+    if method == "lagrange":
+        return dataclasses.replace(config, contact=vfem.Contact(method="lagrange"))
+    if method.startswith("side="):
+        return dataclasses.replace(config, contact=dataclasses.replace(
+            config.contact, compatibility_side=method[5:]))
+    if method == "steps x4":
+        n = 4 * len(config.steps.load_factors)
+        return dataclasses.replace(config, steps=vfem.Steps(
+            load_factors=tuple((i + 1) / n for i in range(n))))
+    if method == "total":
+        return dataclasses.replace(config, bodies=tuple(
+            dataclasses.replace(b, kinematics="total") for b in config.bodies))
+    return config
+
+
+def remedy_summary(stopped: list[str], tried: dict[str, dict[str, dict]]) -> str:
+    """One line: of the stopped models, how many each remedy solves (and turns wrong)."""
+    parts = []
+    for r in REMEDIES:
+        recs = [tried[i][r] for i in stopped if r in tried[i]]
+        n = {k: sum(x["status"] == k for x in recs) for k in ("solved", "wrong", "invalid")}
+        parts.append(f"{r}: {n['solved']} solved, {n['wrong']} wrong"
+                     + (f" ({n['invalid']} not applicable)" if n["invalid"] else ""))
+    either = sum(any(tried[i].get(f"side={b}", {}).get("status") == "solved"
+                     for b in ("upper", "block")) for i in stopped)
+    return (f"remedies for the {len(stopped)} stopped models: " + "; ".join(parts)
+            + f"; the other compatibility side (either forced) {either}")
 
 
 def _cause(message: str) -> str:
@@ -1051,6 +1089,10 @@ def main(argv=None) -> int:
     ap.add_argument("--dump", nargs=2, metavar=("ID", "DIR"),
                     help="write model ID as a vfem input file (and mesh) into DIR")
     ap.add_argument("-v", "--verbose", action="store_true", help="one line per model")
+    ap.add_argument("--remedies", action="store_true",
+                    help="then try each stopped model again with the other compatibility side, "
+                         "four times the steps and large kinematics (the remedies the stop "
+                         "messages name) and print what each solves")
     args = ap.parse_args(argv)
 
     def parse(ident: str) -> dict:
@@ -1099,6 +1141,19 @@ def main(argv=None) -> int:
                "models": [{"parameters": p, **results[p["id"]]} for p in models]}
         Path(args.json).write_text(json.dumps(out, indent=1, default=_json_default))
     print(text)
+    if args.remedies:
+        stopped = [p["id"] for p in models if results[p["id"]]["vfem"]["status"] == "stopped"]
+        tried: dict[str, dict] = {i: {} for i in stopped}
+
+        def tried_one(p, rec):
+            tried[p["id"]][rec["method"]] = rec
+            if args.verbose and len(tried[p["id"]]) == len(REMEDIES):
+                print(p["id"], ", ".join(f"{r} {tried[p['id']][r]['status']}"
+                                         for r in REMEDIES), flush=True)
+
+        run_all([(by_id[i], r) for i in stopped for r in REMEDIES], args.jobs, args.timeout,
+                tried_one)
+        print(remedy_summary(stopped, tried))
     return 0
 
 
