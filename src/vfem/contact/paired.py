@@ -135,6 +135,8 @@ class PairSet(SurfaceGroup):
     _refused = None
     _stale_mask = None
     _stale_changes = 0
+    #: :meth:`_reserve`, once found
+    _reserved = None
 
     #: whether the equilibrium side's nodes are held too, where they would penetrate the
     #: compatibility side (issue 37, :func:`~vfem.contact.pairing.held_nodes`): the
@@ -540,7 +542,7 @@ class PairedContact(PairSet):
             pens = self.penetrations(state)
             traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
             self._check_rind(pens)
-            stale_moved = self._update_stale(state, traction_values)
+            stale_moved = self._update_stale(state, traction_values, pens)
             errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
             platen_ok = self.platen_met(state)
             rec = IterationRecord(it, pen_err, 0.0, contact, tension,
@@ -655,15 +657,14 @@ class PairedContact(PairSet):
         return linear_complementarity(W, q0, p, tol, factor=self._factor, reserve=reserve,
                                       guard=guard, refused=refused)
 
-    def _update_stale(self, state: ContactState, traction_values: list[np.ndarray]) -> bool:
+    def _update_stale(self, state: ContactState, traction_values: list[np.ndarray],
+                      pens: list[np.ndarray]) -> bool:
         """Read which held nodes are stale (:meth:`_stale`) in this state; whether the last
         correction held a node that is stale now, or left out as stale one that is not and
         penetrates, so that the contact set must be found again (the answer is then the stale
         nodes' own fixed point, however the step was reached).
         After :data:`STALE_CHANGES` such changes in one solve the set only grows (no cycle)."""
-        reserve = np.concatenate([np.full(len(p.nodes) * len(self.directions(k)), p.point)
-                                  for k, p in enumerate(self.contact_pairs)]
-                                 or [np.zeros(0, dtype=bool)])
+        reserve = self._reserve()[0]
         if not reserve.any():
             return False
         stale = self._stale(state, reserve)
@@ -671,7 +672,7 @@ class PairedContact(PairSet):
         if self._stale_changes >= STALE_CHANGES:
             stale |= before
         q = np.concatenate(traction_values or [np.zeros(0)])
-        p = np.concatenate(self.penetrations(state) or [np.zeros(0)])
+        p = np.concatenate(pens or [np.zeros(0)])
         # (the last correction read other stale nodes than this state has where it matters:
         # a node held that is stale now, or one left out as stale that is not and penetrates)
         moved = bool(((stale & ~before & (q > 0))
@@ -707,15 +708,24 @@ class PairedContact(PairSet):
             pos += m
         return out
 
+    def _held_unknowns(self) -> np.ndarray:
+        """(unknowns,) bool: the unknowns of the held nodes (``point`` pairs)."""
+        return np.concatenate([np.full(len(pair.nodes) * len(self.directions(k)), pair.point)
+                               for k, pair in enumerate(self.contact_pairs)]
+                              or [np.zeros(0, dtype=bool)])
+
     def _reserve(self) -> tuple[np.ndarray, np.ndarray | None]:
         """(unknowns,) bool: the held nodes (``point`` pairs), which join the contact set
         only where they would penetrate; and (unknowns, k) the unknowns of each one's guard
         (the compatibility side's nodes around its virtual node, -1 for none), or None
-        without held nodes."""
+        without held nodes. Fixed by the pairs: found once."""
+        if self._reserved is None:
+            self._reserved = self._find_reserve()
+        return self._reserved
+
+    def _find_reserve(self) -> tuple[np.ndarray, np.ndarray | None]:
         pairs = self.contact_pairs
-        reserve = np.concatenate([np.full(len(pair.nodes) * len(self.directions(k)),
-                                          pair.point) for k, pair in enumerate(pairs)]
-                                 or [np.zeros(0, dtype=bool)])
+        reserve = self._held_unknowns()
         if not reserve.any():
             return reserve, None
         offsets = np.cumsum([0] + [len(p.nodes) * len(self.directions(k))

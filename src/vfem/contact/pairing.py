@@ -147,6 +147,17 @@ def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np
     return normal, np.einsum("ij,ij->i", d, normal), interp, seg, past
 
 
+def blended_normal(other: np.ndarray, own: np.ndarray, c_own: float, c_other: float
+                   ) -> np.ndarray:
+    """(m, dim) unit normals: the other surface's outward normals ``other`` blended with minus
+    the nodes' own ``own``, each weighted by its body's stiffness per unit length (``c`` the
+    compliance densities: the stiffer surface weighs more; equal ones meet on the mean)."""
+    total = c_own + c_other
+    w_other = c_own / total if total > 0 else 0.5
+    n = w_other * other - (1.0 - w_other) * own
+    return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+
+
 def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: float,
                   c_coarse: float) -> None:
     """Small-strain contact: measure the gaps along one normal that does not depend on which
@@ -164,11 +175,8 @@ def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: 
     """
     if not len(geo.nodes):
         return
-    total = c_fine + c_coarse
-    w_coarse = c_fine / total if total > 0 else 0.5  # the stiffer surface weighs more
-    own = sf.node_normals(None, geo.fpatch)[geo.nodes]
-    n = w_coarse * geo.normal - (1.0 - w_coarse) * own
-    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+    n = blended_normal(geo.normal, sf.node_normals(None, geo.fpatch)[geo.nodes], c_fine,
+                       c_coarse)
     n = np.where(geo.beyond[:, None], geo.normal, n)
     d = sf.X[geo.nodes] - geo.interp @ sc.X[: sc.nc]  # from the virtual node to the node
     geo.normal = n
@@ -239,11 +247,7 @@ def held_force_directions(s: ContactSurface, patch: np.ndarray, held: Overlap, c
     forces 20 degrees off its face's normal when the gaskets had slid by several elements.
     The gap stays read along the facet's normal, the line the node must not cross: a
     positive scale of a gap changes nothing of where it closes."""
-    total = c_own + c_other
-    w_other = c_own / total if total > 0 else 0.5  # the stiffer surface weighs more
-    own = s.node_normals(None, patch)[held.nodes]
-    n = w_other * held.normal - (1.0 - w_other) * own
-    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+    n = blended_normal(held.normal, s.node_normals(None, patch)[held.nodes], c_own, c_other)
     # (a blend that turns more than 60 degrees from the facet's normal — a node facing away —
     # keeps the facet's)
     keep = held.beyond | (np.einsum("ij,ij->i", n, held.normal) < 0.5)
