@@ -165,6 +165,9 @@ ENFORCED = ("force balance", "interpenetration", "tension")
 
 #: steps in a row that must converge easily before a cut increment doubles again
 EASY_STEPS = 2
+#: at most this many nodes a step that broke invariant (b) has the formulation hold before it
+#: is cut (:meth:`Analysis._enforce`)
+ENFORCED_NODES = 10
 
 #: a small-kinematics body whose largest principal strain (:meth:`Body.max_strain`) exceeds
 #: this after a step is warned about, once per run (small strain pushed too far, issue 16)
@@ -619,6 +622,8 @@ class Analysis:
                     where = invariants.where or {}
                     exc.bodies = None if invariants.separated or "into" not in where else (
                         where["body"], where["into"])
+                    exc.where = (dict(where) if "interpenetration" in invariants.failed()
+                                 and not invariants.separated else None)
                     raise exc
                 if invariants.failed() and caps.invariants == "recorded":
                     log.warning("step to load factor %.6g: recorded, not enforced: %s violated "
@@ -627,6 +632,8 @@ class Analysis:
             except AnalysisError as exc:
                 for b in self.model.bodies:
                     b.discard_step()
+                if self._enforce(exc):
+                    continue  # the same step again, the node held (not a cut)
                 self.easy = 0
                 if self.level >= max_cuts:
                     converged = False
@@ -641,6 +648,8 @@ class Analysis:
                 continue
             for b in self.model.bodies:
                 b.commit_step()
+            if hasattr(self.contact, "enforce"):
+                self.contact.enforce(None)  # each step finds its own (resumed runs alike)
             state = self.state = new
             iterations = sum(1 for h in history if h.iteration > 0) or 0
             if res.fixed_point:  # the thesis variant's: not converged (issue 37)
@@ -687,6 +696,23 @@ class Analysis:
                               self.surfaces, self.contact.penetration_tolerance, self.backend,
                               "matrix_free" if getattr(self, "matrix_free", False) else "dense",
                               complete)
+
+    def _enforce(self, exc: AnalysisError) -> bool:
+        """A step stopped at invariant (b) at a node the formulation left out on purpose (a
+        held node its guard excused): whether the formulation now holds it
+        (:meth:`~vfem.contact.paired.PairedContact.enforce`), at most :data:`ENFORCED_NODES`
+        times a step; the step is then solved again at the same load factor. Each step starts
+        without such nodes (a run resumed from a checkpoint finds the same ones)."""
+        where = getattr(exc, "where", None)
+        if (not isinstance(exc, InvariantViolation) or not where
+                or not hasattr(self.contact, "enforce")):
+            return False
+        count = getattr(self, "_enforced_step", (None, 0))
+        n = count[1] if count[0] == len(self.steps) else 0
+        if n >= ENFORCED_NODES or not self.contact.enforce(where):
+            return False
+        self._enforced_step = (len(self.steps), n + 1)
+        return True
 
     def _add_time(self, key: str, seconds: float) -> None:
         self.timings[key] = self.timings.get(key, 0.0) + seconds
