@@ -655,6 +655,23 @@ class PairedContact(PairSet):
                          else np.zeros(len(reserve), dtype=bool))
         q, dplaten = self._complementarity_with(state, pens, W, rate, dR, q0, p, reserve,
                                                 (guard, self._refused))
+        # the held nodes stale after this correction, predicted on the pairs (linear): where
+        # they differ from those it left out where it matters, the set again with them, so
+        # that the bodies need not be corrected once more to find out
+        while q is not None and self._stale_changes < STALE_CHANGES:
+            predicted = self._predicted_stale(state, q, dplaten, reserve)
+            if predicted is None:
+                break
+            stale, pen = predicted
+            before = self._stale_mask
+            if not ((stale & ~before & (q > 0))
+                    | (~stale & before & (pen > self.penetration_tolerance))).any():
+                break
+            self._stale_changes += 1
+            self._stale_mask = stale
+            self._refused = stale.copy()
+            q, dplaten = self._complementarity_with(state, pens, W, rate, dR, q0, p, reserve,
+                                                    (guard, self._refused))
         if self._refused.any():
             log.info("%d held nodes found no contact set with the others: left out",
                      int(self._refused.sum()))
@@ -690,6 +707,24 @@ class PairedContact(PairSet):
                 reserve=reserve, guard=guard, refused=refused)
         return linear_complementarity(W, q0, p, tol, factor=self._factor, reserve=reserve,
                                       guard=guard, refused=refused)
+
+    def _predicted_stale(self, state: ContactState, q: np.ndarray, dplaten: float,
+                         reserve: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The held nodes :meth:`_stale` finds, and every unknown's penetration, in the state
+        that the traction values ``q`` and the platen moved by ``dplaten`` make (the bodies'
+        linear response to those forces, not yet applied to ``state``); None where no node
+        can be stale."""
+        if not reserve.any() or self._stale_mask is None:
+            return None
+        after = state.copy()
+        pos = 0
+        for k, pair in enumerate(self.contact_pairs):
+            self.tractions(after, k)[:] = q[pos:pos + len(pair.nodes)]
+            pos += len(pair.nodes)
+        after.platen_displacement += dplaten
+        self.assemble_forces(after)
+        return (self._stale(after, reserve),
+                np.concatenate(self.penetrations(after) or [np.zeros(0)]))
 
     def _update_stale(self, state: ContactState, traction_values: list[np.ndarray],
                       pens: list[np.ndarray]) -> bool:
