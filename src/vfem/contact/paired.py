@@ -193,6 +193,7 @@ class PairSet(SurfaceGroup):
                                        or cfg.first_relaxation == 1.0)
             and cfg.release_iterations == 1)
         gap = geo.gap
+        # (the relaxed corrections too: one problem, whichever way it is solved)
         if self.both_surfaces and len(geo.nodes):
             gap = approach_gaps(sf, sc, geo, self._approach(fine, coarse, geo))
         pair = ContactPair(fine, coarse, geo.nodes, geo.normal, gap, geo.interp,
@@ -232,13 +233,14 @@ class PairSet(SurfaceGroup):
         the gap (:func:`~vfem.contact.pairing.approach_gaps`)."""
         sf, sc = self.surfaces[fine], self.surfaces[coarse]
 
-        def relative(motion) -> np.ndarray:
-            return motion[fine][geo.nodes] - geo.interp @ motion[coarse][: sc.nc]
+        def relative(of_fine: np.ndarray, of_coarse: np.ndarray) -> np.ndarray:
+            return of_fine[geo.nodes] - geo.interp @ of_coarse[: sc.nc]
 
-        load = [s.body.load_displacement(1.0, s.candidate_dofs).reshape(-1, s.dim)
-                for s in self.surfaces]
-        out = relative(load)
-        platen = relative(self.platen_motion)
+        def load(s: ContactSurface) -> np.ndarray:
+            return s.body.load_displacement(1.0, s.candidate_dofs).reshape(-1, s.dim)
+
+        out = relative(load(sf), load(sc))
+        platen = relative(self.platen_motion[fine], self.platen_motion[coarse])
         sense = -np.sign(np.einsum("ij,ij->i", platen, geo.normal))[:, None]
         none = np.linalg.norm(out, axis=1) <= 1e-12 * max(float(np.abs(sf.X).max()), 1e-300)
         return np.where(none[:, None], sense * platen, out)
@@ -663,9 +665,7 @@ class PairedContact(PairSet):
             if predicted is None:
                 break
             stale, pen = predicted
-            before = self._stale_mask
-            if not ((stale & ~before & (q > 0))
-                    | (~stale & before & (pen > self.penetration_tolerance))).any():
+            if not self._stale_moved(stale, self._stale_mask, q, pen):
                 break
             self._stale_changes += 1
             self._stale_mask = stale
@@ -740,17 +740,23 @@ class PairedContact(PairSet):
         before = self._stale_mask if self._stale_mask is not None else np.zeros_like(stale)
         if self._stale_changes >= STALE_CHANGES:
             stale |= before
-        q = np.concatenate(traction_values or [np.zeros(0)])
-        p = np.concatenate(pens or [np.zeros(0)])
-        # (the last correction read other stale nodes than this state has where it matters:
-        # a node held that is stale now, or one left out as stale that is not and penetrates)
-        moved = bool(((stale & ~before & (q > 0))
-                      | (~stale & before & (p > self.penetration_tolerance))).any())
+        moved = self._stale_moved(stale, before,
+                                  np.concatenate(traction_values or [np.zeros(0)]),
+                                  np.concatenate(pens or [np.zeros(0)]))
         self._stale_changes += int(moved)
         self._stale_mask = stale
         # (a stale node is excused where it is not held: :meth:`_excused`)
         self._refused = stale if self._refused is None else (self._refused | stale)
         return moved
+
+    def _stale_moved(self, stale: np.ndarray, before: np.ndarray, q: np.ndarray,
+                     p: np.ndarray) -> bool:
+        """Whether the stale held nodes ``stale`` of a state (traction values ``q``,
+        penetrations ``p``) differ from those a correction left out, ``before``, where it
+        matters: a node held that is stale, or one left out as stale that is not and
+        penetrates."""
+        return bool(((stale & ~before & (q > 0))
+                     | (~stale & before & (p > self.penetration_tolerance))).any())
 
     def _stale(self, state: ContactState, reserve: np.ndarray) -> np.ndarray:
         """(unknowns,) bool: the held nodes over the other surface that have slid along it,
@@ -764,9 +770,7 @@ class PairedContact(PairSet):
         if not reserve.any():
             return out
         relative = self.relative_displacements(state)
-        pos = 0
-        for k, pair in enumerate(self.contact_pairs):
-            m = len(pair.nodes) * len(self.directions(k))
+        for k, (pair, pos) in enumerate(zip(self.contact_pairs, self._offsets())):
             if pair.point and pair.reach is not None and pair.gap_normal is not None:
                 d = relative[k]
                 n = pair.gap_normal
@@ -774,7 +778,6 @@ class PairedContact(PairSet):
                 over = pair.guard[:, 0] >= 0  # (beyond the other patch: read to its end)
                 out[pos:pos + len(pair.nodes)] = over & (
                     np.linalg.norm(slide, axis=1) > pair.reach)
-            pos += m
         return out
 
     def enforce(self, where: dict | None) -> bool:
@@ -809,9 +812,7 @@ class PairedContact(PairSet):
         reserve = self._held_unknowns()
         if self._forced is None:
             self._forced = np.zeros(len(reserve), dtype=bool)
-        pos = 0
-        for k, pair in enumerate(self.contact_pairs):
-            m = len(pair.nodes) * len(self.directions(k))
+        for pair, pos in zip(self.contact_pairs, self._offsets()):
             if pair.point and pair.fine == b and pair.coarse == into:
                 hit = np.flatnonzero(pair.nodes == local[0])
                 if hit.size and not self._forced[pos + hit[0]]:
@@ -821,8 +822,13 @@ class PairedContact(PairSet):
                              "invariant (b) allows; the step again", where.get("node"),
                              where["body"], where["into"])
                     return True
-            pos += m
         return False
+
+    def _offsets(self) -> np.ndarray:
+        """(pairs + 1,) where each pair's unknowns start among all of them (its nodes times
+        its directions)."""
+        return np.cumsum([0] + [len(p.nodes) * len(self.directions(k))
+                                for k, p in enumerate(self.contact_pairs)])
 
     def _held_unknowns(self) -> np.ndarray:
         """(unknowns,) bool: the unknowns of the held nodes (``point`` pairs)."""
@@ -844,8 +850,7 @@ class PairedContact(PairSet):
         reserve = self._held_unknowns()
         if not reserve.any():
             return reserve, None
-        offsets = np.cumsum([0] + [len(p.nodes) * len(self.directions(k))
-                                   for k, p in enumerate(pairs)])
+        offsets = self._offsets()
         width = max(p.guard.shape[1] for p in pairs if p.point)
         guard = np.full((len(reserve), width), -1)
         for k, pair in enumerate(pairs):

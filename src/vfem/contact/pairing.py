@@ -199,16 +199,22 @@ def _pieces(s: ContactSurface) -> tuple[np.ndarray, np.ndarray]:
     return (np.vstack([f[:, [0, 1, 2]], f[:, [0, 2, 3]]]), np.tile(np.arange(len(f)), 2))
 
 
-def ray_entry(s: ContactSurface, points: np.ndarray, directions: np.ndarray,
-              chunk: int = 256) -> np.ndarray:
+#: points times pieces that :func:`ray_entry` tests at once (its memory: some ten arrays of
+#: that many floats)
+RAY_BLOCK = 500_000
+
+
+def ray_entry(s: ContactSurface, points: np.ndarray, directions: np.ndarray) -> np.ndarray:
     """(m,) how far each of ``points`` travels along its unit ``directions`` before it enters
     the body of the surface ``s`` through one of its facets (undeformed; crossing a piece from
-    its outer side), inf where the ray meets none."""
+    its outer side), inf where the ray meets none. Every piece is tested against every ray
+    (blocks of :data:`RAY_BLOCK`): done once per pair, for the nodes that approach."""
     pieces, facet = _pieces(s)
     x = s.X[: s.nc]
     outward = s.facet_normals()[facet]
     out = np.full(len(points), np.inf)
     scale = max(float(np.ptp(x, axis=0).max(initial=0.0)), 1e-300)
+    chunk = max(1, RAY_BLOCK // max(len(pieces), 1))
     for lo in range(0, len(points), chunk):
         p, d = points[lo:lo + chunk, None, :], directions[lo:lo + chunk, None, :]
         entering = np.einsum("pd,nd->np", outward, directions[lo:lo + chunk]) < 0
@@ -220,7 +226,7 @@ def ray_entry(s: ContactSurface, points: np.ndarray, directions: np.ndarray,
                 return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 
             den = cross(d, e)
-            ok = np.abs(den) > 1e-14
+            ok = np.abs(den) > 1e-14 * scale
             den = np.where(ok, den, 1.0)
             t, r = cross(ap, e) / den, cross(ap, d) / den
             hit = ok & (r >= -1e-12) & (r <= 1 + 1e-12)
