@@ -7,7 +7,9 @@ the facet under it) all touch is left to the block's faceting. At load factor 0.
 node lay 3.5e-7 inside where invariant (b) allowed less, and the step was cut six times and
 the analysis stopped (random model 2d-132 of ``benchmarks/random_models.py``). The solver now
 has the formulation hold that node and solves the step again
-(``vfem.solver.Analysis._enforce``, ``vfem.contact.paired.PairedContact.enforce``).
+(``vfem.solver.Analysis._enforce``, ``vfem.contact.paired.PairedContact.enforce``). Since
+a stiffer surface's own features are held whatever their guard (``pairing.held_nodes``), the
+fillet's vertices are held from the start; the mechanism is tested with the guard as before.
 
 The depth is read from the full-mesh results alone: every boundary node of the punch at
 X + u against the polyline of the block's deformed top.
@@ -48,8 +50,31 @@ def test_a_fillet_node_inside_beyond_faceting_is_held_and_the_step_solved():
     assert deepest_punch_node(result, m) <= result.penetration_tolerance
 
 
+def guard_as_before(monkeypatch):
+    """Held nodes paired at their closest points and excused by their guard whatever their own
+    surface does, as when this mechanism came (a stiff surface's own features, the punch's
+    fillet vertices, are held now whatever their guard, and paired where the loads' approach
+    meets the other surface: ``pairing.held_nodes``)."""
+    import vfem.contact.paired as paired
+    made_by = paired.held_nodes
+
+    def as_before(*args, **kwargs):
+        return made_by(*args, **{**kwargs, "features": False, "approach": None})
+
+    monkeypatch.setattr(paired, "held_nodes", as_before)
+
+
+def test_alone_it_holds_the_node_and_solves_the_step(monkeypatch):
+    guard_as_before(monkeypatch)
+    m = vfem.load(MODEL).build()
+    result = vfem.solve(m)
+    assert result.converged, result.message
+    assert deepest_punch_node(result, m) <= result.penetration_tolerance
+
+
 def test_without_it_the_step_stops_at_invariant_b(monkeypatch):
     """The same model with no node held after a check: the mechanism is what solves it."""
+    guard_as_before(monkeypatch)
     monkeypatch.setattr(vfem.solver, "ENFORCED_NODES", 0)
     result = vfem.solve(vfem.load(MODEL).build())
     assert not result.converged

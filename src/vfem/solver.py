@@ -277,23 +277,23 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
                 "platen) has nothing to push against until it touches")
     if isinstance(exc, InvariantViolation):
         bodies = getattr(exc, "bodies", None)
-        # (measured: benchmarks/random_models.py --remedies, seed 0: of its 20 stopped
-        # models, 18 at an invariant, the other compatibility side solved 13, four times
-        # the steps none, large kinematics none, 12 of the 14 it applies to turned wrong)
+        # (measured: benchmarks/random_models.py --remedies, seed 0, 2026-11-29: of its 3
+        # stopped models the other compatibility side solved all 3, four times the steps
+        # none, large kinematics none, 2 of the 2 it applies to turned wrong; at the state
+        # with 20 stops, 13 of 20, none, none)
         first = "" if not bodies else (
             f"try the other body of the two on the compatibility side (contact."
             f"compatibility_side = \"{bodies[0]}\" or \"{bodies[1]}\": the side whose nodes "
-            "are held by tractions; measured on the 20 random models that stopped "
-            "(benchmarks/random_models.py --remedies), it solved 13, 11 of the 18 at an "
-            "invariant, where four times the steps solved none; and a steel pin in an "
-            "aluminium plate's hole, in six steps); else ")
+            "are held by tractions; measured on the random models that stopped "
+            "(benchmarks/random_models.py --remedies), it solved 3 of 3, and 13 of 20 "
+            "before the last changes, where four times the steps solved none); else ")
         remedy = (f"the contact iteration met its own stopping rule but the state it reached "
                   f"breaks an invariant checked from the full-mesh results; {first}refine the "
                   "mesh where the nodes named are, or take smaller steps ([steps] count); "
                   "where the bodies slide or turn by more than a facet, analyse them with "
                   "large kinematics (kinematics = \"total\": small kinematics pairs the "
                   "surfaces once, undeformed; it does not help where they do not: on the same "
-                  "20 models it solved none); if it persists report it with the input (a "
+                  "models it solved none); if it persists report it with the input (a "
                   "contact formulation error)")
     elif isinstance(exc, RindViolation):
         remedy = ("take smaller steps ([steps] count), or give the bodies deeper surface "

@@ -351,6 +351,11 @@ def linearised_depth(check: InvariantCheck, i: int, j: int, node: np.ndarray,
     r = cur[i].x[node] - (c + uc)
     n = rj.unit_normals[tri]
     depth = np.minimum(-np.einsum("ij,ij->i", r, n), np.einsum("ij,ij->i", r, ri.normals[node]))
+    # or along j's smoothed normal there (its nodal normals interpolated over the facet; 2D:
+    # the same)
+    smooth = np.einsum("mk,mkd->md", lam, rj.normals[corners])
+    smooth /= np.maximum(np.linalg.norm(smooth, axis=1), 1e-300)[:, None]
+    depth = np.minimum(depth, -np.einsum("ij,ij->i", r, smooth))
     # beside an edge or a vertex: the node's projection on the facet's plane lies outside it
     a, b, cc = rj.corners
     free = _barycentric(ri.x[node], a[tri], b[tri], cc[tri])
@@ -368,7 +373,16 @@ def linearised_depth(check: InvariantCheck, i: int, j: int, node: np.ndarray,
     slip = np.linalg.norm(r - np.einsum("ij,ij->i", r, n)[:, None] * n, axis=1)
     cos_beta = np.clip(-np.einsum("ij,ij->i", n, ri.normals[node]), 1e-3, 1.0)
     slip = slip + dist * np.sqrt(1.0 - cos_beta**2) / cos_beta
-    return depth, np.where(vertex, 0.0, slip * np.abs(theta))
+    # and a quadrilateral's warp: the formulation interpolates over it bilinearly, this check
+    # over its two triangles; they part by up to a quarter of the displacements' twist
+    # ((u1 + u3) - (u0 + u2)) / 4 along the normal (a block's node beside a stiff box's corner:
+    # 9.0e-7 inside the box's face where the tolerance was 8.3e-7)
+    warp = np.zeros(len(node))
+    if rj.b.facets.shape[1] == 4:
+        f = rj.b.facets[rj.b.owner[tri]]
+        twist = uj[f[:, 1]] + uj[f[:, 3]] - uj[f[:, 0]] - uj[f[:, 2]]
+        warp = 0.25 * np.abs(np.einsum("ij,ij->i", twist, n))
+    return depth, np.where(vertex, 0.0, slip * np.abs(theta)) + warp
 
 
 def tension(check: InvariantCheck, F: list[np.ndarray], own: list[Surface3],

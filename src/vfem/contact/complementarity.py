@@ -128,12 +128,40 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
 
     def join(active, eligible, new, limit):
         """The set with the nodes ``new`` joined, (q, d, penetrations, set), or None where
-        pivoting finds no complementary one."""
+        pivoting finds no complementary one. A single node that finds none may take the place
+        of a node of the set: with held nodes W need not be a P-matrix (a held node's force
+        and gap directions differ), and beside a compatibility node at almost its point the
+        two conditions' minor is negative: with both, the held node's value is negative,
+        without it, it penetrates, and pivoting cycles between the two sets, where the held
+        node alone, the other open, is complementary (random model 2d-137: a coarse half
+        disk's lowest vertex 0.0037 from a block node). Tried: the nodes of the set whose
+        values the node's joining raised most (:data:`SWAPS` of them)."""
         try:
-            q, d, pen, active, ok = pivoting(active | new, eligible, limit)
+            q, d, pen, found, ok = pivoting(active | new, eligible, limit)
         except np.linalg.LinAlgError:  # a set whose conditions repeat one another
+            ok = False
+        if ok:
+            return q, d, pen, found
+        if new.sum() != 1 or not active.any():
             return None
-        return (q, d, pen, active) if ok else None
+        try:
+            before, after = on(active)[0], on(active | new)[0]
+        except np.linalg.LinAlgError:
+            return None
+        raised = np.flatnonzero(active)
+        raised = raised[np.argsort(-(after - before)[raised], kind="stable")][:SWAPS]
+        for j in raised:
+            if after[j] <= before[j]:
+                break
+            trial = active | new
+            trial[j] = False
+            try:
+                q, d, pen, found, ok = pivoting(trial, eligible, limit)
+            except np.linalg.LinAlgError:
+                continue
+            if ok and found[new].all():
+                return q, d, pen, found
+        return None
 
     # the compatibility sides' set first, the held nodes waiting
     eligible = ~reserve
@@ -180,6 +208,10 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
         refused |= reserve & ~eligible & ~excused(active) & (pen > tol)
     return q, d
 
+
+#: at most this many nodes of the set a held node that finds no set may take the place of
+#: (:func:`linear_complementarity`'s ``join``)
+SWAPS = 3
 
 #: at most this many rounds of held nodes joining the contact set
 #: (:func:`linear_complementarity`)

@@ -210,7 +210,13 @@ class PairSet(SurfaceGroup):
             if which is not None and not len(which):
                 continue
             patches = (geo.cpatch, geo.fpatch) if own == coarse else (geo.fpatch, geo.cpatch)
-            made = held_nodes(self.surfaces[own], self.surfaces[other], *patches, which)
+            c_own, c_other = (c_coarse, c_fine) if own == coarse else (c_fine, c_coarse)
+            # a stiffer surface's own features (its vertices, not the other side's faceting)
+            # are held even between compatibility nodes in contact: the softer side must
+            # take their shape (:func:`held_nodes`)
+            made = held_nodes(self.surfaces[own], self.surfaces[other], *patches, which,
+                              features=c_own < c_other,
+                              approach=lambda g, o=own, t=other: self._approach(o, t, g))
             if made is None:
                 continue
             h, guard, reach = made
@@ -218,7 +224,6 @@ class PairSet(SurfaceGroup):
                 guard = np.full_like(guard, -1)
             log.info("contact pair: %d nodes of %s held against %s", len(h.nodes),
                      self.surfaces[own].body.name, self.surfaces[other].body.name)
-            c_own, c_other = (c_coarse, c_fine) if own == coarse else (c_fine, c_coarse)
             force = held_force_directions(self.surfaces[own], patches[0], h, c_own, c_other)
             held.append(ContactPair(own, other, h.nodes, force, h.gap, h.interp,
                                     h.transfer, h.mass, h.rind_depth, h.carries,

@@ -12,11 +12,11 @@ between their rims and what presses on them, so their contact zones have edges i
 faces where they end. Meshes do not
 match across any interface: plate k has ``divisions + k % 2`` elements across (and its own
 width), so the stiffer plates (odd k) have the finer meshes. The other way round, a stiff
-coarse face on a soft fine one, is the known limit of docs/method.md §12 (the stiff face's nodes
-sink between the soft face's, which carries compatibility): with ``stiff_modulus`` and
-``soft_modulus`` swapped, ``divisions`` 10, 12, 14 and 20 in 8 steps stop at invariant (b), a
-node of the stiff plate 1-1.4 % deeper than allowed (2.21e-6 against 2.18e-6 at 14), and claim
-no converged state (measured 2026-11-28; 8 and 16 pass).
+coarse face on a soft fine one (``stiff_modulus`` and ``soft_modulus`` swapped), stopped at
+invariant (b) with ``divisions`` 10, 12, 14 and 20 in 8 steps until issue 37, 1-1.4 % beyond
+its tolerance: the check's two triangles per quadrilateral face part from the formulation's
+bilinear face by a quarter of its twist, which (b) now allows for (docs/method.md §7,
+docs/examples.md).
 
 Every node of every upper face is in contact, so the contact zone grows as
 ``divisions**(dim - 1)``: two plates with ``divisions = 70`` in 3D make a flat-on-flat interface
