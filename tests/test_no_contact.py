@@ -7,6 +7,9 @@ Hertz's answer. Bodies that no load brings together are named with their distanc
 analysis that fails for lack of contact says so rather than "allow more iterations".
 """
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -109,3 +112,23 @@ def test_a_platen_pulling_a_touching_body_away_is_named():
     assert "the platen on body 'puck' must move it along +y" in result.message
     assert "moves it away from every body it may touch" in result.message
     assert "allow more iterations" not in result.message
+
+
+def test_a_platen_whose_bodies_meet_edge_or_corner_first_names_the_side_that_solves_it(
+        monkeypatch):
+    """Random model 3d-17 (a tilted box over a block's corner, pushed by a platen): no node of
+    either body lies over the other's surface where they face each other, so nothing holds
+    the platen. The message says so, not "give the platen's force the other sign", and names
+    the compatibility side; the block forced onto it (measured) solves the model."""
+    path = Path(__file__).parent / "data" / "models" / "tilted_box_over_corner.toml"
+    monkeypatch.chdir(path.parent)  # (its mesh file is named relative to it)
+    result = vfem.solve(vfem.load(path).build())
+    assert not result.converged
+    assert "no node of either body lies over the other's surface" in result.message
+    assert "compatibility_side" in result.message
+    assert "give the platen's force the sign" not in result.message
+    m = vfem.load(path).build()
+    m.contact = dataclasses.replace(m.contact, compatibility_side="block")
+    solved = vfem.solve(m)
+    assert solved.converged, solved.message
+    assert all(not s.invariants["failed"] for s in solved.steps)

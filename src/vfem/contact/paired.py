@@ -1021,6 +1021,19 @@ class PairedContact(PairSet):
             state.platen_displacement += min(moves, key=abs)
             return
         body = self.surfaces[self.platen_body].body
+        if body.platen_stiffness == 0.0 and need != 0.0 and not any(
+                len(pair.nodes) for pair in self.contact_pairs):
+            # no node of either body over the other where they face each other: not the
+            # platen's sign, the pairing (random model 3d-17: a tilted box over a block's
+            # corner; either body forced onto the compatibility side solves it)
+            names = " or ".join(sorted(repr(s.body.name) for s in self.surfaces))
+            raise PlatenUnheld(
+                f"the platen on body {body.name!r} must move it along "
+                f"{'-' if need < 0 else '+'}{body.platen.component} to apply its force "
+                f"({state.platen_force:.6g}), but no node of either body lies over the other's "
+                "surface where they face each other (they meet edge or corner first), so no "
+                f"contact can hold it (contact.compatibility_side = {names}: the body that "
+                "the log's 'contact pair' line does not name as the compatibility side)")
         if body.platen_stiffness == 0.0 and need != 0.0:  # nothing but contact could hold it
             raise PlatenUnheld(
                 f"the platen on body {body.name!r} must move it along "
