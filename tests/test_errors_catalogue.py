@@ -38,8 +38,8 @@ CATALOGUE = ROOT / "docs" / "errors.md"
 MESSAGE_ARGUMENT = {"failure": 0, "InputError": 0, "AnalysisError": 0, "RindViolation": 0,
                     "VfemError": 0, "_Inverted": 0, "_Problem": 1, "need": 1, "ContactCycling": 0,
                     "ContactNotConverged": 0, "ElementInverted": 0, "NewtonNotConverged": 0,
-                    "PlatenUnheld": 0, "SingularSystem": 0, "ActiveSetNotSettled": 0,
-                    "PlatenOffForce": 0}
+                    "PlatenUnheld": 0, "PlatenUnpaired": 0, "SingularSystem": 0,
+                    "ActiveSetNotSettled": 0, "PlatenOffForce": 0}
 #: exceptions whose message counts only where they are raised (they are common names)
 RAISED = {"ValueError", "RuntimeError"}
 #: functions whose every string is user-facing text (module relative to src/vfem, name):

@@ -65,6 +65,12 @@ class PlatenUnheld(AnalysisError):
     its force: nothing holds it, and no step size can help."""
 
 
+class PlatenUnpaired(PlatenUnheld):
+    """A force-controlled platen's body meets the other edge or corner first: no node of
+    either lies over the other's surface, so no contact can hold it (the other body on the
+    compatibility side can)."""
+
+
 class SingularSystem(AnalysisError):
     """A classical baseline's global matrix is singular (a body held by nothing but contact,
     with none of its nodes in contact)."""

@@ -41,7 +41,7 @@ import logging
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import PlatenUnheld, RindViolation
+from ..errors import PlatenUnheld, PlatenUnpaired, RindViolation
 from ..parallel import current as current_ranks
 from .capabilities import Capabilities
 from .complementarity import linear_complementarity
@@ -682,10 +682,7 @@ class PairedContact(PairSet):
                      int(self._refused.sum()))
         if q is None:
             return
-        pos = 0
-        for k, pair in enumerate(self.contact_pairs):
-            self.tractions(state, k)[:] = q[pos:pos + len(pair.nodes)]
-            pos += len(pair.nodes)
+        self._set_tractions(state, q)
         state.platen_displacement += dplaten
 
     def _complementarity_with(self, state, pens, W, rate, dR, q0, p, reserve, guards):
@@ -713,6 +710,14 @@ class PairedContact(PairSet):
         return linear_complementarity(W, q0, p, tol, factor=self._factor, reserve=reserve,
                                       guard=guard, refused=refused)
 
+    def _set_tractions(self, state: ContactState, q: np.ndarray) -> None:
+        """Every pair's traction values from ``q``, the complementarity problem's unknowns
+        over all pairs' nodes in order."""
+        pos = 0
+        for k, pair in enumerate(self.contact_pairs):
+            self.tractions(state, k)[:] = q[pos:pos + len(pair.nodes)]
+            pos += len(pair.nodes)
+
     def _predicted_stale(self, state: ContactState, q: np.ndarray, dplaten: float,
                          reserve: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """The held nodes :meth:`_stale` finds, and every unknown's penetration, in the state
@@ -722,10 +727,7 @@ class PairedContact(PairSet):
         if not reserve.any() or self._stale_mask is None:
             return None
         after = state.copy()
-        pos = 0
-        for k, pair in enumerate(self.contact_pairs):
-            self.tractions(after, k)[:] = q[pos:pos + len(pair.nodes)]
-            pos += len(pair.nodes)
+        self._set_tractions(after, q)
         after.platen_displacement += dplaten
         self.assemble_forces(after)
         return (self._stale(after, reserve),
@@ -1021,23 +1023,20 @@ class PairedContact(PairSet):
             state.platen_displacement += min(moves, key=abs)
             return
         body = self.surfaces[self.platen_body].body
-        if body.platen_stiffness == 0.0 and need != 0.0 and not any(
-                len(pair.nodes) for pair in self.contact_pairs):
-            # no node of either body over the other where they face each other: not the
-            # platen's sign, the pairing (random model 3d-17: a tilted box over a block's
-            # corner; either body forced onto the compatibility side solves it)
-            names = " or ".join(sorted(repr(s.body.name) for s in self.surfaces))
-            raise PlatenUnheld(
-                f"the platen on body {body.name!r} must move it along "
-                f"{'-' if need < 0 else '+'}{body.platen.component} to apply its force "
-                f"({state.platen_force:.6g}), but no node of either body lies over the other's "
-                "surface where they face each other (they meet edge or corner first), so no "
-                f"contact can hold it (contact.compatibility_side = {names}: the body that "
-                "the log's 'contact pair' line does not name as the compatibility side)")
         if body.platen_stiffness == 0.0 and need != 0.0:  # nothing but contact could hold it
+            motion = (f"the platen on body {body.name!r} must move it along "
+                      f"{'-' if need < 0 else '+'}{body.platen.component} to apply its force "
+                      f"({state.platen_force:.6g}), but ")
+            if not any(len(pair.nodes) for pair in self.contact_pairs):
+                # no node of either body over the other where they face each other: not the
+                # platen's sign, the pairing (random model 3d-17: a tilted box over a block's
+                # corner; the block forced onto the compatibility side solves it)
+                names = " or ".join(sorted(repr(s.body.name) for s in self.surfaces))
+                raise PlatenUnpaired(
+                    motion + "no node of either body lies over the other's surface where they "
+                    "face each other (they meet edge or corner first), so no contact can hold "
+                    f"it (contact.compatibility_side = {names}: the body that the log's "
+                    "'contact pair' line does not name as the compatibility side)")
             raise PlatenUnheld(
-                f"the platen on body {body.name!r} must move it along "
-                f"{'-' if need < 0 else '+'}{body.platen.component} to apply its force "
-                f"({state.platen_force:.6g}), but that moves it away from every body it may "
-                "touch: nothing holds it (a platen force's sign: negative pushes towards -x or "
-                "-y)")
+                motion + "that moves it away from every body it may touch: nothing holds it "
+                "(a platen force's sign: negative pushes towards -x or -y)")

@@ -251,6 +251,14 @@ def ray_entry(s: ContactSurface, points: np.ndarray, directions: np.ndarray) -> 
     return out
 
 
+def _unit_motion(motion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(m, dim) the unit directions of ``motion`` (m, dim), and (m,) which of them move at all
+    (more than 1e-9 of the largest)."""
+    size = np.linalg.norm(motion, axis=1)
+    return (motion / np.maximum(size, 1e-300)[:, None],
+            size > 1e-9 * float(size.max(initial=0.0)))
+
+
 def approach_gaps(sf: ContactSurface, sc: ContactSurface, geo: Overlap,
                   approach: np.ndarray) -> np.ndarray:
     """(m,) the compatibility side's gaps along the pair's normal n (``geo.normal``, the
@@ -280,12 +288,10 @@ def approach_gaps(sf: ContactSurface, sc: ContactSurface, geo: Overlap,
     into a block (random model 2d-26): the reading is the virtual node's."""
     m, g_m, _, _, _ = virtual_nodes(sf, sc, sf.X, sc.X, geo.nodes, geo.fpatch, geo.cpatch,
                                     facet_normal=True)
-    size = np.linalg.norm(approach, axis=1)
-    a = approach / np.maximum(size, 1e-300)[:, None]
+    a, moving = _unit_motion(approach)
     na = np.einsum("ij,ij->i", geo.normal, a)
     ma = np.einsum("ij,ij->i", m, a)
-    use = (~geo.beyond & (size > 1e-9 * float(size.max(initial=0.0))) & (na <= -0.5)
-           & (ma <= -0.5))
+    use = ~geo.beyond & moving & (na <= -0.5) & (ma <= -0.5)
     if use.any():
         use[use] = np.isfinite(ray_entry(sc, sf.X[geo.nodes[use]], a[use]))
     return np.where(use, g_m * na / np.where(use, ma, -1.0), geo.gap)
@@ -369,10 +375,8 @@ def ray_pairing(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, nodes
     as that body deforms, and the corner sank 12 % of the push into the disk; held where the
     ray enters, the facet is the one it lands on."""
     normal, gap, interp, seg = pairing
-    size = np.linalg.norm(approach, axis=1)
-    u = approach / np.maximum(size, 1e-300)[:, None]
-    use = (~past & (size > 1e-9 * float(size.max(initial=0.0)))
-           & (np.einsum("ij,ij->i", normal, u) <= -0.5))
+    u, moving = _unit_motion(approach)
+    use = ~past & moving & (np.einsum("ij,ij->i", normal, u) <= -0.5)
     if not use.any():
         return
     idx = np.flatnonzero(use)
