@@ -15,6 +15,9 @@ chord of the disk's deformed boundary above it, and each body's contact force.
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -71,3 +74,42 @@ def test_a_corner_met_obliquely_after_a_large_gap_is_held(swap):
     # the contact force adds (at most the push) is read along the common normal, 1.8 degrees
     # off the flank's: about 3 % of the push, bounded here by 5 % (at 81beac1: 97 %)
     assert depth <= result.penetration_tolerance + 0.05 * PUSH
+
+
+ROTATED = Path(__file__).parent / "data" / "models" / "rotated_corner.toml"
+
+
+@pytest.mark.parametrize("swap", [False, True], ids=["rectangle first", "block first"])
+def test_a_rotated_rectangles_corner_presses_along_the_blocks_normal(swap):
+    """A rectangle rotated 5.8 degrees lands on its lowest corner on a block of about its
+    stiffness, after a gap 284 times the push (random model 2d-144); the rectangle's face is
+    the compatibility side and its corner the end of its patch. The corner's gap was read
+    along the pair's common normal, blended between the block's and the rectangle's face's,
+    3.9 degrees off the block's: the corner's slide of 5.3e-4 along the block read as
+    5.3e-4 sin(3.9 deg) of approach, and the corner lay 4.0e-5 (3.2 % of the push) inside
+    the block (at e773403). At its patch's end a node now keeps the other surface's normal
+    (``vfem.contact.pairing.common_normal``): what is left is the block's facet's rotation
+    (1.3e-3 rad) times that slide, small kinematics' own second-order term, 0.06 % of the
+    push; bounded here by 0.5 %."""
+    cfg = vfem.load(ROTATED)
+    if swap:
+        cfg = dataclasses.replace(cfg, bodies=tuple(reversed(cfg.bodies)))
+    m = cfg.build(ROTATED.parent)
+    result = vfem.solve(m)
+    assert result.converged, result.message
+    last = result.steps[-1]
+    bodies = {b.name: b for b in m.bodies}
+    X = bodies["upper"].mesh.p.T
+    corner = int(np.argmin(X[:, 1]))
+    xc = X[corner] + last.bodies["upper"].displacement[corner]
+    block = bodies["block"]
+    xb = block.mesh.p.T + last.bodies["block"].displacement
+    facets = block.mesh.facets[:, block.mesh.boundaries["top"]].T
+    a, b = xb[facets[:, 0]], xb[facets[:, 1]]
+    (k,) = np.flatnonzero((np.minimum(a[:, 0], b[:, 0]) <= xc[0])
+                          & (xc[0] < np.maximum(a[:, 0], b[:, 0])))
+    y_chord = a[k, 1] + (xc[0] - a[k, 0]) / (b[k, 0] - a[k, 0]) * (b[k, 1] - a[k, 1])
+    push = 0.3510142623005617 - 0.3497813174039161  # the top's motion less the gap
+    # the corner carries the contact force: pushed up by the block
+    assert last.bodies["upper"].contact_force[corner][1] > 0
+    assert y_chord - xc[1] <= result.penetration_tolerance + 0.005 * push

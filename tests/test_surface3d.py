@@ -241,3 +241,28 @@ def test_flexibility_is_the_inverse_stiffness_block(cells, order, backend):
     F = s.normal_flexibility(nodes, normals)
     np.testing.assert_allclose(np.diag(F), 1.0 / k, rtol=1e-12)
     np.testing.assert_allclose(F, F.T, rtol=0, atol=1e-12 * np.abs(F).max())
+
+
+@pytest.mark.parametrize("cells", ["tet", "hex"])
+def test_normals_at_do_not_average_across_the_bodys_edges(cells):
+    """``normals_at`` (the virtual node's normal, issue 37): at every point of a top facet,
+    the top's normal, also at the nodes on the box's edges, where the nodal normals (the mean
+    of all the facets around a node) lean 45 degrees towards the side; on the side's facets
+    their own normal. A cylinder's face over a block's edge read its gaps along the leaning
+    one and lay 50 % of the push inside the block (random model 3d-54)."""
+    body = _body(cells, 1, ("top", "right", "front"))
+    s = _surface(body, ("top", "right", "front"))
+    centres = s.X[s.facets[:, :s.kind.corners]].mean(axis=1)
+    for face in ("top", "right", "front"):
+        axis, sign = OUTWARD[face]
+        e = _unit(axis, sign)
+        on = np.flatnonzero(np.isclose(centres[:, axis], SIZE[axis] if sign > 0 else 0.0))
+        for xi in s.kind.readings:  # (the corners among them for linear facets)
+            seg = on
+            t = np.tile(xi, (len(seg), 1))
+            np.testing.assert_allclose(s.normals_at(seg, t), np.tile(e, (len(seg), 1)),
+                                       atol=1e-14)
+        corners = np.unique(s.facets[on, :s.kind.corners])
+        edge = corners[np.isclose(s.X[corners, 0], SIZE[0])
+                       & np.isclose(s.X[corners, 2], SIZE[2])]
+        assert len(edge) and np.all(np.abs(s.node_normals()[edge] @ e) < 0.99)

@@ -278,10 +278,10 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
                 "platen) has nothing to push against until it touches")
     if isinstance(exc, InvariantViolation):
         bodies = getattr(exc, "bodies", None)
-        # (measured: benchmarks/random_models.py --remedies, seed 0, 2026-11-29: of its 3
-        # stopped models the other compatibility side solved all 3, four times the steps
-        # none, large kinematics none, 2 of the 2 it applies to turned wrong; at the state
-        # with 20 stops, 13 of 20, none, none)
+        # (measured: benchmarks/random_models.py --remedies, seed 0, 2026-11-29, fifth
+        # session: of its 3 stopped models the other compatibility side solved all 3, four
+        # times the steps none, large kinematics 2 of the 2 it applies to; at the state with
+        # 20 stops, 13 of 20, none, none)
         first = "" if not bodies else (
             f"try the other body of the two on the compatibility side (contact."
             f"compatibility_side = \"{bodies[0]}\" or \"{bodies[1]}\": the side whose nodes "
@@ -294,8 +294,8 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
                   "where the bodies slide or turn by more than a facet, analyse them with "
                   "large kinematics (kinematics = \"total\": small kinematics pairs the "
                   "surfaces once, undeformed; it does not help where they do not: on the same "
-                  "models it solved none); if it persists report it with the input (a "
-                  "contact formulation error)")
+                  "models it solved 2 of the 2 it applies to); if it persists report it with "
+                  "the input (a contact formulation error)")
     elif isinstance(exc, RindViolation):
         remedy = ("take smaller steps ([steps] count), or give the bodies deeper surface "
                   "elements so a step's overlap stays inside them")
