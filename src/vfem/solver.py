@@ -304,10 +304,13 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
                   f"{settings.max_iterations}) or smaller steps")
     elif isinstance(exc, PlatenUnpaired):
         # (measured: random model 3d-17 of benchmarks/random_models.py, a tilted box over a
-        # block's corner, stops so; the block forced onto the compatibility side solves it)
-        remedy = ("put the other body of the pair on the compatibility side (as named: its "
-                  "nodes then lie over the other surface; measured on the one random model "
-                  "that stopped so, it solved it); no step size or iteration count can help")
+        # block's corner, stopped so with the box on the compatibility side; the block there
+        # solves it, and by default a side that pairs no node gives way to the other)
+        remedy = ("where contact.compatibility_side is set, set it to the other body of the "
+                  "pair (its nodes, or the other's held against it, may then hold the platen; "
+                  "by default a side that pairs no node gives way to the other); else hold "
+                  "the body otherwise, or start it touching; no step size or iteration count "
+                  "can help")
     elif isinstance(exc, PlatenUnheld):
         remedy = ("give the platen's force the sign that pushes the body onto the other (or "
                   "hold the body otherwise); no step size or iteration count can help")

@@ -153,7 +153,33 @@ class PairSet(SurfaceGroup):
         densities against each other (:meth:`_compliance_density`), or None where they do not
         face each other; and with :attr:`both_surfaces` the nodes held by point forces (pairs
         with ``point`` set, :func:`~vfem.contact.pairing.held_nodes`): the equilibrium side's,
-        and the compatibility side's beyond the other patch's ends."""
+        and the compatibility side's beyond the other patch's ends.
+
+        Where the side the rules choose leaves no node paired at all (neither its own nodes
+        over the other surface nor the other's held against it: a tilted box's corner over a
+        block's corner, the two meeting edge on edge) and the other side would pair some, the
+        other side carries compatibility. **Why**: a platen pushing such a box had nothing to
+        hold it and the analysis stopped at the first step (random model 3d-17); with the
+        block on the compatibility side the box's corner nodes are held against it and the
+        model solves."""
+        pair, held = self._make_pair_sided(i, j, density_i, density_j)
+        if self.settings.compatibility_side is None and not self._count(pair, held):
+            other = self._make_pair_sided(i, j, density_i, density_j, flip=True)
+            if self._count(*other):
+                log.info("contact pair: no node paired with the first side on the "
+                         "compatibility side; the other side carries it")
+                return other
+        return pair, held
+
+    @staticmethod
+    def _count(pair: ContactPair | None, held: list[ContactPair]) -> int:
+        return (len(pair.nodes) if pair is not None else 0) + sum(len(h.nodes) for h in held)
+
+    def _make_pair_sided(self, i: int, j: int, density_i: tuple[float, bool],
+                         density_j: tuple[float, bool], flip: bool = False
+                         ) -> tuple[ContactPair | None, list[ContactPair]]:
+        """:meth:`_make_pair` with the compatibility side the rules choose, or (``flip``) the
+        other."""
         si, sj = self.surfaces[i], self.surfaces[j]
         (ci, ei), (cj, ej) = density_i, density_j
         if ci == 0.0 and cj == 0.0:
@@ -171,6 +197,8 @@ class PairSet(SurfaceGroup):
             if self.settings.compatibility_side in names:
                 fine, coarse = (i, j) if si.body.name == self.settings.compatibility_side \
                     else (j, i)
+        if flip:
+            fine, coarse = coarse, fine
         sf, sc = self.surfaces[fine], self.surfaces[coarse]
         nodes = (self._facing_nodes(fine, coarse) if self.keep_all_nodes else None)
         geo = overlap(sf, sc, nodes=nodes)
