@@ -1210,6 +1210,10 @@ def line(p: dict, recs: dict) -> str:
             text += f" [{(r.get('cause') or r['message'])[:70]}]"
         if c:
             text += f" depth/push {c['depth_over_push']:.2g}"
+            if c["depth"] > c["threshold"] and c.get("judged_depth", c["depth"]) < c["depth"]:
+                # (beyond the threshold on the deformed geometry, within it as small
+                # kinematics reads it: check 4)
+                text += f" (linearised {c['judged_depth'] / c['push']:.2g})"
         if "seconds" in r:
             text += f" {r['seconds']:.1f}s"
         return text
