@@ -140,6 +140,7 @@ from multiprocessing.connection import wait as wait_for  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+from scipy.spatial import cKDTree  # noqa: E402
 from skfem import (  # noqa: E402
     Basis,
     ElementHex1,
@@ -745,34 +746,34 @@ def _bilinear_depth(pts: np.ndarray, quads: np.ndarray, nearest: int = 12
     foot of its normal on the nearest patch it projects into (Newton's method on (a, b), over
     the ``nearest`` patches by centre); returns the signed distance along the patch's outward
     normal there (< 0: behind it, inside), the patch, and whether any patch took the point."""
-    centre = quads.mean(axis=1)
-    signed = np.full(len(pts), np.inf)
-    facet = np.full(len(pts), -1)
-    for i, P in enumerate(pts):
-        cand = np.argsort(np.linalg.norm(centre - P, axis=1))[:nearest]
-        q = quads[cand]  # (k, 4, 3)
-        a = np.full(len(cand), 0.5)
-        b = np.full(len(cand), 0.5)
-        for _ in range(25):
-            xa = (1 - b)[:, None] * (q[:, 1] - q[:, 0]) + b[:, None] * (q[:, 2] - q[:, 3])
-            xb = (1 - a)[:, None] * (q[:, 3] - q[:, 0]) + a[:, None] * (q[:, 2] - q[:, 1])
-            x = ((1 - a) * (1 - b))[:, None] * q[:, 0] + (a * (1 - b))[:, None] * q[:, 1] \
-                + (a * b)[:, None] * q[:, 2] + ((1 - a) * b)[:, None] * q[:, 3]
-            r = x - P
-            J11, J12, J22 = (np.einsum("ij,ij->i", u, v) for u, v in ((xa, xa), (xa, xb),
-                                                                       (xb, xb)))
-            g1, g2 = np.einsum("ij,ij->i", r, xa), np.einsum("ij,ij->i", r, xb)
-            det = np.where(np.abs(J11 * J22 - J12**2) > 0, J11 * J22 - J12**2, 1e-300)
-            a = a - (J22 * g1 - J12 * g2) / det
-            b = b - (J11 * g2 - J12 * g1) / det
-        n = np.cross(xa, xb)
-        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-        ok = (a >= -1e-9) & (a <= 1 + 1e-9) & (b >= -1e-9) & (b <= 1 + 1e-9)
-        if ok.any():
-            d = np.linalg.norm(r, axis=1)
-            k = np.flatnonzero(ok)[np.argmin(d[ok])]
-            signed[i], facet[i] = float(np.einsum("j,j->", -r[k], n[k])), int(cand[k])
-    return signed, facet, facet >= 0
+    k = min(nearest, len(quads))
+    cand = cKDTree(quads.mean(axis=1)).query(pts, k=k)[1].reshape(len(pts), k)
+    q = quads[cand]  # (m, k, 4, 3)
+    P = pts[:, None, :]
+    a = np.full(cand.shape, 0.5)
+    b = np.full(cand.shape, 0.5)
+    for _ in range(25):  # Newton on |x(a, b) - P|^2 (exact for a flat patch in one)
+        xa = (1 - b)[..., None] * (q[..., 1, :] - q[..., 0, :]) + b[..., None] * (
+            q[..., 2, :] - q[..., 3, :])
+        xb = (1 - a)[..., None] * (q[..., 3, :] - q[..., 0, :]) + a[..., None] * (
+            q[..., 2, :] - q[..., 1, :])
+        r = (((1 - a) * (1 - b))[..., None] * q[..., 0, :] + (a * (1 - b))[..., None]
+             * q[..., 1, :] + (a * b)[..., None] * q[..., 2, :] + ((1 - a) * b)[..., None]
+             * q[..., 3, :]) - P
+        J11, J12, J22 = ((u * v).sum(axis=-1) for u, v in ((xa, xa), (xa, xb), (xb, xb)))
+        g1, g2 = (r * xa).sum(axis=-1), (r * xb).sum(axis=-1)
+        det = J11 * J22 - J12**2
+        det = np.where(np.abs(det) > 0, det, 1e-300)
+        a, b = a - (J22 * g1 - J12 * g2) / det, b - (J11 * g2 - J12 * g1) / det
+    n = np.cross(xa, xb)
+    n /= np.maximum(np.linalg.norm(n, axis=-1), 1e-300)[..., None]
+    ok = (a >= -1e-9) & (a <= 1 + 1e-9) & (b >= -1e-9) & (b <= 1 + 1e-9)
+    d = np.where(ok, np.linalg.norm(r, axis=-1), np.inf)
+    best = d.argmin(axis=1)
+    rows = np.arange(len(pts))
+    took = np.isfinite(d[rows, best])
+    signed = np.where(took, -(r[rows, best] * n[rows, best]).sum(axis=-1), np.inf)
+    return signed, np.where(took, cand[rows, best], -1), took
 
 
 def _closest(P: np.ndarray, facets: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
@@ -824,15 +825,16 @@ def _facet_normals(facets: np.ndarray) -> np.ndarray:
     return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
 
 
-def linearised_depth(A: BodyCheck, node: int, xA: np.ndarray, B: BodyCheck,
-                     xB: np.ndarray) -> tuple[float, float, bool]:
+def linearised_depth(A: BodyCheck, node: int, xA: np.ndarray, surfaces: tuple
+                     ) -> tuple[float, float, bool]:
     """Node ``node`` of A against B as small kinematics reads it: the gap between the node and
     the material point of B nearest it at rest, along the direction between them at rest (B's
-    outward normal where they touch at rest), with both points displaced: -(x_P - x_Q) . n0.
-    The depth (> 0: inside), the tangential part of x_P - x_Q over the length of B's facet
-    there (the slide, which small kinematics takes to be small), and whether the node is still
-    nearest to that same straight facet of B on the deformed geometry, or to one that lay in
-    its line (plane) at rest.
+    outward normal where they touch at rest), with both points displaced: -(x_P - x_Q) . n0
+    (``surfaces``: B's boundary at rest, its facets' sizes and B's boundary now, as
+    :meth:`Geometry.surface` draws them). The depth (> 0: inside), the tangential part of
+    x_P - x_Q over the length of B's facet there (the slide, which small kinematics takes to
+    be small), and whether the node is still nearest to that same straight facet of B on the
+    deformed geometry, or to one that lay in its line (plane) at rest.
 
     Small kinematics linearises the gap in the displacements. While the node stays over the
     straight facet it touched at rest, its deformed depth is -(x_P - x_Q) . n with n that
@@ -842,8 +844,7 @@ def linearised_depth(A: BodyCheck, node: int, xA: np.ndarray, B: BodyCheck,
     facet's rotation. Once the node has passed onto a facet that turned from it at rest the
     difference is no longer that term alone (B's faceting, or a rigid approach along a curved
     surface), and is not read as one."""
-    surf0, size = B.geo.surface(B.geo.X)
-    surf, _ = B.geo.surface(xB)
+    surf0, size, surf = surfaces  # B's boundary at rest (with its facets' sizes) and now
     XP, xP = A.geo.X[:, node], xA[:, node]
     dist0, near, w = _closest(XP, surf0)
     Q0 = np.einsum("k,kj->j", w[0], surf0[near[0]])
@@ -911,19 +912,20 @@ def penetration(A: BodyCheck, xA: np.ndarray, B: BodyCheck, xB: np.ndarray,
     j = int(dist.argmax())
     node = int(nodes[inside[j]])
     L, alpha = float(size[which[j]]), float(A.geo.turning[node])
-    judged, excused = dist.copy(), 0
+    judged, excused, readings = dist.copy(), 0, {}
     if small:
+        surfaces = (*B.geo.surface(B.geo.X), surf)
         for i in np.flatnonzero(dist > threshold):
-            lin, _, same = linearised_depth(A, int(nodes[inside[i]]), xA, B, xB)
+            readings[i] = lin, _, same = linearised_depth(A, int(nodes[inside[i]]), xA,
+                                                          surfaces)
             if lin <= threshold and same:
                 judged[i], excused = max(lin, 0.0), excused + 1
     out = {"depth": float(dist[j]), "body": A.name, "node": node, "into": B.name,
            "at": [float(v) for v in pts[inside[j]]],
            "faceting_estimate": 0.5 * L * math.tan(0.5 * min(alpha, 3.0)),
            "judged": float(judged.max()), "second_order": excused}
-    if small and dist[j] > threshold:
-        out["linearised"], out["slide"], out["same_facet"] = linearised_depth(A, node, xA,
-                                                                              B, xB)
+    if j in readings:
+        out["linearised"], out["slide"], out["same_facet"] = readings[j]
     return out
 
 

@@ -95,10 +95,7 @@ def _facet_neighbours(s: ContactSurface) -> list[np.ndarray]:
     """Per candidate node of ``s``: the nodes of the facets it is on (itself included); the
     surface's topology, found once."""
     if getattr(s, "_facet_neighbours", None) is None:
-        inc = sp.csr_matrix((np.ones(s.facets.size),
-                             (s.facets.ravel(), np.repeat(np.arange(len(s.facets)),
-                                                          s.facets.shape[1]))),
-                            shape=(s.nc, len(s.facets)))
+        inc = s.incidence()
         adj = (inc @ inc.T + sp.identity(s.nc, format="csr")).tocsr()
         adj.sort_indices()
         s._facet_neighbours = np.split(adj.indices, adj.indptr[1:-1])

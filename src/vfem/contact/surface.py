@@ -295,6 +295,17 @@ class ContactSurface:
             np.add.at(out, col, n)
         return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
 
+    def incidence(self, facets: np.ndarray | None = None) -> sp.csr_matrix:
+        """(nc, len(facets)) the node-facet incidence (1 where a facet of the subset
+        ``facets``, all by default, has the node among its nodes); the whole surface's found
+        once."""
+        if getattr(self, "_incidence", None) is None:
+            f = self.facets
+            self._incidence = sp.csr_matrix(
+                (np.ones(f.size), (f.ravel(), np.repeat(np.arange(len(f)), f.shape[1]))),
+                shape=(self.nc, len(f)))
+        return self._incidence if facets is None else self._incidence[:, facets].tocsr()
+
     def normals_at(self, seg: np.ndarray, t: np.ndarray, x: np.ndarray | None = None,
                    facets: np.ndarray | None = None) -> np.ndarray:
         """(m, dim) outward unit normals at local coordinates ``t`` of facets ``seg``: the
@@ -312,9 +323,7 @@ class ContactSurface:
         x = self.X if x is None else x
         fn = self.kind.facet_normals(x, self.facets[ids])
         own = self.kind.facet_normals(x, self.facets[seg])
-        inc = sp.csr_matrix((np.ones(self.facets[ids].size), (
-            self.facets[ids].ravel(), np.repeat(np.arange(len(ids)), self.facets.shape[1]))),
-            shape=(self.nc, len(ids)))
+        inc = self.incidence(ids)
         phi = self.shape(t)
         out = np.zeros((len(seg), self.dim))
         cos = np.cos(FEATURE_ANGLE)
