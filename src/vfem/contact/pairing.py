@@ -345,7 +345,7 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     between them and past their ends: a stiff body's corner or edge (a node of the equilibrium
     side) then sinks into a softer, finer surface between its nodes, and a node of the
     softer surface just past the stiff body's edge slides under it (the tilted cube of issue
-    37: a corner 9.2e-3 inside, half the force). Held only where it would penetrate
+    37: a corner 9.2e-3 inside). Held only where it would penetrate
     (:func:`~vfem.contact.complementarity.linear_complementarity`'s ``reserve``), such a node
     changes nothing where the two surfaces fit (a flat interface, a convex compatibility
     side) and gives the force where they do not.
