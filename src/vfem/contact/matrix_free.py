@@ -162,7 +162,7 @@ class PairOperator:
         out = np.zeros((self.m, k))
         for i, pair in enumerate(self.pairs):
             n = len(pair.nodes)
-            uf = motion[pair.fine][pair.nodes]
+            uf = pair.fine_read(motion[pair.fine])
             uc_flat = motion[pair.coarse].reshape(len(motion[pair.coarse]), -1)
             uc = (self.interp[i] @ uc_flat).reshape(uf.shape)
             for j, direction in enumerate(self.directions[i]):
@@ -192,7 +192,9 @@ class PairOperator:
             for j, direction in enumerate(self.directions[i]):
                 cols = np.arange(self.offsets[i] + j * n, self.offsets[i] + (j + 1) * n)
                 value = np.zeros(n)
-                for b, read in ((pair.fine, None), (pair.coarse, self.interp[i])):
+                fine = None if pair.at is None else sp.csr_matrix(pair.at)
+                for b, read, sign in ((pair.fine, fine, 1.0),
+                                      (pair.coarse, self.interp[i], -1.0)):
                     s = self.surfaces[b]
                     touched, B = blocks[b]
                     local = np.full(s.nc, -1)
@@ -204,11 +206,12 @@ class PairOperator:
                     if read is None:  # read at the pair node itself
                         at = pair.nodes[f.col] == node
                         weight = at.astype(float)
-                    else:  # read at the virtual node: interp's weight of the forced node
+                    else:  # read at the virtual node (or a held point on the fine side's
+                        # edge): the interpolation's weight of the forced node
                         weight = np.asarray(read[f.col, node]).ravel()
                     contrib = np.einsum("ed,ed->e", u, pair.reading(j, direction)[f.col]) \
                         * weight
-                    np.add.at(value, f.col, contrib if read is None else -contrib)
+                    np.add.at(value, f.col, sign * contrib)
                 diag[cols] = value
         return diag
 

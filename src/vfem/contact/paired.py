@@ -58,6 +58,7 @@ from .pairing import (  # noqa: F401 - the pairing's parts, here too for those w
     beyond,
     common_normal,
     facing,
+    held_edges,
     held_force_directions,
     held_nodes,
     overlap,
@@ -119,8 +120,9 @@ class PairSet(SurfaceGroup):
         # penetration p = -(gap0 + n.(u_fine - u_coarse)): its change per unit platen motion
         v = self.platen_motion
         for pair in self.contact_pairs:
-            pair.platen_rate = np.einsum("id,id->i", pair.reading(0, pair.normal),
-                                         pair.interp @ v[pair.coarse] - v[pair.fine][pair.nodes])
+            pair.platen_rate = np.einsum(
+                "id,id->i", pair.reading(0, pair.normal),
+                pair.interp @ v[pair.coarse] - pair.fine_read(v[pair.fine]))
 
     #: the unknowns are the pairs' traction values
     state_type = TractionState
@@ -257,6 +259,17 @@ class PairSet(SurfaceGroup):
                                     h.transfer, h.mass, h.rind_depth, h.carries,
                                     (h.fpatch, h.cpatch), point=True, guard=guard,
                                     gap_normal=h.normal, reach=reach))
+        # and the equilibrium side's edges where they cross the compatibility side's facets
+        # (3D): a stiff box's edge between its vertices
+        edges = held_edges(sc, sf, geo.cpatch, geo.fpatch, feature=c_coarse < c_fine)
+        if edges is not None:
+            at, nodes, normal, gap, interp, guard, reach, rind = edges
+            log.info("contact pair: %d points of %s's edges held against %s", len(nodes),
+                     sc.body.name, sf.body.name)
+            held.append(ContactPair(coarse, fine, nodes, normal, gap, interp, None, None, rind,
+                                    np.ones(len(nodes), dtype=bool), (geo.cpatch, geo.fpatch),
+                                    point=True, guard=guard, gap_normal=normal, reach=reach,
+                                    at=at))
         return pair, held
 
     def _approach(self, fine: int, coarse: int, geo: Overlap) -> np.ndarray:
@@ -353,8 +366,8 @@ class PairSet(SurfaceGroup):
             F[:] = 0.0
         for k, pair in enumerate(self.contact_pairs):
             q = self.tractions(state, k)[:, None] * pair.normal  # traction vector at the fine nodes
-            state.forces[pair.fine] += pair.mass[:, pair.nodes] @ q
-            state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ q
+            state.forces[pair.fine] += pair.fine_columns() @ q
+            state.forces[pair.coarse] -= pair.coarse_columns() @ q
 
     def compatibility_errors(self, pens: list[np.ndarray], traction_values: list[np.ndarray]
                              ) -> tuple[list[np.ndarray], float, int, int]:
@@ -564,7 +577,7 @@ class PairedContact(PairSet):
         out = []
         for pair in self.contact_pairs:
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            uf = x[pair.fine][pair.nodes] - sf.X[pair.nodes]
+            uf = pair.fine_read(x[pair.fine][: sf.nc] - sf.X[: sf.nc])
             uc = pair.interp @ (x[pair.coarse][: sc.nc] - sc.X[: sc.nc])
             out.append(uf - uc)
         return out
@@ -983,7 +996,7 @@ class PairedContact(PairSet):
         dp_dplaten = np.zeros(m)
         for k, pair in enumerate(self.contact_pairs):
             n = len(pair.nodes)
-            uf = du[pair.fine][pair.nodes]  # (nodes, 2, m)
+            uf = pair.fine_read(du[pair.fine])  # (nodes, dim, m)
             coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
             uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
             for j, direction in enumerate(directions[k]):
@@ -1005,10 +1018,10 @@ class PairedContact(PairSet):
         parts: list[list] = [[] for _ in self.surfaces]  # (rows, cols, values) per body
         for k, pair in enumerate(self.contact_pairs):
             n = len(pair.nodes)
-            for body, per_node, sign in ((pair.fine, pair.mass, 1.0),
-                                         (pair.coarse, pair.transfer, -1.0)):
-                r, c = np.nonzero(per_node[:, pair.nodes])
-                v = sign * per_node[r, pair.nodes[c]]
+            for body, columns, sign in ((pair.fine, pair.fine_columns(), 1.0),
+                                        (pair.coarse, pair.coarse_columns(), -1.0)):
+                r, c = np.nonzero(columns)
+                v = sign * columns[r, c]
                 dim = self.surfaces[body].dim
                 for j, direction in enumerate(directions[k]):
                     for d in range(dim):  # the force along the direction's components
@@ -1038,7 +1051,7 @@ class PairedContact(PairSet):
         """The change of pair k's relative tangential displacement t.(u_f - u_c) per unit
         platen motion (with friction: :mod:`vfem.contact.friction`)."""
         pair, v = self.contact_pairs[k], self.platen_motion
-        return np.einsum("id,id->i", tangent, v[pair.fine][pair.nodes]
+        return np.einsum("id,id->i", tangent, pair.fine_read(v[pair.fine])
                          - pair.interp @ v[pair.coarse])
 
     def _close_gap(self, state: ContactState, pens: list[np.ndarray]) -> None:

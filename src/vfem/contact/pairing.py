@@ -58,6 +58,28 @@ class ContactPair:
     #: slid along it by more is no longer over it, and is not held (small kinematics pairs
     #: once; :meth:`~vfem.contact.paired.PairedContact._stale`)
     reach: np.ndarray | None = None
+    #: (m, nc_fine) held points that are not nodes of the ``fine`` body (3D: where a stiff
+    #: box's edge crosses the other surface's facets, :func:`held_edges`): each point's
+    #: position, and its force's share, over the body's candidate nodes (``nodes`` is then
+    #: the nearer corner, for messages and output); None: the points are ``nodes``
+    at: np.ndarray | None = None
+
+    def fine_columns(self) -> np.ndarray:
+        """(nc_fine, m) the fine body's nodal force per unit traction value of each unknown."""
+        return self.mass[:, self.nodes] if self.at is None else self.at.T
+
+    def coarse_columns(self) -> np.ndarray:
+        """(nc_coarse, m) the coarse body's nodal force per unit traction value of each
+        unknown."""
+        return self.transfer[:, self.nodes] if self.at is None else self.interp.T
+
+    def fine_read(self, v: np.ndarray) -> np.ndarray:
+        """(m, ...) the fine body's nodal values ``v`` ((nc or more, ...)) at the pair's
+        points: at its nodes, or interpolated (:attr:`at`)."""
+        if self.at is None:
+            return v[self.nodes]
+        nc = self.at.shape[1]
+        return (self.at @ v[:nc].reshape(nc, -1)).reshape((len(self.at),) + v.shape[1:])
 
     def reading(self, j: int, direction: np.ndarray) -> np.ndarray:
         """The direction along which the unknowns ``j`` (0 the normal ones) read the relative
@@ -381,6 +403,105 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
         own, other = _own_turning(s, patch, nodes, size), _facet_turning(so, opatch, seg)
         guard[~past & (own > 2.0 * other + FEATURE_TURNING)] = -1
     return geo, guard, size
+
+
+#: degrees: the least angle between the normals of a surface's two facets across an edge (or
+#: an edge of the contact surface's own boundary) that makes it an edge of its own, held where
+#: it crosses the other surface (:func:`held_edges`): a box's edge turns 90 degrees, a sphere
+#: or cylinder faceted at a few degrees does not count (its faceting is what the other side's
+#: nodes and invariant (b)'s allowance see)
+EDGE_FEATURE = 30.0
+
+#: samples per facet of the other surface along an edge, where :func:`held_edges` looks for
+#: the facets it crosses (then found to round-off by bisection)
+EDGE_SAMPLES = 4
+
+
+def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch: np.ndarray,
+               feature: bool) -> tuple | None:
+    """3D: the points where the edges of ``s``'s patch ``patch`` (the equilibrium side's: a
+    stiff box's edges, :data:`EDGE_FEATURE`) cross the edges of the other patch ``opatch``'s
+    facets, held against it by point forces as its nodes are (:func:`held_nodes`), undeformed.
+    Returns (at, nodes, normal, gap, interp, guard, reach, rind) or None: ``at`` (m, nc) the
+    points on ``s`` (linear along the edge between its two corners), ``nodes`` the nearer
+    corner (for messages and output), the normal of the other facet at the closest point (gap
+    and force), its interpolation on ``so``, the guard (the facet's nodes, or -1 where
+    ``feature``: a stiffer body's edge, held whatever the other side's nodes around it do) and
+    the facet's size (how far the point may slide before its pairing is stale).
+
+    **Why**: the compatibility side's nodes and the equilibrium side's vertices leave the
+    equilibrium side's edges free between its vertices. A stiff, coarse cube tilted 10 degrees
+    and pushed 0.02 edge first into a finer, 2000 times softer block had its edge 0.0117 below
+    the block's deformed surface between its vertices, where one block facet spans the edge,
+    and read 0.84 of the force of the block on a rigid cube with that edge held
+    (``benchmarks/tilted_cube.py``). Along a line the other surface is linear between the
+    edges of its facets (bilinear facets too, along a line parallel to a side), so holding
+    the crossings holds the edge; a point within a tenth of a facet of a corner is left to the
+    corner (two conditions of nearly one)."""
+    if s.dim != 3 or s.kind.order != 1 or not len(patch) or not len(opatch):
+        return None
+    ends = s.kind.edge_nodes(s.facets)  # (nf, ne, 2)
+    nf, ne = ends.shape[:2]
+    keys, inverse, counts = np.unique(np.sort(ends.reshape(-1, 2), axis=1), axis=0,
+                                      return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    facet = np.repeat(np.arange(nf), ne)
+    order = np.argsort(inverse, kind="stable")
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    f1, f2 = facet[order[first]], facet[order[first + counts - 1]]
+    n = s.facet_normals()
+    in_patch = np.zeros(nf, dtype=bool)
+    in_patch[patch] = True
+    symmetric = np.zeros(len(keys), dtype=bool)
+    np.logical_or.at(symmetric, inverse, s.symmetry_edges.reshape(-1))
+    sharp = np.einsum("ij,ij->i", n[f1], n[f2]) < np.cos(np.radians(EDGE_FEATURE))
+    edges = keys[((counts == 1) | sharp) & (in_patch[f1] | in_patch[f2]) & ~symmetric]
+    if not len(edges):
+        return None
+    xa, xb = s.X[edges[:, 0]], s.X[edges[:, 1]]
+    length = np.linalg.norm(xb - xa, axis=1)
+    h = float(np.median(so.sizes[opatch]))
+    k = np.clip(np.ceil(EDGE_SAMPLES * length / h).astype(int), 2, 400)
+    edge = np.repeat(np.arange(len(edges)), k + 1)
+    t = np.concatenate([np.linspace(0.0, 1.0, kk + 1) for kk in k])
+
+    def seg_at(e, tt):
+        p = (1 - tt)[:, None] * xa[e] + tt[:, None] * xb[e]
+        return so.closest(p, None, opatch)[0]
+
+    seg = seg_at(edge, t)
+    change = np.flatnonzero((edge[1:] == edge[:-1]) & (seg[1:] != seg[:-1]))
+    if not len(change):
+        return None
+    e, lo, hi = edge[change], t[change], t[change + 1]
+    s_lo = seg[change]
+    for _ in range(40):  # bisection to where the closest facet changes
+        mid = 0.5 * (lo + hi)
+        same = seg_at(e, mid) == s_lo
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    tc = 0.5 * (lo + hi)
+    away = np.minimum(tc, 1 - tc) * length[e] > 0.1 * h
+    e, tc = e[away], tc[away]
+    if not len(e):
+        return None
+    pts = (1 - tc)[:, None] * xa[e] + tc[:, None] * xb[e]
+    seg, tt, _, m, tf = so.closest(pts, None, opatch)
+    past = so.beyond(seg, tf, so.patch_boundary(opatch))
+    closest, _ = so.surface_map(seg, tt)
+    gap = np.einsum("ij,ij->i", pts - closest, m)
+    reach = 2.0 * (float(s.sizes[patch].max()) + float(so.sizes[opatch].max()))
+    keep = ~past & (np.abs(gap) <= reach)
+    if not keep.any():
+        return None
+    e, tc, seg, tt, m, gap = e[keep], tc[keep], seg[keep], tt[keep], m[keep], gap[keep]
+    at = np.zeros((len(e), s.nc))
+    rows = np.arange(len(e))
+    at[rows, edges[e, 0]] = 1 - tc
+    at[rows, edges[e, 1]] = tc
+    nodes = np.where(tc < 0.5, edges[e, 0], edges[e, 1])
+    guard = np.full((len(e), so.facets.shape[1]), -1) if feature else so.facets[seg]
+    return (at, nodes, m, gap, so.interpolation(seg, tt), guard, so.sizes[seg],
+            so.rind_depth[seg])
 
 
 def ray_pairing(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, nodes: np.ndarray,
