@@ -8,10 +8,11 @@ nodes only (the cube's edge may pass between them) gives a lower bound of the fo
 cube's edge too wherever it crosses a line of the block's nodes an upper one (the elastic cube
 only lowers it, by about its shortening, 0.1 % of the push). vfem's default answer — the block on
 the compatibility side, the cube's vertices held, and its edge held where it crosses the block's
-facets (``pairing.held_edges``) — must lie between them, within 2 % of the upper one: the block's
-nodes just past the cube's edge are held along the direction to it where the reference holds them
-against the cube's side face (measured: 0.999, 1.010 and 0.999 of it on the 24, 36 and 48 blocks;
-0.843, 0.910 and 0.860 before the edges were held).
+facets (``pairing.held_edges``) — must read more than the lower one and within 2 % of the upper
+one, not below it by more: the block's nodes just past the cube's edge are held along the direction
+to it where the reference holds them against the cube's side face, which can put it a little above
+(measured: 0.999, 1.010 and 0.999 of it on the 24, 36 and 48 blocks, 1.014 and 1.008 on 12 x 12 x 4
+and 16 x 16 x 4; 0.843, 0.910 and 0.860 on the first three before the edges were held).
 """
 import sys
 import tempfile
@@ -30,5 +31,5 @@ def test_the_tilted_cubes_force_lies_within_the_rigid_references_bracket():
     with tempfile.TemporaryDirectory() as tmp:
         run = tilted_cube.run_vfem(24, None, Path(tmp))
     assert run["converged"]
-    assert nodes <= run["force"][2] <= edge
+    assert run["force"][2] >= nodes
     assert abs(run["force"][2] / edge - 1.0) <= 0.02

@@ -89,6 +89,14 @@ SIDE_SAMPLE = 4096
 STALE_CHANGES = 5
 
 
+#: a body forced onto the compatibility side (``contact.compatibility_side``) against the rules'
+#: choice is warned about when its facets over the other surface are this many times larger
+#: (median sizes): it resolves the traction on its own facets (the tilted cube of issue 37, its
+#: facets twice the 24 block's and three times the 36 block's: 1.5-1.8 times a rigid reference,
+#: ``benchmarks/tilted_cube.py``)
+FORCED_COARSER = 1.5
+
+
 class PairSet(SurfaceGroup):
     """The paired variant's parts shared by small and large displacements: the contact pairs
     (which side carries compatibility, their nodes, normals, gaps and transfer), the traction
@@ -194,6 +202,7 @@ class PairSet(SurfaceGroup):
             fine, coarse = (i, j) if ci > cj else (j, i)
         else:  # equal: a rule that does not depend on the order of the bodies
             fine, coarse = (i, j) if si.body.name < sj.body.name else (j, i)
+        chosen = fine
         if self.settings.compatibility_side is not None:  # forced (for testing)
             names = (si.body.name, sj.body.name)
             if self.settings.compatibility_side in names:
@@ -207,6 +216,16 @@ class PairSet(SurfaceGroup):
         if geo is None:
             return None, []
         c_fine, c_coarse = (ci, cj) if fine == i else (cj, ci)
+        if fine != chosen and not flip:
+            ratio = float(np.median(sf.sizes[geo.fpatch]) / np.median(sc.sizes[geo.cpatch]))
+            if ratio >= FORCED_COARSER:
+                log.warning(
+                    "contact pair: %r is forced onto the compatibility side "
+                    "(contact.compatibility_side) with facets %.3g times the size of %r's: its "
+                    "traction is resolved on its own facets, and where the contact zone is "
+                    "narrower than they are the force can be far off (a tilted cube's edge: "
+                    "1.5-1.8 times a rigid reference, docs/benchmarks.md)",
+                    sf.body.name, ratio, sc.body.name)
         past = geo.nodes[geo.beyond]
         if not self.keep_all_nodes:  # only the nodes over the other surface take part
             keep = geo.carries & ~geo.beyond
