@@ -159,7 +159,10 @@ class ContactSettings:
         compatibility_side: the paired variant: the name of a body that carries compatibility
             in every contact pair it belongs to, instead of the surface chosen by stiffness and
             facet size (for testing that the answer does not depend on the choice beyond
-            discretisation error). Default (None): the softer surface, of equals the finer.
+            discretisation error). Default (None): the softer surface, of equals the finer. A
+            forced body whose facets over the other surface are 1.5 times the other's or more
+            is warned about: it resolves the traction on its own facets, and a contact zone
+            narrower than they are can read far off (docs/benchmarks.md, the tilted cube).
         friction: Coulomb's coefficient of friction μ of every contact pair: a node in contact
             sticks (no relative tangential motion against its virtual node within the step) while
             its tangential traction stays within μ times its normal traction, and slips with
