@@ -426,8 +426,10 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     points on ``s`` (linear along the edge between its two corners), ``nodes`` the nearer
     corner (for messages and output), the normal of the other facet at the closest point (gap
     and force), its interpolation on ``so``, the guard (the facet's nodes, or -1 where
-    ``feature``: a stiffer body's edge, held whatever the other side's nodes around it do) and
-    the facet's size (how far the point may slide before its pairing is stale).
+    ``feature``: a stiffer body's edge, held whatever the other side's nodes around it do),
+    the facet's size (how far the point may slide before its pairing is stale) and the
+    thickness of the other body's element under it (the rind check). Points over the other
+    patch are kept at any gap, as its nodes are.
 
     **Why**: the compatibility side's nodes and the equilibrium side's vertices leave the
     equilibrium side's edges free between its vertices. A stiff, coarse cube tilted 10 degrees
