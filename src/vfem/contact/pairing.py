@@ -458,8 +458,14 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     in_patch[patch] = True
     symmetric = np.zeros(len(keys), dtype=bool)
     np.logical_or.at(symmetric, inverse, s.symmetry_edges.reshape(-1))
-    sharp = np.einsum("ij,ij->i", n[f1], n[f2]) < np.cos(np.radians(EDGE_FEATURE))
-    edges = keys[((counts == 1) | sharp) & (in_patch[f1] | in_patch[f2]) & ~symmetric]
+    cos_feature = np.cos(np.radians(EDGE_FEATURE))
+    sharp = np.einsum("ij,ij->i", n[f1], n[f2]) < cos_feature
+    # an edge of the candidate surface's own boundary is sharp where the body's boundary
+    # turns there (a box's face named alone), not where the candidates merely end on a face
+    ends_ = counts == 1
+    if ends_.any():
+        sharp[ends_] = _body_turn(s, keys[ends_], f1[ends_]) < cos_feature
+    edges = keys[sharp & (in_patch[f1] | in_patch[f2]) & ~symmetric]
     if not len(edges):
         return None
     xa, xb = s.X[edges[:, 0]], s.X[edges[:, 1]]
@@ -510,6 +516,33 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     guard = np.full((len(e), so.facets.shape[1]), -1) if feature else so.facets[seg]
     return (at, nodes, m, gap, so.interpolation(seg, tt), guard, so.sizes[seg],
             so.rind_depth[seg])
+
+
+def _body_turn(s: ContactSurface, edges: np.ndarray, facet: np.ndarray) -> np.ndarray:
+    """(k,) the cosine between the candidate ``facet``'s normal and the normal of the body's
+    other boundary facet across each of ``edges`` (candidate numbers; 1 where there is none)."""
+    mesh = s.body.mesh
+    bf = mesh.boundary_facets()
+    corners = mesh.facets[: s.kind.corners, bf].T  # (nb, c) point numbers
+    c = corners.shape[1]
+    pairs = np.sort(np.stack([corners, np.roll(corners, -1, axis=1)], axis=2), axis=2)
+    owner = np.repeat(bf, c)
+    pairs = pairs.reshape(-1, 2)
+    want = np.sort(s.nodes[edges], axis=1)
+    out = np.ones(len(edges))
+    p = mesh.p.T
+    for k, (a, b) in enumerate(want):
+        hit = owner[(pairs[:, 0] == a) & (pairs[:, 1] == b)]
+        other = hit[hit != s.facet_ids[facet[k]]]
+        if not len(other):
+            continue
+        f = other[0]
+        q = p[mesh.facets[: s.kind.corners, f]]
+        m = np.cross(q[1] - q[0], q[2] - q[0])
+        inner = p[mesh.t[:, mesh.f2t[0, f]]].mean(axis=0)
+        m *= np.sign(np.dot(m, q.mean(axis=0) - inner)) / max(np.linalg.norm(m), 1e-300)
+        out[k] = float(np.dot(m, s.facet_normals()[facet[k]]))
+    return out
 
 
 def ray_pairing(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, nodes: np.ndarray,
