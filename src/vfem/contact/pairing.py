@@ -405,11 +405,11 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     return geo, guard, size
 
 
-#: degrees: the least angle between the normals of a surface's two facets across an edge (or
-#: an edge of the contact surface's own boundary) that makes it an edge of its own, held where
-#: it crosses the other surface (:func:`held_edges`): a box's edge turns 90 degrees, a sphere
-#: or cylinder faceted at a few degrees does not count (its faceting is what the other side's
-#: nodes and invariant (b)'s allowance see)
+#: degrees: the least angle between the normals of a surface's two facets across an edge (at
+#: the contact surface's own boundary, its facet's and the body's next boundary facet's) that
+#: makes it an edge of its own, held where it crosses the other surface (:func:`held_edges`):
+#: a box's edge turns 90 degrees, a sphere or cylinder faceted at a few degrees does not count
+#: (its faceting is what the other side's nodes and invariant (b)'s allowance see)
 EDGE_FEATURE = 30.0
 
 #: samples per facet of the other surface along an edge, where :func:`held_edges` looks for
