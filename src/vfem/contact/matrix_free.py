@@ -138,6 +138,8 @@ class PairOperator:
         self.offsets = offsets
         self.m = int(offsets[-1])
         self.interp = [sp.csr_matrix(p.interp) for p in pairs]
+        #: held points on a fine body's edge (``ContactPair.at``), sparse; None at its nodes
+        self.at = [None if p.at is None else sp.csr_matrix(p.at) for p in pairs]
         self.bodies = sorted({b for p in pairs for b in (p.fine, p.coarse)})
         self.diagonal = self._diagonal()
         self.applications = 0  # columns of W applied, for the log and the benchmark
@@ -192,8 +194,7 @@ class PairOperator:
             for j, direction in enumerate(self.directions[i]):
                 cols = np.arange(self.offsets[i] + j * n, self.offsets[i] + (j + 1) * n)
                 value = np.zeros(n)
-                fine = None if pair.at is None else sp.csr_matrix(pair.at)
-                for b, read, sign in ((pair.fine, fine, 1.0),
+                for b, read, sign in ((pair.fine, self.at[i], 1.0),
                                       (pair.coarse, self.interp[i], -1.0)):
                     s = self.surfaces[b]
                     touched, B = blocks[b]

@@ -522,26 +522,29 @@ def _body_turn(s: ContactSurface, edges: np.ndarray, facet: np.ndarray) -> np.nd
     """(k,) the cosine between the candidate ``facet``'s normal and the normal of the body's
     other boundary facet across each of ``edges`` (candidate numbers; 1 where there is none)."""
     mesh = s.body.mesh
+    c = s.kind.corners
     bf = mesh.boundary_facets()
-    corners = mesh.facets[: s.kind.corners, bf].T  # (nb, c) point numbers
-    c = corners.shape[1]
+    corners = mesh.facets[:c, bf].T  # (nb, c) point numbers
     pairs = np.sort(np.stack([corners, np.roll(corners, -1, axis=1)], axis=2), axis=2)
-    owner = np.repeat(bf, c)
-    pairs = pairs.reshape(-1, 2)
+    pairs, owner = pairs.reshape(-1, 2), np.repeat(bf, c)
     want = np.sort(s.nodes[edges], axis=1)
-    out = np.ones(len(edges))
+    # each boundary facet edge's rank among the wanted ones (one sort, not a scan per edge)
+    span = int(max(pairs.max(initial=0), want.max(initial=0))) + 1
+    key, wkey = pairs[:, 0] * span + pairs[:, 1], want[:, 0] * span + want[:, 1]
+    order = np.argsort(wkey)
+    pos = np.clip(np.searchsorted(wkey[order], key), 0, len(wkey) - 1)
+    hit = wkey[order][pos] == key
+    k, f = order[pos[hit]], owner[hit]
+    other = f != s.facet_ids[facet[k]]
+    k, f = k[other], f[other]
     p = mesh.p.T
-    for k, (a, b) in enumerate(want):
-        hit = owner[(pairs[:, 0] == a) & (pairs[:, 1] == b)]
-        other = hit[hit != s.facet_ids[facet[k]]]
-        if not len(other):
-            continue
-        f = other[0]
-        q = p[mesh.facets[: s.kind.corners, f]]
-        m = np.cross(q[1] - q[0], q[2] - q[0])
-        inner = p[mesh.t[:, mesh.f2t[0, f]]].mean(axis=0)
-        m *= np.sign(np.dot(m, q.mean(axis=0) - inner)) / max(np.linalg.norm(m), 1e-300)
-        out[k] = float(np.dot(m, s.facet_normals()[facet[k]]))
+    q = p[mesh.facets[:c, f].T]  # (m, c, 3)
+    m = np.cross(q[:, 1] - q[:, 0], q[:, 2] - q[:, 0])
+    inner = p[mesh.t[:, mesh.f2t[0, f]].T].mean(axis=1)
+    m *= (np.sign(np.einsum("ij,ij->i", m, q.mean(axis=1) - inner))
+          / np.maximum(np.linalg.norm(m, axis=1), 1e-300))[:, None]
+    out = np.ones(len(edges))
+    out[k] = np.einsum("ij,ij->i", m, s.facet_normals()[facet[k]])
     return out
 
 
