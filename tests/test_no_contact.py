@@ -114,26 +114,23 @@ def test_a_platen_pulling_a_touching_body_away_is_named():
     assert "allow more iterations" not in result.message
 
 
-def test_a_platen_whose_bodies_meet_edge_or_corner_first_names_the_side_that_solves_it(
+def test_a_platen_whose_bodies_meet_edge_or_corner_first_is_held_on_either_side(
         monkeypatch):
     """Random model 3d-17 (a tilted box over a block's corner, pushed by a platen): with the
-    box on the compatibility side no node of either body lies over the other's surface where
-    they face each other, so nothing holds the platen. Forced so, the message says that, not
-    "give the platen's force the other sign", and names the compatibility side; by default
-    the side that pairs no node at all gives way to the other (``PairSet._make_pair``) and the
-    model solves, as the block forced onto it did (measured)."""
+    box on the compatibility side none of its nodes' facets carry traction over the block, and
+    before the box's corner node was held as a point (``PairSet._make_pair``: a compatibility
+    node over the other patch whose facets carry none of its traction) and the edges of both
+    bodies where they cross the other's facets (``pairing.held_edges``), nothing held the
+    platen: the analysis stopped with "no node of either body lies over the other's surface"
+    (``PlatenUnpaired``). Now either side, forced or by default, converges with every
+    invariant, the platen's force carried."""
     path = Path(__file__).parent / "data" / "models" / "tilted_box_over_corner.toml"
     monkeypatch.chdir(path.parent)  # (its mesh file is named relative to it)
-    m = vfem.load(path).build()
-    m.contact = dataclasses.replace(m.contact, compatibility_side="upper")
-    result = vfem.solve(m)
-    assert not result.converged
-    assert "no node of either body lies over the other's surface" in result.message
-    assert "compatibility_side" in result.message
-    assert "give the platen's force the sign" not in result.message
-    for side in (None, "block"):
+    for side in (None, "upper", "block"):
         m = vfem.load(path).build()
         m.contact = dataclasses.replace(m.contact, compatibility_side=side)
         solved = vfem.solve(m)
         assert solved.converged, solved.message
         assert all(not s.invariants["failed"] for s in solved.steps)
+        force = solved.steps[-1].bodies["upper"].contact_force.sum(axis=0)
+        assert force[2] == pytest.approx(-m.bodies[0].platen.force, rel=1e-8)

@@ -226,7 +226,14 @@ class PairSet(SurfaceGroup):
                     "narrower than they are the force can be far off (a tilted cube's edge: "
                     "1.5-1.8 times a rigid reference, docs/benchmarks.md)",
                     sf.body.name, ratio, sc.body.name)
-        past = geo.nodes[geo.beyond]
+        # the compatibility side's nodes beyond the other patch, and those over it whose
+        # facets carry none of its traction (a stiff box's corner over a block's corner, its
+        # facet over the block's top by a quarter: it went 45 % of the push into the block,
+        # random model 3d-17): held as points, as the equilibrium side's nodes are
+        loose = geo.beyond.copy()
+        if not self.keep_all_nodes:
+            loose |= ~geo.carries
+        past = geo.nodes[loose]
         if not self.keep_all_nodes:  # only the nodes over the other surface take part
             keep = geo.carries & ~geo.beyond
             geo = geo.subset(keep)
@@ -278,15 +285,21 @@ class PairSet(SurfaceGroup):
                                     h.transfer, h.mass, h.rind_depth, h.carries,
                                     (h.fpatch, h.cpatch), point=True, guard=guard,
                                     gap_normal=h.normal, reach=reach))
-        # and the equilibrium side's edges where they cross the compatibility side's facets
-        # (3D): a stiff box's edge between its vertices
-        edges = held_edges(sc, sf, geo.cpatch, geo.fpatch, feature=c_coarse < c_fine)
-        if edges is not None:
+        # and each side's edges where they cross the other side's facets (3D): a stiff box's
+        # edge between its vertices, a soft block's rim under an overhanging punch
+        for own, other, patches, feature in (
+                (coarse, fine, (geo.cpatch, geo.fpatch), c_coarse < c_fine),
+                (fine, coarse, (geo.fpatch, geo.cpatch), True)):
+            edges = held_edges(
+                self.surfaces[own], self.surfaces[other], *patches, feature=feature,
+                approach=lambda *a, o=own, t=other: self._relative_motion(o, t, *a))
+            if edges is None:
+                continue
             at, nodes, normal, gap, interp, guard, reach, rind = edges
             log.info("contact pair: %d points of %s's edges held against %s", len(nodes),
-                     sc.body.name, sf.body.name)
-            held.append(ContactPair(coarse, fine, nodes, normal, gap, interp, None, None, rind,
-                                    np.ones(len(nodes), dtype=bool), (geo.cpatch, geo.fpatch),
+                     self.surfaces[own].body.name, self.surfaces[other].body.name)
+            held.append(ContactPair(own, other, nodes, normal, gap, interp, None, None, rind,
+                                    np.ones(len(nodes), dtype=bool), patches,
                                     point=True, guard=guard, gap_normal=normal, reach=reach,
                                     at=at))
         return pair, held
@@ -296,18 +309,28 @@ class PairSet(SurfaceGroup):
         loads alone (small kinematics, at load factor 1): the loads' and prescribed
         displacements' motion, or where that is none, the platen's, in the sense that closes
         the gap (:func:`~vfem.contact.pairing.approach_gaps`)."""
-        sf, sc = self.surfaces[fine], self.surfaces[coarse]
+        nc = self.surfaces[coarse].nc
+        return self._relative_motion(fine, coarse, lambda f: f[geo.nodes],
+                                     lambda f: geo.interp @ f[:nc], geo.normal)
 
-        def relative(of_fine: np.ndarray, of_coarse: np.ndarray) -> np.ndarray:
-            return of_fine[geo.nodes] - geo.interp @ of_coarse[: sc.nc]
+    def _relative_motion(self, own: int, other: int, read, read_other,
+                         normal: np.ndarray) -> np.ndarray:
+        """(m, dim) :meth:`_approach` for points of surface ``own`` against ``other``:
+        ``read(field)`` and ``read_other(field)`` give a field of each side's candidate nodes
+        ((nc, dim)) at the points and at their virtual points; ``normal`` the other side's,
+        for the platen's sense."""
+        s, so = self.surfaces[own], self.surfaces[other]
+
+        def relative(of_own: np.ndarray, of_other: np.ndarray) -> np.ndarray:
+            return read(of_own) - read_other(of_other)
 
         def load(s: ContactSurface) -> np.ndarray:
             return s.body.load_displacement(1.0, s.candidate_dofs).reshape(-1, s.dim)
 
-        out = relative(load(sf), load(sc))
-        platen = relative(self.platen_motion[fine], self.platen_motion[coarse])
-        sense = -np.sign(np.einsum("ij,ij->i", platen, geo.normal))[:, None]
-        none = np.linalg.norm(out, axis=1) <= 1e-12 * max(float(np.abs(sf.X).max()), 1e-300)
+        out = relative(load(s), load(so))
+        platen = relative(self.platen_motion[own], self.platen_motion[other])
+        sense = -np.sign(np.einsum("ij,ij->i", platen, normal))[:, None]
+        none = np.linalg.norm(out, axis=1) <= 1e-12 * max(float(np.abs(s.X).max()), 1e-300)
         return np.where(none[:, None], sense * platen, out)
 
     def _compliance_density(self, i: int, j: int) -> tuple[float, bool]:

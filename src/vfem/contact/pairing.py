@@ -256,10 +256,23 @@ def ray_entry(s: ContactSurface, points: np.ndarray, directions: np.ndarray) -> 
     the body of the surface ``s`` through one of its facets (undeformed; crossing a piece from
     its outer side), inf where the ray meets none. Every piece is tested against every ray
     (blocks of :data:`RAY_BLOCK`): done once per pair, for the nodes that approach."""
+    return ray_facet(s, points, directions)[0]
+
+
+def ray_facet(s: ContactSurface, points: np.ndarray, directions: np.ndarray,
+              facets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`ray_entry` through the facets ``facets`` of ``s`` alone (all where None), and
+    the facet each ray enters by (-1 where it meets none)."""
     pieces, facet = _pieces(s)
+    if facets is not None:
+        mine = np.isin(facet, facets)
+        pieces, facet = pieces[mine], facet[mine]
     x = s.X[: s.nc]
     outward = s.facet_normals()[facet]
     out = np.full(len(points), np.inf)
+    which = np.full(len(points), -1)
+    if not len(pieces):
+        return out, which
     scale = max(float(np.ptp(x, axis=0).max(initial=0.0)), 1e-300)
     chunk = max(1, RAY_BLOCK // max(len(pieces), 1))
     for lo in range(0, len(points), chunk):
@@ -292,8 +305,12 @@ def ray_entry(s: ContactSurface, points: np.ndarray, directions: np.ndarray) -> 
             t = np.einsum("npd,npd->np", np.broadcast_to(e2, q.shape), q) / den
             hit = ok & (u >= -1e-12) & (v >= -1e-12) & (u + v <= 1 + 1e-12)
         hit &= entering & (t >= -1e-12 * scale)
-        out[lo:lo + chunk] = np.where(hit, t, np.inf).min(axis=1, initial=np.inf)
-    return out
+        t = np.where(hit, t, np.inf)
+        first = t.argmin(axis=1)
+        rows = np.arange(len(t))
+        out[lo:lo + chunk] = t[rows, first]
+        which[lo:lo + chunk] = np.where(np.isfinite(t[rows, first]), facet[first], -1)
+    return out, which
 
 
 def _unit_motion(motion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -416,32 +433,54 @@ EDGE_FEATURE = 30.0
 #: the facets it crosses (then found to round-off by bisection)
 EDGE_SAMPLES = 4
 
+#: of the other surface's facet size: a crossing nearer than this to a corner of the edge that
+#: lies over the other patch is left to that corner (:func:`held_edges`; two conditions of
+#: nearly one)
+EDGE_NEAR = 0.02
+
+#: the least product of the local coordinates' changes across a bilinear facet for which an
+#: edge is held at the midpoint between its crossings too (:func:`_twisted`)
+EDGE_TWIST = 0.05
+
 
 def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch: np.ndarray,
-               feature: bool) -> tuple | None:
-    """3D: the points where the edges of ``s``'s patch ``patch`` (the equilibrium side's: a
-    stiff box's edges, :data:`EDGE_FEATURE`) cross the edges of the other patch ``opatch``'s
+               feature: bool, approach=None) -> tuple | None:
+    """3D: the points where the sharp edges of ``s``'s patch ``patch`` (:data:`EDGE_FEATURE`:
+    a stiff box's edges, a block's rim) cross the edges of the other patch ``opatch``'s
     facets, held against it by point forces as its nodes are (:func:`held_nodes`), undeformed.
     Returns (at, nodes, normal, gap, interp, guard, reach, rind) or None: ``at`` (m, nc) the
     points on ``s`` (linear along the edge between its two corners), ``nodes`` the nearer
-    corner (for messages and output), the normal of the other facet at the closest point (gap
-    and force), its interpolation on ``so``, the guard (the facet's nodes, or -1 where
-    ``feature``: a stiffer body's edge, held whatever the other side's nodes around it do),
-    the facet's size (how far the point may slide before its pairing is stale) and the
-    thickness of the other body's element under it (the rind check). Points over the other
-    patch are kept at any gap, as its nodes are.
+    corner (for messages and output), the normal of the other facet where the point meets it
+    (gap and force), its interpolation on ``so``, the guard (the facet's nodes, or -1 where
+    ``feature``: held whatever the other side's nodes around it do), the facet's size (how
+    far the point may slide before its pairing is stale) and the thickness of the other
+    body's element under it (the rind check). Points over the other patch are kept at any
+    gap, as its nodes are.
+
+    Where ``approach`` is given (``approach(read, read_other, normal)``, the loads' relative
+    motion, :meth:`~vfem.contact.paired.PairSet._relative_motion`), a point that approaches
+    its closest facet clearly (within 60 degrees of its inward normal) is read where the ray
+    along that motion enters the other patch (:func:`ray_facet`): the facet under it, and its
+    pairing; others at their closest point, and only where they lie over (or under) that
+    facet, not off its edge past a corner of the other surface.
 
     **Why**: the compatibility side's nodes and the equilibrium side's vertices leave the
-    equilibrium side's edges free between its vertices. A stiff, coarse cube tilted 10 degrees
-    and pushed 0.02 edge first into a finer, 2000 times softer block had its edge 0.0117 below
-    the block's deformed surface between its vertices, where one block facet spans the edge,
-    and read 0.84 of the force of the block on a rigid cube with that edge held
+    edges free between their vertices. A stiff, coarse cube tilted 10 degrees and pushed
+    0.02 edge first into a finer, 2000 times softer block had its edge 0.0117 below the
+    block's deformed surface between its vertices, where one block facet spans the edge, and
+    read 0.84 of the force of the block on a rigid cube with that edge held
     (``benchmarks/tilted_cube.py``). Along a line the other surface is linear between the
-    edges of its facets (bilinear facets too, along a line parallel to a side), so holding
-    the crossings holds the edge, and where the edge leaves the other patch, the last point
-    over it (a box's edge across a block's edge: the box's edge inside the block by 18 % of
-    the push at the block's rim, random model 3d-51); a point within a tenth of a facet of a
-    corner is left to the corner (two conditions of nearly one)."""
+    edges of its facets (bilinear facets too along a line parallel to a side; obliquely,
+    :func:`_twisted`), so holding the crossings holds the edge, and where the edge leaves
+    the other patch, the last point over it (a box's edge across a block's edge: the box's
+    edge inside the block by 18 % of the push at the block's rim, random model 3d-51). The
+    compatibility side's edges too: a soft block's rim under an overhanging stiff punch lay
+    between the block's rim nodes inside the punch's facets (random models 3d-6, 3d-41,
+    3d-47). Read by closest point at rest, a point far from the other surface (a block's rim
+    0.47 below a sphere-ended punch's cap) is under a facet near the cap's lowest point, not
+    the one it meets: the crossings were missed and the rim went 0.9 of the push into the
+    cap (3d-14). A point within :data:`EDGE_NEAR` of a facet of a corner over the patch is
+    left to the corner (two conditions of nearly one)."""
     if s.dim != 3 or s.kind.order != 1 or not len(patch) or not len(opatch):
         return None
     ends = s.kind.edge_nodes(s.facets)  # (nf, ne, 2)
@@ -477,34 +516,73 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
 
     boundary = so.patch_boundary(opatch)
 
-    def label(e, tt):
-        """The facet of the other patch under each point, -1 beyond the patch."""
-        p = (1 - tt)[:, None] * xa[e] + tt[:, None] * xb[e]
-        seg, _, _, _, tf = so.closest(p, None, opatch)
-        return np.where(so.beyond(seg, tf, boundary), -1, seg)
+    def point(e, tt):
+        return (1 - tt)[:, None] * xa[e] + tt[:, None] * xb[e]
 
-    lab = label(edge, t)
+    def label(e, tt, u):
+        """The facet of the other patch under each point, -1 beyond the patch: where the ray
+        along ``u`` enters it, or (rows of ``u`` nan) the closest."""
+        p = point(e, tt)
+        seg, xi, _, m, tf = so.closest(p, None, opatch)
+        out = np.where(so.beyond(seg, tf, boundary) | ~over_facet(p, seg, xi, m), -1, seg)
+        ray = ~np.isnan(u[:, 0])
+        if ray.any():
+            out[ray] = ray_facet(so, p[ray], u[ray], opatch)[1]
+        return out
+
+    def meet(p, u):
+        """Where each point meets the other patch, along its ray (rows of ``u`` not nan) or
+        at its closest point: (facet, local coordinates, normal, over the patch)."""
+        ray = ~np.isnan(u[:, 0])
+        q = p.copy()
+        over = np.ones(len(p), dtype=bool)
+        if ray.any():
+            dist, _ = ray_facet(so, p[ray], u[ray], opatch)
+            over[ray] = np.isfinite(dist)
+            q[ray] = p[ray] + np.where(np.isfinite(dist), dist, 0.0)[:, None] * u[ray]
+        # (a ray that enters at an edge of two facets meets the one that faces it)
+        seg, tt, _, m, tf = so.closest(q, None, opatch, np.where(ray[:, None], u, 0.0))
+        over &= ray | (~so.beyond(seg, tf, boundary) & over_facet(p, seg, tt, m))
+        return seg, tt, m, over
+
+    def over_facet(p, seg, xi, m):
+        """Whether each point lies over (or under) its closest facet, within 60 degrees of
+        its normal, not past a corner of the other surface off the facet's edge (a box's
+        edge 0.42 above a block's top, closest to the block's side at its rim: gap 0 along
+        that side's normal), or on it."""
+        c, _ = so.surface_map(seg, xi)
+        d = p - c
+        dist = np.linalg.norm(d, axis=1)
+        return ((np.abs(np.einsum("ij,ij->i", d, m)) >= 0.5 * dist)
+                | (dist <= 1e-3 * so.sizes[seg]))
+
+    u_s = _edge_approach(s, so, opatch, edges, edge, t, point(edge, t), approach)
+    lab = label(edge, t, u_s)
     change = np.flatnonzero((edge[1:] == edge[:-1]) & (lab[1:] != lab[:-1]))
-    if not len(change):
-        return None
-    e, lo, hi = edge[change], t[change], t[change + 1]
+    e, lo, hi, u = edge[change], t[change], t[change + 1], u_s[change]
     s_lo, s_hi = lab[change], lab[change + 1]
     for _ in range(40):  # bisection to where the facet under the edge changes
         mid = 0.5 * (lo + hi)
-        same = label(e, mid) == s_lo
+        same = label(e, mid, u) == s_lo
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
     # (where the edge leaves the patch, the last point over it: the patch's own edge)
     tc = np.where(s_hi < 0, lo, np.where(s_lo < 0, hi, 0.5 * (lo + hi)))
-    away = np.minimum(tc, 1 - tc) * length[e] > 0.1 * h
-    e, tc = e[away], tc[away]
+    # (a point within EDGE_NEAR of a facet of a corner over the patch is left to that
+    # corner: two conditions of nearly one; a corner beyond the patch holds nothing)
+    near = np.where(s_hi < 0, tc, np.where(s_lo < 0, 1 - tc, np.minimum(tc, 1 - tc)))
+    away = near * length[e] > EDGE_NEAR * h
+    if so.kind.corners == 4 and so.kind.order == 1:  # and across twisted bilinear facets
+        te, tt_, tu = _twisted(len(edges), point, k, u_s, e, tc, label, meet)
+        e, tc, u = np.r_[e[away], te], np.r_[tc[away], tt_], np.r_[u[away], tu]
+    else:
+        e, tc, u = e[away], tc[away], u[away]
     if not len(e):
         return None
-    pts = (1 - tc)[:, None] * xa[e] + tc[:, None] * xb[e]
-    seg, tt, _, m, tf = so.closest(pts, None, opatch)
-    past = so.beyond(seg, tf, boundary)
+    pts = point(e, tc)
+    # each point paired where it meets the other patch: along its ray, else the closest point
+    seg, tt, m, keep = meet(pts, u)  # (over the other patch, at any gap)
     closest, _ = so.surface_map(seg, tt)
     gap = np.einsum("ij,ij->i", pts - closest, m)
-    keep = ~past  # (over the other patch, at any gap: as the nodes are)
     if not keep.any():
         return None
     e, tc, seg, tt, m, gap = e[keep], tc[keep], seg[keep], tt[keep], m[keep], gap[keep]
@@ -516,6 +594,69 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     guard = np.full((len(e), so.facets.shape[1]), -1) if feature else so.facets[seg]
     return (at, nodes, m, gap, so.interpolation(seg, tt), guard, so.sizes[seg],
             so.rind_depth[seg])
+
+
+def _twisted(ne: int, point, k: np.ndarray, u: np.ndarray, e: np.ndarray, tc: np.ndarray,
+             label, meet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The midpoints of the pieces of ``ne`` edges (``point(edge, t)`` their points; ``k``
+    sample intervals each, ``u`` the samples' directions) between their ends and the
+    crossings ``e``, ``tc`` that lie over one bilinear facet of the other patch and cross it
+    obliquely (its local coordinates changing by at least :data:`EDGE_TWIST` in product):
+    (edge, parameter, direction) each; ``label`` and ``meet`` :func:`held_edges`' own.
+
+    **Why**: a bilinear facet along a line oblique to its sides is quadratic, c s (1 - s)
+    off the chord between the line's crossings of its edges, c the facet's twist (x1 - x2 +
+    x3 - x4 of its corners, along its normal) times the product of the local coordinates'
+    changes, largest at the midpoint whatever its sign. A flat cylinder's rim across a soft
+    block's twisted hexahedron faces (random model 3d-59) lay 5.1 % of the push inside the
+    block between crossings held at their gaps. Where the product is small the midpoint adds
+    nearly the crossings' own condition (two of nearly one)."""
+    ea = np.r_[np.arange(ne), np.arange(ne), e]
+    ta = np.r_[np.zeros(ne), np.ones(ne), tc]
+    order = np.lexsort((ta, ea))
+    ea, ta = ea[order], ta[order]
+    same = (ea[1:] == ea[:-1]) & (ta[1:] - ta[:-1] > 1e-9)
+    em, a, b = ea[:-1][same], ta[:-1][same], ta[1:][same]
+    tm = 0.5 * (a + b)
+    starts = np.r_[0, np.cumsum(k + 1)[:-1]]
+    um = u[starts[em] + np.rint(tm * k[em]).astype(int)]
+    lab = label(em, tm, um) if len(em) else np.zeros(0, dtype=int)
+    on = lab >= 0
+    em, a, b, tm, um, lab = em[on], a[on], b[on], tm[on], um[on], lab[on]
+    if not len(em):
+        return np.zeros(0, dtype=int), np.zeros(0), np.zeros((0, u.shape[1]))
+    s1, x1, _, o1 = meet(point(em, a + 0.25 * (b - a)), um)
+    s3, x3, _, o3 = meet(point(em, a + 0.75 * (b - a)), um)
+    d = 2.0 * (x3 - x1)  # the local coordinates' change over the piece
+    use = o1 & o3 & (s1 == lab) & (s3 == lab) & (np.abs(d[:, 0] * d[:, 1]) >= EDGE_TWIST)
+    return em[use], tm[use], um[use]
+
+
+def _edge_approach(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, edges: np.ndarray,
+                   edge: np.ndarray, t: np.ndarray, points: np.ndarray, approach) -> np.ndarray:
+    """(m, dim) the unit direction along which each point of an edge (``edges[edge]`` at
+    ``t``, at ``points``) approaches the other patch ``opatch``, nan where it does not clearly
+    (within 60 degrees of the closest facet's inward normal) or ``approach`` is None.
+    ``approach(read, read_other, normal)``: the relative motion under the loads
+    (:meth:`~vfem.contact.paired.PairSet._relative_motion`) given how to read a field of
+    each side's candidate nodes at the points and at their closest points."""
+    out = np.full(points.shape, np.nan)
+    if approach is None:
+        return out
+    seg, tt, _, m, _ = so.closest(points, None, opatch)
+    a, b = edges[edge, 0], edges[edge, 1]
+    phi, nodes = so.shape(tt), so.facets[seg]
+
+    def read(field: np.ndarray) -> np.ndarray:
+        return (1 - t)[:, None] * field[a] + t[:, None] * field[b]
+
+    def read_other(field: np.ndarray) -> np.ndarray:
+        return np.einsum("kn,knd->kd", phi, field[nodes])
+
+    u, moving = _unit_motion(approach(read, read_other, m))
+    clear = moving & (np.einsum("ij,ij->i", m, u) <= -0.5)
+    out[clear] = u[clear]
+    return out
 
 
 def _body_turn(s: ContactSurface, edges: np.ndarray, facet: np.ndarray) -> np.ndarray:
