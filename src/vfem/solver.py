@@ -278,15 +278,15 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
                 "platen) has nothing to push against until it touches")
     if isinstance(exc, InvariantViolation):
         bodies = getattr(exc, "bodies", None)
-        # (measured: benchmarks/random_models.py --remedies, seed 0, 2026-11-29, fifth
-        # session: of its 3 stopped models the other compatibility side solved all 3, four
-        # times the steps none, large kinematics 2 of the 2 it applies to; at the state with
-        # 20 stops, 13 of 20, none, none)
+        # (measured: benchmarks/random_models.py --remedies, seed 0, 2026-11-30, seventh
+        # session: of its 2 stopped models the other compatibility side solved both, four
+        # times the steps none, large kinematics the 1 it applies to; the fifth session, 3 of
+        # 3, none, 2 of 2; at the state with 20 stops, 13 of 20, none, none)
         first = "" if not bodies else (
             f"try the other body of the two on the compatibility side (contact."
             f"compatibility_side = \"{bodies[0]}\" or \"{bodies[1]}\": the side whose nodes "
             "are held by tractions; measured on the random models that stopped "
-            "(benchmarks/random_models.py --remedies), it solved 3 of 3, and 13 of 20 "
+            "(benchmarks/random_models.py --remedies), it solved 2 of 2, and 13 of 20 "
             "before the last changes, where four times the steps solved none); else ")
         remedy = (f"the contact iteration met its own stopping rule but the state it reached "
                   f"breaks an invariant checked from the full-mesh results; {first}refine the "
