@@ -567,6 +567,13 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
     # (where the edge leaves the patch, the last point over it: the patch's own edge)
     tc = np.where(s_hi < 0, lo, np.where(s_lo < 0, hi, 0.5 * (lo + hi)))
+    # one point where two changes meet (a sample on a vertex of the other surface, read on a
+    # third facet by the ray's tie: two changes bisected to one point, two equal conditions)
+    order = np.lexsort((tc, e))
+    e, tc, u, s_lo, s_hi = e[order], tc[order], u[order], s_lo[order], s_hi[order]
+    again = np.zeros(len(e), dtype=bool)
+    again[1:] = (e[1:] == e[:-1]) & ((tc[1:] - tc[:-1]) * length[e[1:]] <= EDGE_NEAR * h)
+    e, tc, u, s_lo, s_hi = e[~again], tc[~again], u[~again], s_lo[~again], s_hi[~again]
     # (a point within EDGE_NEAR of a facet of a corner over the patch is left to that
     # corner: two conditions of nearly one; a corner beyond the patch holds nothing)
     near = np.where(s_hi < 0, tc, np.where(s_lo < 0, 1 - tc, np.minimum(tc, 1 - tc)))
