@@ -523,11 +523,15 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
         """The facet of the other patch under each point, -1 beyond the patch: where the ray
         along ``u`` enters it, or (rows of ``u`` nan) the closest."""
         p = point(e, tt)
-        seg, xi, _, m, tf = so.closest(p, None, opatch)
-        out = np.where(so.beyond(seg, tf, boundary) | ~over_facet(p, seg, xi, m), -1, seg)
         ray = ~np.isnan(u[:, 0])
+        out = np.full(len(p), -1)
         if ray.any():
             out[ray] = ray_facet(so, p[ray], u[ray], opatch)[1]
+        if (~ray).any():  # (the closest point only where there is no ray: the bisection's
+            q = p[~ray]   # 40 passes read every crossing)
+            seg, xi, _, m, tf = so.closest(q, None, opatch)
+            out[~ray] = np.where(so.beyond(seg, tf, boundary) | ~over_facet(q, seg, xi, m),
+                                 -1, seg)
         return out
 
     def meet(p, u):
