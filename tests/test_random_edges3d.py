@@ -20,22 +20,29 @@ Measured before (2026-11-30, at 59efe15), the deepest point inside the other bod
   accident of the closest point at rest, now refused: ``over_facet``).
 
 The first three are quick enough for every run; the slow set holds the others of the kind.
+
+Not tuned for (seed 2): 3d-5, a stiff block's edge under a soft flat cylinder's face, crossed
+two of the cylinder's facet edges 0.19 of a facet apart, between two of ``held_edges``'
+samples; one bisection found one of them, and the edge lay 2.08 % of the push inside the
+cylinder at the other (now both, ``pairing._crossings``: 0.30 %).
 """
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import vfem
+from vfem.contact.pairing import _crossings
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import random_models  # noqa: E402
 
 
-def solve_and_check(k: int, folder: Path) -> dict:
-    p = random_models.draw(0, 3, k)
+def solve_and_check(k: int, folder: Path, seed: int = 0) -> dict:
+    p = random_models.draw(seed, 3, k)
     assert p["id"] == f"3d-{k}"
     config, info = random_models.build(p, folder)
     result = vfem.solve(config.build(folder))
@@ -57,3 +64,28 @@ def test_the_other_rims_of_the_study_stay_outside(k, tmp_path):
     stiff block's rim under a soft sphere-ended punch's cap, 0.5 below it at rest)."""
     checks = solve_and_check(k, tmp_path)
     assert not checks["failed"], checks
+
+
+@pytest.mark.slow
+def test_two_crossings_between_two_samples_hold_the_edge(tmp_path):
+    """3d-5 of seed 2 (module docstring)."""
+    checks = solve_and_check(5, tmp_path, seed=2)
+    assert not checks["failed"], checks["deepest"]
+
+
+def test_two_crossings_between_two_samples_are_both_found():
+    """``held_edges``' bisection: where the facet under an edge changes twice between two
+    samples (the edge passing near a vertex of the other surface), both changes are found, and
+    a third: each to round-off, with the facets on either side."""
+    walls = np.array([0.30, 0.31, 0.32])
+
+    def label(e, t, u):
+        return np.searchsorted(walls, t)  # facets 0 | 1 | 2 | 3 along the edge
+
+    e, lo, hi, u, s_lo, s_hi = _crossings(
+        label, np.array([0]), np.array([0.25]), np.array([0.5]), np.full((1, 3), np.nan),
+        np.array([0]), np.array([3]))
+    order = np.argsort(lo)
+    np.testing.assert_allclose(lo[order], walls, atol=1e-12)
+    np.testing.assert_allclose(hi[order], walls, atol=1e-12)
+    assert list(s_lo[order]) == [0, 1, 2] and list(s_hi[order]) == [1, 2, 3]
