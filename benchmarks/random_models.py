@@ -1151,7 +1151,9 @@ def solve_one(p: dict, method: str) -> dict:
                     "traceback": traceback.format_exc()[-2000:]}
         rec.update(seconds=time.perf_counter() - t0, steps=len(result.steps),
                    iterations=[s.iterations for s in result.steps],
-                   solver_pen_tol=result.penetration_tolerance)
+                   solver_pen_tol=result.penetration_tolerance,
+                   # the solver switched a pair's compatibility side on the way (issue 37)
+                   switched=bool(result.steps and result.steps[-1].compatibility_switched))
         try:
             checks = check(result, p, info)
         except Exception:
@@ -1285,6 +1287,8 @@ def line(p: dict, recs: dict) -> str:
                 # (beyond the threshold on the deformed geometry, within it as small
                 # kinematics reads it: check 4)
                 text += f" (linearised {c['judged_depth'] / c['push']:.2g})"
+        if r.get("switched"):
+            text += " (side switched)"
         if "seconds" in r:
             text += f" {r['seconds']:.1f}s"
         return text
@@ -1307,6 +1311,8 @@ def summary(models: list[dict], results: dict, seed: int, seconds: float) -> tup
         counts[cls]["second order"] = sum(
             r["status"] == "solved" and r["checks"]["depth"] > r["checks"]["threshold"]
             for r in recs)
+        counts[cls]["switched"] = sum(r["status"] == "solved" and bool(r.get("switched"))
+                                      for r in recs)
         for kind in ("timeout", "crash"):
             counts[cls][kind] = sum(r["status"] == "stopped" and r["message"].startswith(kind)
                                     for r in recs)
@@ -1318,6 +1324,9 @@ def summary(models: list[dict], results: dict, seed: int, seconds: float) -> tup
             which = ", ".join(f"{c[k]} {k}" for k in ("timeout", "crash") if c[k])
             second = (f", {c['second order']} of the solved beyond it on the deformed geometry"
                       if c["second order"] else "")
+            if c["switched"]:
+                second += (f", {c['switched']} of the solved with the compatibility side "
+                           "switched")
             parts.append(f"{cls} {c['solved']}/{c['total']} solved ({c['stopped']} stopped"
                          f"{f' [{which}]' if which else ''}, {c['wrong']} wrong{other}"
                          f"{second})")

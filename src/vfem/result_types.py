@@ -108,6 +108,9 @@ class StepResult:
     #: the invariants of the converged state (``Invariants.record()``: force_balance,
     #: max_penetration_any_body, allowed, where, tension, ...); empty when not checked
     invariants: dict = field(default_factory=dict)
+    #: per pair ("a/b") whose compatibility side the solver switched in this run by this step
+    #: (:meth:`vfem.solver.Analysis._switch_side`), the body that carries it; empty where none
+    compatibility_switched: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -139,6 +142,9 @@ class Checkpoint:
     target: int = 1  # the next scheduled load factor: model.load_factors[target - 1]
     level: int = 0  # halvings of the scheduled increment now in use
     easy: int = 0  # easy steps in a row at that level
+    #: [i, j, body] per pair of bodies i < j whose compatibility side the run had switched,
+    #: and the body that carries it (``Analysis.sides``)
+    sides: list = field(default_factory=list)
 
 
 #: The phases of a run (issue 19): what each takes, from the timings an analysis records

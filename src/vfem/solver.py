@@ -266,10 +266,13 @@ def fixed_point_message(steps: list[StepResult], penetration_tolerance: float) -
 
 
 def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
-              settings: ContactSettings, unreachable: list[str] = ()) -> str:
+              settings: ContactSettings, unreachable: list[str] = (),
+              tried: str = "") -> str:
     """The message of an analysis that stops: which step, what failed (the error names the
     bodies and nodes), and what the user can change. ``unreachable``: notes of
-    :func:`unreachable_pairs`, the likely cause when there are any."""
+    :func:`unreachable_pairs`, the likely cause when there are any; ``tried``: what the
+    solver's switch of the pair's compatibility side came to (:meth:`Analysis._switch_side`):
+    "" where it was not tried."""
     text = str(exc)
     if unreachable:
         return (f"step {step} (load factor {start:.6g} -> {target:.6g}) failed: no contact was "
@@ -282,12 +285,15 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
         # session: of its 2 stopped models the other compatibility side solved both, four
         # times the steps none, large kinematics the 1 it applies to; the fifth session, 3 of
         # 3, none, 2 of 2; at the state with 20 stops, 13 of 20, none, none)
-        first = "" if not bodies else (
+        first = "" if not bodies or tried else (
             f"try the other body of the two on the compatibility side (contact."
             f"compatibility_side = \"{bodies[0]}\" or \"{bodies[1]}\": the side whose nodes "
             "are held by tractions; measured on the random models that stopped "
             "(benchmarks/random_models.py --remedies), it solved 2 of 2, and 13 of 20 "
-            "before the last changes, where four times the steps solved none); else ")
+            "before the last changes, where four times the steps solved none; the solver "
+            "switches it itself where the side was not set, without friction, under small "
+            "kinematics); else ")
+        first = tried or first
         remedy = (f"the contact iteration met its own stopping rule but the state it reached "
                   f"breaks an invariant checked from the full-mesh results; {first}refine the "
                   "mesh where the nodes named are, or take smaller steps ([steps] count); "
@@ -297,8 +303,8 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
                   "models it solved 2 of the 2 it applies to); if it persists report it with "
                   "the input (a contact formulation error)")
     elif isinstance(exc, RindViolation):
-        remedy = ("take smaller steps ([steps] count), or give the bodies deeper surface "
-                  "elements so a step's overlap stays inside them")
+        remedy = (f"{tried}take smaller steps ([steps] count), or give the bodies deeper "
+                  "surface elements so a step's overlap stays inside them")
     elif isinstance(exc, PlatenOffForce):
         remedy = (f"{PLATEN_REMEDY}; else allow more iterations (contact.max_iterations = "
                   f"{settings.max_iterations}) or smaller steps")
@@ -351,6 +357,11 @@ class Analysis:
         self.timings: dict[str, float] = {}
         self.strain_warned: set[str] = set()  # bodies already warned about (warn_large_strain)
         self.unreachable: list[str] = []  # pairs that cannot touch (unreachable_pairs)
+        #: per pair (i, j), i < j, whose compatibility side was switched (:meth:`_switch_side`),
+        #: the body that carries it; and per pair whose other side was tried and not kept,
+        #: what the stop message says of it
+        self.sides: dict[tuple[int, int], int] = {}
+        self.side_notes: dict[tuple[int, int], str] = {}
 
     def setup(self) -> None:
         """Find each body's contact candidates, then assemble and factorize every body.
@@ -377,6 +388,7 @@ class Analysis:
         log.info("linear solver: %s", self.backend)
         bodies = self.model.bodies
         pairs, self.surfaces = self.model.contact_surfaces()
+        self.pairs = pairs
         # condensed to the candidate dofs alone unless the formulation reads the rind (issue 19)
         reads_rind = self._formulation().capabilities.reads_rind
         for s in self.surfaces:
@@ -450,8 +462,9 @@ class Analysis:
     def _contact(self, pairs: set[frozenset[int]]):
         """The contact formulation of the model's settings and kinematics
         (:func:`~vfem.contact.formulation.formulation_class`)."""
+        extra = {"sides": dict(self.sides)} if self.sides else {}
         return self._formulation()(self.surfaces, pairs, self.model.contact,
-                                   backend=self.backend)
+                                   backend=self.backend, **extra)
 
     def _formulation(self) -> type:
         """The formulation class of the model's contact settings and kinematics."""
@@ -580,7 +593,9 @@ class Analysis:
         increment, down to 1 / 2**``max_step_cuts`` of the scheduled one; after
         :data:`EASY_STEPS` steps in a row that converge in at most :func:`easy_iterations`
         iterations the increment doubles again, up to the scheduled one. Scheduled load factors
-        are always reached exactly.
+        are always reached exactly. A step that breaks invariant (b) or meets the rind at every
+        cut may have its pair's compatibility side switched (:meth:`_switch_side`) and is then
+        solved again from the full increment.
         """
         if not hasattr(self, "contact"):
             self.setup()
@@ -593,10 +608,18 @@ class Analysis:
         max_cuts = settings.max_step_cuts if caps.cuts_steps else 0
         easy_limit = easy_iterations(settings)
         if start is None:
+            if self.sides:  # (a run before on this analysis switched some: the rules' again)
+                self.sides.clear()
+                self.contact = self._contact(self.pairs)
+            self.side_notes.clear()
             state = self.contact.new_state()
             steps: list[StepResult] = []
             self.target, self.level, self.easy = 1, 0, 0
         else:
+            sides = {(int(i), int(j)): int(c) for i, j, c in start.sides}
+            if sides != self.sides:  # the sides the run had switched by then
+                self.sides = sides
+                self.contact = self._contact(self.pairs)
             state, steps = start.state.copy(), list(start.steps)
             self.target, self.level, self.easy = start.target, start.level, start.easy
             for b in self.model.bodies:
@@ -645,10 +668,18 @@ class Analysis:
                 if self._enforce(exc):
                     continue  # the same step again, the node held (not a cut)
                 self.easy = 0
+                switched = self._switch_side(exc, lf, steps) if self.level >= max_cuts \
+                    else None
+                if switched is not None:
+                    # the step again from the last converged load factor and the full
+                    # increment, the pair's other side carrying compatibility
+                    state = self.state = switched
+                    self.level = 0
+                    continue
                 if self.level >= max_cuts:
                     converged = False
                     message = diagnosis(len(steps) + 1, state.load_factor, lf, self.level, exc,
-                                        settings, self.unreachable)
+                                        settings, self.unreachable, self._tried(exc))
                     log.info(message)  # the caller reports it (AnalysisResult.message)
                     break
                 self.level += 1
@@ -671,7 +702,8 @@ class Analysis:
             step = StepResult(step=len(steps) + 1, load_factor=lf, iterations=iterations,
                               converged=not res.fixed_point, history=history,
                               platen_displacement=state.platen_displacement, cuts=self.level,
-                              fixed_point=res.fixed_point, invariants=invariants.record())
+                              fixed_point=res.fixed_point, invariants=invariants.record(),
+                              compatibility_switched=self._sides())
             step.bodies = fields
             self.warn_large_strain(step)
             steps.append(step)
@@ -724,6 +756,109 @@ class Analysis:
         self._enforced_step = (len(self.steps), n + 1)
         return True
 
+    def _pair_of(self, exc: AnalysisError) -> tuple[int, int] | None:
+        """The pair (i, j), i < j, of the two bodies an error names (``exc.bodies``), or None."""
+        bodies = getattr(exc, "bodies", None)
+        names = [b.name for b in self.model.bodies]
+        if not bodies or any(n not in names for n in bodies) or bodies[0] == bodies[1]:
+            return None
+        i, j = sorted(names.index(n) for n in bodies)
+        return i, j
+
+    def _tried(self, exc: AnalysisError) -> str:
+        """What the stop message says of the pair an error names where the solver tried its
+        other compatibility side (:meth:`_switch_side`), "" where it did not."""
+        key = self._pair_of(exc)
+        if key in self.sides:
+            return ("the solver switched the pair's compatibility side to the other body "
+                    f"({self.model.bodies[self.sides[key]].name!r}) already, and it failed "
+                    "too; ")
+        return self.side_notes.get(key, "")
+
+    def _switch_side(self, exc: AnalysisError, load_factor: float, steps: list[StepResult]
+                     ) -> ContactState | None:
+        """A step that broke invariant (b), or pushed a node past the rind, at every cut: where
+        the rules chose the pair's compatibility side (``contact.compatibility_side`` unset),
+        the contact is frictionless under small kinematics (each load factor's answer its own,
+        whatever the path) and the pair has not been switched before, the other body carries
+        it from now on. Returns the contact state of the switched formulation at the last
+        converged load factor (reached through the load factors of ``steps``), or None: no
+        switch (the other side pairs no node, or it did not reach those load factors again:
+        the rules' side is kept, and the stop message says what was tried).
+
+        **Why**: where one side's mesh cannot resolve the contact (a soft rectangle's corner
+        sliding along a block turned by the load, random model 2d-75; a stiff round face
+        coarsely met, 2d-215), no step size helps (four times the steps solved neither) and
+        the other side solves both (``benchmarks/random_models.py --remedies``). The
+        invariants judge the switched side as they judged the first; a forced coarser side's
+        warning (:data:`~vfem.contact.paired.FORCED_COARSER`) is given for it too."""
+        from .contact.paired import PairedContact
+
+        if not (isinstance(exc, RindViolation)
+                or (isinstance(exc, InvariantViolation) and getattr(exc, "where", None))):
+            return None  # ((b) failed: ``where`` is set only then)
+        key = self._pair_of(exc)
+        if (key is None or key in self.sides or key in self.side_notes
+                or self.model.contact.compatibility_side is not None
+                or type(self.contact) is not PairedContact or key not in self.contact.carriers):
+            return None
+        carrier, _ = self.contact.carriers[key]
+        other = key[1] if carrier == key[0] else key[0]
+        a, b = (self.model.bodies[k].name for k in key)
+        name = self.model.bodies[other].name
+        kept = self.contact, self.invariant_check
+        self.sides[key] = other
+        self.contact = self._contact(self.pairs)
+        self.invariant_check = self._invariant_check()
+        why = ""
+        if self.contact.carriers.get(key, (other, 0))[1] == 0:
+            why = f"with {name!r} on the compatibility side no node of the two is paired"
+        else:
+            state = self._replay(steps)
+            if state is not None:
+                self._enforced_step = (None, 0)  # (the switched formulation's own count)
+                log.warning(
+                    "step to load factor %.6g %s at every cut with the compatibility side the "
+                    "rules chose for bodies %r and %r: %r carries it from here (summary.json: "
+                    "steps[].compatibility_switched)", load_factor,
+                    "broke invariant (b)" if isinstance(exc, InvariantViolation) else
+                    "pushed a node past the other body's outer layer of elements", a, b, name)
+                return state
+            why = (f"with {name!r} on the compatibility side the steps before did not "
+                   "converge again")
+        del self.sides[key]
+        self.contact, self.invariant_check = kept
+        self.side_notes[key] = (f"the solver tried the other body of the two on the "
+                                f"compatibility side and kept the rules' ({why}); ")
+        log.info("compatibility side of bodies %r and %r not switched: %s", a, b, why)
+        return None
+
+    def _replay(self, steps: list[StepResult]) -> ContactState | None:
+        """The switched formulation's contact state at the last converged load factor, reached
+        through the load factors of ``steps`` as the run reached them (each a step of the
+        same size as it was, so that no node goes past the rind for want of a path; the
+        steps' results stand as they were found, and the progress display is not told);
+        None where one of them fails."""
+        state = self.contact.new_state()
+        shown, self.on_iteration = self.on_iteration, None
+        t0 = time.perf_counter()
+        try:
+            for s in steps:
+                state, _ = self.solve_step(state, s.load_factor, [])
+        except AnalysisError as exc:
+            log.info("with the switched compatibility side, the load factor %.6g of step %d "
+                     "was not reached again (%s)", s.load_factor, s.step, exc)
+            return None
+        finally:
+            self.on_iteration = shown
+            self._add_time("contact_s", time.perf_counter() - t0)
+        return state
+
+    def _sides(self) -> dict[str, str]:
+        """Per switched pair ("a/b"), the body that carries its compatibility now."""
+        return {f"{self.model.bodies[i].name}/{self.model.bodies[j].name}":
+                self.model.bodies[c].name for (i, j), c in sorted(self.sides.items())}
+
     def _add_time(self, key: str, seconds: float) -> None:
         self.timings[key] = self.timings.get(key, 0.0) + seconds
 
@@ -732,7 +867,8 @@ class Analysis:
         to continue from it (and what step cutting goes back to)."""
         return Checkpoint(list(self.steps), self.state.copy(),
                           {b.name: b.saved_state() for b in self.model.bodies},
-                          self.target, self.level, self.easy)
+                          self.target, self.level, self.easy,
+                          [[i, j, c] for (i, j), c in sorted(self.sides.items())])
 
     def _fields(self, state: ContactState, result: SolveResult) -> dict[str, BodyStepResult]:
         """Full-mesh results of a converged state (the formulation's

@@ -106,8 +106,12 @@ class PairSet(SurfaceGroup):
     :class:`~vfem.contact.large.LargeDeformationContact` are built on it."""
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
-                 backend: str | None = None):
+                 backend: str | None = None, sides: dict | None = None):
         super().__init__(surfaces, pairs, settings, backend)
+        #: per pair (i, j), i < j, the body that carries its compatibility instead of the one
+        #: the rules choose (:meth:`_make_pair`): the solver's switch after a step that the
+        #: rules' side could not hold (:meth:`vfem.solver.Analysis._switch_side`)
+        self.given_sides = dict(sides or {})
         keys = [tuple(sorted(pp)) for pp in sorted(pairs, key=sorted)]
         keys = [(i, j) for i, j in keys if len(surfaces[i].facets) and len(surfaces[j].facets)]
         # each body's compliance densities against the bodies it may touch on the rank that
@@ -125,6 +129,10 @@ class PairSet(SurfaceGroup):
         # not depend on whether the other surface is enforced too)
         self.contact_pairs = ([made[k][0] for k in range(len(keys)) if made[k][0] is not None]
                               + [h for k in range(len(keys)) for h in made[k][1]])
+        #: per pair (i, j) of bodies that face each other, the body that carries its
+        #: compatibility and how many nodes it holds (its own and the other side's held)
+        self.carriers = {keys[k]: (made[k][2], self._count(made[k][0], made[k][1]))
+                         for k in range(len(keys)) if made[k][2] >= 0}
         # penetration p = -(gap0 + n.(u_fine - u_coarse)): its change per unit platen motion
         v = self.platen_motion
         for pair in self.contact_pairs:
@@ -171,29 +179,36 @@ class PairSet(SurfaceGroup):
         other side carries compatibility. **Why**: a platen pushing such a box had nothing to
         hold it and the analysis stopped at the first step (random model 3d-17); with the
         block on the compatibility side the box's corner nodes are held against it and the
-        model solves."""
-        pair, held = self._make_pair_sided(i, j, density_i, density_j)
+        model solves.
+
+        A pair in :attr:`given_sides` is carried by the body given there. Returns (pair, held,
+        the body carrying compatibility, -1 where neither faces the other)."""
+        given = self.given_sides.get((i, j))
+        if given is not None:
+            return self._make_pair_sided(i, j, density_i, density_j, carrier=given)
+        pair, held, fine = self._make_pair_sided(i, j, density_i, density_j)
         if self.settings.compatibility_side is None and not self._count(pair, held):
             other = self._make_pair_sided(i, j, density_i, density_j, flip=True)
-            if self._count(*other):
+            if self._count(*other[:2]):
                 log.info("contact pair: no node paired with the first side on the "
                          "compatibility side; the other side carries it")
                 return other
-        return pair, held
+        return pair, held, fine
 
     @staticmethod
     def _count(pair: ContactPair | None, held: list[ContactPair]) -> int:
         return (len(pair.nodes) if pair is not None else 0) + sum(len(h.nodes) for h in held)
 
     def _make_pair_sided(self, i: int, j: int, density_i: tuple[float, bool],
-                         density_j: tuple[float, bool], flip: bool = False
-                         ) -> tuple[ContactPair | None, list[ContactPair]]:
+                         density_j: tuple[float, bool], flip: bool = False,
+                         carrier: int | None = None
+                         ) -> tuple[ContactPair | None, list[ContactPair], int]:
         """:meth:`_make_pair` with the compatibility side the rules choose, or (``flip``) the
-        other."""
+        other, or (``carrier``) the one given."""
         si, sj = self.surfaces[i], self.surfaces[j]
         (ci, ei), (cj, ej) = density_i, density_j
         if ci == 0.0 and cj == 0.0:
-            return None, []  # no facet of either faces the other
+            return None, [], -1  # no facet of either faces the other
         if ei != ej and (ci if ei else cj) * EDGE_RATIO >= max(ci, cj):
             # the contact zone ends at an edge of one surface (a corner over the other): that
             # surface carries compatibility, unless it is much stiffer
@@ -210,22 +225,25 @@ class PairSet(SurfaceGroup):
                     else (j, i)
         if flip:
             fine, coarse = coarse, fine
+        if carrier is not None:  # given (the solver's switch)
+            fine, coarse = (i, j) if carrier == i else (j, i)
         sf, sc = self.surfaces[fine], self.surfaces[coarse]
         nodes = (self._facing_nodes(fine, coarse) if self.keep_all_nodes else None)
         geo = overlap(sf, sc, nodes=nodes)
         if geo is None:
-            return None, []
+            return None, [], fine
         c_fine, c_coarse = (ci, cj) if fine == i else (cj, ci)
-        if fine != chosen and not flip:
+        if fine != chosen and (carrier is not None or not flip):
             ratio = float(np.median(sf.sizes[geo.fpatch]) / np.median(sc.sizes[geo.cpatch]))
             if ratio >= FORCED_COARSER:
                 log.warning(
-                    "contact pair: %r is forced onto the compatibility side "
-                    "(contact.compatibility_side) with facets %.3g times the size of %r's: its "
-                    "traction is resolved on its own facets, and where the contact zone is "
-                    "narrower than they are the force can be far off (a tilted cube's edge: "
-                    "1.5-1.8 times a rigid reference, docs/benchmarks.md)",
-                    sf.body.name, ratio, sc.body.name)
+                    "contact pair: %r carries compatibility (%s) with facets %.3g times the "
+                    "size of %r's: its traction is resolved on its own facets, and where the "
+                    "contact zone is narrower than they are the force can be far off (a tilted "
+                    "cube's edge: 1.5-1.8 times a rigid reference, docs/benchmarks.md)",
+                    sf.body.name, "switched to it: the other side could not hold the contact"
+                    if carrier is not None else "contact.compatibility_side", ratio,
+                    sc.body.name)
         # the compatibility side's nodes beyond the other patch, and those over it whose
         # facets carry none of its traction (a stiff box's corner over a block's corner, its
         # facet over the block's top by a quarter: it went 45 % of the push into the block,
@@ -258,7 +276,7 @@ class PairSet(SurfaceGroup):
         if not both:
             # (the thesis's relaxed corrections, §5.6, act one correction of the bodies at a
             # time on the compatibility side's nodes alone)
-            return pair, []
+            return pair, [], fine
         held = []
         for own, other, which in (
                 (coarse, fine, None),  # the equilibrium side's nodes
@@ -302,7 +320,7 @@ class PairSet(SurfaceGroup):
                                     np.ones(len(nodes), dtype=bool), patches,
                                     point=True, guard=guard, gap_normal=normal, reach=reach,
                                     at=at))
-        return pair, held
+        return pair, held, fine
 
     def _approach(self, fine: int, coarse: int, geo: Overlap) -> np.ndarray:
         """(m, dim) how the pair's nodes move relative to their virtual nodes under the
@@ -495,10 +513,12 @@ class PairSet(SurfaceGroup):
             if deep.any():
                 k = int(np.flatnonzero(deep)[0])
                 sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-                raise RindViolation(
+                exc = RindViolation(
                     f"node {int(sf.nodes[pair.nodes[k]])} of body {sf.body.name!r} went "
                     f"{p[k]:.3g} deep into body {sc.body.name!r}, past its outer layer of "
                     "elements: the step is too large")
+                exc.bodies = (sf.body.name, sc.body.name)  # (the solver's side switch)
+                raise exc
 
     # -- what the results need --------------------------------------------------------------------
 
@@ -602,8 +622,8 @@ class PairedContact(PairSet):
     both_surfaces = True
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
-                 backend: str | None = None):
-        super().__init__(surfaces, pairs, settings, backend)
+                 backend: str | None = None, sides: dict | None = None):
+        super().__init__(surfaces, pairs, settings, backend, sides)
         #: W, the penetration change per unit platen motion, the platen reaction per unit
         #: traction value and the pairs' offsets (:meth:`_full_flexibility`): the pairs'
         #: geometry is fixed under small kinematics, so they are computed once, when first

@@ -163,6 +163,11 @@ class ContactSettings:
             forced body whose facets over the other surface are 1.5 times the other's or more
             is warned about: it resolves the traction on its own facets, and a contact zone
             narrower than they are can read far off (docs/benchmarks.md, the tilted cube).
+            Unset, a pair whose chosen side breaks invariant (b), or pushes a node past the
+            other body's outer layer of elements, at every cut has its side switched to the
+            other body for the rest of the run (frictionless, small kinematics: each load
+            factor's answer is its own; ``steps[].compatibility_switched`` in summary.json
+            says where); set, the side stays.
         friction: Coulomb's coefficient of friction μ of every contact pair: a node in contact
             sticks (no relative tangential motion against its virtual node within the step) while
             its tangential traction stays within μ times its normal traction, and slips with

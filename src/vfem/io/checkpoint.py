@@ -165,6 +165,7 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
                  "iterations": step.iterations, "converged": step.converged,
                  "platen_displacement": step.platen_displacement, "cuts": step.cuts,
                  "fixed_point": step.fixed_point, "invariants": step.invariants,
+                 "compatibility_switched": step.compatibility_switched,
                  "history": [dataclasses.asdict(h) for h in step.history]},
         "reactions": {b.name: {k: list(v) for k, v in step.bodies[b.name].reactions.items()}
                       for b in model.bodies},
@@ -174,7 +175,8 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
                   "type": type(state).__name__, "unknowns": sorted(state.unknowns())},
         "bodies": {b.name: sorted(checkpoint.bodies.get(b.name, {})) for b in model.bodies},
         "control": {"target": checkpoint.target, "level": checkpoint.level,
-                    "easy": checkpoint.easy},
+                    "easy": checkpoint.easy,
+                    "sides": [[int(v) for v in row] for row in checkpoint.sides]},
     }
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
     folder = Path(out) / FOLDER

@@ -447,7 +447,9 @@ def step_record(step: StepResult) -> dict:
             "stopped_at_fixed_point": step.fixed_point,
             "max_penetration": last.max_penetration if last else 0.0,
             "max_equilibrium_error": last.max_equilibrium_error if last else 0.0,
-            "invariants": step.invariants, **force_record(step)}
+            "invariants": step.invariants, **force_record(step),
+            **({"compatibility_switched": step.compatibility_switched}
+               if step.compatibility_switched else {})}
 
 
 def frictional_work(steps: list[StepResult]) -> list[float]:
