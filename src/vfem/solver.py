@@ -291,8 +291,7 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
             "are held by tractions; measured on the random models that stopped "
             "(benchmarks/random_models.py --remedies), it solved 2 of 2, and 13 of 20 "
             "before the last changes, where four times the steps solved none; the solver "
-            "switches it itself where the side was not set, without friction, under small "
-            "kinematics); else ")
+            "switches it itself where the side was not set and without friction); else ")
         first = tried or first
         remedy = (f"the contact iteration met its own stopping rule but the state it reached "
                   f"breaks an invariant checked from the full-mesh results; {first}refine the "
@@ -417,6 +416,9 @@ class Analysis:
                     b.setup(self.backend,
                             condensed_dofs=None if self.matrix_free else s.condensed_dofs)
             t2 = time.perf_counter()
+            # the bodies' unloaded state (a switch of a compatibility side under large
+            # kinematics goes through the steps again from it: :meth:`_replay`)
+            self._unloaded = {b.name: b.saved_state() for b in bodies}
             for i, s in enumerate(self.surfaces):
                 s.compute_flexibility(matrix_free=self.matrix_free,
                                       remote=not (shared or ranks.mine(i)))
@@ -779,19 +781,22 @@ class Analysis:
                      ) -> ContactState | None:
         """A step that broke invariant (b), or pushed a node past the rind, at every cut: where
         the rules chose the pair's compatibility side (``contact.compatibility_side`` unset),
-        the contact is frictionless under small kinematics (each load factor's answer its own,
-        whatever the path) and the pair has not been switched before, the other body carries
-        it from now on. Returns the contact state of the switched formulation at the last
-        converged load factor (reached through the load factors of ``steps``), or None: no
+        the contact is frictionless (its answer at a load factor owes nothing to which side
+        carried compatibility on the way: no slip history) and the pair has not been switched
+        before, the other body carries it from now on. Returns the contact state of the
+        switched formulation at the last converged load factor (reached through the load
+        factors of ``steps``), or None: no
         switch (the other side pairs no node, or it did not reach those load factors again:
         the rules' side is kept, and the stop message says what was tried).
 
         **Why**: where one side's mesh cannot resolve the contact (a soft rectangle's corner
         sliding along a block turned by the load, random model 2d-75; a stiff round face
         coarsely met, 2d-215), no step size helps (four times the steps solved neither) and
-        the other side solves both (``benchmarks/random_models.py --remedies``). The
+        the other side solves both (``benchmarks/random_models.py --remedies``); the
+        large-kinematics gasket of docs/examples.md, stopped at step 11, runs through. The
         invariants judge the switched side as they judged the first; a forced coarser side's
         warning (:data:`~vfem.contact.paired.FORCED_COARSER`) is given for it too."""
+        from .contact.large import LargeDeformationContact
         from .contact.paired import PairedContact
 
         if not (isinstance(exc, RindViolation)
@@ -800,7 +805,8 @@ class Analysis:
         key = self._pair_of(exc)
         if (key is None or key in self.sides or key in self.side_notes
                 or self.model.contact.compatibility_side is not None
-                or type(self.contact) is not PairedContact or key not in self.contact.carriers):
+                or type(self.contact) not in (PairedContact, LargeDeformationContact)
+                or key not in self.contact.carriers):
             return None
         carrier, _ = self.contact.carriers[key]
         other = key[1] if carrier == key[0] else key[0]
@@ -838,16 +844,29 @@ class Analysis:
         through the load factors of ``steps`` as the run reached them (each a step of the
         same size as it was, so that no node goes past the rind for want of a path; the
         steps' results stand as they were found, and the progress display is not told);
-        None where one of them fails."""
+        None where one of them fails. Large-kinematics bodies go through them too, from their
+        unloaded state, committing each (and back to the state they had where one fails)."""
+        bodies = self.model.bodies
+        large = any(b.large for b in bodies)
+        kept = {b.name: b.saved_state() for b in bodies} if large else {}
+        if large:
+            for b in bodies:
+                b.restore_state(self._unloaded[b.name])
         state = self.contact.new_state()
         shown, self.on_iteration = self.on_iteration, None
         t0 = time.perf_counter()
         try:
             for s in steps:
                 state, _ = self.solve_step(state, s.load_factor, [])
+                for b in bodies:
+                    b.commit_step()
         except AnalysisError as exc:
             log.info("with the switched compatibility side, the load factor %.6g of step %d "
                      "was not reached again (%s)", s.load_factor, s.step, exc)
+            for b in bodies:
+                b.discard_step()
+                if large:
+                    b.restore_state(kept[b.name])
             return None
         finally:
             self.on_iteration = shown

@@ -165,9 +165,9 @@ class ContactSettings:
             narrower than they are can read far off (docs/benchmarks.md, the tilted cube).
             Unset, a pair whose chosen side breaks invariant (b), or pushes a node past the
             other body's outer layer of elements, at every cut has its side switched to the
-            other body for the rest of the run (frictionless, small kinematics: each load
-            factor's answer is its own; ``steps[].compatibility_switched`` in summary.json
-            says where); set, the side stays.
+            other body for the rest of the run (frictionless contact: no slip history ties
+            the answer to the side that carried it; ``steps[].compatibility_switched`` in
+            summary.json says where); set, the side stays.
         friction: Coulomb's coefficient of friction μ of every contact pair: a node in contact
             sticks (no relative tangential motion against its virtual node within the step) while
             its tangential traction stays within μ times its normal traction, and slips with
