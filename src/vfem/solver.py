@@ -285,14 +285,13 @@ def diagnosis(step: int, start: float, target: float, cuts: int, exc: Exception,
         # session: of its 2 stopped models the other compatibility side solved both, four
         # times the steps none, large kinematics the 1 it applies to; the fifth session, 3 of
         # 3, none, 2 of 2; at the state with 20 stops, 13 of 20, none, none)
-        first = "" if not bodies or tried else (
+        first = tried or ("" if not bodies else (
             f"try the other body of the two on the compatibility side (contact."
             f"compatibility_side = \"{bodies[0]}\" or \"{bodies[1]}\": the side whose nodes "
             "are held by tractions; measured on the random models that stopped "
             "(benchmarks/random_models.py --remedies), it solved 2 of 2, and 13 of 20 "
             "before the last changes, where four times the steps solved none; the solver "
-            "switches it itself where the side was not set and without friction); else ")
-        first = tried or first
+            "switches it itself where the side was not set and without friction); else "))
         remedy = (f"the contact iteration met its own stopping rule but the state it reached "
                   f"breaks an invariant checked from the full-mesh results; {first}refine the "
                   "mesh where the nodes named are, or take smaller steps ([steps] count); "
@@ -785,17 +784,18 @@ class Analysis:
         carried compatibility on the way: no slip history) and the pair has not been switched
         before, the other body carries it from now on. Returns the contact state of the
         switched formulation at the last converged load factor (reached through the load
-        factors of ``steps``), or None: no
-        switch (the other side pairs no node, or it did not reach those load factors again:
-        the rules' side is kept, and the stop message says what was tried).
+        factors of ``steps``), or None: no switch (the other side pairs no node, or it did
+        not reach those load factors again: the rules' side is kept, and the stop message says
+        what was tried).
 
         **Why**: where one side's mesh cannot resolve the contact (a soft rectangle's corner
         sliding along a block turned by the load, random model 2d-75; a stiff round face
         coarsely met, 2d-215), no step size helps (four times the steps solved neither) and
         the other side solves both (``benchmarks/random_models.py --remedies``); the
         large-kinematics gasket of docs/examples.md, stopped at step 11, runs through. The
-        invariants judge the switched side as they judged the first; a forced coarser side's
-        warning (:data:`~vfem.contact.paired.FORCED_COARSER`) is given for it too."""
+        invariants judge the switched side as they judged the first (their tolerance is the
+        surfaces', not the side's: the check stands); a forced coarser side's warning
+        (:data:`~vfem.contact.paired.FORCED_COARSER`) is given for it too."""
         from .contact.large import LargeDeformationContact
         from .contact.paired import PairedContact
 
@@ -812,10 +812,9 @@ class Analysis:
         other = key[1] if carrier == key[0] else key[0]
         a, b = (self.model.bodies[k].name for k in key)
         name = self.model.bodies[other].name
-        kept = self.contact, self.invariant_check
+        kept = self.contact
         self.sides[key] = other
         self.contact = self._contact(self.pairs)
-        self.invariant_check = self._invariant_check()
         why = ""
         if self.contact.carriers.get(key, (other, 0))[1] == 0:
             why = f"with {name!r} on the compatibility side no node of the two is paired"
@@ -833,7 +832,7 @@ class Analysis:
             why = (f"with {name!r} on the compatibility side the steps before did not "
                    "converge again")
         del self.sides[key]
-        self.contact, self.invariant_check = kept
+        self.contact = kept
         self.side_notes[key] = (f"the solver tried the other body of the two on the "
                                 f"compatibility side and kept the rules' ({why}); ")
         log.info("compatibility side of bodies %r and %r not switched: %s", a, b, why)
@@ -845,13 +844,12 @@ class Analysis:
         same size as it was, so that no node goes past the rind for want of a path; the
         steps' results stand as they were found, and the progress display is not told);
         None where one of them fails. Large-kinematics bodies go through them too, from their
-        unloaded state, committing each (and back to the state they had where one fails)."""
+        unloaded state, committing each (and back to the state they had where one fails;
+        a linear body's state is empty, :class:`~vfem.bodies.mechanics.LinearMechanics`)."""
         bodies = self.model.bodies
-        large = any(b.large for b in bodies)
-        kept = {b.name: b.saved_state() for b in bodies} if large else {}
-        if large:
-            for b in bodies:
-                b.restore_state(self._unloaded[b.name])
+        kept = {b.name: b.saved_state() for b in bodies}
+        for b in bodies:
+            b.restore_state(self._unloaded[b.name])
         state = self.contact.new_state()
         shown, self.on_iteration = self.on_iteration, None
         t0 = time.perf_counter()
@@ -865,8 +863,7 @@ class Analysis:
                      "was not reached again (%s)", s.load_factor, s.step, exc)
             for b in bodies:
                 b.discard_step()
-                if large:
-                    b.restore_state(kept[b.name])
+                b.restore_state(kept[b.name])
             return None
         finally:
             self.on_iteration = shown
