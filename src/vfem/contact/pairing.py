@@ -198,24 +198,32 @@ def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: 
     compatibility side has none. Nodes beyond the other surface keep the direction to its end.
 
     A node at the end of its own patch (its body's corner or edge: a rotated punch's lowest
-    corner, a tilted box's edge) keeps the other surface's normal too: its own surface has no
-    normal there that the interface could take, and the corner presses into the other face
-    along that face's normal. **Why**: the blend, turned from the other face's normal by a
-    fraction of the angle between the faces, reads the corner's slide s along that face as
-    s sin(beta) of approach: a punch rotated 5.8 degrees, its corner sliding 5.3e-4 on a block
-    of equal stiffness, lay 4.0e-5 (3.2 % of the push) inside it (random model 2d-144; 2d-7,
-    2d-100, 2d-285 and 3d-5 likewise 2.1-2.6 %). Along the face's normal: 0.05 %. Only where
+    corner, a tilted box's edge), or on an edge inside it (its facets there turning by more
+    than :data:`~vfem.contact.surface.FEATURE_ANGLE`: a block's corner whose top and side
+    both face a disk's flank), keeps the other surface's normal too: its own surface has no
+    normal there that the interface could take (its nodal normal is only a bisector), and the
+    corner presses into the other face along that face's normal. **Why**: the blend, turned
+    from the other face's normal by a fraction of the angle between the faces, reads the
+    corner's slide s along that face as s sin(beta) of approach: a punch rotated 5.8 degrees,
+    its corner sliding 5.3e-4 on a block of equal stiffness, lay 4.0e-5 (3.2 % of the push)
+    inside it (random model 2d-144; 2d-7, 2d-100, 2d-285 and 3d-5 likewise 2.1-2.6 %). Along
+    the face's normal: 0.05 %. Only where
     that face is flat about the virtual node: on a faceted curve the facet of the closest
     point at rest is not the one the corner lands on after a gap of facets, and its normal
     is off by the faceting angle (a stiff block's corner under a soft, coarse quarter disk's
     flank, random model 2d-185: 7.3 % of the push inside on the deformed geometry along the
-    flank's normal, none with the blend, which leans to the stiff block's own).
+    flank's normal, none with the blend, which leans to the stiff block's own). The edge
+    inside a patch: a block's corner under a quarter disk's flank (one facet of 0.3 there,
+    2.3 degrees between the blend and the facet's normal, a slide of 0.016 along it) lay
+    3.3 % of the push inside the disk with the blend, 0.7 % along the facet's normal (random
+    model 2d-52 of seed 3).
     """
     if not len(geo.nodes):
         return
     n = blended_normal(geo.normal, sf.node_normals(None, geo.fpatch)[geo.nodes], c_fine,
                        c_coarse)
-    end = sf.kind.boundary_nodes(sf.facets, sf.patch_boundary(geo.fpatch), sf.nc)[geo.nodes]
+    end = (sf.kind.boundary_nodes(sf.facets, sf.patch_boundary(geo.fpatch), sf.nc)
+           | sf.edge_nodes(geo.fpatch))[geo.nodes]
     # (only where the other surface is flat about the virtual node: its nodal normals there
     # all one, the weighted sum as long as the weights; a virtual node at a vertex reads
     # that vertex's normal alone. Measured and not kept: no turning across the whole facet

@@ -337,6 +337,29 @@ class ContactSurface:
             out += phi[:, k, None] * corner
         return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
 
+    def edge_nodes(self, facets: np.ndarray | None = None) -> np.ndarray:
+        """(nc,) True at the nodes where two of the facets around them (of the subset
+        ``facets``) turn by more than :data:`FEATURE_ANGLE`: an edge or corner of the body
+        (a block's corner, a box's edge), where its surface has no normal of its own; the
+        nodal normal there (:meth:`node_normals`) is only a bisector."""
+        ids = np.arange(len(self.facets)) if facets is None else np.asarray(facets)
+        out = np.zeros(self.nc, dtype=bool)
+        if not len(ids):
+            return out
+        fn = self.kind.facet_normals(self.X, self.facets[ids])
+        inc = self.incidence(ids).tocoo()
+        # each node's facets side by side (padded with zero normals, which never count)
+        order = np.argsort(inc.row, kind="stable")
+        node, facet = inc.row[order], inc.col[order]
+        start = np.searchsorted(node, np.arange(self.nc))
+        slot = np.arange(len(node)) - start[node]
+        star = np.zeros((self.nc, int(slot.max()) + 1, self.dim))
+        star[node, slot] = fn[facet]
+        cos = np.einsum("nad,nbd->nab", star, star)
+        present = np.linalg.norm(star, axis=2) > 0
+        both = present[:, :, None] & present[:, None, :]
+        return np.any(both & (cos < np.cos(FEATURE_ANGLE)), axis=(1, 2))
+
     @property
     def rind_depth(self) -> np.ndarray:
         """(nf,) thickness of the element behind each candidate facet: its area / facet length
