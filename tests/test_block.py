@@ -6,8 +6,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from vfem.contact.check import largest_penetrations
 from vfem.examples import block
+from vfem.result_types import largest_penetrations
 from vfem.solver import Analysis
 
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from vfem.bodies import PrescribedDisplacement
-from vfem.contact.check import largest_penetrations
 from vfem.examples import hertz, sliding
+from vfem.result_types import largest_penetrations
 from vfem.solver import Analysis
 
 

@@ -16,13 +16,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from . import examples as _examples  # noqa: F401, I001 - registers their figure sets (io.replot)
 from ._version import __version__  # noqa: F401 (vfem.__version__)
 from .bodies import Body, Platen, PrescribedDisplacement, Support, Traction
 from .config import BodyConfig, MeshSpec, ModelConfig, Steps
 from .contact.settings import ContactSettings
 from .errors import AnalysisError, InputError, VfemError
 from .materials import LinearElastic
-from .solver import Analysis, AnalysisResult, Model, StepResult
+from .model import Model
+from .result_types import AnalysisResult, StepResult
+from .solver import Analysis
 
 #: The contact settings under the name the input file uses (``[contact]``).
 Contact = ContactSettings

@@ -1,9 +1,10 @@
 """What an analysis gives back: per converged step the full-mesh fields of every body, and the
 run as a whole (its steps, the model, timings); and what a run needs to continue after a step.
 
-Their own module (issue 18): the solver fills them, the contact formulations (the classical
-baselines build their own steps) and the independent checks read them, and the writers turn them
-into files, so none of those needs to import the solver.
+Their own module (issue 18): the solver fills them and the writers turn them into files, so
+neither needs the other. One body's results (:class:`BodyStepResult`, :func:`add_reactions`) are
+below contact, in :mod:`vfem.bodies.results` (issue 38), since the formulations build them and
+the independent checks read them; they are here too for those who import them from here.
 """
 
 from __future__ import annotations
@@ -13,85 +14,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .bodies.results import BodyStepResult
 from .contact.state import ContactState, IterationRecord
 
 if TYPE_CHECKING:
-    from .bodies import Body
     from .contact.surface import ContactSurface
-    from .solver import Model
-
-
-@dataclass
-class BodyStepResult:
-    """The state of one body at the end of a converged step (full mesh fields)."""
-
-    displacement: np.ndarray  # (npoints, dim), at the body's points (Body.points)
-    contact_force: np.ndarray  # (npoints, dim) nodal force applied by the other bodies
-    #: (npoints,) nominal normal pressure: normal nodal contact force / undeformed tributary
-    #: length, i.e. the traction averaged with the node's shape function (int phi q / int phi)
-    contact_pressure: np.ndarray
-    contact_status: np.ndarray  # (npoints,) 0 free, 1 in contact
-    penetration: np.ndarray  # (npoints,) signed penetration at candidate nodes (0 elsewhere)
-    #: (npoints,) the formulation's nominal normal traction at the node (paired variant: the
-    #: unknowns q on the compatibility side, that field read at the other side's nodes); where a
-    #: formulation has none, the nodal reading ``contact_pressure``
-    contact_traction: np.ndarray | None = None
-    #: (npoints, dim) nodal force the supports, prescribed displacements and platen apply to the
-    #: body (:meth:`Body.nodal_reaction`): zero on unconstrained dofs. With the contact force and
-    #: the applied loads it balances the body (:func:`add_reactions`)
-    reaction: np.ndarray | None = None
-    #: per boundary carrying a support, a prescribed displacement or the platen, the total (x, y)
-    #: (3D: (x, y, z)) of ``reaction`` over the dofs that boundary's own conditions constrain
-    #: (:meth:`Body.boundary_reactions`: a shared corner dof counts in each boundary constraining
-    #: it; the body's total, ``reaction.sum(axis=0)``, counts it once)
-    reactions: dict[str, tuple[float, ...]] = field(default_factory=dict)
-    #: (dim,) resultant (x, y[, z]) of the body's applied loads (its tractions) at the step's
-    #: load factor
-    applied_load: np.ndarray | None = None
-    # -- with friction (vfem.contact.friction; None without): at the nodes that carry a contact
-    # pair's compatibility (where its traction values live), zero at the others
-    #: (npoints, dim) the tangential traction on the body (x, y[, z]), the part of the pair's
-    #: traction field along the contact surface
-    contact_shear: np.ndarray | None = None
-    #: (npoints,) the relative tangential displacement against the virtual node in this step
-    #: (2D: signed along the pair's tangent, the opposing surface's outward normal turned by
-    #: +90°; 3D: its length, the direction being the opposite of a slipping node's traction)
-    slip_increment: np.ndarray | None = None
-    #: (npoints,) the slip accumulated over the converged steps so far (length)
-    accumulated_slip: np.ndarray | None = None
-    #: (npoints,) 0 free, 1 sticking, 2 slipping; -1 at the nodes that carry no pair's
-    #: compatibility (the other side of a pair reads the traction field its partner defines)
-    friction_status: np.ndarray | None = None
-    #: (npoints, dim) the part of ``contact_force`` that the tangential traction makes (on both
-    #: sides of a pair): what the friction's work is measured with
-    friction_force: np.ndarray | None = None
-
-    def __post_init__(self):
-        if self.contact_traction is None:
-            self.contact_traction = self.contact_pressure
-
-    @property
-    def reaction_total(self) -> np.ndarray:
-        """(dim,) the body's total support reaction (x, y[, z]): ``reaction`` summed over the
-        nodes, each constrained dof once; zeros where reactions were not computed."""
-        if self.reaction is None:
-            shape = np.shape(self.displacement)
-            return np.zeros(shape[1] if len(shape) == 2 else 2)
-        return self.reaction.sum(axis=0)
-
-
-def add_reactions(body: Body, r: BodyStepResult, load_factor: float) -> BodyStepResult:
-    """Fill ``r``'s support reactions (``reaction``, ``reactions``, ``applied_load``) from its
-    displacement and contact force at ``load_factor``: one evaluation of the body's stiffness
-    (internal force under large kinematics) per converged step, so every output reads the same
-    numbers. Returns ``r``."""
-    nodal = body.nodal_reaction(np.asarray(r.displacement).ravel(), load_factor,
-                                np.asarray(r.contact_force).ravel())
-    dim = body.mesh.p.shape[0]
-    r.reaction = nodal.reshape(-1, dim)
-    r.reactions = body.boundary_reactions(nodal)
-    r.applied_load = body.applied_load(load_factor).reshape(-1, dim).sum(axis=0)
-    return r
+    from .model import Model
 
 
 @dataclass
@@ -177,3 +105,63 @@ def phase_table(timings: dict[str, float]) -> dict[str, float]:
     out["other"] = max(0.0, float(wall) - sum(out.values()))
     return out
 
+
+def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
+                         ) -> dict[str, dict]:
+    """Per body: the largest penetration of its candidate nodes into another body (the older
+    check of the contact candidates' linearised gaps; the invariants are
+    :mod:`vfem.contact.check`'s).
+
+    The paired variant enforces compatibility at one surface of each pair (docs/method.md §6);
+    the other surface's nodes are free to indent it where its facets are longer or its geometry
+    sharper. This measures that, for every candidate node of every body against every other
+    body's candidate surface, with the same linear kinematics as the analysis: the node's
+    closest point on the other undeformed surface, the outward normal there, and the gap
+    ``g0 + n . (u_node - u_other(closest point))``; where the closest point is a vertex (a
+    corner), n is the direction from it to the node. Nodes whose closest point is an end of the
+    other surface (beyond its edge) are left out. When any body is analysed under large
+    displacements the same measure is taken on the deformed surfaces: each node's current
+    position against the other surface as it now lies.
+
+    Returns ``{body: {"penetration": value (> 0 overlap, <= 0 none), "node": point number,
+    "into": other body}}`` for the given step (default: the last).
+    """
+    step = step or result.steps[-1]
+    surfaces = result.surfaces
+    out = {}
+    for s in surfaces:
+        best = {"penetration": -np.inf, "node": -1, "into": ""}
+        if s.nc == 0:
+            out[s.body.name] = best
+            continue
+        large = any(b.large for b in result.model.bodies)
+        u = step.bodies[s.body.name].displacement[s.nodes[: s.nc]]
+        x = s.X[: s.nc] + u if large else s.X[: s.nc]
+        for so in surfaces:
+            if so is s or so.nc == 0:
+                continue
+            xo = so.X + step.bodies[so.body.name].displacement[so.nodes] if large else so.X
+            seg, t, dist, n = so.project(x, xo)
+            pos, _ = so.curve(seg, t, xo)
+            # closest to a vertex (a corner of the other surface): measure along the line from
+            # that vertex to the node, not along a facet normal that does not reach it
+            at_vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * max(so.lengths.max(), 1e-300))
+            n = np.where(at_vertex[:, None],
+                         (x - pos) / np.maximum(dist, 1e-300)[:, None], n)
+            if large:
+                pen = -np.einsum("ij,ij->i", x - pos, n)
+            else:
+                uo = step.bodies[so.body.name].displacement[so.nodes[: so.nc]]
+                uv = np.einsum("nk,nkd->nd", so.shape(t), uo[so.facets[seg]])
+                pen = -(np.einsum("ij,ij->i", x - pos, n)
+                        + np.einsum("ij,ij->i", u - uv, n))
+            ends = so.facets[seg]
+            off = (((t <= 0) & so.surface_ends[ends[:, 0]])
+                   | ((t >= 1) & so.surface_ends[ends[:, 1]]))
+            pen = np.where(off, -np.inf, pen)
+            k = int(np.argmax(pen))
+            if pen[k] > best["penetration"]:
+                best = {"penetration": float(pen[k]), "node": int(s.nodes[k]),
+                        "into": so.body.name}
+        out[s.body.name] = best
+    return out

@@ -676,7 +676,7 @@ class GlobalContact:
         candidate nodes (nc, 2). ``friction`` (frictional lagrange): per row the tangential
         force ``shear``, the step's slip ``increment``, the ``accumulated`` slip and the
         ``status`` (0 free, 1 stick, 2 slip), which add the friction's fields."""
-        from ..result_types import BodyStepResult, add_reactions
+        from ..bodies.results import BodyStepResult, add_reactions
 
         U = self.T @ q + self.at(load_factor, self.U_prescribed)
         f_slave = self.c.B_slave.T @ Lam

@@ -54,7 +54,6 @@ carries compatibility). It checks
 The solver (:meth:`vfem.solver.Analysis.run`) evaluates them after every converged contact
 step and treats a violation as a failed step (:class:`vfem.errors.InvariantViolation`).
 
-:func:`largest_penetrations` is the older check of the contact candidates' linearised gaps.
 """
 
 from __future__ import annotations
@@ -75,7 +74,6 @@ from .search import project_points
 
 if TYPE_CHECKING:
     from ..bodies import Body
-    from ..result_types import AnalysisResult, StepResult
 
 #: (a): the resultant of all contact forces, relative to the largest body's total contact force
 FORCE_BALANCE_TOLERANCE = 1e-8
@@ -487,9 +485,10 @@ class InvariantCheck:
         cur = [r if not np.any(ui) else check3d.Surface3(r.b, r.x + ui) for r, ui in zip(ref, u)]
         Fb = [f[g.nodes] for f, g in zip(F, self._boundaries)]
         self._interpenetration(cur, out, extra, Fb, lambda i, j, node, cur:
-                               check3d.linearised_depth(self, i, j, node, cur))
+                               check3d.linearised_depth(ref, i, j, node, cur))
         own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
-        check3d.tension(self, Fb, own, out)
+        out.tension, out.tension_tolerance, out.tension_where = check3d.tension(
+            self.bodies, self._tolerance, self.tension_tolerance, Fb, own)
         out.seconds = time.perf_counter() - t0
         return out
 
@@ -755,62 +754,3 @@ def step_invariants(model_or_bodies, pairs, fields: dict, penetration_tolerance:
     ``fields``: body name -> its :class:`~vfem.result_types.BodyStepResult`, or anything with
     ``displacement`` and ``contact_force``)."""
     return InvariantCheck(model_or_bodies, pairs, penetration_tolerance, **options)(fields)
-
-
-def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
-                         ) -> dict[str, dict]:
-    """Per body: the largest penetration of its candidate nodes into another body.
-
-    The paired variant enforces compatibility at one surface of each pair (docs/method.md §6);
-    the other surface's nodes are free to indent it where its facets are longer or its geometry
-    sharper. This measures that, for every candidate node of every body against every other
-    body's candidate surface, with the same linear kinematics as the analysis: the node's
-    closest point on the other undeformed surface, the outward normal there, and the gap
-    ``g0 + n . (u_node - u_other(closest point))``; where the closest point is a vertex (a
-    corner), n is the direction from it to the node. Nodes whose closest point is an end of the
-    other surface (beyond its edge) are left out. When any body is analysed under large
-    displacements the same measure is taken on the deformed surfaces: each node's current
-    position against the other surface as it now lies.
-
-    Returns ``{body: {"penetration": value (> 0 overlap, <= 0 none), "node": point number,
-    "into": other body}}`` for the given step (default: the last).
-    """
-    step = step or result.steps[-1]
-    surfaces = result.surfaces
-    out = {}
-    for s in surfaces:
-        best = {"penetration": -np.inf, "node": -1, "into": ""}
-        if s.nc == 0:
-            out[s.body.name] = best
-            continue
-        large = any(b.large for b in result.model.bodies)
-        u = step.bodies[s.body.name].displacement[s.nodes[: s.nc]]
-        x = s.X[: s.nc] + u if large else s.X[: s.nc]
-        for so in surfaces:
-            if so is s or so.nc == 0:
-                continue
-            xo = so.X + step.bodies[so.body.name].displacement[so.nodes] if large else so.X
-            seg, t, dist, n = so.project(x, xo)
-            pos, _ = so.curve(seg, t, xo)
-            # closest to a vertex (a corner of the other surface): measure along the line from
-            # that vertex to the node, not along a facet normal that does not reach it
-            at_vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * max(so.lengths.max(), 1e-300))
-            n = np.where(at_vertex[:, None],
-                         (x - pos) / np.maximum(dist, 1e-300)[:, None], n)
-            if large:
-                pen = -np.einsum("ij,ij->i", x - pos, n)
-            else:
-                uo = step.bodies[so.body.name].displacement[so.nodes[: so.nc]]
-                uv = np.einsum("nk,nkd->nd", so.shape(t), uo[so.facets[seg]])
-                pen = -(np.einsum("ij,ij->i", x - pos, n)
-                        + np.einsum("ij,ij->i", u - uv, n))
-            ends = so.facets[seg]
-            off = (((t <= 0) & so.surface_ends[ends[:, 0]])
-                   | ((t >= 1) & so.surface_ends[ends[:, 1]]))
-            pen = np.where(off, -np.inf, pen)
-            k = int(np.argmax(pen))
-            if pen[k] > best["penetration"]:
-                best = {"penetration": float(pen[k]), "node": int(s.nodes[k]),
-                        "into": so.body.name}
-        out[s.body.name] = best
-    return out

@@ -35,6 +35,7 @@ Linear facets only: quadratic 3D bodies in contact, and the "consistent" tension
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -47,7 +48,6 @@ from .facets3d import closest_on_facets
 
 if TYPE_CHECKING:
     from ..bodies import Body
-    from .check import InvariantCheck, Invariants
 
 #: a feature of a triangle: the barycentric coordinates below this (relative) are on its edge
 FEATURE = 1e-9
@@ -344,12 +344,12 @@ class Surface3(CachedBoundary):
         return self._get("adjacent", make)
 
 
-def linearised_depth(check: InvariantCheck, i: int, j: int, node: np.ndarray,
+def linearised_depth(reference: list[Surface3], i: int, j: int, node: np.ndarray,
                      cur: list[Surface3]) -> tuple[np.ndarray, np.ndarray]:
     """Small kinematics: the depth of body i's boundary ``node`` (local numbers) into body j as
     linear theory reads it, and its second-order allowance (2D:
     :meth:`~vfem.contact.check.InvariantCheck._linearised_depth`)."""
-    ri, rj = check.reference[i], check.reference[j]
+    ri, rj = reference[i], reference[j]
     keep = rj.surface
     tri, lam, c, dist = rj._closest(ri.x[node], keep, point_normals=ri.normals[node])
     corners = rj.b.triangles[tri]
@@ -395,22 +395,26 @@ def linearised_depth(check: InvariantCheck, i: int, j: int, node: np.ndarray,
     return depth, np.where(vertex, 0.0, slip * np.abs(theta)) + warp
 
 
-def tension(check: InvariantCheck, F: list[np.ndarray], own: list[Surface3],
-            out: Invariants) -> None:
+def tension(bodies: list[Body], tolerance: Callable[[Body], float], least: float,
+            F: list[np.ndarray], own: list[Surface3]) -> tuple[float, float, dict | None]:
     """(c), the nodal measure, on 3D bodies: F·n at every node of linear facets. On quadratic
     triangles (T6) a corner's shape function L (2 L - 1) is negative near the far edge, so a
     compressive traction can put a tensile force on a corner (none at all under a uniform one);
     but phi_corner + (phi_mid1 + phi_mid2) / 2 = L >= 0 on each facet (the midpoints of its
     two edges from the corner), so the corner is read with half of each such midpoint's force
     (a midpoint's own phi = 4 L x >= 0: alone), and a body with quadratic elements takes the
-    quadratic tolerance, as in 2D (:mod:`vfem.contact.check`'s docstring)."""
+    quadratic tolerance, as in 2D (:mod:`vfem.contact.check`'s docstring).
+
+    ``tolerance(body)``: a body's tolerance (``least`` where there are no bodies). Returns the
+    largest tensile measure over the largest nodal force (0 where none), its tolerance (the
+    least of the bodies' where none) and where it is (``{"body", "node", "value"}``, or None).
+    """
     scale = max((float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in F), default=0.0)
-    out.tension_tolerance = min((check._tolerance(b) for b in check.bodies),
-                                default=check.tension_tolerance)
+    least = min((tolerance(b) for b in bodies), default=least)
     if scale == 0:
-        return
+        return 0.0, least, None
     worst = None
-    for b, f, g in zip(check.bodies, F, own):
+    for b, f, g in zip(bodies, F, own):
         if not len(f):
             continue
         fn = np.einsum("ij,ij->i", f, g.tension_normals)
@@ -421,11 +425,10 @@ def tension(check: InvariantCheck, F: list[np.ndarray], own: list[Surface3],
             patch[mid] = fn[mid]
             fn = patch
         k = int(np.argmax(fn))
-        ratio = fn[k] / scale / check._tolerance(b)
+        ratio = fn[k] / scale / tolerance(b)
         if fn[k] > 0 and (worst is None or ratio > worst[0]):
             worst = (ratio, float(fn[k]), b, int(g.b.nodes[k]))
-    if worst is not None:
-        _, value, b, node = worst
-        out.tension = value / scale
-        out.tension_tolerance = check._tolerance(b)
-        out.tension_where = {"body": b.name, "node": node, "value": value}
+    if worst is None:
+        return 0.0, least, None
+    _, value, b, node = worst
+    return value / scale, tolerance(b), {"body": b.name, "node": node, "value": value}

@@ -21,7 +21,7 @@ from ..errors import InputError
 from .capabilities import Capabilities
 
 if TYPE_CHECKING:
-    from ..result_types import BodyStepResult
+    from ..bodies.results import BodyStepResult
     from .state import ContactState, IterationRecord, SolveResult
     from .surface import ContactSurface
 

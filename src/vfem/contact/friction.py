@@ -351,8 +351,8 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     #: the equilibrium side's nodes are not held (issue 37): not yet with friction
     both_surfaces = False
 
-    def __init__(self, surfaces, pairs, settings, backend: str | None = None):
-        super().__init__(surfaces, pairs, settings, backend)
+    def __init__(self, surfaces, pairs, settings, backend: str | None = None, executor=None):
+        super().__init__(surfaces, pairs, settings, backend, executor=executor)
         self._init_friction(settings)
         self._tangents = [tangents(plane_normals(self.surfaces[pair.fine], pair))
                           for pair in self.contact_pairs]

@@ -14,8 +14,8 @@ import warnings
 import numpy as np
 import scipy.linalg as sla
 
-from ..parallel import current as current_ranks
-from ..result_types import BodyStepResult, add_reactions
+from ..bodies.results import BodyStepResult, add_reactions
+from ..executor import SERIAL, Executor
 from ..threads import dense_threads
 from .bordered import bordered_matrix, bordered_solve  # noqa: F401 - here too, as before
 from .settings import ContactSettings
@@ -89,9 +89,13 @@ class SurfaceGroup:
     penetration tolerance and the platen (see the module docstring)."""
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]],
-                 settings: ContactSettings, backend: str | None = None):
+                 settings: ContactSettings, backend: str | None = None,
+                 executor: Executor | None = None):
         self.surfaces = surfaces
         self.backend = backend  # the linear solver of the bodies' tangents (large kinematics)
+        #: where each body's work runs (each on the MPI rank that owns it, :mod:`vfem.parallel`,
+        #: handed in by the solver; serially without one)
+        self.executor = executor if executor is not None else SERIAL
         self.pairs = pairs
         self.settings = settings
         lengths = np.concatenate([s.lengths for s in surfaces if len(s.lengths)] or [[1.0]])
@@ -119,7 +123,7 @@ class SurfaceGroup:
         the tracked nodes, or the candidates alone, :attr:`ContactSurface.rind_rows`):
         X + u(load, platen, forces), the bodies' linear response (superposition)."""
         # the contact forces' share: each body on the rank that owns it (vfem.parallel)
-        moved = current_ranks().map(range(len(self.surfaces)), lambda i: self.surfaces[
+        moved = self.executor.map(range(len(self.surfaces)), lambda i: self.surfaces[
             i].motion(state.forces[i].ravel()))
         out = []
         for i, s in enumerate(self.surfaces):
@@ -186,7 +190,7 @@ class SurfaceGroup:
             return s.body.displacement(state.load_factor, state.platen_displacement, f)
 
         # each body's back-substitution on the rank that owns it (vfem.parallel)
-        displacements = current_ranks().map(range(len(self.surfaces)), displacement)
+        displacements = self.executor.map(range(len(self.surfaces)), displacement)
         out = {}
         for i, (s, F, p) in enumerate(zip(self.surfaces, state.forces, result.pairings)):
             b = s.body

@@ -117,7 +117,7 @@ class LargeDeformationContact(PairSet):
     keep_all_nodes = True  # which nodes are over the other surface changes as bodies slide
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
-                 backend: str | None = None, sides: dict | None = None):
+                 backend: str | None = None, sides: dict | None = None, executor=None):
         for s in surfaces:
             # (the facet kind's order: ``s.order`` counts a 2D facet's nodes; a 3D body that
             # touches nothing has no kind and no candidate)
@@ -126,7 +126,7 @@ class LargeDeformationContact(PairSet):
                                  "linear elements (order 1)")
         # (its own pairs, built on the undeformed geometry, which side carries compatibility
         # and which nodes decided once; :meth:`penetrations` moves them to the current one)
-        super().__init__(surfaces, pairs, settings, backend, sides)
+        super().__init__(surfaces, pairs, settings, backend, sides, executor=executor)
         self._offsets = np.cumsum([0] + [s.dim * s.nc for s in surfaces])
 
     # -- the bodies' current state ----------------------------------------------------------------

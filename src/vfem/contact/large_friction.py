@@ -78,8 +78,8 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
                                        friction=("frictionless", "coulomb"))
     state_type = FrictionState
 
-    def __init__(self, surfaces, pairs, settings, backend: str | None = None):
-        super().__init__(surfaces, pairs, settings, backend)
+    def __init__(self, surfaces, pairs, settings, backend: str | None = None, executor=None):
+        super().__init__(surfaces, pairs, settings, backend, executor=executor)
         self._init_friction(settings)
         #: 3D: per pair and node, the global axis whose projection on the current tangent plane
         #: is the first tangent (:func:`~vfem.contact.friction.tangents`): the one least aligned

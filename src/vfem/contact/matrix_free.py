@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator, gmres
 
-from ..parallel import current as current_ranks
+from ..executor import SERIAL
 from .bordered import bordered_solve
 
 log = logging.getLogger(__name__)
@@ -129,8 +129,9 @@ class PairOperator:
     laid out (pair by pair, direction by direction, node by node).
     """
 
-    def __init__(self, surfaces, flex, dF, pairs, directions, offsets):
+    def __init__(self, surfaces, flex, dF, pairs, directions, offsets, executor=SERIAL):
         self.surfaces = surfaces
+        self.executor = executor  # each body on the rank that owns it (vfem.executor)
         self.flex = flex
         self.dF = dF
         self.pairs = pairs
@@ -160,7 +161,7 @@ class PairOperator:
             return u.reshape(s.nc, s.dim, k)
 
         # each body on the rank that owns it, all at once (vfem.parallel; in order in serial)
-        motion = current_ranks().map(self.bodies, move)
+        motion = self.executor.map(self.bodies, move)
         out = np.zeros((self.m, k))
         for i, pair in enumerate(self.pairs):
             n = len(pair.nodes)

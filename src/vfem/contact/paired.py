@@ -42,7 +42,6 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import PlatenUnheld, PlatenUnpaired, RindViolation
-from ..parallel import current as current_ranks
 from .capabilities import Capabilities
 from .complementarity import linear_complementarity
 from .corrections import relaxation, release_tension
@@ -106,8 +105,8 @@ class PairSet(SurfaceGroup):
     :class:`~vfem.contact.large.LargeDeformationContact` are built on it."""
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
-                 backend: str | None = None, sides: dict | None = None):
-        super().__init__(surfaces, pairs, settings, backend)
+                 backend: str | None = None, sides: dict | None = None, executor=None):
+        super().__init__(surfaces, pairs, settings, backend, executor=executor)
         #: per pair (i, j), i < j, the body that carries its compatibility instead of the one
         #: the rules choose (:meth:`_make_pair`): the solver's switch after a step that the
         #: rules' side could not hold (:meth:`vfem.solver.Analysis._switch_side`)
@@ -117,7 +116,7 @@ class PairSet(SurfaceGroup):
         # each body's compliance densities against the bodies it may touch on the rank that
         # owns it (its flexibility), then each pair's geometry on a rank of its own, all at
         # once (vfem.parallel; in serial in order, as before)
-        ranks = current_ranks()
+        ranks = self.executor
         partners = {b: [j if i == b else i for i, j in keys if b in (i, j)]
                     for b in range(len(surfaces))}
         density = ranks.map(range(len(surfaces)), lambda b: {
@@ -622,8 +621,8 @@ class PairedContact(PairSet):
     both_surfaces = True
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
-                 backend: str | None = None, sides: dict | None = None):
-        super().__init__(surfaces, pairs, settings, backend, sides)
+                 backend: str | None = None, sides: dict | None = None, executor=None):
+        super().__init__(surfaces, pairs, settings, backend, sides, executor=executor)
         #: W, the penetration change per unit platen motion, the platen reaction per unit
         #: traction value and the pairs' offsets (:meth:`_full_flexibility`): the pairs'
         #: geometry is fixed under small kinematics, so they are computed once, when first
@@ -1042,7 +1041,7 @@ class PairedContact(PairSet):
             from .matrix_free import PairOperator
 
             W = PairOperator(self.surfaces, [s.flexibility for s in self.surfaces], dF,
-                             self.contact_pairs, directions, offsets)
+                             self.contact_pairs, directions, offsets, self.executor)
             dp_dplaten = np.concatenate(
                 [pair.platen_rate if j == 0 else self._tangent_platen_rate(k, direction)
                  for k, pair in enumerate(self.contact_pairs)
@@ -1053,7 +1052,7 @@ class PairedContact(PairSet):
             return np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T).reshape(
                 s.nc, s.dim, m)
 
-        du = current_ranks().map(range(len(self.surfaces)), motion)
+        du = self.executor.map(range(len(self.surfaces)), motion)
         W = np.zeros((m, m))
         dp_dplaten = np.zeros(m)
         for k, pair in enumerate(self.contact_pairs):

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import importlib
 
+from ..io import replot
+
 EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
             "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack")
 
@@ -17,3 +19,7 @@ EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", 
 def load(name: str):
     """The module of a built-in example."""
     return importlib.import_module(f"{__name__}.{name}")
+
+
+# the figure sets of the folders the examples' runs write (vfem plot, and each run's own figures)
+replot.register_examples(EXAMPLES, load)

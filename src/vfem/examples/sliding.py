@@ -38,11 +38,11 @@ import numpy as np
 
 from ..bodies import PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.check import largest_penetrations
 from ..contact.settings import ContactSettings
 from ..errors import InputError
 from ..io.runner import friction_line, run_headline
 from ..materials import LinearElastic
+from ..result_types import largest_penetrations
 from ..solver import AnalysisResult, Model
 
 

@@ -36,6 +36,7 @@ import logging
 import re
 import shlex
 import xml.etree.ElementTree as ET
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -459,6 +460,20 @@ def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> lis
     return summary["figures"]
 
 
+#: the built-in examples whose figure sets a results folder may name, and the loader of their
+#: modules (each with ``figures(folder)``, or without, drawing none): handed in by
+#: :mod:`vfem.examples` when it is imported (:func:`register_examples`), since the writers sit
+#: below the examples and do not import them (issue 38); none until then
+_examples: tuple[tuple[str, ...], Callable[[str], object]] = ((), lambda name: None)
+
+
+def register_examples(names: Iterable[str], load: Callable[[str], object]) -> None:
+    """Make the built-in examples ``names`` (their modules by ``load(name)``) the figure sets
+    that :func:`plot_results` draws for the folders their runs wrote."""
+    global _examples
+    _examples = (tuple(names), load)
+
+
 def plot_results(directory: Path | str) -> list[Path]:
     """Draw a results folder's figures from its files; return the paths written.
 
@@ -476,7 +491,7 @@ def plot_results(directory: Path | str) -> list[Path]:
     ``results.pvd`` or a VTU file it lists is missing or unreadable, and naming the fix when
     matplotlib is not installed (:func:`vfem.io.plots.require_matplotlib`).
     """
-    from ..examples import EXAMPLES, load
+    EXAMPLES, load = _examples
 
     plots.require_matplotlib()
     folder = Folder(directory)
@@ -507,7 +522,7 @@ def unfinished_example(directory: Path | str) -> str | None:
     profiles, the reactions over the slide), which its ``summary.json`` does not hold yet. One
     line: which example, how far it came, why, and how to finish it; None where the folder's
     figures are its own (a finished run, an input file's run, not a results folder)."""
-    from ..examples import EXAMPLES, load
+    EXAMPLES, load = _examples
     from .folders import read_record
 
     directory = Path(directory)

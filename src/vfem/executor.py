@@ -1,0 +1,31 @@
+"""Where per-body work runs: in order in this process (:data:`SERIAL`), or each body on the MPI
+rank that owns it (:class:`vfem.parallel.Ranks`, whose ``map`` is the same call).
+
+The contact formulations are handed one (their ``executor``) by whoever builds them instead of
+fetching the run's ranks themselves, so that contact does not depend on the MPI layer above it
+(issue 38); without one they run serially.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from typing import Protocol
+
+
+class Executor(Protocol):
+    def map(self, indices: Iterable[int], compute: Callable[[int], object],
+            owners: list[int] | None = None) -> dict:
+        """``compute(i)`` for every ``i`` of ``indices`` (each body's work on its owner, or on
+        ``owners[i]``), every value to every caller, keyed by ``i``."""
+
+
+class Serial:
+    """Every body in this process, in order."""
+
+    def map(self, indices: Iterable[int], compute: Callable[[int], object],
+            owners: list[int] | None = None) -> dict:
+        return {i: compute(i) for i in indices}
+
+
+#: the executor of a serial run (and of formulations built without one)
+SERIAL = Serial()

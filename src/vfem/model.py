@@ -1,0 +1,96 @@
+"""The model: bodies, the contact settings and the load schedule (:class:`Model`), and the
+contact surfaces its meshes give (:meth:`Model.contact_surfaces`).
+
+Below the driver (:mod:`vfem.solver`) and the result types, which both read it; it depends on
+the bodies and on contact's search and surfaces only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .bodies import Body
+from .contact.formulation import check_capabilities
+from .contact.settings import ContactSettings
+from .contact.surface import ContactSurface, check_initial_overlap, select_candidate_facets
+from .errors import InputError
+
+
+@dataclass
+class Model:
+    """Bodies, the contact settings and the load schedule.
+
+    ``load_factors``: the load factor at the end of each step, starting from 0. They may go down
+    as well as up (unloading, thesis §5.5); loads and prescribed displacements scale with them,
+    or follow their load curves (``amplitude``).
+    """
+
+    name: str
+    bodies: list[Body]
+    contact: ContactSettings = field(default_factory=ContactSettings)
+    load_factors: tuple[float, ...] = (1.0,)
+    contact_pairs: tuple[tuple[str, str], ...] | None = None  # default: every pair may touch
+    #: seconds spent building it (meshes, bodies, checks: ModelConfig.build), for the phases
+    build_s: float = field(default=0.0, compare=False)
+
+    def validate(self) -> None:
+        names = [b.name for b in self.bodies]
+        if not self.bodies:
+            raise InputError(f"model {self.name!r} has no bodies")
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise InputError(f"model {self.name!r}: body names must be unique, repeated: "
+                             f"{', '.join(sorted(dup))}")
+        lf = np.asarray(self.load_factors, dtype=float)
+        if lf.size == 0 or not np.all(np.isfinite(lf)) or np.any(np.diff(np.r_[0.0, lf]) == 0):
+            raise InputError(f"model {self.name!r}: load_factors must be finite numbers, each "
+                             f"different from the one before (and the first not 0), got "
+                             f"{list(self.load_factors)}")
+        for a, b in self.contact_pairs or ():
+            if a == b:
+                raise InputError(f"model {self.name!r}: contact pair [{a!r}, {b!r}] names one "
+                                 "body twice: contact of a body with itself is not supported")
+            for n in (a, b):
+                if n not in names:
+                    raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
+        for b in self.bodies:
+            b.validate()
+        dims = {b.name: b.dim for b in self.bodies}
+        if len(set(dims.values())) > 1:
+            raise InputError(f"model {self.name!r}: its bodies must all be 2D or all 3D, got "
+                             + ", ".join(f"{n!r} {d}D" for n, d in dims.items()))
+        check_capabilities(self)  # what the formulation supports, as it declares it
+        if sum(b.platen is not None for b in self.bodies) > 1:
+            raise InputError(f"model {self.name!r}: at most one force-controlled platen")
+        self.contact.validate()
+
+    def contact_surfaces(self) -> tuple[set[frozenset[int]], list[ContactSurface]]:
+        """The pairs of bodies (by index) that may touch (``contact_pairs``, or every pair) and
+        each body's contact surface: candidate facets within ``contact.search_distance`` of a
+        body it may touch (by default every facet that may touch under large kinematics, where
+        bodies may slide far; a distance given is honoured there, along the whole path of the
+        prescribed motions).
+
+        Depends on the meshes only, so it is also part of ``vfem check``: bodies that start
+        deeper into each other than the outer layer of elements are refused here
+        (:func:`~vfem.contact.surface.check_initial_overlap`).
+        """
+        index = {b.name: i for i, b in enumerate(self.bodies)}
+        if self.contact_pairs is None:
+            pairs = {frozenset((i, j)) for i in range(len(self.bodies)) for j in range(i)}
+        else:
+            pairs = {frozenset((index[a], index[b])) for a, b in self.contact_pairs}
+        distance = self.contact.search_distance
+        large = any(b.large for b in self.bodies)
+        if distance is None and large:  # bodies may slide anywhere: every facet (issue 19:
+            distance = np.inf           # a distance given is honoured, with the path followed)
+        elif distance is None:
+            diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in self.bodies]
+            distance = 0.02 * min(diag)
+        facets = select_candidate_facets(self.bodies, pairs, distance, self.load_factors,
+                                         follow_path=large)
+        surfaces = [ContactSurface.build(b, f) for b, f in zip(self.bodies, facets)]
+        check_initial_overlap(surfaces, pairs)
+        return pairs, surfaces
