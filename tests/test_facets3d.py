@@ -18,7 +18,7 @@ from vfem.contact.facets3d import (
     check_facets,
     closest_on_facets,
     closest_on_triangles,
-    facet_kind,
+    facet_shape,
     outside,
     shape_functions,
 )
@@ -538,7 +538,7 @@ def test_degenerate_facets_are_refused():
     with pytest.raises(ValueError, match="not a finite number"):
         check_facets(np.vstack([x, [np.nan, 0, 0]]), np.array([[0, 1, 5]]))
     with pytest.raises(ValueError, match="must have 3, 4, 6 or 9 nodes"):
-        facet_kind(np.zeros((2, 5), dtype=int))
+        facet_shape(np.zeros((2, 5), dtype=int))
     with pytest.raises(ValueError, match="pairs must be"):
         closest_on_facets(x, x, np.array([[0, 1, 3]]), pairs="some")
     # a thin but proper triangle is accepted and projected exactly

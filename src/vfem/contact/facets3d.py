@@ -105,8 +105,10 @@ FEW_PAIRS = 4096  # up to this many pairs the Newton stages on curved facets run
 
 
 @dataclass(frozen=True)
-class FacetKind:
-    """A kind of 3D surface facet: its nodes, reference domain and edges.
+class FacetShape:
+    """The reference shape of a 3D surface facet: its nodes, reference domain and edges (the
+    geometry that :class:`vfem.contact.facets.Triangle` and ``Quad``, the facet kinds the
+    contact code sees, wrap; named apart from :class:`~vfem.contact.facets.FacetKind`).
 
     Attributes:
         name: "T3", "Q4", "T6" or "Q9".
@@ -140,18 +142,18 @@ class FacetKind:
 _TRI_EDGES = ((0, 1), (1, 2), (0, 2))
 _QUAD_EDGES = ((0, 1), (1, 2), (2, 3), (0, 3))
 
-T3 = FacetKind("T3", 3, 3, 1, tuple((a, b, -1) for a, b in _TRI_EDGES), (1 / 3, 1 / 3))
-Q4 = FacetKind("Q4", 4, 4, 1, tuple((a, b, -1) for a, b in _QUAD_EDGES), (0.5, 0.5))
-T6 = FacetKind("T6", 6, 3, 2, tuple((a, b, 3 + i) for i, (a, b) in enumerate(_TRI_EDGES)),
+T3 = FacetShape("T3", 3, 3, 1, tuple((a, b, -1) for a, b in _TRI_EDGES), (1 / 3, 1 / 3))
+Q4 = FacetShape("Q4", 4, 4, 1, tuple((a, b, -1) for a, b in _QUAD_EDGES), (0.5, 0.5))
+T6 = FacetShape("T6", 6, 3, 2, tuple((a, b, 3 + i) for i, (a, b) in enumerate(_TRI_EDGES)),
                (1 / 3, 1 / 3))
-Q9 = FacetKind("Q9", 9, 4, 2, tuple((a, b, 4 + i) for i, (a, b) in enumerate(_QUAD_EDGES)),
+Q9 = FacetShape("Q9", 9, 4, 2, tuple((a, b, 4 + i) for i, (a, b) in enumerate(_QUAD_EDGES)),
                (0.5, 0.5))
 
 #: the facet kinds by nodes per facet
 KINDS = {3: T3, 4: Q4, 6: T6, 9: Q9}
 
 
-def facet_kind(facets: np.ndarray) -> FacetKind:
+def facet_shape(facets: np.ndarray) -> FacetShape:
     """The kind of (nf, k) facets, from k."""
     k = np.shape(facets)[1] if np.ndim(facets) == 2 else None
     if k not in KINDS:
@@ -203,7 +205,7 @@ _TENSOR = {4: ((0, 0), (1, 0), (1, 1), (0, 1)),
            9: ((0, 0), (1, 0), (1, 1), (0, 1), (2, 0), (1, 2), (2, 1), (0, 2), (2, 2))}
 
 
-def shape_functions(kind: FacetKind, xi: np.ndarray
+def shape_functions(kind: FacetShape, xi: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Shape functions of ``kind`` at (n, 2) local coordinates: values (n, k), first
     derivatives (n, k, 2) (d/dξ, d/dη) and second derivatives (n, k, 3) (ξξ, ξη, ηη).
@@ -235,7 +237,7 @@ def shape_functions(kind: FacetKind, xi: np.ndarray
     return N, dN, d2N
 
 
-def _evaluate(kind: FacetKind, X: np.ndarray, xi: np.ndarray):
+def _evaluate(kind: FacetShape, X: np.ndarray, xi: np.ndarray):
     """Position (n, 3), Jacobian (n, 3, 2) and second derivatives (n, 3, 3) (ξξ, ξη, ηη) of
     facets with node coordinates X (n, k, 3) at xi (n, 2)."""
     N, dN, d2N = shape_functions(kind, xi)
@@ -255,7 +257,7 @@ def facet_map(x: np.ndarray, facets: np.ndarray, facet: np.ndarray, xi: np.ndarr
               ) -> tuple[np.ndarray, np.ndarray]:
     """Positions (n, 3) and Jacobians (n, 3, 2) (columns x_ξ, x_η) of ``facets[facet]`` (node
     coordinates ``x``) at local coordinates ``xi`` (n, 2)."""
-    kind = facet_kind(facets)
+    kind = facet_shape(facets)
     pos, J, _ = _evaluate(kind, np.asarray(x, dtype=float)[np.asarray(facets)[facet]], xi)
     return pos, J
 
@@ -268,7 +270,7 @@ def facet_normals(x: np.ndarray, facets: np.ndarray, facet: np.ndarray, xi: np.n
     return _unit(np.cross(J[:, :, 0], J[:, :, 1]))
 
 
-def outside(kind: FacetKind, xi_free: np.ndarray, eps: float = OUTSIDE) -> np.ndarray:
+def outside(kind: FacetShape, xi_free: np.ndarray, eps: float = OUTSIDE) -> np.ndarray:
     """(n, edges) whether each point lies past each reference edge of its facet (edges in
     ``kind.edges``' order): a triangle's edge 0-1 is η = 0, 1-2 is ξ + η = 1, 0-2 is ξ = 0; a
     quadrilateral's 0-1 is η = 0, 1-2 is ξ = 1, 2-3 is η = 1, 0-3 is ξ = 0."""
@@ -289,7 +291,7 @@ def check_facets(x: np.ndarray, facets: np.ndarray) -> None:
     Raises:
         ValueError: naming how many, the first facet, its nodes and corners.
     """
-    kind = facet_kind(facets)
+    kind = facet_shape(facets)
     facets = np.asarray(facets)
     if len(facets) == 0:
         return
@@ -324,7 +326,7 @@ def _corners(c: np.ndarray) -> str:
     return "[" + ", ".join("(" + ", ".join(f"{v:.6g}" for v in row) + ")" for row in c) + "]"
 
 
-def chord_deviation(kind: FacetKind, X: np.ndarray) -> np.ndarray:
+def chord_deviation(kind: FacetShape, X: np.ndarray) -> np.ndarray:
     """(n,) an upper bound of |x(ξ) − x_c(ξ)| over the facet, x_c the piecewise linear map on
     its chord triangles (corners 0-1-2 and 0-2-3 of a quadrilateral, the corners of a
     triangle): the distance from any point to the facet and to its chord triangles differ by
@@ -354,7 +356,7 @@ def bounding_spheres(x: np.ndarray, facets: np.ndarray) -> tuple[np.ndarray, np.
     """(nf, 3) centres (a point on each facet: ``x`` at ``kind.centre``) and (nf,) radii of
     spheres that hold the facets: the farthest corner (a bilinear facet lies in its corners'
     convex hull) plus, on a quadratic facet, its :func:`chord_deviation`."""
-    kind = facet_kind(facets)
+    kind = facet_shape(facets)
     X = np.asarray(x, dtype=float)[np.asarray(facets)]
     N, _, _ = shape_functions(kind, np.array([kind.centre]))
     centre = (N[0] @ X) if len(X) else np.zeros((0, 3))
@@ -458,7 +460,7 @@ def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndar
     return np.column_stack([s, t])
 
 
-def _to_domain(kind: FacetKind, xi: np.ndarray) -> np.ndarray:
+def _to_domain(kind: FacetShape, xi: np.ndarray) -> np.ndarray:
     """Clamp local coordinates into the reference domain."""
     xi = np.clip(xi, 0.0, 1.0)
     if kind.simplex:
@@ -468,7 +470,7 @@ def _to_domain(kind: FacetKind, xi: np.ndarray) -> np.ndarray:
     return xi
 
 
-def _reduced_step(kind: FacetKind, xi: np.ndarray, g: np.ndarray, H: np.ndarray,
+def _reduced_step(kind: FacetShape, xi: np.ndarray, g: np.ndarray, H: np.ndarray,
                   G: np.ndarray) -> np.ndarray:
     """Newton step at ``xi`` restricted to the bounds that are not active: a bound is active
     where ``xi`` lies on it and the gradient ``g`` pushes out of the domain there.
@@ -508,7 +510,7 @@ def _reduced_step(kind: FacetKind, xi: np.ndarray, g: np.ndarray, H: np.ndarray,
          np.column_stack([ds, -ds])], step)
 
 
-def _newton(kind: FacetKind, X: np.ndarray, p: np.ndarray, xi: np.ndarray
+def _newton(kind: FacetShape, X: np.ndarray, p: np.ndarray, xi: np.ndarray
             ) -> tuple[np.ndarray, np.ndarray]:
     """Projected Newton for min f = ½|x(ξ) − p|² over the reference domain, from ``xi``
     (:func:`_reduced_step` on the active bounds). Every iterate is in the domain and no
@@ -618,7 +620,7 @@ def _curved_edges(A: np.ndarray, B: np.ndarray, M: np.ndarray, p: np.ndarray, t:
     return s.reshape(n, ns)[rows, j], f[rows, j]
 
 
-def _chord_start(kind: FacetKind, X: np.ndarray, p: np.ndarray
+def _chord_start(kind: FacetShape, X: np.ndarray, p: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Distance to the chord triangles and the facet coordinates of its closest point."""
     C = X[:, :kind.corners]
@@ -642,7 +644,7 @@ def _chunks(n: int, size: int = CHUNK) -> list[slice]:
     return [slice(i, i + size) for i in range(0, n, size)]
 
 
-def _lattice(kind: FacetKind, n: int = 6) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _lattice(kind: FacetShape, n: int = 6) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A lattice of local coordinates over the reference domain (n intervals a side), its
     neighbour table (each point's lattice neighbours, padded with itself) and its shape
     functions."""
@@ -661,7 +663,7 @@ def _lattice(kind: FacetKind, n: int = 6) -> tuple[np.ndarray, np.ndarray, np.nd
 _LATTICES: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 
-def _lattice_starts(kind: FacetKind, X: np.ndarray, p: np.ndarray
+def _lattice_starts(kind: FacetShape, X: np.ndarray, p: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
     """Newton starts that catch every basin of the distance on a facet: the points of a
     lattice over the facet (7 x 7, or 28 on a triangle) no farther from p than their lattice
@@ -690,7 +692,7 @@ def _best_per_row(rows: np.ndarray, n: int, xi: np.ndarray, f: np.ndarray
     return out_xi, out_f
 
 
-def _project_curved(kind: FacetKind, x: np.ndarray, facets: np.ndarray, points: np.ndarray,
+def _project_curved(kind: FacetShape, x: np.ndarray, facets: np.ndarray, points: np.ndarray,
                     pt: np.ndarray, fc: np.ndarray, tol: float):
     """Closest points of the candidate pairs (pt, fc) on bilinear or quadratic facets, less
     the pairs that cannot be nearest: (pt, fc, xi).
@@ -803,7 +805,7 @@ def closest_on_facets(points: np.ndarray, x: np.ndarray, facets: np.ndarray,
     Raises:
         ValueError: facets of another node count, or degenerate (:func:`check_facets`).
     """
-    kind = facet_kind(facets)
+    kind = facet_shape(facets)
     facets = np.asarray(facets, dtype=np.int64)
     x = np.asarray(x, dtype=float)
     points = np.asarray(points, dtype=float).reshape(-1, 3)
