@@ -3,6 +3,7 @@
     python benchmarks/dimension_count.py            # the count over src/vfem, per file
     python benchmarks/dimension_count.py --lines    # and every line counted
     python benchmarks/dimension_count.py --root /tmp/before/src/vfem   # another checkout
+    python benchmarks/dimension_count.py --tests    # the tests of the dimension instead (issue 38)
 
 A line counts once if it matches any of :data:`PATTERNS`: the forms 2D takes in this code (dofs
 as ``2n, 2n+1``, arrays of two columns, ``reshape(-1, 2)``, strided ``::2`` dof slices, a normal
@@ -34,6 +35,26 @@ PATTERNS: dict[str, str] = {
     "2x2 closed forms": r"\[0, 0\] \* \w+\[1, 1\]|\[\.\.\., 0, 0\] \* \w+\[\.\.\., 1, 1\]",
     "range(2) components": r"for \w+ in range\(2\)",
 }
+
+#: ``--tests``: the forms a test of the dimension takes (a branch on it), what issue 38 wants in
+#: the geometry layer alone: a dimension compared (``dim == 3``, ``s.dim != 2``), an array's
+#: number of axes compared (the tangential arrays, ``(n,)`` in 2D and ``(n, 2)`` in 3D), a
+#: normal's or a point's columns compared (``normal.shape[1] == 2``, ``len(pos) == 3``), and the
+#: 3D twins called by name
+#: (``_three_d(``, ``..._3d(``)
+TESTS: dict[str, str] = {
+    "dimension compared": r"\bdim\b\s*(==|!=|<=?|>=?)\s*[123]\b|\b[123]\s*(==|!=)\s*\w*\.?dim\b",
+    # (not a matrix-free operator's vector-or-block test, ``vector = x.ndim == 1``)
+    "axes compared": r"(?<!vector = )\b\w+(\[\w+\])?\.ndim\b\s*(==|!=|<=?|>=?)\s*\d",
+    # (not a facet's node count: a quadratic 2D facet's three columns)
+    "normal's columns": r"normals?\w*\.shape\[(1|-1)\]\s*(==|!=)\s*[23]\b|len\(pos\)\s*==\s*3\b",
+    "3D twin by name": r"\b\w*(_3d|three_d)\(",
+}
+
+#: ``--tests``: the geometry layer of issue 38 (search, facet kinds, surfaces, pairing, transfer)
+GEOMETRY = ("contact/search.py", "contact/facets.py", "contact/facets3d.py",
+            "contact/overlap3d.py", "contact/surface.py", "contact/pairing.py",
+            "contact/transfer.py")
 
 #: patterns read on the raw line (their form is a string)
 RAW = ("components x, y",)
@@ -71,11 +92,12 @@ def code_lines(text: str) -> list[str]:
     return ["".join(row) for row in lines]
 
 
-def count(root: Path) -> tuple[Counter, Counter, list[tuple[str, int, str, str]]]:
+def count(root: Path, patterns: dict[str, str] = PATTERNS
+          ) -> tuple[Counter, Counter, list[tuple[str, int, str, str]]]:
     per_file: Counter = Counter()
     per_kind: Counter = Counter()
     lines = []
-    compiled = {k: re.compile(v) for k, v in PATTERNS.items()}
+    compiled = {k: re.compile(v) for k, v in patterns.items()}
     for path in sorted(root.rglob("*.py")):
         rel = path.relative_to(root).as_posix()
         text = path.read_text()
@@ -97,14 +119,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--root", type=Path,
                         default=Path(__file__).resolve().parents[1] / "src" / "vfem")
     parser.add_argument("--lines", action="store_true", help="list every line counted")
+    parser.add_argument("--tests", action="store_true",
+                        help="count the tests of the dimension (branches on it) instead")
     args = parser.parse_args(argv)
-    per_file, per_kind, lines = count(args.root)
+    per_file, per_kind, lines = count(args.root, TESTS if args.tests else PATTERNS)
     total = sum(per_file.values())
-    print(f"{total} lines assume 2D in {len(per_file)} files under {args.root}")
+    groups = GROUPS
+    if args.tests:
+        contact = [f for f in per_file if f.startswith("contact/") and f not in GEOMETRY]
+        print(f"{total} tests of the dimension in {len(per_file)} files under {args.root}; "
+              f"{sum(per_file[f] for f in contact)} in {len(contact)} contact modules outside "
+              "its geometry layer")
+        groups = (("the geometry layer (" + ", ".join(GEOMETRY) + ")", GEOMETRY),
+                  ("the rest of contact", ("contact/",)), ("elsewhere", ("",)))
+    else:
+        print(f"{total} lines assume 2D in {len(per_file)} files under {args.root}")
     grouped: Counter = Counter()
     for f, n in per_file.items():
-        grouped[next(name for name, prefixes in GROUPS if f.startswith(prefixes))] += n
-    for name, _ in GROUPS:
+        grouped[next(name for name, prefixes in groups if f.startswith(prefixes))] += n
+    for name, _ in groups:
         if grouped[name]:
             print(f"  {grouped[name]:4d}  {name}")
     print("by form:")

@@ -58,6 +58,12 @@ class FacetKind:
     nodes: int
     #: the local coordinates at which a facet is read against the other surface, one row each
     readings: np.ndarray
+    #: where a corner's shape function integrates to zero over its facet (quadratic triangles,
+    #: T6: a uniform pressure puts no force on a corner, and a varying one a force of either
+    #: sign), each corner with the midpoints of its two edges, as columns of ``facets``: its
+    #: nodal force cannot tell whether it is in contact, nor its tributary read its pressure
+    #: (:func:`vfem.contact.group.quadratic_status`, ``consistent_pressure``); empty elsewhere
+    weightless_corners: tuple[tuple[int, int, int], ...] = ()
 
     def shape(self, xi: np.ndarray) -> np.ndarray:
         """(n, nodes) shape functions at ``xi``, in the column order of ``facets``."""
@@ -351,6 +357,10 @@ class _Facet3D(FacetKind):
         self.nodes = self._NODES[order]
         self.geometry = facets3d.KINDS[self.nodes]
         self.corners = self.geometry.corners
+        if order == 2 and self.corners == 3:  # the 6-node triangle: its corners weigh nothing
+            self.weightless_corners = tuple(
+                (c, *(mid for a, b, mid in self.geometry.edges if c in (a, b)))
+                for c in range(3))
         centre = np.asarray(self.geometry.centre)
         # the centre and points 0.9 of the way from it to each corner (2D: 0.5, 0.05, 0.95)
         self.readings = np.vstack([centre, centre + 0.9 * (self.geometry.vertices - centre)])

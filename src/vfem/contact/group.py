@@ -23,19 +23,22 @@ from .state import ContactState, SolveResult
 from .surface import ContactSurface
 
 
-def quadratic_3d(s) -> bool:
-    """Whether ``s`` is a 3D surface of quadratic facets (with candidate facets)."""
-    return s.dim == 3 and s.kind is not None and s.kind.order == 2 and len(s.facets) > 0
+def weightless_corners(s) -> bool:
+    """Whether the facets of ``s`` (it has candidate facets) have corners whose shape
+    functions integrate to zero (:attr:`~vfem.contact.facets.FacetKind.weightless_corners`:
+    quadratic triangles, T6)."""
+    return s.kind is not None and bool(s.kind.weightless_corners) and len(s.facets) > 0
 
 
 def quadratic_status(s, participating: np.ndarray) -> np.ndarray:
-    """In contact, on quadratic triangles (T6): a node the formulation counts in (the
-    compatibility side's positive tractions, the other side's compressive forces), and a
-    corner both of whose edge midpoints in one of its facets are: a corner's force is zero
-    under a uniform pressure and of either sign under a varying one, so it cannot tell."""
+    """In contact, where corners weigh nothing (quadratic triangles, T6): a node the
+    formulation counts in (the compatibility side's positive tractions, the other side's
+    compressive forces), and a corner both of whose edge midpoints in one of its facets are: a
+    corner's force is zero under a uniform pressure and of either sign under a varying one, so
+    it cannot tell."""
     on = np.asarray(participating, dtype=bool).copy()
-    f = s.facets  # (nf, 6): corners 0, 1, 2, midpoints 3 (0-1), 4 (1-2), 5 (0-2)
-    for corner, m1, m2 in ((0, 3, 5), (1, 3, 4), (2, 4, 5)):
+    f = s.facets
+    for corner, m1, m2 in s.kind.weightless_corners:
         both = on[f[:, m1]] & on[f[:, m2]]
         on[f[both, corner]] = True
     return on
@@ -48,7 +51,7 @@ def consistent_pressure(s, force: np.ndarray) -> np.ndarray:
     integrate to zero (a uniform pressure puts no force on them), the consistent pressure
     instead, the nodal values p with N p = force (N the surface's mass matrix, ∫ phi phi^T):
     exact for any pressure the facets can represent (the 3D patch test's to round-off)."""
-    if quadratic_3d(s):
+    if weightless_corners(s):
         from scipy.sparse.linalg import spsolve
 
         N = s.mass_matrix(np.ones(len(s.facets))).tocsc()
@@ -206,7 +209,7 @@ class SurfaceGroup:
                 traction = np.zeros(nv)
                 traction[cand] = p.pressure
             status = np.zeros(nv, dtype=int)
-            if quadratic_3d(s):
+            if weightless_corners(s):
                 status[cand] = quadratic_status(s, p.participating)
             else:
                 status[cand] = p.participating & (p.force > 0)
