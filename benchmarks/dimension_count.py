@@ -54,7 +54,7 @@ TESTS: dict[str, str] = {
 #: ``--tests``: the geometry layer of issue 38 (search, facet kinds, surfaces, pairing, transfer)
 GEOMETRY = ("contact/search.py", "contact/facets.py", "contact/facets3d.py",
             "contact/overlap3d.py", "contact/surface.py", "contact/pairing.py",
-            "contact/transfer.py")
+            "contact/transfer.py", "contact/flexibility.py")
 
 #: patterns read on the raw line (their form is a string)
 RAW = ("components x, y",)

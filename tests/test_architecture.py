@@ -33,6 +33,21 @@ LAYERS: tuple[tuple[str, ...], ...] = (
 )
 
 
+#: Inside contact, the pipeline's stages, lowest first (issue 38): each module imports only from
+#: its own stage or those below. The modules are not yet in subpackages of these names.
+CONTACT_STAGES: tuple[tuple[str, ...], ...] = (
+    ("settings", "state", "capabilities"),  # the data every stage passes on
+    ("search",),  # candidates, closest points
+    # geometry: facet kinds, surfaces and a body's flexibility on them, pairing, transfer
+    ("facets3d", "overlap3d", "facets", "surface", "flexibility", "transfer", "pairing"),
+    ("corrections",),  # laws: the thesis's two corrections, node by node
+    ("bordered", "complementarity", "iteration", "matrix_free"),  # solvers
+    ("group", "paired", "large", "friction", "large_friction", "algorithm", "baselines",
+     "formulation", "onedim"),  # formulations
+    ("cached_boundary", "check3d", "check"),  # the invariants
+)
+
+
 def import_graph(typing: bool = True) -> dict[str, set[str]]:
     """Module -> the modules of ``vfem`` it imports (``typing``: those under ``TYPE_CHECKING``
     too)."""
@@ -126,6 +141,23 @@ def upward(graph: dict[str, set[str]]) -> list[str]:
 
 def test_no_module_imports_from_a_layer_above_its_own():
     assert not upward(import_graph()), "\n".join(upward(import_graph()))
+
+
+def stage(module: str) -> int:
+    name = module.removeprefix("vfem.contact.")
+    found = [k for k, members in enumerate(CONTACT_STAGES) if name in members]
+    assert len(found) == 1, f"{module} is in {len(found)} stages: name it once in CONTACT_STAGES"
+    return found[0]
+
+
+def test_contact_imports_only_from_its_own_stage_or_those_below():
+    graph = import_graph()
+    inside = [m for m in graph if m.startswith("vfem.contact.")]
+    for m in inside:
+        stage(m)
+    back = sorted(f"{m} (stage {stage(m)}) imports {t} (stage {stage(t)})" for m in inside
+                  for t in graph[m] if t.startswith("vfem.contact.") and stage(t) > stage(m))
+    assert not back, "\n".join(back)
 
 
 def test_the_layer_rule_finds_an_upward_import():

@@ -1,10 +1,17 @@
 """The platen's bordered system, which every formulation's compatibility correction solves
-(:func:`bordered_solve`): a leaf module, so that the formulations and the matrix-free operator
-(:mod:`vfem.contact.matrix_free`) share it without importing each other."""
+(:func:`bordered_solve`), and the dense pair matrix's factors kept while it recurs
+(:class:`ReusedFactor`): the solvers' dense linear algebra, below the formulations, so that
+they, the complementarity solver and the matrix-free operator (:mod:`vfem.contact.matrix_free`)
+share it without importing each other."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
+import scipy.linalg as sla
+
+from ..threads import dense_threads
 
 
 def bordered_solve(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: float,
@@ -46,3 +53,32 @@ def bordered_matrix(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: 
     A[m, :m] = row
     A[m, m] = corner
     return A
+
+
+class ReusedFactor:
+    """The LU factors of the last matrix solved, kept for as long as the matrix recurs.
+
+    Under small kinematics the paired variant's pair matrix over an active set is the same
+    whenever that set recurs (its flexibility over every pair node is fixed): in the
+    iterations that only adjust the traction values, and in the steps whose contact set holds.
+    It is factorized when the set changes, not at every solve (issue 19, item 4: the dense solve
+    is O(m^3), seconds at a few thousand nodes). Partial pivoting as ``numpy.linalg.solve``.
+    """
+
+    def __init__(self):
+        self.key = None
+        self.factors = None
+
+    def solve(self, key, matrix, b: np.ndarray) -> np.ndarray | None:
+        """The solution of ``matrix() x = b``, ``matrix`` called only when ``key`` is new;
+        None when the matrix is singular (an exactly zero pivot)."""
+        if key != self.key:
+            A = matrix()
+            with dense_threads(len(A)), warnings.catch_warnings():
+                warnings.simplefilter("ignore", sla.LinAlgWarning)  # singular: None, below
+                lu, piv = sla.lu_factor(A, check_finite=False, overwrite_a=True)
+            self.key = key
+            self.factors = None if (np.diag(lu) == 0.0).any() else (lu, piv)
+        if self.factors is None:
+            return None
+        return sla.lu_solve(self.factors, b, check_finite=False)

@@ -17,7 +17,7 @@ import logging
 
 import numpy as np
 
-from .group import ReusedFactor, bordered_matrix, bordered_solve
+from .bordered import ReusedFactor, bordered_matrix, bordered_solve
 
 log = logging.getLogger(__name__)
 

@@ -9,15 +9,11 @@ the platen's bordered system that each of them solves in its compatibility corre
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
-import scipy.linalg as sla
 
 from ..bodies.results import BodyStepResult, add_reactions
 from ..executor import SERIAL, Executor
-from ..threads import dense_threads
-from .bordered import bordered_matrix, bordered_solve  # noqa: F401 - here too, as before
+from .bordered import ReusedFactor, bordered_matrix, bordered_solve  # noqa: F401 - here too, as before
 from .settings import ContactSettings
 from .state import ContactState, SolveResult
 from .surface import ContactSurface
@@ -57,35 +53,6 @@ def consistent_pressure(s, force: np.ndarray) -> np.ndarray:
         N = s.mass_matrix(np.ones(len(s.facets))).tocsc()
         return np.asarray(spsolve(N, force), dtype=float).ravel()
     return force / s.tributary
-
-class ReusedFactor:
-    """The LU factors of the last matrix solved, kept for as long as the matrix recurs.
-
-    Under small kinematics the paired variant's pair matrix over an active set is the same
-    whenever that set recurs (its flexibility over every pair node is fixed): in the
-    iterations that only adjust the traction values, and in the steps whose contact set holds.
-    It is factorized when the set changes, not at every solve (issue 19, item 4: the dense solve
-    is O(m^3), seconds at a few thousand nodes). Partial pivoting as ``numpy.linalg.solve``.
-    """
-
-    def __init__(self):
-        self.key = None
-        self.factors = None
-
-    def solve(self, key, matrix, b: np.ndarray) -> np.ndarray | None:
-        """The solution of ``matrix() x = b``, ``matrix`` called only when ``key`` is new;
-        None when the matrix is singular (an exactly zero pivot)."""
-        if key != self.key:
-            A = matrix()
-            with dense_threads(len(A)), warnings.catch_warnings():
-                warnings.simplefilter("ignore", sla.LinAlgWarning)  # singular: None, below
-                lu, piv = sla.lu_factor(A, check_finite=False, overwrite_a=True)
-            self.key = key
-            self.factors = None if (np.diag(lu) == 0.0).any() else (lu, piv)
-        if self.factors is None:
-            return None
-        return sla.lu_solve(self.factors, b, check_finite=False)
-
 
 class SurfaceGroup:
     """The contact surfaces of all bodies, the pairs of bodies that may touch, the settings, the

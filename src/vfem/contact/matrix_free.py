@@ -8,16 +8,16 @@ contact dofs, 7 GB for one body's block and minutes of dense factorization.
 
 Here neither is formed. A body's flexibility on its candidates is applied to a set of nodal
 forces by one back-substitution through its own (plain) factorization
-(:class:`SurfaceFlexibility`), and W to a vector of traction values by one such
-back-substitution per body (:class:`PairOperator`): the forces the traction values make (the
-same sparse ``N`` and ``T`` rows the dense route uses, eq. 4.4.11), each body's motion under
-them, read at the pair nodes and their virtual nodes along the directions (eq. 4.2.4 in matrix
-form). The linear complementarity problem of the correction
+(:class:`~vfem.contact.flexibility.SurfaceFlexibility`), and W to a vector of traction values
+by one such back-substitution per body (:class:`PairOperator`): the forces the traction values
+make (the same sparse ``N`` and ``T`` rows the dense route uses, eq. 4.4.11), each body's motion
+under them, read at the pair nodes and their virtual nodes along the directions (eq. 4.2.4 in
+matrix form). The linear complementarity problem of the correction
 (:func:`~vfem.contact.complementarity.linear_complementarity`) is then solved with the same
 block principal pivoting, each set's system by GMRES on this operator (W is not symmetric: the
 paired variant reads penetrations at the virtual nodes but applies forces through N and T, so
 conjugate gradients do not apply), preconditioned by an estimate of W's diagonal from each
-node's own block of its body's stiffness (:meth:`SurfaceFlexibility.local_blocks`: no
+node's own block of its body's stiffness (``SurfaceFlexibility.local_blocks``: no
 back-substitution).
 
 The answers are the dense route's to the iteration's tolerance (:data:`RTOL`, relative to the
@@ -42,80 +42,6 @@ log = logging.getLogger(__name__)
 RTOL = 1e-12
 #: GMRES's restart length and the most restarts
 RESTART, MAX_RESTARTS = 200, 50
-#: candidate nodes solved for at once when a surface's nodal flexibilities are computed
-PROBE_CHUNK = 96
-
-
-class SurfaceFlexibility:
-    """A body's flexibility on its contact candidates, applied through its factorization.
-
-    ``apply(F)``: the motion of the surface's condensed dofs (its candidates', and the rind's
-    where the formulation reads it) under nodal forces ``F`` on its candidate dofs, supports
-    held: ``G F`` of the dense route, by one back-substitution (several columns at once).
-    """
-
-    def __init__(self, surface):
-        body = surface.body
-        self.body = body
-        self.dim = surface.dim
-        self.n_free = len(body.free_dofs)
-        self._col_pos, self._col_free = body.free_positions(surface.candidate_dofs)
-        self._row_pos, self._row_free = body.free_positions(surface.condensed_dofs)
-        self.n_cols = len(surface.candidate_dofs)
-        self._cand_dofs = surface.candidate_dofs.reshape(-1, self.dim)
-        self.n_rows = len(surface.condensed_dofs)
-
-    def apply(self, F: np.ndarray, rows: int | None = None) -> np.ndarray:
-        """The condensed dofs' motion (their first ``rows``, default all) under candidate-dof
-        forces ``F`` ((n_cols,) or (n_cols, k))."""
-        F = np.asarray(F, dtype=float)
-        vector = F.ndim == 1
-        F2 = F[:, None] if vector else F
-        k = F2.shape[1]
-        rhs = np.zeros((self.n_free, k))
-        rhs[self._col_pos[self._col_free]] = F2[self._col_free]
-        x = self.body.factor.solve(rhs if k > 1 else rhs[:, 0])
-        x = x.reshape(self.n_free, k)
-        n = self.n_rows if rows is None else rows
-        out = np.zeros((n, k))
-        ok = self._row_free[:n]
-        out[ok] = x[self._row_pos[:n][ok]]
-        return out[:, 0] if vector else out
-
-    def normal_compliance(self, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
-        """n^T C_jj n at candidate nodes ``nodes`` along unit ``normals``: each node's motion
-        along its normal under a unit force along it (one back-substitution a node,
-        :data:`PROBE_CHUNK` at a time); what ``ContactSurface.normal_stiffness`` inverts."""
-        nodes = np.asarray(nodes, dtype=int)
-        d = self.dim
-        out = np.zeros(len(nodes))
-        for start in range(0, len(nodes), PROBE_CHUNK):
-            chunk = nodes[start:start + PROBE_CHUNK]
-            n = normals[start:start + PROBE_CHUNK]
-            cols = d * chunk[:, None] + np.arange(d)  # (k, d)
-            k = np.arange(len(chunk))
-            F = np.zeros((self.n_cols, len(chunk)))
-            F[cols, k[:, None]] = n
-            U = self.apply(F, rows=self.n_cols)
-            out[start:start + len(chunk)] = np.einsum("kd,kd->k", U[cols, k[:, None]], n)
-        return out
-
-    def local_blocks(self, nodes: np.ndarray) -> np.ndarray:
-        """(len(nodes), dim, dim) a cheap stand-in for the flexibility's diagonal blocks at
-        candidate nodes ``nodes``: the inverse of each node's own block of the stiffness (its
-        dofs held by the neighbours alone). It scales as the flexibility does with the element
-        size and the modulus (1 / (E h) in 3D), which is what a preconditioner needs, at no
-        back-substitution; a supported dof gets zero."""
-        d = self.dim
-        dofs = self._cand_dofs[np.asarray(nodes, dtype=int)]  # (k, d)
-        K = self.body.K
-        blocks = np.stack([np.stack([np.asarray(K[dofs[:, a], dofs[:, b]]).ravel()
-                                     for b in range(d)], axis=1) for a in range(d)], axis=1)
-        free = self._col_free.reshape(-1, d)[np.asarray(nodes, dtype=int)]
-        mask = free[:, :, None] & free[:, None, :]
-        blocks = np.where(mask, blocks, np.eye(d)[None])
-        inv = np.linalg.inv(blocks)
-        return np.where(mask, inv, 0.0)
 
 
 class PairOperator:
@@ -125,8 +51,9 @@ class PairOperator:
 
     ``dF``: per body, the sparse nodal forces on its candidate dofs per unit traction value
     ((dim nc, m), :meth:`~vfem.contact.paired.PairedContact._force_rows`); ``flex``: per body its
-    :class:`SurfaceFlexibility`; ``pairs``, ``directions``, ``offsets``: how the unknowns are
-    laid out (pair by pair, direction by direction, node by node).
+    :class:`~vfem.contact.flexibility.SurfaceFlexibility`; ``pairs``, ``directions``,
+    ``offsets``: how the unknowns are laid out (pair by pair, direction by direction, node by
+    node).
     """
 
     def __init__(self, surfaces, flex, dF, pairs, directions, offsets, executor=SERIAL):
@@ -176,7 +103,7 @@ class PairOperator:
     def _diagonal(self) -> np.ndarray:
         """An estimate of W's diagonal (the preconditioner): each unknown's own force's motion
         read at itself, from stand-ins for the bodies' nodal flexibility blocks
-        (:meth:`SurfaceFlexibility.local_blocks`) and the sparse force rows.
+        (``SurfaceFlexibility.local_blocks``) and the sparse force rows.
 
         A pair node's traction value moves its own node and its neighbours (its row of N)
         and, through T, the coarse nodes under it; W_ii reads node i's motion and its virtual
@@ -291,4 +218,4 @@ def matrix_free_refusal(settings, bodies) -> str | None:
     return None
 
 
-__all__ = ["PairOperator", "SurfaceFlexibility", "matrix_free_refusal"]
+__all__ = ["PairOperator", "matrix_free_refusal"]

@@ -42,10 +42,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import PlatenUnheld, PlatenUnpaired, RindViolation
+from .bordered import ReusedFactor, bordered_matrix, bordered_solve
 from .capabilities import Capabilities
 from .complementarity import linear_complementarity
 from .corrections import relaxation, release_tension
-from .group import ReusedFactor, SurfaceGroup, bordered_matrix, bordered_solve
+from .group import SurfaceGroup
 from .iteration import Check, iterate
 from .pairing import (  # noqa: F401 - the pairing's parts, here too for those who import them here
     EDGE_RATIO,

@@ -238,7 +238,7 @@ class ContactSurface:
         a candidate dof is, by reciprocity, minus that dof's motion under a unit platen motion.
         ``matrix_free`` (issue 22): no dense block at all; the flexibility is applied through
         the body's factorization when asked (:attr:`flexibility`,
-        :class:`~vfem.contact.matrix_free.SurfaceFlexibility`). ``remote``: the body is another
+        :class:`~vfem.contact.flexibility.SurfaceFlexibility`). ``remote``: the body is another
         MPI rank's, which alone reads its dense flexibility (:mod:`vfem.parallel`): none here.
         """
         body = self.body
@@ -246,7 +246,7 @@ class ContactSurface:
         rows = self.condensed_dofs
         self.platen_row = -body.u_platen[self.candidate_dofs]
         if matrix_free:
-            from .matrix_free import SurfaceFlexibility
+            from .flexibility import SurfaceFlexibility
 
             self.G = None
             self.flexibility = SurfaceFlexibility(self)
