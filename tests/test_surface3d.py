@@ -266,3 +266,36 @@ def test_normals_at_do_not_average_across_the_bodys_edges(cells):
         edge = corners[np.isclose(s.X[corners, 0], SIZE[0])
                        & np.isclose(s.X[corners, 2], SIZE[2])]
         assert len(edge) and np.all(np.abs(s.node_normals()[edge] @ e) < 0.99)
+
+
+@pytest.mark.parametrize(("cells", "order"), CASES)
+def test_feature_nodes_are_the_boxs_edges(cells, order):
+    """``feature_nodes`` (issue 37): the nodes on the box's edges where two of the given faces
+    meet (at 90 degrees), and no other: not the faces' inner nodes, not a quadratic facet's
+    midside or centre nodes off the edges; with one face alone, none."""
+    body = _body(cells, order, ("top", "right", "front"))
+    s = _surface(body, ("top", "right", "front"))
+    x = s.X[: s.nc]
+    on_top, on_right, on_front = (np.isclose(x[:, 2], SIZE[2]), np.isclose(x[:, 0], SIZE[0]),
+                                  np.isclose(x[:, 1], 0.0))
+    edges = (on_top & on_right) | (on_top & on_front) | (on_right & on_front)
+    np.testing.assert_array_equal(s.feature_nodes(), edges)
+    top = np.flatnonzero(np.isin(s.facet_ids, body.mesh.boundaries["top"]))
+    assert not s.feature_nodes(top).any()
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_feature_nodes_in_2d_are_the_corners(order):
+    """The same in 2D: a block's top and side meet at its corner; a faceted arc's nodes turn
+    by less than 60 degrees and are no feature."""
+    from skfem import MeshTri
+
+    mesh = MeshTri.init_tensor(np.linspace(0, 1, 5), np.linspace(0, 1, 4)).with_boundaries(
+        {"top": lambda p: p[1] > 1 - 1e-9, "left": lambda p: p[0] < 1e-9})
+    body = Body("block", mesh, LinearElastic(200.0, 0.3), supports=(Support("top"),),
+                order=order)
+    ids = np.concatenate([mesh.boundaries["top"], mesh.boundaries["left"]])
+    s = ContactSurface.build(body, ids)
+    corner = np.isclose(s.X[: s.nc, 0], 0.0) & np.isclose(s.X[: s.nc, 1], 1.0)
+    assert corner.sum() == 1
+    np.testing.assert_array_equal(s.feature_nodes(), corner)

@@ -12,7 +12,7 @@ Classes that describe a body's physics are the solver's own: :class:`~vfem.mater
 :class:`~vfem.bodies.Traction`, :class:`~vfem.bodies.Platen` and
 :class:`~vfem.contact.settings.ContactSettings`. What only a description needs (how to make the
 mesh, the steps, where results go) is defined here. :meth:`ModelConfig.build` turns the
-description into a :class:`~vfem.solver.Model`.
+description into a :class:`~vfem.model.Model`.
 """
 
 from __future__ import annotations

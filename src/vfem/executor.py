@@ -13,6 +13,9 @@ from typing import Protocol
 
 
 class Executor(Protocol):
+    #: how many processes share the work (owners run from 0 to size - 1)
+    size: int
+
     def map(self, indices: Iterable[int], compute: Callable[[int], object],
             owners: list[int] | None = None) -> dict:
         """``compute(i)`` for every ``i`` of ``indices`` (each body's work on its owner, or on
@@ -21,6 +24,8 @@ class Executor(Protocol):
 
 class Serial:
     """Every body in this process, in order."""
+
+    size = 1
 
     def map(self, indices: Iterable[int], compute: Callable[[int], object],
             owners: list[int] | None = None) -> dict:

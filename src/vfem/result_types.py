@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .bodies.results import BodyStepResult
+from .bodies.results import BodyStepResult, add_reactions  # noqa: F401 - here too
 from .contact.state import ContactState, IterationRecord
 
 if TYPE_CHECKING:

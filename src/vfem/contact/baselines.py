@@ -1,7 +1,7 @@
 """The classical contact methods vfem is measured against (``contact.method``): penalty,
 Lagrange multipliers and the augmented Lagrangian, on one global system of every body.
 
-This is contact the way most finite element codes do it, on the same :class:`~vfem.solver.Model`
+This is contact the way most finite element codes do it, on the same :class:`~vfem.model.Model`
 as the virtual finite element method (bodies, meshes, supports, loads, platen, load factors):
 
 * **one global system**: the stiffness of every body, block diagonal, reduced to the free dofs
@@ -672,7 +672,7 @@ class GlobalContact:
 
     def fields_of(self, load_factor: float, q: np.ndarray, Lam: np.ndarray, g: np.ndarray,
                   friction: dict | None = None):
-        """Per body: the :class:`~vfem.result_types.BodyStepResult` and the contact forces on its
+        """Per body: the :class:`~vfem.bodies.results.BodyStepResult` and the contact forces on its
         candidate nodes (nc, 2). ``friction`` (frictional lagrange): per row the tangential
         force ``shear``, the step's slip ``increment``, the ``accumulated`` slip and the
         ``status`` (0 free, 1 stick, 2 slip), which add the friction's fields."""

@@ -2,7 +2,7 @@
 
 :func:`step_invariants` (and :class:`InvariantCheck`, which keeps each body's boundary between
 steps) takes only the full-mesh results of a step — each body's displacement and contact force
-at every point (:class:`vfem.result_types.BodyStepResult`) — and the bodies' meshes and supports;
+at every point (:class:`vfem.bodies.results.BodyStepResult`) — and the bodies' meshes and supports;
 nothing of the contact formulation's own state (pairings, virtual nodes, multipliers, which side
 carries compatibility). It checks
 
@@ -607,12 +607,12 @@ class InvariantCheck:
         # choice of the formulation, and after a slip s along surfaces that meet at an angle
         # the readings differ by s times that angle: a penetration counts only if both
         # surfaces' normals see it
-        # (not along i's own normal at a corner of i, turning by more than CORNER_ANGLE: its
-        # nodal normal is only a bisector there, along which no contact is measured, and a
-        # slide along j's facet read along it is a large false gap; a block's corner slid
-        # 0.016 along a quarter disk's flank, 1.3e-5 inside it, read 7.4e-3 outside)
+        # (not along i's own normal at a convex corner of i, turning by more than
+        # CORNER_ANGLE: its nodal normal is only a bisector there, along which no contact is
+        # measured, and a slide along j's facet read along it is a large false gap; a block's
+        # corner slid 0.016 along a quarter disk's flank, 1.3e-5 inside it, read 7.4e-3 outside)
         own = np.einsum("ij,ij->i", r, ri.normals[node])
-        own[np.abs(ri.turning[node]) > CORNER_ANGLE] = np.inf
+        own[ri.turning[node] > CORNER_ANGLE] = np.inf
         depth = np.minimum(-np.einsum("ij,ij->i", r, normals[seg]), own)
         # or along j's smoothed normal there (its vertex normals, the mean of the adjacent
         # facets' unit normals, interpolated along the facet: the usual normal field of
@@ -751,6 +751,6 @@ def _loaded_or_next(segments: np.ndarray, forces: np.ndarray) -> np.ndarray:
 def step_invariants(model_or_bodies, pairs, fields: dict, penetration_tolerance: float,
                     **options) -> Invariants:
     """The three invariants of one state (see :class:`InvariantCheck` for the arguments;
-    ``fields``: body name -> its :class:`~vfem.result_types.BodyStepResult`, or anything with
+    ``fields``: body name -> its :class:`~vfem.bodies.results.BodyStepResult`, or anything with
     ``displacement`` and ``contact_force``)."""
     return InvariantCheck(model_or_bodies, pairs, penetration_tolerance, **options)(fields)

@@ -19,7 +19,7 @@ along its first diagonal) in place of its boundary polygon:
 * **linearised depth** under small kinematics: the node's offset r from its closest point on
   the other undeformed surface moved with the surface's displacement (interpolated linearly on
   the triangle), read along the facet's normal and along the node's own normal (the smaller;
-  not the node's own at an edge or corner of its body, :data:`CORNER_ANGLE`);
+  not the node's own at a convex edge or corner of its body, :data:`CORNER_ANGLE`);
   beside an edge or a vertex (the node's projection on the facet's plane outside it, not across
   an edge on a symmetry plane, where the facet's mirror image continues it), |r| signed by the
   feature's pseudonormal; the second-order allowance the slip times the angle the facet
@@ -52,8 +52,8 @@ if TYPE_CHECKING:
 #: a feature of a triangle: the barycentric coordinates below this (relative) are on its edge
 FEATURE = 1e-9
 
-#: radians: a boundary node whose own surface turns by more than this is a corner or an edge
-#: of its body (a block's corner, a box's edge), whose nodal normal is only a bisector: the
+#: radians: a boundary node whose own surface turns convexly by more than this is a corner or
+#: an edge of its body (a block's corner, a box's edge), whose nodal normal is only a bisector: the
 #: linearised depth is not read along it (the formulation's edge angle, chosen alike: a faceted
 #: curve turns less per facet)
 CORNER_ANGLE = np.radians(60.0)
@@ -357,7 +357,7 @@ def linearised_depth(reference: list[Surface3], i: int, j: int, node: np.ndarray
     uc = np.einsum("mk,mkd->md", lam, uj[corners])
     r = cur[i].x[node] - (c + uc)
     n = rj.unit_normals[tri]
-    # (not along i's own normal at its edges and corners: 2D's reading)
+    # (not along i's own normal at its convex edges and corners: 2D's reading)
     own = np.einsum("ij,ij->i", r, ri.normals[node])
     own[ri.own_turning[node] > CORNER_ANGLE] = np.inf
     depth = np.minimum(-np.einsum("ij,ij->i", r, n), own)

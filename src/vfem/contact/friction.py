@@ -310,7 +310,7 @@ class FrictionHistory:
 
     def fields(self, state: ContactState, result: SolveResult) -> dict:
         """The frictionless fields, and the friction's at each pair's compatibility-side nodes
-        (:class:`~vfem.result_types.BodyStepResult`: tangential traction, slip increment,
+        (:class:`~vfem.bodies.results.BodyStepResult`: tangential traction, slip increment,
         accumulated slip, stick or slip)."""
         out = super().fields(state, result)
         increments = self._increments

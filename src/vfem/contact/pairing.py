@@ -223,7 +223,7 @@ def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: 
     n = blended_normal(geo.normal, sf.node_normals(None, geo.fpatch)[geo.nodes], c_fine,
                        c_coarse)
     end = (sf.kind.boundary_nodes(sf.facets, sf.patch_boundary(geo.fpatch), sf.nc)
-           | sf.edge_nodes(geo.fpatch))[geo.nodes]
+           | sf.feature_nodes(geo.fpatch))[geo.nodes]
     # (only where the other surface is flat about the virtual node: its nodal normals there
     # all one, the weighted sum as long as the weights; a virtual node at a vertex reads
     # that vertex's normal alone. Measured and not kept: no turning across the whole facet

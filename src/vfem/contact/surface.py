@@ -337,7 +337,7 @@ class ContactSurface:
             out += phi[:, k, None] * corner
         return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
 
-    def edge_nodes(self, facets: np.ndarray | None = None) -> np.ndarray:
+    def feature_nodes(self, facets: np.ndarray | None = None) -> np.ndarray:
         """(nc,) True at the nodes where two of the facets around them (of the subset
         ``facets``) turn by more than :data:`FEATURE_ANGLE`: an edge or corner of the body
         (a block's corner, a box's edge), where its surface has no normal of its own; the

@@ -11,7 +11,7 @@ nominal traction at the node: in the paired variant its unknowns q on the compat
 read at the other side's nodes; elsewhere as ``contact_pressure``), ``contact_status``
 (1 in contact, 0 free), ``penetration`` (> 0 overlapping), ``reaction`` (3 components, z = 0:
 the nodal force the supports, prescribed displacements and platen apply to the body, zero on
-unconstrained dofs; :attr:`vfem.result_types.BodyStepResult.reaction`); with friction also
+unconstrained dofs; :attr:`vfem.bodies.results.BodyStepResult.reaction`); with friction also
 ``contact_shear`` (3 components, z = 0: the tangential traction), ``slip_increment``,
 ``accumulated_slip`` and ``friction_status`` (0 free, 1 stick, 2 slip, -1 on nodes that carry
 no pair's compatibility; :mod:`vfem.contact.friction`). Cell fields:
@@ -524,7 +524,7 @@ def force_record(step: StepResult) -> dict:
     the force the supports,
     prescribed displacements and platen apply to the body (the total counts each constrained
     dof once, each boundary sums the dofs its own conditions constrain, see
-    :attr:`vfem.result_types.BodyStepResult.reactions`); ``applied_load`` the resultant of its
+    :attr:`vfem.bodies.results.BodyStepResult.reactions`); ``applied_load`` the resultant of its
     tractions at the step's load factor; ``reaction_imbalance``: :func:`imbalance` of the three,
     which balance (0 up to the solver's residual). The last three leave out a body whose
     reactions were not computed (a step read back from an older checkpoint)."""

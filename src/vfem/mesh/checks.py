@@ -7,7 +7,7 @@ overlap or turn inside out (negative Jacobian). :func:`check_mesh` finds these f
 parametric shapes with user parameters, imported files, meshes built in Python — and raises one
 :class:`~vfem.errors.InputError` naming the body, the problem, the first offending element or
 node with its coordinates, and what to do. :meth:`vfem.bodies.Body.validate` calls it, so
-``vfem check``, ``vfem run`` and :meth:`vfem.solver.Model.validate` all go through it.
+``vfem check``, ``vfem run`` and :meth:`vfem.model.Model.validate` all go through it.
 
 Node numbers in messages are the body's (as in its results files; an imported mesh keeps only
 the body's nodes, numbered in their order in the file); the coordinates locate them in any

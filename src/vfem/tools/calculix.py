@@ -3,7 +3,7 @@
 For comparing vfem with a general-purpose code on the *same mesh* (docs/benchmarks.md, *Hertz in
 CalculiX*):
 
-* :func:`write_deck` writes a two-body, linear-element, small-kinematics :class:`~vfem.solver.Model`
+* :func:`write_deck` writes a two-body, linear-element, small-kinematics :class:`~vfem.model.Model`
   (the Hertz example's, or any like it) as a CalculiX deck: the same nodes and elements (3-node
   triangles as CPE3, 4-node quadrilaterals as CPE4; CPS3/CPS4 for plane stress), each counter-
   clockwise in the x-y plane as ccx requires, unit thickness; one linear elastic material per
@@ -261,7 +261,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     """Write ``model`` as a CalculiX input deck at ``path`` (see the module docstring).
 
     Args:
-        model: a two-body :class:`~vfem.solver.Model` with linear elements, small kinematics,
+        model: a two-body :class:`~vfem.model.Model` with linear elements, small kinematics,
             supports, prescribed displacements and at most one platen (with amplitudes, i.e.
             load curves, only with ``steps="curves"``).
         path: the ``.inp`` file to write.
