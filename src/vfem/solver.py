@@ -44,9 +44,7 @@ from .contact.matrix_free import matrix_free_refusal
 from .contact.search import project_points
 from .contact.settings import ContactSettings
 from .contact.state import ContactState, IterationRecord, SolveResult
-from .contact.surface import (
-    exterior_facets,
-)
+from .contact.surface import exterior_facets
 from .errors import (
     ActiveSetNotSettled,
     AnalysisError,

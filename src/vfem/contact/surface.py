@@ -343,22 +343,17 @@ class ContactSurface:
         (a block's corner, a box's edge), where its surface has no normal of its own; the
         nodal normal there (:meth:`node_normals`) is only a bisector."""
         ids = np.arange(len(self.facets)) if facets is None else np.asarray(facets)
-        out = np.zeros(self.nc, dtype=bool)
         if not len(ids):
-            return out
+            return np.zeros(self.nc, dtype=bool)
         fn = self.kind.facet_normals(self.X, self.facets[ids])
-        inc = self.incidence(ids).tocoo()
-        # each node's facets side by side (padded with zero normals, which never count)
-        order = np.argsort(inc.row, kind="stable")
-        node, facet = inc.row[order], inc.col[order]
-        start = np.searchsorted(node, np.arange(self.nc))
-        slot = np.arange(len(node)) - start[node]
-        star = np.zeros((self.nc, int(slot.max()) + 1, self.dim))
-        star[node, slot] = fn[facet]
-        cos = np.einsum("nad,nbd->nab", star, star)
-        present = np.linalg.norm(star, axis=2) > 0
-        both = present[:, :, None] & present[:, None, :]
-        return np.any(both & (cos < np.cos(FEATURE_ANGLE)), axis=(1, 2))
+        inc = self.incidence(ids)  # (nc, len(ids))
+        # the pairs of facets that share a node, those of them that turn, and per node how
+        # many such pairs it lies in (the diagonal of inc @ turned @ inc^T)
+        pairs = (inc.T @ inc).tocoo()
+        turned = np.einsum("ij,ij->i", fn[pairs.row], fn[pairs.col]) < np.cos(FEATURE_ANGLE)
+        turned = sp.csr_matrix((np.ones(int(turned.sum())), (pairs.row[turned],
+                                pairs.col[turned])), shape=pairs.shape)
+        return np.asarray((inc @ turned).multiply(inc).sum(axis=1)).ravel() > 0
 
     @property
     def rind_depth(self) -> np.ndarray:
