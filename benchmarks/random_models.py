@@ -119,10 +119,14 @@ traction unknowns, tolerances' readings), and neither ``vfem.contact.check`` nor
 
 One line at the end sums it up per class (2D linear, 2D quadratic, 3D) and for the baseline
 (the baselines need linear elements: run on the 2D linear models only; its answers get the same
-checks); ``-v`` adds one line per model. Models run in parallel (``--jobs``), each solve in its
-own process on one BLAS thread, killed after ``--timeout`` seconds. It measures the vfem it
-imports: ``PYTHONPATH=/tmp/tree/src python3 benchmarks/random_models.py`` measures another tree
-(``git archive COMMIT src | tar -x -C /tmp/tree``).
+checks); "warned of" counts the models on which vfem itself warned that a node lies inside
+on the deformed geometry beyond what faceting and linear theory's second-order terms explain
+(``Invariants.second_order``; the warning does not change a model's class: a wrong answer
+warned of is still counted wrong); ``-v`` adds one line per model. Models run in parallel
+(``--jobs``), each solve in its own process on one BLAS thread, killed after ``--timeout``
+seconds. It measures the vfem it imports: ``PYTHONPATH=/tmp/tree/src python3
+benchmarks/random_models.py`` measures another tree (``git archive COMMIT src | tar -x -C
+/tmp/tree``).
 """
 
 from __future__ import annotations
@@ -1153,7 +1157,12 @@ def solve_one(p: dict, method: str) -> dict:
                    iterations=[s.iterations for s in result.steps],
                    solver_pen_tol=result.penetration_tolerance,
                    # the solver switched a pair's compatibility side on the way (issue 37)
-                   switched=bool(result.steps and result.steps[-1].compatibility_switched))
+                   switched=bool(result.steps and result.steps[-1].compatibility_switched),
+                   # vfem warned that a node lies inside on the deformed geometry beyond what
+                   # faceting and linear theory's second order explain (its own invariant (b)
+                   # reading, recorded, not enforced: Invariants.second_order)
+                   warned=any(bool(s.invariants and s.invariants.get("second_order"))
+                              for s in result.steps))
         try:
             checks = check(result, p, info)
         except Exception:
@@ -1313,6 +1322,9 @@ def summary(models: list[dict], results: dict, seed: int, seconds: float) -> tup
             for r in recs)
         counts[cls]["switched"] = sum(r["status"] == "solved" and bool(r.get("switched"))
                                       for r in recs)
+        for status in ("solved", "wrong"):
+            counts[cls][f"{status} warned"] = sum(r["status"] == status and bool(r.get("warned"))
+                                                  for r in recs)
         for kind in ("timeout", "crash"):
             counts[cls][kind] = sum(r["status"] == "stopped" and r["message"].startswith(kind)
                                     for r in recs)
@@ -1327,8 +1339,11 @@ def summary(models: list[dict], results: dict, seed: int, seconds: float) -> tup
             if c["switched"]:
                 second += (f", {c['switched']} of the solved with the compatibility side "
                            "switched")
+            if c["solved warned"]:
+                second += f", {c['solved warned']} of the solved warned of"
+            warned = (f" [{c['wrong warned']} warned of]" if c["wrong warned"] else "")
             parts.append(f"{cls} {c['solved']}/{c['total']} solved ({c['stopped']} stopped"
-                         f"{f' [{which}]' if which else ''}, {c['wrong']} wrong{other}"
+                         f"{f' [{which}]' if which else ''}, {c['wrong']} wrong{warned}{other}"
                          f"{second})")
     text = f"random models (seed {seed}): " + ", ".join(parts)
     lag = [results[p["id"]]["lagrange"] for p in models if "lagrange" in results[p["id"]]]

@@ -246,6 +246,33 @@ def test_a_corner_slid_along_a_tilted_face_is_read_along_that_face():
     assert inv.allowed == pytest.approx(TOL)  # nothing touches the facet: no faceting
 
 
+def test_a_node_inside_only_on_the_deformed_geometry_is_recorded_not_failed(monkeypatch):
+    """Small kinematics: a node that linear theory reads outside but that lies inside on the
+    deformed geometry beyond its allowance passes (b) (the smaller reading is judged) and is
+    recorded as ``second_order`` (the solver warns about it). Linear theory's reading is made
+    here to say 1e-3 outside while the upper block lies 1e-3 inside the lower one."""
+    bodies = blocks()
+    shift = 1e-3
+    real = InvariantCheck._linearised_depth
+
+    def outside(self, i, j, node, cur):
+        depth, second = real(self, i, j, node, cur)
+        return depth - 2 * shift, second
+
+    fields = state(bodies, shift=shift, pressure=0.0)
+    assert step_invariants(bodies, None, fields, TOL).second_order is None  # read alike
+    monkeypatch.setattr(InvariantCheck, "_linearised_depth", outside)
+    inv = step_invariants(bodies, None, fields, TOL)
+    assert inv.separated and inv.ok
+    w = inv.second_order
+    assert w is not None and {w["body"], w["into"]} == {"upper", "lower"}
+    # round-off of O(1) coordinates on a depth of 1e-3
+    assert w["deformed_depth"] == pytest.approx(shift, rel=1e-9)
+    assert w["linearised_depth"] < 0  # (made 2e-3 less than its own reading)
+    assert w["allowed"] == pytest.approx(TOL)  # no force: no faceting allowance
+    assert w["beyond"] == pytest.approx(shift - TOL, rel=1e-9)
+    assert inv.record()["second_order"] == w
+
 
 # -- the solver ---------------------------------------------------------------------------------
 

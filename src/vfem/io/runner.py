@@ -138,6 +138,12 @@ def invariants_line(steps: list[dict]) -> str:
                  f"(allowed {c['allowed']:.1e}), ")
     else:
         text += "no node inside another body, "
+    beyond = [c["second_order"] for c in checked if c.get("second_order")]
+    if beyond:  # small kinematics: recorded, not enforced (vfem.contact.check)
+        w = max(beyond, key=lambda w: w["beyond"])
+        text += (f"on the deformed geometry node {w['node']} of {w['body']!r} "
+                 f"{w['deformed_depth']:.1e} inside {w['into']!r} (allowed {w['allowed']:.1e}; "
+                 "within as linear theory reads it), ")
     if tension["tension"] > tension["tension_tolerance"]:
         w = tension["tension_where"]
         text += f"tension {tension['tension']:.1e} at node {w['node']} of {w['body']!r}"
