@@ -52,9 +52,10 @@ TESTS: dict[str, str] = {
 }
 
 #: ``--tests``: the geometry layer of issue 38 (search, facet kinds, surfaces, pairing, transfer)
-GEOMETRY = ("contact/search.py", "contact/facets.py", "contact/facets3d.py",
-            "contact/overlap3d.py", "contact/surface.py", "contact/pairing.py",
-            "contact/transfer.py", "contact/flexibility.py")
+GEOMETRY = ("contact/search/closest.py", "contact/geometry/facets.py",
+            "contact/geometry/facets3d.py", "contact/geometry/overlap3d.py",
+            "contact/geometry/surface.py", "contact/geometry/pairing.py",
+            "contact/geometry/transfer.py", "contact/geometry/flexibility.py")
 
 #: patterns read on the raw line (their form is a string)
 RAW = ("components x, y",)
@@ -62,13 +63,14 @@ RAW = ("components x, y",)
 #: where the remaining lines are, by layer (first match); what the restructuring wants is every
 #: 2D line of the contact core in its geometry layer
 GROUPS = (
-    ("geometry layer (contact/surface.py, contact/search.py, contact/facets.py)",
-     ("contact/surface.py", "contact/search.py", "contact/facets.py")),
+    ("geometry layer (contact/geometry/surface.py, contact/search/closest.py, "
+     "contact/geometry/facets.py)",
+     ("contact/geometry/surface.py", "contact/search/closest.py", "contact/geometry/facets.py")),
     ("bodies and their 2D mechanics (bodies, nonlinear, kinematics, materials, result types)",
      ("bodies.py", "bodies/", "nonlinear.py", "kinematics.py", "materials/", "result_types.py")),
-    ("the thesis variant (kept 2D, issue 18 item 7)", ("contact/algorithm.py",)),
-    ("the independent invariant check", ("contact/check.py",)),
-    ("the classical baselines", ("contact/baselines.py",)),
+    ("the thesis variant (kept 2D, issue 18 item 7)", ("contact/formulations/algorithm.py",)),
+    ("the independent invariant check", ("contact/invariants/check.py",)),
+    ("the classical baselines", ("contact/formulations/baselines.py",)),
     ("the rest of the contact core", ("contact/",)),
     ("meshes", ("mesh/",)),
     ("examples (2D models)", ("examples/",)),

@@ -45,8 +45,9 @@ its base.
 **The checks**, on each body at every converged step, from the final fields alone (displacement
 and contact force at the body's points, the solver's reported reactions), the meshes, the
 materials and the supports this script set up. Nothing of the formulation is read (no pairing,
-traction unknowns, tolerances' readings), and neither ``vfem.contact.check`` nor ``check3d``
-(the solver's own invariants) is called; the stiffness is assembled here with scikit-fem.
+traction unknowns, tolerances' readings), and neither ``vfem.contact.invariants.check`` nor
+``check3d`` (the solver's own invariants) is called; the stiffness is assembled here with
+scikit-fem.
 
 1. *Each body in equilibrium*: K u - f_contact, K assembled here (``skfem.models.elasticity.
    linear_elasticity``, Lame's constants from E and nu; plane strain in 2D), vanishes at the

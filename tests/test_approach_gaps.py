@@ -7,7 +7,7 @@ length); its corner node's gap was read along the pair's common normal, 1.8 degr
 flank's normal, and the disk's vertical motion closed it 7.8e-5 late: the analysis
 "converged" with no contact force at all and the corner 6.5e-5 (97 % of the push) inside the
 disk (random model 2d-63 of ``benchmarks/random_models.py``). The gap is now scaled to the
-loads' own approach (``vfem.contact.pairing.approach_gaps``).
+loads' own approach (``vfem.contact.geometry.pairing.approach_gaps``).
 
 The check reads the full-mesh results alone: the corner's deformed position against the
 chord of the disk's deformed boundary above it, and each body's contact force.
@@ -88,7 +88,7 @@ def test_a_rotated_rectangles_corner_presses_along_the_blocks_normal(swap):
     3.9 degrees off the block's: the corner's slide of 5.3e-4 along the block read as
     5.3e-4 sin(3.9 deg) of approach, and the corner lay 4.0e-5 (3.2 % of the push) inside
     the block (at e773403). At its patch's end a node now keeps the other surface's normal
-    (``vfem.contact.pairing.common_normal``): what is left is the block's facet's rotation
+    (``vfem.contact.geometry.pairing.common_normal``): what is left is the block's facet's rotation
     (1.3e-3 rad) times that slide, small kinematics' own second-order term, 0.06 % of the
     push; bounded here by 0.5 %."""
     cfg = vfem.load(ROTATED)

@@ -3,7 +3,9 @@
 those under ``if TYPE_CHECKING:`` counted too (they never run, but a circle of type hints is a
 circle of knowledge: neither side can change alone); and every module imports only from its
 own layer or the layers below (:data:`LAYERS`: data flows mesh -> body -> contact -> solver ->
-results, and so do the imports). Nothing under ``contact/`` imports the solver."""
+results, and so do the imports). Nothing under ``contact/`` imports the solver; inside it, the
+pipeline's stages (:data:`CONTACT_STAGES`) import downwards only, each other through their
+faces."""
 
 import ast
 from pathlib import Path
@@ -33,19 +35,19 @@ LAYERS: tuple[tuple[str, ...], ...] = (
 )
 
 
-#: Inside contact, the pipeline's stages, lowest first (issue 38): each module imports only from
-#: its own stage or those below. The modules are not yet in subpackages of these names.
-CONTACT_STAGES: tuple[tuple[str, ...], ...] = (
-    ("settings", "state", "capabilities"),  # the data every stage passes on
-    ("search",),  # candidates, closest points
-    # geometry: facet kinds, surfaces and a body's flexibility on them, pairing, transfer
-    ("facets3d", "overlap3d", "facets", "surface", "flexibility", "transfer", "pairing"),
-    ("corrections",),  # laws: the thesis's two corrections, node by node
-    ("bordered", "complementarity", "iteration", "matrix_free"),  # solvers
-    ("group", "paired", "large", "friction", "large_friction", "algorithm", "baselines",
-     "formulation", "onedim"),  # formulations
-    ("cached_boundary", "check3d", "check"),  # the invariants
+#: Inside contact, the pipeline's stages, lowest first (issue 38): a subpackage of
+#: ``vfem.contact`` each, whose ``__init__`` is its public face. A module imports only from its
+#: own stage or those below, and from another stage only through that stage's face. The modules
+#: directly under ``vfem.contact`` are the data every stage passes on (:data:`CONTACT_DATA`).
+CONTACT_STAGES: tuple[str, ...] = (
+    "search",  # candidates, closest points
+    "geometry",  # facet kinds, surfaces and a body's flexibility on them, pairing, transfer
+    "laws",  # the thesis's two corrections, node by node
+    "solvers",  # the contact-set iteration, complementarity, bordered and matrix-free solves
+    "formulations",  # the paired and thesis variants, the baselines: compositions of the above
+    "invariants",  # the checks of every converged state
 )
+CONTACT_DATA: tuple[str, ...] = ("settings", "state", "capabilities")
 
 
 def import_graph(typing: bool = True) -> dict[str, set[str]]:
@@ -77,7 +79,8 @@ def import_graph(typing: bool = True) -> dict[str, set[str]]:
             if node.level:
                 parts = package.split(".")[: len(package.split(".")) - node.level + 1]
                 base = ".".join(parts + ([base] if base else []))
-            for target in [base] + [f"{base}.{a.name}" for a in node.names]:
+            for a in node.names:  # a submodule by name, else a name of the module itself
+                target = f"{base}.{a.name}" if f"{base}.{a.name}" in modules else base
                 if target in modules and target != m:
                     graph[m].add(target)
     return graph
@@ -144,26 +147,54 @@ def test_no_module_imports_from_a_layer_above_its_own():
 
 
 def stage(module: str) -> int:
-    name = module.removeprefix("vfem.contact.")
-    found = [k for k, members in enumerate(CONTACT_STAGES) if name in members]
-    assert len(found) == 1, f"{module} is in {len(found)} stages: name it once in CONTACT_STAGES"
-    return found[0]
+    """0 for contact's data, k for the k-th of :data:`CONTACT_STAGES` (its face or a module)."""
+    parts = module.split(".")
+    assert parts[:2] == ["vfem", "contact"] and len(parts) >= 3, module
+    if parts[2] in CONTACT_STAGES:
+        return CONTACT_STAGES.index(parts[2]) + 1
+    assert len(parts) == 3 and parts[2] in CONTACT_DATA, (
+        f"{module} is in no stage: move it into one of {CONTACT_STAGES}, or name it in "
+        "CONTACT_DATA")
+    return 0
 
 
 def test_contact_imports_only_from_its_own_stage_or_those_below():
     graph = import_graph()
     inside = [m for m in graph if m.startswith("vfem.contact.")]
-    for m in inside:
-        stage(m)
     back = sorted(f"{m} (stage {stage(m)}) imports {t} (stage {stage(t)})" for m in inside
                   for t in graph[m] if t.startswith("vfem.contact.") and stage(t) > stage(m))
     assert not back, "\n".join(back)
 
 
+def reaching_in(graph: dict[str, set[str]]) -> list[str]:
+    """Each import of a stage's module (not its face) from outside that stage."""
+    def stem(t: str) -> str:  # vfem.contact.<stage>
+        return ".".join(t.split(".")[:3])
+
+    return sorted(f"{m} imports {t}" for m, targets in graph.items() for t in targets
+                  if t.startswith("vfem.contact.") and len(t.split(".")) == 4
+                  and t.split(".")[2] in CONTACT_STAGES
+                  and not (m == stem(t) or m.startswith(stem(t) + ".")))
+
+
+def test_a_stage_is_reached_through_its_face():
+    """Outside a stage (the rest of contact, the solver, the writers, the examples) its names
+    come from its face, ``vfem.contact.<stage>``: what a stage offers is what its
+    ``__init__`` lists, and its modules can be split or merged without touching the callers."""
+    assert not reaching_in(import_graph()), "\n".join(reaching_in(import_graph()))
+    assert reaching_in({"vfem.solver": {"vfem.contact.geometry.surface"},
+                        "vfem.contact.geometry.pairing": {"vfem.contact.geometry.surface"},
+                        "vfem.contact.formulations.paired": {"vfem.contact.geometry"}}) == [
+        "vfem.solver imports vfem.contact.geometry.surface"]
+    for name in CONTACT_STAGES:
+        face = ROOT / "contact" / name / "__init__.py"
+        assert face.is_file() and "__all__" in face.read_text(encoding="utf-8"), face
+
+
 def test_the_layer_rule_finds_an_upward_import():
-    assert upward({"vfem.contact.paired": {"vfem.parallel", "vfem.bodies"},
+    assert upward({"vfem.contact.formulations.paired": {"vfem.parallel", "vfem.bodies"},
                    "vfem.bodies": set(), "vfem.parallel": {"vfem.bodies"}}) == [
-        "vfem.contact.paired (layer 3) imports vfem.parallel (layer 4)"]
+        "vfem.contact.formulations.paired (layer 3) imports vfem.parallel (layer 4)"]
     assert layer("vfem.bodies.results") == 2 and layer("vfem") == 9
 
 

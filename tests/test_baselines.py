@@ -189,7 +189,7 @@ def test_cli_runs_hertz_with_a_baseline(tmp_path, capsys):
 def test_a_body_only_contact_could_hold_but_none_can_touch_is_refused():
     """A puck pulled away from a block by its platen: no candidates, so nothing holds it
     (singular). Pushed towards the block from the same gap, it finds it (the candidates are
-    looked for where the platen brings it, vfem.contact.surface.platen_approach)."""
+    looked for where the platen brings it, vfem.contact.geometry.surface.platen_approach)."""
     from test_no_contact import puck
 
     away = puck(+1e6)
@@ -272,7 +272,7 @@ def test_one_row_per_slave_node_and_none_beyond_the_end():
     """The block, slave of both punches (coarse punches): one row per node, on the punch it
     lies under or nearer to (the node midway between them: one on each, mirrored); no
     punch node of the punch-punch pair is constrained against the other's face line."""
-    from vfem.contact.baselines import GlobalContact
+    from vfem.contact.formulations.baselines import GlobalContact
 
     g = GlobalContact(two_punches("lagrange", faces_only=True, nx=10))
     c, names = g.c, [b.name for b in g.model.bodies]

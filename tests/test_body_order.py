@@ -7,7 +7,7 @@ import dataclasses
 
 import pytest
 
-from vfem.contact.onedim import SecantSpring, solve_step
+from vfem.contact.formulations.onedim import SecantSpring, solve_step
 from vfem.examples import block, hertz, patch
 from vfem.solver import Analysis
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
-from vfem.contact.surface import (
+from vfem.contact.geometry.surface import (
     ContactSurface,
     check_initial_overlap,
     exterior_facets,

@@ -10,17 +10,17 @@ import pytest
 from skfem import MeshQuad, MeshTri
 
 from vfem.bodies import Body, Support
-from vfem.contact.algorithm import VirtualElementContact
-from vfem.contact.baselines import GlobalContact
-from vfem.contact.formulation import check_capabilities, formulation_class
-from vfem.contact.group import bordered_solve
-from vfem.contact.iteration import Check, iterate
-from vfem.contact.large import LargeDeformationContact
-from vfem.contact.paired import PairedContact
-from vfem.contact.pairing import overlap
+from vfem.contact.formulations.algorithm import VirtualElementContact
+from vfem.contact.formulations.baselines import GlobalContact
+from vfem.contact.formulations.formulation import check_capabilities, formulation_class
+from vfem.contact.formulations.large import LargeDeformationContact
+from vfem.contact.formulations.paired import PairedContact
+from vfem.contact.geometry.pairing import overlap
+from vfem.contact.geometry.surface import ContactSurface, beyond, patch_ends
 from vfem.contact.settings import ContactSettings
+from vfem.contact.solvers import bordered_solve
+from vfem.contact.solvers.iteration import Check, iterate
 from vfem.contact.state import IterationRecord
-from vfem.contact.surface import ContactSurface, beyond, patch_ends
 from vfem.errors import ContactCycling, ContactNotConverged, InputError
 from vfem.materials import LinearElastic
 
@@ -171,10 +171,10 @@ def test_beyond_the_end_of_a_surface_only_past_its_end_facets(surfaces):
 
 
 def test_a_2d_surface_reaches_its_facets_through_its_segment_kind(surfaces):
-    """The facet-kind layer (vfem.contact.facets): a 2D surface's kind is Segment(order), and
-    the surface's geometry goes through it (issue 21, C4)."""
-    from vfem.contact.facets import FACET_READINGS, Segment
-    from vfem.contact.search import outward_normals
+    """The facet-kind layer (vfem.contact.geometry.facets): a 2D surface's kind is Segment(order),
+    and the surface's geometry goes through it (issue 21, C4)."""
+    from vfem.contact.geometry.facets import FACET_READINGS, Segment
+    from vfem.contact.search.closest import outward_normals
 
     s = surfaces[0]  # the lower block's top: 3 facets from x = 0 to 1
     assert s.kind == Segment(1) and s.kind.corners == 2 and s.kind.nodes == 2

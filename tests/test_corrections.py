@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from vfem.contact.corrections import (
+from vfem.contact.laws.corrections import (
     compatibility_displacement,
     compatibility_force,
     equilibrium_force,

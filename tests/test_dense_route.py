@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from vfem import linalg
-from vfem.contact.bordered import ReusedFactor
+from vfem.contact.solvers.bordered import ReusedFactor
 from vfem.examples.hertz import HertzParameters, build
 from vfem.linalg.common import mirror, spd_inverse, spd_inverse_in_place
 from vfem.memory import factor_entries

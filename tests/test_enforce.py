@@ -7,8 +7,8 @@ the facet under it) all touch is left to the block's faceting. At load factor 0.
 node lay 3.5e-7 inside where invariant (b) allowed less, and the step was cut six times and
 the analysis stopped (random model 2d-132 of ``benchmarks/random_models.py``). The solver now
 has the formulation hold that node and solves the step again
-(``vfem.solver.Analysis._enforce``, ``vfem.contact.paired.PairedContact.enforce``). Since
-a stiffer surface's own features are held whatever their guard (``pairing.held_nodes``), the
+(``vfem.solver.Analysis._enforce``, ``vfem.contact.formulations.paired.PairedContact.enforce``).
+Since a stiffer surface's own features are held whatever their guard (``pairing.held_nodes``), the
 fillet's vertices are held from the start; the mechanism is tested with the guard as before.
 
 The depth is read from the full-mesh results alone: every boundary node of the punch at
@@ -55,7 +55,7 @@ def guard_as_before(monkeypatch):
     surface does, as when this mechanism came (a stiff surface's own features, the punch's
     fillet vertices, are held now whatever their guard, and paired where the loads' approach
     meets the other surface: ``pairing.held_nodes``)."""
-    import vfem.contact.paired as paired
+    import vfem.contact.formulations.paired as paired
     made_by = paired.held_nodes
 
     def as_before(*args, **kwargs):

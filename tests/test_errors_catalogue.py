@@ -12,7 +12,8 @@ a message for the user is found:
 * ``SolveResult(False, ..., message)``: a contact solve that failed (shown through
   ``diagnosis()`` when the analysis stops);
 * the text returned by ``diagnosis()``, ``fixed_point_message()`` and ``_platen_off()``
-  (solver.py) and by ``CycleWatch`` (contact/algorithm.py), and what the CLI prints on stderr.
+  (solver.py) and by ``CycleWatch`` (contact/formulations/algorithm.py), and what the CLI prints on
+  stderr.
 
 From each message the first literal fragment of at least 12 characters (ends trimmed of spaces
 and punctuation, whitespace normalised) must occur in ``docs/errors.md``; a message with no
@@ -72,12 +73,12 @@ _WRAPPERS_AS_WRITTEN = {
     ("solver.py", "message"):
         "failure(message): a failed contact solve's SolveResult message (with the platen's "
         "clause where it ends off its force, _platen_off), raised as its failure kind",
-    ("contact/iteration.py", "cycling"):
+    ("contact/solvers/iteration.py", "cycling"):
         "SolveResult(False, ..., cycling): the CycleWatch message (catalogued from CycleWatch)",
-    ("contact/iteration.py", "c.unconverged()"):
+    ("contact/solvers/iteration.py", "c.unconverged()"):
         "SolveResult(False, ..., c.unconverged()): each formulation's 'no convergence in' "
         "message, made by its check (catalogued as 'no convergence in')",
-    ("contact/baselines.py", "str(exc)"):
+    ("contact/formulations/baselines.py", "str(exc)"):
         "SingularSystem(str(exc)): the linear solver's factorization failure "
         "(catalogued at vfem.linalg.factorize)",
 }
@@ -210,7 +211,8 @@ def test_the_scan_finds_the_messages():
     assert len(SITES) > 150
     modules = {m for m, _, _ in SITES}
     assert {"cli.py", "config.py", "solver.py", "bodies/__init__.py", "io/input.py",
-            "mesh/imports.py", "mesh/shapes.py", "contact/paired.py", "nonlinear.py"} <= modules
+            "mesh/imports.py", "mesh/shapes.py", "contact/formulations/paired.py",
+            "nonlinear.py"} <= modules
 
 
 def test_every_message_is_in_the_catalogue():

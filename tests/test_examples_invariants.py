@@ -10,7 +10,7 @@ checks which are). ``springs`` is the thesis's 1D analogy: no meshes, no contact
 nothing for the invariants to read; it is left out.
 
 For each case: the analysis converges, every converged step has its invariants recorded
-(``StepResult.invariants``, :mod:`vfem.contact.check`), and none of the three fails —
+(``StepResult.invariants``, :mod:`vfem.contact.invariants.check`), and none of the three fails —
 (a) force balance, (b) no interpenetration beyond the tolerance and faceting allowance, (c) no
 tension — whether or not the solver enforces it yet (it enforces (a) only: ``ENFORCED``).
 

@@ -7,9 +7,9 @@ from skfem import MeshQuad, MeshTri
 
 from vfem import parallel
 from vfem.bodies import Body, Support
-from vfem.contact.paired import PairedContact
+from vfem.contact.formulations.paired import PairedContact
+from vfem.contact.geometry.surface import ContactSurface
 from vfem.contact.settings import ContactSettings
-from vfem.contact.surface import ContactSurface
 from vfem.executor import SERIAL
 from vfem.materials import LinearElastic
 

@@ -1,4 +1,5 @@
-"""Closest points on 3D surface facets (vfem.contact.facets3d; issue 21, C5 of the 3D plan).
+"""Closest points on 3D surface facets (vfem.contact.geometry.facets3d; issue 21, C5 of the 3D
+plan).
 
 The reference is independent of the module: each facet's map is rebuilt from scikit-fem's own
 shape functions (``ElementTriP1/Quad1/TriP2/Quad2.lbasis``) as a polynomial, the closest point
@@ -12,8 +13,8 @@ from scipy.optimize import least_squares, minimize
 from scipy.spatial import cKDTree
 from skfem import ElementQuad1, ElementQuad2, ElementTriP1, ElementTriP2
 
-from vfem.contact import facets3d
-from vfem.contact.facets3d import (
+from vfem.contact.geometry import facets3d
+from vfem.contact.geometry.facets3d import (
     KINDS,
     check_facets,
     closest_on_facets,
@@ -553,7 +554,7 @@ def test_tree_search_over_facets_of_many_sizes_finds_the_direct_pairs(monkeypatc
     as the direct search, and the same closest points."""
     from skfem import MeshQuad
 
-    from vfem.contact.facets3d import candidate_pairs
+    from vfem.contact.geometry.facets3d import candidate_pairs
 
     g = np.linspace(0.0, 1.0, 13) ** 3  # facets from 1/1728 to 0.42 wide
     m = MeshQuad.init_tensor(g, g)

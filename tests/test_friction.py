@@ -1,5 +1,5 @@
-"""Coulomb friction in the paired variant (issue 20, vfem.contact.friction): the law's exact
-consequences (a sliding block carries mu times its normal force, to round-off; above the
+"""Coulomb friction in the paired variant (issue 20, vfem.contact.formulations.friction): the law's
+exact consequences (a sliding block carries mu times its normal force, to round-off; above the
 coefficient it needs, the answer does not depend on mu), the invariances (body order, the
 direction of the slide), the history in the state, the inputs refused, and Cattaneo-Mindlin
 partial slip on two elastically similar cylinders against the closed-form stick zone."""
@@ -15,9 +15,9 @@ import pytest
 
 from resume_check import assert_resumed_equals_whole
 from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
-from vfem.contact.formulation import formulation_class
-from vfem.contact.friction import FrictionalPairedContact, coulomb_status, tangents
-from vfem.contact.paired import PairedContact
+from vfem.contact.formulations.formulation import formulation_class
+from vfem.contact.formulations.friction import FrictionalPairedContact, coulomb_status, tangents
+from vfem.contact.formulations.paired import PairedContact
 from vfem.contact.settings import ContactSettings
 from vfem.contact.state import FrictionState
 from vfem.errors import InputError

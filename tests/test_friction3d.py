@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, PrescribedDisplacement, Support, Traction
-from vfem.contact.friction import tangents
+from vfem.contact.formulations.friction import tangents
 from vfem.contact.settings import ContactSettings, PairFriction
 from vfem.io.results import frictional_work
 from vfem.materials import LinearElastic
@@ -207,8 +207,8 @@ def test_the_elastoplastic_law_in_3d():
 @pytest.mark.parametrize("rollers", [False, True], ids=["free", "rollers"])
 def test_the_3d_friction_patch_sticks_under_large_kinematics(rollers):
     """The sticking patch with both boxes under total Lagrangian kinematics
-    (vfem.contact.large_friction; tests/test_large_friction3d.py slides): two iterations a
-    step, every node sticks and carries the applied shear but for the geometric
+    (vfem.contact.formulations.large_friction; tests/test_large_friction3d.py slides): two
+    iterations a step, every node sticks and carries the applied shear but for the geometric
     nonlinearity's share (the pressure 1.5e-4 below p: measured 1.4e-4 of tau); with a roller
     plane through the contact the held tangent carries nothing."""
     model = stacked(("hex", 4), ("tet", 7), *STICK, rollers=rollers, large=True)

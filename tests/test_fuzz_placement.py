@@ -16,7 +16,7 @@ bodies are listed, and small kinematics (one in ten "total"). Meshes stay small 
 Each run must either
 
 * converge, with every converged step's three invariants (``StepResult.invariants``,
-  :mod:`vfem.contact.check`: force balance, no interpenetration beyond the tolerance and
+  :mod:`vfem.contact.invariants.check`: force balance, no interpenetration beyond the tolerance and
   faceting allowance, no tension) holding — enforced by the solver or only recorded —, the
   last step at load factor 1, and, when the bodies moved rigidly would overlap at the end, a
   compressive contact force that is not zero; checked besides, independently of vfem's own
@@ -318,8 +318,8 @@ FOUND = {
     "the same overhang under large kinematics: raw ValueError": (
         rect(block_nx=7, width=1.2, height=0.6, nx=2, ny=1, centre=1.46, push=0.002,
              stiffness_ratio=50.0, kinematics="total"),
-        "ValueError: need at least one array to concatenate (contact/large.py, _correct_all, "
-        "with no contact pair)"),
+        "ValueError: need at least one array to concatenate "
+        "(contact/formulations/large.py, _correct_all, with no contact pair)"),
     "overlap inside the rind across the block's corner: contact missed": (
         rect(block_nx=8, width=0.8, height=1.2, nx=1, ny=2, centre=1.018, gap=-0.09,
              push=0.0021),
@@ -328,7 +328,8 @@ FOUND = {
     "the same overlap under large kinematics: raw ValueError": (
         rect(block_nx=8, width=0.8, height=1.2, nx=1, ny=2, centre=1.018, gap=-0.09,
              push=0.0021, kinematics="total"),
-        "ValueError: need at least one array to concatenate (contact/large.py, _correct_all)"),
+        "ValueError: need at least one array to concatenate "
+        "(contact/formulations/large.py, _correct_all)"),
     "stiff rounded punch, its lowest node between the coarser block's nodes: contact missed": (
         rect(shape="rounded", block_nx=11, width=0.4, height=0.35, nx=4, ny=2, radius=0.3,
              push=0.002, stiffness_ratio=4.0),
@@ -391,8 +392,9 @@ UNSOLVED = {
 def test_found(name):
     """Each was a silent failure (see FOUND); each now converges with the invariants or stops
     with a clear message. Fixed by reading a facet's facing and overlap at its ends as well as
-    its midpoint (contact/paired.py ``facing``), by granting the faceting allowance only under
-    facets that touch (contact/check.py), and by a large-kinematics correction with no pair."""
+    its midpoint (contact/formulations/paired.py ``facing``), by granting the faceting allowance
+    only under facets that touch (contact/invariants/check.py), and by a large-kinematics correction
+    with no pair."""
     check(FOUND[name][0])
 
 

@@ -45,8 +45,8 @@ def test_contact_forces_balance_the_applied_load(hertz_level0):
 
 
 def test_no_node_penetrates_at_convergence(hertz_level0):
-    """Measured independently of the formulation (vfem.contact.check: every node of either
-    body against the other's deformed facets), not the formulation's own gaps (the flat's are
+    """Measured independently of the formulation (vfem.contact.invariants.check: every node of
+    either body against the other's deformed facets), not the formulation's own gaps (the flat's are
     zero by construction: it carries equilibrium)."""
     _, result, _ = hertz_level0
     for step in result.steps:

@@ -1,5 +1,5 @@
 """Invariants of every converged step, checked independently of the contact formulation
-(issue 16, item 2): force balance, no interpenetration, no tension (vfem.contact.check).
+(issue 16, item 2): force balance, no interpenetration, no tension (vfem.contact.invariants.check).
 
 Hand-made states that satisfy or break each one; the solver cutting and then stopping when a
 converged state breaks one; summary.json and checkpoints carrying the measures per step.
@@ -17,7 +17,7 @@ from skfem import MeshQuad, MeshTri
 
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.cli import main
-from vfem.contact.check import InvariantCheck, _Boundary, _Polygon, step_invariants
+from vfem.contact.invariants.check import InvariantCheck, _Boundary, _Polygon, step_invariants
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InvariantViolation
 from vfem.io import checkpoint

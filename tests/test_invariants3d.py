@@ -1,5 +1,5 @@
-"""The invariants of vfem.contact.check on 3D bodies (issue 21, C9 of the 3D plan): hand-made
-states of two boxes (hexahedra and tetrahedra) touching at a flat interface, z = 0.
+"""The invariants of vfem.contact.invariants.check on 3D bodies (issue 21, C9 of the 3D plan):
+hand-made states of two boxes (hexahedra and tetrahedra) touching at a flat interface, z = 0.
 
 A consistent state (equal and opposite forces from one pressure field, the lower box's share
 by ``transfer_matrices``, no penetration) passes; a node moved 10x the penetration tolerance
@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, Support
-from vfem.contact.check import InvariantCheck
-from vfem.contact.surface import ContactSurface
-from vfem.contact.transfer import transfer_matrices
+from vfem.contact.geometry.surface import ContactSurface
+from vfem.contact.geometry.transfer import transfer_matrices
+from vfem.contact.invariants.check import InvariantCheck
 from vfem.materials import LinearElastic
 from vfem.mesh.solids import box
 

@@ -1,5 +1,5 @@
-"""Contact under large displacements (vfem.contact.large): the bodies equilibrated by Newton's
-method inside every contact iteration, paired on their deformed surfaces."""
+"""Contact under large displacements (vfem.contact.formulations.large): the bodies equilibrated by
+Newton's method inside every contact iteration, paired on their deformed surfaces."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
-"""Contact under large displacements (``vfem.contact.large``): the linearised complementarity
-problem, and the gasket crushed by backs moving 0.5 each, loaded and unloaded, by the total and
-the updated Lagrangian formulations."""
+"""Contact under large displacements (``vfem.contact.formulations.large``): the linearised
+complementarity problem, and the gasket crushed by backs moving 0.5 each, loaded and unloaded, by
+the total and the updated Lagrangian formulations."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import itertools
 import numpy as np
 import pytest
 
-from vfem.contact.large import linear_complementarity
+from vfem.contact.formulations.large import linear_complementarity
 from vfem.examples import gasket
 from vfem.solver import Analysis
 
@@ -79,7 +79,7 @@ def test_follower_stiffness_coloured_equals_one_coordinate_at_a_time(model, monk
     vectors: in every iteration of a slide (the punch's corner region passing over the block's
     facets) and of the crushed gasket (curved against curved, the contact zone growing). A
     coordinate whose reach were drawn too small would miss entries of the size of the matrix."""
-    from vfem.contact.large import LargeDeformationContact
+    from vfem.contact.formulations.large import LargeDeformationContact
     from vfem.examples import sliding
 
     if model == "sliding":

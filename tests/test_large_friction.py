@@ -1,7 +1,8 @@
-"""Coulomb friction under large displacements (issue 20, item 3; vfem.contact.large_friction):
-a block slid far over another carries mu times its normal force, in any orientation and either
-body order; a block pushed less than its friction allows sticks, as the small-kinematics
-friction says for a small push; what is not solved yet is refused naming why."""
+"""Coulomb friction under large displacements (issue 20, item 3;
+vfem.contact.formulations.large_friction): a block slid far over another carries mu times its normal
+force, in any orientation and either body order; a block pushed less than its friction allows
+sticks, as the small-kinematics friction says for a small push; what is not solved yet is refused
+naming why."""
 
 from __future__ import annotations
 
@@ -12,8 +13,8 @@ import numpy as np
 import pytest
 
 from resume_check import assert_resumed_equals_whole
-from vfem.contact.formulation import formulation_class
-from vfem.contact.large_friction import FrictionalLargeContact
+from vfem.contact.formulations.formulation import formulation_class
+from vfem.contact.formulations.large_friction import FrictionalLargeContact
 from vfem.contact.settings import ContactSettings, PairFriction
 from vfem.errors import InputError
 from vfem.io.input import loads

@@ -1,7 +1,7 @@
-"""Coulomb friction in 3D under large displacements (issue 21; vfem.contact.large_friction): the
-2D variant's anchors (material points of the opposing surface) and traction field
-``q n + s1 t1 + s2 t2`` along the current normal and tangents, with the cone a disk and the slip
-direction turning in the linearised solve.
+"""Coulomb friction in 3D under large displacements (issue 21;
+vfem.contact.formulations.large_friction): the 2D variant's anchors (material points of the opposing
+surface) and traction field ``q n + s1 t1 + s2 t2`` along the current normal and tangents, with the
+cone a disk and the slip direction turning in the linearised solve.
 
 The slide: a block (0.5 x 0.5 x 0.25) pressed into a wider base by 2 % of its height, then slid
 along a direction in the plane (30 degrees off x unless said) over several of the base's facets,
@@ -245,7 +245,7 @@ def test_a_tilted_block_started_apart_lands_on_its_edge_and_slides():
 def test_the_tangential_helpers_take_no_nodes():
     """A linearised problem with nothing within reach (a 50 times stiffer tilted block started
     apart met it) has tangential arrays of no nodes: seen as (0, ntan), of no length."""
-    from vfem.contact.friction import columns, magnitudes
+    from vfem.contact.formulations.friction import columns, magnitudes
 
     assert columns(np.zeros(0)).shape == (0, 1)
     assert columns(np.zeros((0, 2))).shape == (0, 2)

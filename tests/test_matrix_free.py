@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from test_patch3d import stacked
-from vfem.contact import paired
+from vfem.contact.formulations import paired
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
 from vfem.examples import load, stack

@@ -2,8 +2,8 @@
 item 8: "the stop diagnosis names the real cause").
 
 A body pushed by a platen (force control) towards another from a gap wider than the contact
-search distance finds it (:func:`vfem.contact.surface.platen_approach`): Hertz with a gap gives
-Hertz's answer. Bodies that no load brings together are named with their distance, and an
+search distance finds it (:func:`vfem.contact.geometry.surface.platen_approach`): Hertz with a gap
+gives Hertz's answer. Bodies that no load brings together are named with their distance, and an
 analysis that fails for lack of contact says so rather than "allow more iterations".
 """
 
@@ -15,7 +15,7 @@ import pytest
 
 import vfem
 from vfem.config import check
-from vfem.contact.surface import platen_approach
+from vfem.contact.geometry.surface import platen_approach
 from vfem.examples.hertz import HertzParameters, build
 from vfem.io.input import loads
 

@@ -1,4 +1,4 @@
-"""The 3D overlap quadrature (issue 21, item 3; plan C8): ``vfem.contact.overlap3d``.
+"""The 3D overlap quadrature (issue 21, item 3; plan C8): ``vfem.contact.geometry.overlap3d``.
 
 Surfaces are scikit-fem's tensor meshes of the plane, lifted to 3D and placed by a rotation
 and a translation, the opposing side a gap away and numbered the other way round (it faces the
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from skfem import Basis, ElementQuad1, ElementTriP1, LinearForm, MeshQuad, MeshTri
 
-from vfem.contact.overlap3d import (
+from vfem.contact.geometry.overlap3d import (
     candidate_pairs,
     overlap_matrices,
     overlap_quadrature,

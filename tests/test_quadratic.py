@@ -100,7 +100,7 @@ def test_order_must_be_one_or_two():
 def test_the_traction_on_a_three_node_facet_is_linear_on_each_half():
     """Issue 37, item 3: values >= 0 give a traction >= 0 everywhere (a quadratic interpolant
     of (1, 0, 0) dips to -1/8), and a uniform one is represented exactly."""
-    from vfem.contact.facets import Segment
+    from vfem.contact.geometry.facets import Segment
 
     t = np.linspace(0.0, 1.0, 201)
     psi = Segment(2).traction_shape(t)

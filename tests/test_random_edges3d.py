@@ -35,7 +35,7 @@ import numpy as np
 import pytest
 
 import vfem
-from vfem.contact.pairing import _crossings
+from vfem.contact.geometry.pairing import _crossings
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import random_models  # noqa: E402

@@ -1,4 +1,4 @@
-"""``vfem.contact.pairing.ray_entry`` (issue 37): how far a point travels along a direction
+"""``vfem.contact.geometry.pairing.ray_entry`` (issue 37): how far a point travels along a direction
 before it enters a body through its contact surface — the test that scales a gap to the loads'
 approach only where the other surface is there to meet (``approach_gaps``).
 
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, Support
-from vfem.contact.pairing import ray_entry
-from vfem.contact.surface import ContactSurface
+from vfem.contact.geometry.pairing import ray_entry
+from vfem.contact.geometry.surface import ContactSurface
 from vfem.materials import LinearElastic
 from vfem.mesh import rectangle
 from vfem.mesh.solids import box

@@ -4,8 +4,8 @@ import numpy as np
 from skfem import MeshTri
 
 from vfem.bodies import Body, Support
-from vfem.contact.search import outward_normals, project_points
-from vfem.contact.surface import ContactSurface
+from vfem.contact.geometry.surface import ContactSurface
+from vfem.contact.search.closest import outward_normals, project_points
 from vfem.materials import LinearElastic
 
 
@@ -40,7 +40,7 @@ def test_direct_and_tree_candidates_choose_the_same_segments(monkeypatch):
     """Few pairs take the direct candidate search, many the KD-tree (``DIRECT_PAIRS``): both
     give the same candidates, so the same segment, t and distance, ties included (points on
     the vertices two segments share, with normals deciding)."""
-    from vfem.contact import search
+    from vfem.contact.search import closest as search
 
     rng = np.random.default_rng(7)
     for m, s in [(1, 1), (3, 40), (40, 40), (25, 300), (200, 30)]:

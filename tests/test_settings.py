@@ -7,9 +7,9 @@ import pytest
 from skfem import MeshQuad, MeshTri
 
 from vfem.bodies import Body, Support
-from vfem.contact.algorithm import VirtualElementContact
+from vfem.contact.formulations.algorithm import VirtualElementContact
+from vfem.contact.geometry.surface import ContactSurface
 from vfem.contact.settings import ContactSettings
-from vfem.contact.surface import ContactSurface
 from vfem.errors import InputError
 from vfem.examples.hertz import build, evaluate
 from vfem.materials import LinearElastic

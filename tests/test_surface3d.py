@@ -1,6 +1,6 @@
 """3D contact surfaces (issue 21, C6 of the 3D plan): ``ContactSurface.build`` on a 3D body's
-boundary with the ``Triangle`` and ``Quad`` facet kinds (contact/facets.py on
-contact/facets3d.py): orientation and normals, sizes and tributary areas, the rind, closest
+boundary with the ``Triangle`` and ``Quad`` facet kinds (contact/geometry/facets.py on
+contact/geometry/facets3d.py): orientation and normals, sizes and tributary areas, the rind, closest
 points, patch boundaries, and the flexibility on the candidate dofs from the factorization's
 trailing inverse."""
 
@@ -9,9 +9,9 @@ import pytest
 
 from vfem import linalg
 from vfem.bodies import Body, Support
-from vfem.contact import facets3d
-from vfem.contact.facets import Quad, Segment, Triangle, kind_of
-from vfem.contact.surface import ContactSurface, element_volumes, simplices
+from vfem.contact.geometry import facets3d
+from vfem.contact.geometry.facets import Quad, Segment, Triangle, kind_of
+from vfem.contact.geometry.surface import ContactSurface, element_volumes, simplices
 from vfem.materials import LinearElastic
 from vfem.mesh.solids import FACES, box
 

@@ -5,10 +5,10 @@ import pytest
 from skfem import MeshQuad, MeshTri
 
 from vfem.bodies import Body, Support
-from vfem.contact.algorithm import VirtualElementContact
+from vfem.contact.formulations.algorithm import VirtualElementContact
+from vfem.contact.geometry.surface import ContactSurface
+from vfem.contact.geometry.transfer import traction_from_forces
 from vfem.contact.settings import ContactSettings
-from vfem.contact.surface import ContactSurface
-from vfem.contact.transfer import traction_from_forces
 from vfem.materials import LinearElastic
 
 

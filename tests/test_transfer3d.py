@@ -1,6 +1,6 @@
 """The exact transfer in 3D (issue 21, C8 of the 3D plan): ``transfer_matrices`` on two 3D
 contact surfaces (``Triangle``/``Quad`` kinds, their ``overlap_quadrature`` on
-contact/overlap3d.py), boxes stacked with non-matching faces, either side the compatibility
+contact/geometry/overlap3d.py), boxes stacked with non-matching faces, either side the compatibility
 one. ``N`` (compatibility nodes)² and ``T`` (opposing nodes x compatibility nodes), 2D's
 layout: ``T``'s columns sum like ``N``'s; a uniform or linear traction on the compatibility
 side transferred by ``T`` gives the opposing side's consistent nodal loads."""
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, Support
-from vfem.contact.surface import ContactSurface
-from vfem.contact.transfer import transfer_matrices
+from vfem.contact.geometry.surface import ContactSurface
+from vfem.contact.geometry.transfer import transfer_matrices
 from vfem.materials import LinearElastic
 from vfem.mesh.solids import box
 

@@ -29,7 +29,7 @@ class RindViolation(AnalysisError):
 class InvariantViolation(AnalysisError):
     """A contact solve converged to a state that breaks an invariant every contact solution must
     satisfy — force balance, no interpenetration, no tension — checked from the full-mesh
-    results independently of the contact formulation (:mod:`vfem.contact.check`).
+    results independently of the contact formulation (:mod:`vfem.contact.invariants.check`).
 
     The solver treats it as a failed step: discarded, cut and retried.
     """

@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .bodies import Body
-from .contact.formulation import check_capabilities
+from .contact.formulations import check_capabilities
+from .contact.geometry import ContactSurface, check_initial_overlap, select_candidate_facets
 from .contact.settings import ContactSettings
-from .contact.surface import ContactSurface, check_initial_overlap, select_candidate_facets
 from .errors import InputError
 
 
@@ -75,7 +75,7 @@ class Model:
 
         Depends on the meshes only, so it is also part of ``vfem check``: bodies that start
         deeper into each other than the outer layer of elements are refused here
-        (:func:`~vfem.contact.surface.check_initial_overlap`).
+        (:func:`~vfem.contact.geometry.surface.check_initial_overlap`).
         """
         index = {b.name: i for i, b in enumerate(self.bodies)}
         if self.contact_pairs is None:

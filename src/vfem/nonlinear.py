@@ -3,9 +3,9 @@
 This is the geometrically (and materially) nonlinear counterpart of :class:`vfem.bodies.Body`:
 plane strain or 3D, a hyperelastic material (:mod:`vfem.materials.hyperelastic`), prescribed
 displacements and dead nodal forces scaled by a load factor. A large-kinematics
-:class:`~vfem.bodies.Body` wraps one; the contact iteration (:mod:`vfem.contact.large`) drives it
-through a trial state: :meth:`NonlinearBody.linearize` and :meth:`NonlinearBody.move` for its
-Newton corrections, :meth:`NonlinearBody.equilibrate` under the converged contact forces, then
+:class:`~vfem.bodies.Body` wraps one; the contact iteration (:mod:`vfem.contact.formulations.large`)
+drives it through a trial state: :meth:`NonlinearBody.linearize` and :meth:`NonlinearBody.move` for
+its Newton corrections, :meth:`NonlinearBody.equilibrate` under the converged contact forces, then
 :meth:`NonlinearBody.accept` (or :meth:`NonlinearBody.discard` when a step is cut).
 
 Equilibrium (thesis eq. 3.10.8, the configurational derivative of the potential energy vanishes)
@@ -727,7 +727,7 @@ class NonlinearBody:
 
     def linearize(self, load_factor: float, extra_force: np.ndarray | None = None):
         """Newton's system at the trial state, for a caller that solves it together with other
-        unknowns (the contact iteration of :mod:`vfem.contact.large`) instead of
+        unknowns (the contact iteration of :mod:`vfem.contact.formulations.large`) instead of
         :meth:`equilibrate`.
 
         Returns ``(R, ref, K, D, pending)``: the residual ``f_int - f_ext`` (ndofs; ``f_ext``

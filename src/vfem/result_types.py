@@ -18,7 +18,7 @@ from .bodies.results import BodyStepResult, add_reactions  # noqa: F401 - here t
 from .contact.state import ContactState, IterationRecord
 
 if TYPE_CHECKING:
-    from .contact.surface import ContactSurface
+    from .contact.geometry import ContactSurface
     from .model import Model
 
 
@@ -110,7 +110,7 @@ def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
                          ) -> dict[str, dict]:
     """Per body: the largest penetration of its candidate nodes into another body (the older
     check of the contact candidates' linearised gaps; the invariants are
-    :mod:`vfem.contact.check`'s).
+    :mod:`vfem.contact.invariants.check`'s).
 
     The paired variant enforces compatibility at one surface of each pair (docs/method.md §6);
     the other surface's nodes are free to indent it where its facets are longer or its geometry

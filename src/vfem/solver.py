@@ -7,15 +7,16 @@ For each step (an increment of the load factor):
    ``u = load_factor * u_load + platen * u_platen + K^-1 f_contact``, the first term summed
    over the body's load curves, :meth:`~vfem.bodies.Body.load_displacement`);
 2. **resolve contact** — the formulation of the model's settings and kinematics
-   (:func:`~vfem.contact.formulation.formulation_class`: the paired variant by default, small
-   or large displacements, the thesis's plain reading, or a classical baseline) solves the
-   step from the last converged state (:class:`~vfem.contact.formulation.ContactFormulation`),
-   moving a force-controlled platen as it goes; what it supports it declares as data
-   (``capabilities``), which the model's checks and the step loop read;
+   (:func:`~vfem.contact.formulations.formulation.formulation_class`: the paired variant by default,
+   small or large displacements, the thesis's plain reading, or a classical baseline) solves the
+   step from the last converged state
+   (:class:`~vfem.contact.formulations.formulation.ContactFormulation`), moving a force-controlled
+   platen as it goes; what it supports it declares as data (``capabilities``), which the model's
+   checks and the step loop read;
 3. **check** — three invariants of the converged state's full-mesh results, checked
-   independently of the contact formulation (:mod:`vfem.contact.check`): the contact forces of
-   all bodies balance, no boundary node lies inside another body, no node carries tension. All
-   three are recorded per step; those in :data:`ENFORCED` (all three, for the paired
+   independently of the contact formulation (:mod:`vfem.contact.invariants.check`): the contact
+   forces of all bodies balance, no boundary node lies inside another body, no node carries tension.
+   All three are recorded per step; those in :data:`ENFORCED` (all three, for the paired
    variant) fail the step;
 4. a step that fails (no convergence, a cycling contact set, a node pushed past the rind of
    another body, a broken enforced invariant) is cut in half and retried from exactly the last
@@ -37,14 +38,13 @@ import numpy as np
 
 from .bodies import multiplier
 from .bodies.stresses import max_strain
-from .contact.check import InvariantCheck, Invariants
-from .contact.formulation import formulation_class
-from .contact.group import SurfaceGroup
-from .contact.matrix_free import matrix_free_refusal
+from .contact.formulations import SurfaceGroup, formulation_class
+from .contact.geometry import exterior_facets
+from .contact.invariants import InvariantCheck, Invariants
 from .contact.search import project_points
 from .contact.settings import ContactSettings
+from .contact.solvers import matrix_free_refusal
 from .contact.state import ContactState, IterationRecord, SolveResult
-from .contact.surface import exterior_facets
 from .errors import (
     ActiveSetNotSettled,
     AnalysisError,
@@ -290,7 +290,7 @@ class Analysis:
         ensure_threads()  # the thread pools sized once, unless the caller did (vfem.threads)
         self.matrix_free = False  # the contact flexibility formed (issue 22: or applied)
         if self.model.contact.method != "vfem":  # a classical baseline: one global system
-            from .contact.baselines import GlobalContact
+            from .contact.formulations import GlobalContact
 
             self.contact = GlobalContact(self.model, self.backend)
             self.surfaces = self.contact.surfaces
@@ -379,7 +379,7 @@ class Analysis:
 
     def _contact(self, pairs: set[frozenset[int]]):
         """The contact formulation of the model's settings and kinematics
-        (:func:`~vfem.contact.formulation.formulation_class`)."""
+        (:func:`~vfem.contact.formulations.formulation.formulation_class`)."""
         extra = {"sides": dict(self.sides)} if self.sides else {}
         return self._formulation()(self.surfaces, pairs, self.model.contact,
                                    backend=self.backend, executor=current_ranks(), **extra)
@@ -389,8 +389,8 @@ class Analysis:
         return formulation_class(self.model.contact, any(b.large for b in self.model.bodies))
 
     def _invariant_check(self) -> InvariantCheck:
-        """The invariants every converged step must satisfy (:mod:`vfem.contact.check`), to the
-        contact's penetration tolerance."""
+        """The invariants every converged step must satisfy (:mod:`vfem.contact.invariants.check`),
+        to the contact's penetration tolerance."""
         return InvariantCheck(self.model, None, self.contact.penetration_tolerance)
 
     def check_invariants(self, fields: dict[str, BodyStepResult],
@@ -533,7 +533,7 @@ class Analysis:
 
         Step control: a step that fails (no convergence within ``max_iterations``, a contact
         set that cycles, a node pushed past a rind, an element turned inside out, a converged state
-        that breaks an enforced invariant of :mod:`vfem.contact.check`) is discarded
+        that breaks an enforced invariant of :mod:`vfem.contact.invariants.check`) is discarded
         — every body goes back to the last converged state exactly — and retried with half the
         increment, down to 1 / 2**``max_step_cuts`` of the scheduled one; after
         :data:`EASY_STEPS` steps in a row that converge in at most :func:`easy_iterations`
@@ -688,9 +688,10 @@ class Analysis:
     def _enforce(self, exc: AnalysisError) -> bool:
         """A step stopped at invariant (b) at a node the formulation left out on purpose (a
         held node its guard excused): whether the formulation now holds it
-        (:meth:`~vfem.contact.paired.PairedContact.enforce`), at most :data:`ENFORCED_NODES`
-        times a step; the step is then solved again at the same load factor. Each step starts
-        without such nodes (a run resumed from a checkpoint finds the same ones)."""
+        (:meth:`~vfem.contact.formulations.paired.PairedContact.enforce`), at most
+        :data:`ENFORCED_NODES` times a step; the step is then solved again at the same load factor.
+        Each step starts without such nodes (a run resumed from a checkpoint finds the same
+        ones)."""
         where = getattr(exc, "where", None)
         if (not isinstance(exc, InvariantViolation) or not where
                 or not hasattr(self.contact, "enforce")):
@@ -740,9 +741,8 @@ class Analysis:
         large-kinematics gasket of docs/examples.md, stopped at step 11, runs through. The
         invariants judge the switched side as they judged the first (their tolerance is the
         surfaces', not the side's: the check stands); a forced coarser side's warning
-        (:data:`~vfem.contact.paired.FORCED_COARSER`) is given for it too."""
-        from .contact.large import LargeDeformationContact
-        from .contact.paired import PairedContact
+        (:data:`~vfem.contact.formulations.paired.FORCED_COARSER`) is given for it too."""
+        from .contact.formulations import LargeDeformationContact, PairedContact
 
         if not (isinstance(exc, RindViolation)
                 or (isinstance(exc, InvariantViolation) and getattr(exc, "where", None))):
@@ -833,5 +833,5 @@ class Analysis:
 
     def _fields(self, state: ContactState, result: SolveResult) -> dict[str, BodyStepResult]:
         """Full-mesh results of a converged state (the formulation's
-        :meth:`~vfem.contact.formulation.ContactFormulation.fields`)."""
+        :meth:`~vfem.contact.formulations.formulation.ContactFormulation.fields`)."""
         return self.contact.fields(state, result)

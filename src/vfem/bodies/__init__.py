@@ -345,9 +345,9 @@ class Body:
         along one axis only, :meth:`support_components`) whose facets are all flat, normal to
         that axis and on one plane (x, y, or z in 3D). The model continues across them as
         their mirror image: no surface that contact sees (the invariants,
-        :func:`vfem.contact.check._symmetry_facets`), no edge of a contact patch
-        (:meth:`vfem.contact.surface.ContactSurface.patch_boundary`), a tangent plane for
-        friction (:func:`vfem.contact.friction.plane_normals`)."""
+        :func:`vfem.contact.invariants.check._symmetry_facets`), no edge of a contact patch
+        (:meth:`vfem.contact.geometry.surface.ContactSurface.patch_boundary`), a tangent plane for
+        friction (:func:`vfem.contact.formulations.friction.plane_normals`)."""
         mesh = self.mesh
         out = []
         for sup in self.supports:
@@ -389,8 +389,9 @@ class Body:
         proportional case first). Refuses a body free to move as a rigid body. Returns the
         prescribed value of every supported or prescribed dof.
 
-        :meth:`setup` starts with it; the classical baselines (:mod:`vfem.contact.baselines`),
-        which solve every body in one global system, need only this part.
+        :meth:`setup` starts with it; the classical baselines
+        (:mod:`vfem.contact.formulations.baselines`), which solve every body in one global system,
+        need only this part.
         """
         self.validate()
         t0 = time.perf_counter()

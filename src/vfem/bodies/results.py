@@ -44,8 +44,8 @@ class BodyStepResult:
     #: (dim,) resultant (x, y[, z]) of the body's applied loads (its tractions) at the step's
     #: load factor
     applied_load: np.ndarray | None = None
-    # -- with friction (vfem.contact.friction; None without): at the nodes that carry a contact
-    # pair's compatibility (where its traction values live), zero at the others
+    # -- with friction (vfem.contact.formulations.friction; None without): at the nodes that carry a
+    # contact pair's compatibility (where its traction values live), zero at the others
     #: (npoints, dim) the tangential traction on the body (x, y[, z]), the part of the pair's
     #: traction field along the contact surface
     contact_shear: np.ndarray | None = None

@@ -1,4 +1,5 @@
-"""What a contact formulation supports, declared as data (:mod:`vfem.contact.formulation`)."""
+"""What a contact formulation supports, declared as data
+(:mod:`vfem.contact.formulations.formulation`)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from dataclasses import dataclass
 class Capabilities:
     """What a formulation supports, as data.
 
-    ``invariants``: what a broken invariant of :mod:`vfem.contact.check` does to a step —
+    ``invariants``: what a broken invariant of :mod:`vfem.contact.invariants.check` does to a step —
     ``"enforced"`` (the step fails and is cut), ``"recorded"`` (recorded and warned about: the
     thesis's plain reading leaves errors by design) or ``"compared"`` (recorded silently: a
     baseline's answer is its own, compared with vfem's). ``cuts_steps``: whether a failed step

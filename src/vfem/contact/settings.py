@@ -105,7 +105,7 @@ class ContactSettings:
             compatibility and equilibrium (docs/method.md); ``"paired"`` — per contact pair one
             surface (the softer, or of equals the finer) carries compatibility and the other
             equilibrium, so the exact discrete contact state is the fixed point
-            (``vfem/contact/paired.py``).
+            (``vfem/contact/formulations/paired.py``).
         penetration_tolerance: largest penetration (length) left uncorrected (thesis §5.6). Must
             be small against the thickness of the surface elements. Default (None): 1e-5 times the
             shortest candidate contact facet.
@@ -178,7 +178,7 @@ class ContactSettings:
             ``bodies``, ``friction``, ``law`` and its parameters), instead of ``friction``;
             different laws in different contact areas, as the thesis allows (§1.10).
         flexibility: how the contact correction reads the bodies' flexibility on their contact
-            surfaces (issue 22, :mod:`vfem.contact.matrix_free`): ``"dense"`` — formed, each
+            surfaces (issue 22, :mod:`vfem.contact.solvers.matrix_free`): ``"dense"`` — formed, each
             body condensed to its contact dofs (a dense block of (dim nc)^2 numbers, fastest for
             small zones); ``"matrix_free"`` — applied through each body's factorization, one
             back-substitution per body per iteration of a GMRES solve, nothing dense (large

@@ -1,7 +1,7 @@
 """What the contact formulations share with the solver: the state a step starts from and
 ends in, the record of each iteration, a solve's result, and the cycle watch.
 
-Every formulation (:mod:`vfem.contact.formulation`) keeps its contact forces in a
+Every formulation (:mod:`vfem.contact.formulations.formulation`) keeps its contact forces in a
 :class:`ContactState`, or in a subclass with its own unknowns: the paired variant's traction
 values (:class:`TractionState`), a baseline's active set and pressures
 (:class:`BaselineState`); reports per body a :class:`Pairing` for the output fields, one
@@ -96,8 +96,8 @@ class TractionState(ContactState):
 
 @dataclass
 class FrictionState(TractionState):
-    """The frictional paired variant's state (:mod:`vfem.contact.friction`): besides the normal
-    traction values, per contact pair (its index) at its compatibility-side nodes the
+    """The frictional paired variant's state (:mod:`vfem.contact.formulations.friction`): besides
+    the normal traction values, per contact pair (its index) at its compatibility-side nodes the
     tangential traction values (``shear``), the relative tangential displacement against the
     virtual node at the last converged step (``anchor``: a node that sticks keeps it within the
     step), the slip accumulated since the start (``slip``) and the penetration at the last

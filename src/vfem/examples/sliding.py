@@ -3,7 +3,7 @@
 The method's claim (thesis abstract and §4.5) is that virtual nodes allow "any amount of sliding of
 the touching surfaces without requiring rediscretization". This example slides a punch 40 of the
 block's facet lengths along it at constant indentation, with both bodies under large
-displacements (:mod:`vfem.contact.large`), and records the reactions.
+displacements (:mod:`vfem.contact.formulations.large`), and records the reactions.
 
 Plane strain, our dimensions (the thesis has no such example):
 
@@ -18,8 +18,8 @@ Plane strain, our dimensions (the thesis has no such example):
 Frictionless sliding over an elastic block stores no energy in the motion, so once the punch is
 away from the block's ends the normal reaction is constant and the tangential one nearly zero:
 any jump when a node of one surface passes a vertex of the other is a defect of the
-discretisation. With ``friction = mu`` (:mod:`vfem.contact.large_friction`) every node in contact
-slips in steady sliding and the tangential tractions are mu times the normal ones; the
+discretisation. With ``friction = mu`` (:mod:`vfem.contact.formulations.large_friction`) every node
+in contact slips in steady sliding and the tangential tractions are mu times the normal ones; the
 reactions' ratio is mu less the tilt of the normal tractions' resultant over the curved face
 (:func:`_friction_reading`).
 

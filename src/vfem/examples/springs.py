@@ -14,7 +14,7 @@ import logging
 import time
 from dataclasses import asdict, dataclass
 
-from ..contact.onedim import SecantSpring, Step1D, solve_step
+from ..contact.formulations import SecantSpring, Step1D, solve_step
 
 log = logging.getLogger(__name__)
 

@@ -21,8 +21,8 @@ docs/examples.md).
 Every node of every upper face is in contact, so the contact zone grows as
 ``divisions**(dim - 1)``: two plates with ``divisions = 70`` in 3D make a flat-on-flat interface
 of 71 x 71 against 72 x 72 nodes (29,004 contact dofs), about where the dense contact blocks
-stop fitting (``contact.flexibility``, :mod:`vfem.contact.matrix_free`). ``blocks = 2`` with a
-thin ``thickness`` is a flange-like pair of plates.
+stop fitting (``contact.flexibility``, :mod:`vfem.contact.solvers.matrix_free`). ``blocks = 2`` with
+a thin ``thickness`` is a flange-like pair of plates.
 
 No closed form; the checks are those every contact solution must meet (every invariant at
 every converged step: the forces balance, no body inside another, no tension), the contact

@@ -14,7 +14,7 @@ the nodal force the supports, prescribed displacements and platen apply to the b
 unconstrained dofs; :attr:`vfem.bodies.results.BodyStepResult.reaction`); with friction also
 ``contact_shear`` (3 components, z = 0: the tangential traction), ``slip_increment``,
 ``accumulated_slip`` and ``friction_status`` (0 free, 1 stick, 2 slip, -1 on nodes that carry
-no pair's compatibility; :mod:`vfem.contact.friction`). Cell fields:
+no pair's compatibility; :mod:`vfem.contact.formulations.friction`). Cell fields:
 ``stress_xx``, ``stress_yy``, ``stress_xy``, ``stress_zz``, ``von_mises`` (element averages).
 Quadratic elements are written as VTK's 6-node triangles and 9-node quadrilaterals, with the
 fields at every node.
@@ -70,7 +70,7 @@ import meshio
 import numpy as np
 
 from ..bodies.stresses import stress as body_stress
-from ..contact.surface import ContactSurface
+from ..contact.geometry import ContactSurface
 from ..errors import InputError
 from ..result_types import BodyStepResult, phase_table
 from ..solver import Analysis, AnalysisResult, Model, StepResult
@@ -194,7 +194,8 @@ class ResultsWriter:
                             "reaction": pad(reaction)},
                 cell_data={_CELL_FIELD.get(k, k): [v] for k, v in stress.items()},
             )
-            if r.contact_shear is not None:  # friction's fields (vfem.contact.friction)
+            # friction's fields (vfem.contact.formulations.friction)
+            if r.contact_shear is not None:
                 m.point_data.update({
                     "contact_shear": pad(r.contact_shear),
                     "slip_increment": r.slip_increment,
@@ -439,8 +440,9 @@ def progress_summary(model: Model, steps: list[StepResult], status: str, message
 
 def step_record(step: StepResult) -> dict:
     """The fields every example's ``summary.json`` gives per step; ``invariants``: the
-    independent checks of the converged state (:meth:`vfem.contact.check.Invariants.record`;
-    empty when the step was not checked); the forces on each body (:func:`force_record`)."""
+    independent checks of the converged state
+    (:meth:`vfem.contact.invariants.check.Invariants.record`; empty when the step was not checked);
+    the forces on each body (:func:`force_record`)."""
     last = step.history[-1] if step.history else None
     return {"step": step.step, "load_factor": step.load_factor, "iterations": step.iterations,
             "converged": step.converged, "cuts": step.cuts,

@@ -131,7 +131,7 @@ def invariants_line(steps: list[dict]) -> str:
                  f"{w['into']!r} (allowed {c['allowed']:.1e}), ")
     elif any(c["where"] for c in checked):
         # the deepest node may have a large faceting allowance (a corner); the node nearest
-        # its own limit is the one the check compares (vfem.contact.check)
+        # its own limit is the one the check compares (vfem.contact.invariants.check)
         deepest = max(c["max_penetration_any_body"] for c in checked)
         c = max((c for c in checked if c["where"]), key=lambda c: c["penetration"] - c["allowed"])
         text += (f"deepest node {deepest:.1e} inside, nearest its limit {c['penetration']:.1e} "
@@ -139,7 +139,7 @@ def invariants_line(steps: list[dict]) -> str:
     else:
         text += "no node inside another body, "
     beyond = [c["second_order"] for c in checked if c.get("second_order")]
-    if beyond:  # small kinematics: recorded, not enforced (vfem.contact.check)
+    if beyond:  # small kinematics: recorded, not enforced (vfem.contact.invariants.check)
         w = max(beyond, key=lambda w: w["beyond"])
         text += (f"on the deformed geometry node {w['node']} of {w['body']!r} "
                  f"{w['deformed_depth']:.1e} inside {w['into']!r} (allowed {w['allowed']:.1e}; "

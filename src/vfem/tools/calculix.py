@@ -237,7 +237,7 @@ def _initial_gap(s, m) -> float:
     none)."""
     pts = s.X[: s.nc]
     if pts.shape[1] == 3:
-        from ..contact.facets3d import closest_on_facets
+        from ..contact.geometry import closest_on_facets
 
         if not len(pts) or not len(m.facets):
             return 0.0

@@ -2,26 +2,26 @@
 tracked nodes are, and the force-controlled platen.
 
 :class:`SurfaceGroup` is the shared part of the thesis variant
-(:class:`~vfem.contact.algorithm.VirtualElementContact`) and the paired variant (small and large
-displacements, :mod:`vfem.contact.paired`, :mod:`vfem.contact.large`); :func:`bordered_solve` is
-the platen's bordered system that each of them solves in its compatibility correction.
+(:class:`~vfem.contact.formulations.algorithm.VirtualElementContact`) and the paired variant (small
+and large displacements, :mod:`vfem.contact.formulations.paired`,
+:mod:`vfem.contact.formulations.large`); :func:`bordered_solve` is the platen's bordered system that
+each of them solves in its compatibility correction.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..bodies.results import BodyStepResult, add_reactions
-from ..executor import SERIAL, Executor
-from .bordered import ReusedFactor, bordered_matrix, bordered_solve  # noqa: F401 - here too, as before
-from .settings import ContactSettings
-from .state import ContactState, SolveResult
-from .surface import ContactSurface
+from ...bodies.results import BodyStepResult, add_reactions
+from ...executor import SERIAL, Executor
+from ..geometry import ContactSurface
+from ..settings import ContactSettings
+from ..state import ContactState, SolveResult
 
 
 def weightless_corners(s) -> bool:
     """Whether the facets of ``s`` (it has candidate facets) have corners whose shape
-    functions integrate to zero (:attr:`~vfem.contact.facets.FacetKind.weightless_corners`:
+    functions integrate to zero (:attr:`~vfem.contact.geometry.facets.FacetKind.weightless_corners`:
     quadratic triangles, T6)."""
     return s.kind is not None and bool(s.kind.weightless_corners) and len(s.facets) > 0
 

@@ -1,6 +1,6 @@
 """A body's flexibility on its contact surface, applied through its own factorization (issue 22):
-what the matrix-free route (:mod:`vfem.contact.matrix_free`) and the side rules read of a body
-instead of its dense condensed block (``ContactSurface.G``). With the surfaces (the geometry
+what the matrix-free route (:mod:`vfem.contact.solvers.matrix_free`) and the side rules read of a
+body instead of its dense condensed block (``ContactSurface.G``). With the surfaces (the geometry
 stage of contact): a body's condensation to its surface, below the solvers that use it.
 """
 

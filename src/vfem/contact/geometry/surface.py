@@ -27,9 +27,10 @@ from skfem import BilinearForm, ElementLineP1, FacetBasis, MeshHex, MeshTet, Mes
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
-from ..bodies import COMPONENTS, Body
-from ..errors import InputError
-from ..mesh.checks import _corners
+from ...bodies import COMPONENTS, Body
+from ...errors import InputError
+from ...mesh.checks import _corners
+from ..search import project_points
 from .facets import (  # noqa: F401 - the 2D facet's functions, here too for those who import them here
     _SECOND,
     FacetKind,
@@ -39,7 +40,6 @@ from .facets import (  # noqa: F401 - the 2D facet's functions, here too for tho
     kind_of,
 )
 from .facets3d import closest_on_facets
-from .search import project_points
 
 log = logging.getLogger(__name__)
 
@@ -82,9 +82,10 @@ class ContactSurface:
         facets: (nf, 2) local node numbers, ordered so the outward normal is (t_y, -t_x) (the
             first node to the second); with quadratic elements (nf, 3), the midpoint third. In
             3D (nf, 3/6/4/9) triangles or quadrilaterals, corners counter-clockwise seen from
-            outside (:class:`~vfem.contact.facets.Triangle`, :class:`~vfem.contact.facets.Quad`).
-            What a facet is (its shape functions, normals, closest point, patch boundary,
-            readings, overlap quadrature) is its ``kind`` (:mod:`vfem.contact.facets`).
+            outside (:class:`~vfem.contact.geometry.facets.Triangle`,
+            :class:`~vfem.contact.geometry.facets.Quad`). What a facet is (its shape functions,
+            normals, closest point, patch boundary, readings, overlap quadrature) is its ``kind``
+            (:mod:`vfem.contact.geometry.facets`).
         nodes: (nt,) point numbers (``Body.points``) of the tracked nodes; the first ``nc`` are
             the candidate nodes (on candidate facets), the rest the other vertices of the rind
             elements.
@@ -101,7 +102,8 @@ class ContactSurface:
             tracked nodes' with ``rind_rows``, else only the candidates', nr = nc) for the
             candidate dofs.
         platen_row: (2 nc,) the platen reaction per unit contact force on the candidate dofs.
-        kind: the :class:`~vfem.contact.facets.FacetKind` of the facets: ``Segment(order)`` in
+        kind: the :class:`~vfem.contact.geometry.facets.FacetKind` of the facets: ``Segment(order)``
+        in
             2D (set from ``facets`` when not given), ``Triangle(order)`` or ``Quad(order)`` in
             3D (None for a 3D surface without candidate facets).
     """
@@ -122,8 +124,8 @@ class ContactSurface:
     rind_rows: bool = True
     #: whether ``C`` equals its transpose to the last bit (set by :meth:`compute_flexibility`)
     exactly_symmetric: bool = False
-    #: what a facet is (:mod:`vfem.contact.facets`): ``Segment(order)`` in 2D, ``Triangle`` or
-    #: ``Quad`` in 3D; None for a 3D surface without candidate facets
+    #: what a facet is (:mod:`vfem.contact.geometry.facets`): ``Segment(order)`` in 2D, ``Triangle``
+    #: or ``Quad`` in 3D; None for a 3D surface without candidate facets
     kind: FacetKind | None = None
 
     def __post_init__(self):
@@ -168,8 +170,8 @@ class ContactSurface:
     @classmethod
     def _untouched(cls, body: Body, fn: np.ndarray) -> ContactSurface:
         """The surface of a 3D body without candidate facets (in no pair that may touch,
-        :func:`~vfem.contact.formulation.bodies_that_may_touch`): no candidate, no rind, no
-        kind."""
+        :func:`~vfem.contact.formulations.formulation.bodies_that_may_touch`): no candidate, no
+        rind, no kind."""
         none = np.zeros(0, dtype=np.int64)
         return cls(body=body, facet_ids=none, facets=fn.astype(np.int64), nodes=none, nc=0,
                    X=np.zeros((0, 3)), lengths=np.zeros(0), tributary=np.zeros(0),
@@ -187,7 +189,7 @@ class ContactSurface:
 
     def traction_interpolation(self, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
         """As :meth:`interpolation` for a contact traction's nodal values
-        (:meth:`~vfem.contact.facets.FacetKind.traction_shape`)."""
+        (:meth:`~vfem.contact.geometry.facets.FacetKind.traction_shape`)."""
         return self._rows(seg, self.kind.traction_shape(t))
 
     def _rows(self, seg: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -238,8 +240,9 @@ class ContactSurface:
         a candidate dof is, by reciprocity, minus that dof's motion under a unit platen motion.
         ``matrix_free`` (issue 22): no dense block at all; the flexibility is applied through
         the body's factorization when asked (:attr:`flexibility`,
-        :class:`~vfem.contact.flexibility.SurfaceFlexibility`). ``remote``: the body is another
-        MPI rank's, which alone reads its dense flexibility (:mod:`vfem.parallel`): none here.
+        :class:`~vfem.contact.geometry.flexibility.SurfaceFlexibility`). ``remote``: the body is
+        another MPI rank's, which alone reads its dense flexibility (:mod:`vfem.parallel`): none
+        here.
         """
         body = self.body
         nc2 = self.dim * self.nc
@@ -485,7 +488,7 @@ class ContactSurface:
         facet, a first t and ``t_free``, the unclamped coordinate along the chord (outside
         [0, 1]: the point lies beyond that end of the facet); on curved facets a few Newton
         steps then find the closest point on the curve. Ties between facets are broken by
-        ``point_normals`` (:func:`~vfem.contact.search.project_points`);
+        ``point_normals`` (:func:`~vfem.contact.search.closest.project_points`);
         :meth:`FacetKind.closest`.
         """
         x = self.X if x is None else x
@@ -744,8 +747,8 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
     """Refuse bodies that start deeper into each other than the outer layer of elements.
 
     The contact iteration finds a node's partner on the other surface only while the node is
-    within that body's rind (thesis §5.6): :class:`~vfem.contact.paired.PairedContact` stops a
-    step whose penetration passes the depth of the element behind the facet it is measured
+    within that body's rind (thesis §5.6): :class:`~vfem.contact.formulations.paired.PairedContact`
+    stops a step whose penetration passes the depth of the element behind the facet it is measured
     against (``rind_depth``), and cuts it; an overlap that deep at the start cannot be cut away,
     so every step would fail. The same rule is applied here to the undeformed bodies: for each
     pair of bodies that may touch, each candidate node of one is projected onto the other's

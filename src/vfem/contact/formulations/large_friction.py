@@ -1,10 +1,11 @@
 """Coulomb friction under large displacements and sliding (issue 20, item 3).
 
-The small-kinematics friction (:mod:`vfem.contact.friction`) measures a node's slip as the change
-of its relative tangential displacement against its virtual node on the undeformed pairs. When
-the bodies slide far and turn, that measure means nothing: the virtual node moves along the
+The small-kinematics friction (:mod:`vfem.contact.formulations.friction`) measures a node's slip as
+the change of its relative tangential displacement against its virtual node on the undeformed pairs.
+When the bodies slide far and turn, that measure means nothing: the virtual node moves along the
 opposing surface, facet after facet. Here, as in the frictionless large-displacement variant
-(:mod:`vfem.contact.large`), every iteration pairs the surfaces on the current geometry, and:
+(:mod:`vfem.contact.formulations.large`), every iteration pairs the surfaces on the current
+geometry, and:
 
 * **the anchor** of a compatibility-side node is a *material point of the opposing surface*:
   where its virtual node was at the last converged step, kept as that surface's facet and
@@ -47,7 +48,9 @@ import logging
 
 import numpy as np
 
-from ..errors import AnalysisError
+from ...errors import AnalysisError
+from ..geometry import virtual_nodes
+from ..state import ContactState, FrictionState
 from .friction import (
     CONE_TOLERANCE,
     HELD,
@@ -59,8 +62,6 @@ from .friction import (
     tangents,
 )
 from .large import LargeDeformationContact
-from .pairing import virtual_nodes
-from .state import ContactState, FrictionState
 
 log = logging.getLogger(__name__)
 
@@ -82,18 +83,18 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         super().__init__(surfaces, pairs, settings, backend, executor=executor)
         self._init_friction(settings)
         #: 3D: per pair and node, the global axis whose projection on the current tangent plane
-        #: is the first tangent (:func:`~vfem.contact.friction.tangents`): the one least aligned
-        #: with the node's own undeformed outward normal (on a symmetry plane, in the plane), so
-        #: the tangents follow the turning normal smoothly and the choice depends on nothing but
-        #: the mesh (not on where the pairing first put the node: a node beyond the other
-        #: surface has the direction to its edge as pair normal, nearly in the surface's plane,
-        #: and the axis across the surface then met the normal once the other body slid over
+        #: is the first tangent (:func:`~vfem.contact.formulations.friction.tangents`): the one
+        #: least aligned with the node's own undeformed outward normal (on a symmetry plane, in the
+        #: plane), so the tangents follow the turning normal smoothly and the choice depends on
+        #: nothing but the mesh (not on where the pairing first put the node: a node beyond the
+        #: other surface has the direction to its edge as pair normal, nearly in the surface's
+        #: plane, and the axis across the surface then met the normal once the other body slid over
         #: it). None in 2D.
         self._axes = [tangent_axes(plane_normals(sf, p, sf.node_normals()[p.nodes]))
                       if sf.dim == 3 else None
                       for p, sf in ((p, self.surfaces[p.fine]) for p in self.contact_pairs)]
         # (the elasto-plastic law and a force-controlled platen are refused before, by
-        # vfem.contact.formulation.check_capabilities)
+        # vfem.contact.formulations.formulation.check_capabilities)
 
     # -- the traction field ----------------------------------------------------------------------
 
@@ -106,7 +107,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         """Pair k's tangents at its nodes ``on`` with unit ``normal`` there: 2D the normal
         turned by +90 degrees; 3D the projection of each node's axis (:attr:`_axes`) on the
         tangent plane, and the normal times it (the normal less its part across a symmetry
-        plane at a node on one, :func:`~vfem.contact.friction.plane_normals`)."""
+        plane at a node on one, :func:`~vfem.contact.formulations.friction.plane_normals`)."""
         if self._axes[k] is None:
             return tangents(normal)
         flat, turned = self._turned(k, on, normal)
@@ -379,7 +380,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         held along one tangent slides along the other only.
 
         Sigma turns with the solution: as in the small-kinematics variant
-        (:meth:`~vfem.contact.friction.FrictionalPairedContact._correct_frictional`), a
+        (:meth:`~vfem.contact.formulations.friction.FrictionalPairedContact._correct_frictional`), a
         slipping node's traction is ``-mu q sigma + s_perp e``, e across sigma, and its row asks
         its slip across sigma to vanish, linearised in the turn of sigma: ``e . slip +
         (sigma . slip) / |s| s_perp = 0`` (a semismooth Newton step on the disk); sigma is then

@@ -68,12 +68,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
 
+from ..search import project_points
 from .cached_boundary import CachedBoundary
 from .check3d import CORNER_ANGLE
-from .search import project_points
 
 if TYPE_CHECKING:
-    from ..bodies import Body
+    from ...bodies import Body
 
 #: (a): the resultant of all contact forces, relative to the largest body's total contact force
 FORCE_BALANCE_TOLERANCE = 1e-8
@@ -464,11 +464,10 @@ class InvariantCheck:
 
     def _three_d(self, fields: dict, out: Invariants, extra: float, t0: float
                  ) -> Invariants:
-        """The invariants of 3D bodies (:mod:`vfem.contact.check3d`: boundaries of triangles
-        and quadrilaterals). Bodies that touch nothing (no pair, no contact force) are not
+        """The invariants of 3D bodies (:mod:`vfem.contact.invariants.check3d`: boundaries of
+        triangles and quadrilaterals). Bodies that touch nothing (no pair, no contact force) are not
         visited: (a) their forces, all zero, balance; (b) and (c) hold."""
         from . import check3d
-
         F = [np.asarray(fields[b.name].contact_force, dtype=float) for b in self.bodies]
         self._force_balance(F, out)
         if not self.pairs and not any(np.any(f) for f in F):
@@ -515,7 +514,7 @@ class InvariantCheck:
     def _interpenetration(self, cur: list, out: Invariants, extra: float,
                           forces: list[np.ndarray] | None = None, linearised_depth=None) -> None:
         """(b) on the current surfaces ``cur`` (2D :class:`_Polygon` s, or 3D
-        :class:`~vfem.contact.check3d.Surface3` s, which answer the same questions: box,
+        :class:`~vfem.contact.invariants.check3d.Surface3` s, which answer the same questions: box,
         inside, depth, turning_within, adjacent); ``linearised_depth`` (i, j, node, cur) ->
         (depth, second-order allowance): small kinematics' reading, 2D's
         :meth:`_linearised_depth` by default."""

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ContactCycling, ContactNotConverged
-from .settings import ContactSettings
-from .state import CycleWatch, IterationRecord, Pairing, SolveResult
+from ...errors import ContactCycling, ContactNotConverged
+from ..settings import ContactSettings
+from ..state import CycleWatch, IterationRecord, Pairing, SolveResult
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""The invariants (b) and (c) of :mod:`vfem.contact.check` on 3D bodies (issue 21, C9).
+"""The invariants (b) and (c) of :mod:`vfem.contact.invariants.check` on 3D bodies (issue 21, C9).
 
 The same checks as in 2D, on a body's boundary of triangles (a quadrilateral split in two
 along its first diagonal) in place of its boundary polygon:
@@ -9,7 +9,7 @@ along its first diagonal) in place of its boundary polygon:
   faces' normals at a vertex: exact for a closed surface, Bærentzen & Aanæs 2005); the whole
   closed boundary is used, symmetry planes included.
 * **depth**: the distance to the boundary without its symmetry planes (roller supports held
-  normal to a flat boundary, any axis, :func:`~vfem.contact.check._symmetry_facets`); the
+  normal to a flat boundary, any axis, :func:`~vfem.contact.invariants.check._symmetry_facets`); the
   facet's size L is its longest side.
 * **allowance** (L/2)·tan(α/2), α twice the largest angle between the node's normal and the
   normal of a boundary node within L of it on the convex side (the 2D "convex turning within
@@ -29,7 +29,7 @@ along its first diagonal) in place of its boundary polygon:
 
 Linear facets only: quadratic 3D bodies in contact, and the "consistent" tension measure in
 3D, are refused with NotImplementedError (docs/errors.md). The loop of (b) over the pairs is
-:meth:`~vfem.contact.check.InvariantCheck._interpenetration`, shared with 2D: a
+:meth:`~vfem.contact.invariants.check.InvariantCheck._interpenetration`, shared with 2D: a
 :class:`Surface3` answers the questions a 2D boundary polygon does.
 """
 
@@ -42,12 +42,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..geometry import closest_on_facets, kind_of
 from .cached_boundary import CachedBoundary
-from .facets import kind_of
-from .facets3d import closest_on_facets
 
 if TYPE_CHECKING:
-    from ..bodies import Body
+    from ...bodies import Body
 
 #: a feature of a triangle: the barycentric coordinates below this (relative) are on its edge
 FEATURE = 1e-9
@@ -81,7 +80,7 @@ class Boundary3:
     @classmethod
     def of(cls, body: Body, symmetry: np.ndarray) -> Boundary3:
         """``symmetry``: the body's facets on a symmetry plane
-        (:func:`vfem.contact.check._symmetry_facets`)."""
+        (:func:`vfem.contact.invariants.check._symmetry_facets`)."""
         mesh = body.mesh
         bf = mesh.boundary_facets()
         fp = body.facet_points(bf).copy()
@@ -139,7 +138,7 @@ def _barycentric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> 
 
 class Surface3(CachedBoundary):
     """A 3D body's boundary at positions ``x`` ((nb, 3), local numbering); what is asked is
-    computed on first use (the API of :class:`~vfem.contact.check._Polygon`)."""
+    computed on first use (the API of :class:`~vfem.contact.invariants.check._Polygon`)."""
 
     @property
     def corners(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -348,7 +347,7 @@ def linearised_depth(reference: list[Surface3], i: int, j: int, node: np.ndarray
                      cur: list[Surface3]) -> tuple[np.ndarray, np.ndarray]:
     """Small kinematics: the depth of body i's boundary ``node`` (local numbers) into body j as
     linear theory reads it, and its second-order allowance (2D:
-    :meth:`~vfem.contact.check.InvariantCheck._linearised_depth`)."""
+    :meth:`~vfem.contact.invariants.check.InvariantCheck._linearised_depth`)."""
     ri, rj = reference[i], reference[j]
     keep = rj.surface
     tri, lam, c, dist = rj._closest(ri.x[node], keep, point_normals=ri.normals[node])
@@ -403,7 +402,7 @@ def tension(bodies: list[Body], tolerance: Callable[[Body], float], least: float
     but phi_corner + (phi_mid1 + phi_mid2) / 2 = L >= 0 on each facet (the midpoints of its
     two edges from the corner), so the corner is read with half of each such midpoint's force
     (a midpoint's own phi = 4 L x >= 0: alone), and a body with quadratic elements takes the
-    quadratic tolerance, as in 2D (:mod:`vfem.contact.check`'s docstring).
+    quadratic tolerance, as in 2D (:mod:`vfem.contact.invariants.check`'s docstring).
 
     ``tolerance(body)``: a body's tolerance (``least`` where there are no bodies). Returns the
     largest tensile measure over the largest nodal force (0 where none), its tolerance (the

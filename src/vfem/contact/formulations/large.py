@@ -1,14 +1,14 @@
 """Contact between bodies under large displacements: the paired variant, current configuration.
 
-With small displacements (:class:`~vfem.contact.paired.PairedContact`) the bodies are paired once,
-on the undeformed geometry, and each body's response to its contact forces is linear. Here the
-bodies may slide far and deform much (thesis Chapters 2-3; the method's claim is "any amount of
-sliding of the touching surfaces without requiring rediscretization"), so every iteration
+With small displacements (:class:`~vfem.contact.formulations.paired.PairedContact`) the bodies are
+paired once, on the undeformed geometry, and each body's response to its contact forces is linear.
+Here the bodies may slide far and deform much (thesis Chapters 2-3; the method's claim is "any
+amount of sliding of the touching surfaces without requiring rediscretization"), so every iteration
 
 1. **re-pairs** the surfaces on the current geometry: every compatibility-side node finds its
    virtual node on the opposing surface as it now lies, with that surface's current normal
-   (continuous along it, :func:`~vfem.contact.paired.virtual_nodes`); the transfer of the
-   traction to the opposing nodes is re-integrated over the current overlap of the two surfaces.
+   (continuous along it, :func:`~vfem.contact.formulations.paired.virtual_nodes`); the transfer of
+   the traction to the opposing nodes is re-integrated over the current overlap of the two surfaces.
    Tractions stay nominal (per undeformed length of the compatibility side), so the two sides'
    forces remain equal and opposite in total, and act along the current normals;
 2. **linearizes** every large-kinematics body at its current state (Newton's system of
@@ -71,14 +71,12 @@ import logging
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import AnalysisError, InputError
-from .capabilities import Capabilities
-from .complementarity import linear_complementarity
-from .iteration import Check, iterate
+from ...errors import AnalysisError, InputError
+from ..capabilities import Capabilities
+from ..geometry import ContactSurface, overlap, virtual_nodes
+from ..solvers import Check, iterate, linear_complementarity
+from ..state import ContactState, IterationRecord, SolveResult, closing_motion
 from .paired import PairSet
-from .pairing import overlap, virtual_nodes
-from .state import ContactState, IterationRecord, SolveResult, closing_motion
-from .surface import ContactSurface
 
 log = logging.getLogger(__name__)
 
@@ -184,7 +182,7 @@ class LargeDeformationContact(PairSet):
 
     def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
         """Newton's method on the bodies and the traction values together (module docstring),
-        by :func:`~vfem.contact.iteration.iterate`.
+        by :func:`~vfem.contact.solvers.iteration.iterate`.
 
         The history records, per iteration, the largest penetration and, as its equilibrium
         error, the largest out-of-balance force of a body relative to its reference force.
@@ -258,8 +256,8 @@ class LargeDeformationContact(PairSet):
 
     def _platen_on_force(self, state: ContactState, need: float) -> bool:
         """Whether the platen's reaction is on its force: ``need`` (:meth:`_platen_terms`)
-        within :meth:`~vfem.contact.group.SurfaceGroup.platen_allowance` (a zero force: of the
-        forces its reaction sums, issue 37)."""
+        within :meth:`~vfem.contact.formulations.group.SurfaceGroup.platen_allowance` (a zero force:
+        of the forces its reaction sums, issue 37)."""
         return self.platen_body is None or abs(need) <= self.platen_allowance(state)
 
     def _platen_terms(self, state: ContactState, lins: list) -> tuple[float, float, np.ndarray]:

@@ -1,9 +1,10 @@
 """Pairing and gaps of the paired variant: which facets of two surfaces face each other, each
 compatibility-side node's virtual node on the other surface (its normal, gap and interpolation,
-thesis §4.3), and the overlap of a pair with its traction transfer (:mod:`vfem.contact.transfer`).
+thesis §4.3), and the overlap of a pair with its traction transfer
+(:mod:`vfem.contact.geometry.transfer`).
 
-Shared by the small-displacement (:mod:`vfem.contact.paired`, once, undeformed) and the
-large-displacement paired variant (:mod:`vfem.contact.large`, every iteration, current
+Shared by the small-displacement (:mod:`vfem.contact.formulations.paired`, once, undeformed) and the
+large-displacement paired variant (:mod:`vfem.contact.formulations.large`, every iteration, current
 configuration).
 """
 
@@ -48,7 +49,8 @@ class ContactPair:
     point: bool = False
     #: (m, k) per held node, the other surface's nodes around its virtual node (the nodes of
     #: the facet it lies on; -1 beyond the other patch): while they all touch, the held node
-    #: is not held (:func:`~vfem.contact.complementarity.linear_complementarity`'s ``guard``)
+    #: is not held (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`'s
+    #: ``guard``)
     guard: np.ndarray | None = None
     #: (m, dim) where the gap is read along another direction than the force acts (held
     #: nodes, :func:`held_nodes`): the penetration is ``-(gap0 + gap_normal . (u_f - u_c))``
@@ -56,7 +58,7 @@ class ContactPair:
     gap_normal: np.ndarray | None = None
     #: (m,) per held node, the size of the facet its virtual node lies on: a node that has
     #: slid along it by more is no longer over it, and is not held (small kinematics pairs
-    #: once; :meth:`~vfem.contact.paired.PairedContact._stale`)
+    #: once; :meth:`~vfem.contact.formulations.paired.PairedContact._stale`)
     reach: np.ndarray | None = None
     #: (m, nc_fine) held points that are not nodes of the ``fine`` body (3D: where a stiff
     #: box's edge crosses the other surface's facets, :func:`held_edges`): each point's
@@ -130,7 +132,7 @@ def read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
                  so: ContactSurface, xo: np.ndarray | None, ofacets: np.ndarray | None,
                  normals: np.ndarray):
     """For each of the kind's readings (``s.kind.readings``; 2D:
-    :data:`~vfem.contact.facets.FACET_READINGS`): the closest point on ``so`` (its facets
+    :data:`~vfem.contact.geometry.facets.FACET_READINGS`): the closest point on ``so`` (its facets
     ``ofacets``, all if None) of that point of each of ``facets`` of ``s`` (positions ``x``,
     ``xo``; ties by ``normals``), as (facet of so, its normal there, unclamped xi)."""
     n = len(facets)
@@ -151,8 +153,8 @@ def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np
     ``xf``, ``xc``): (normal, gap, interp, facet, beyond) — see :func:`overlap`.
     ``beyond_normal=False``: a node beyond the patch keeps the normal interpolated at its
     virtual node instead of the direction to it (the large-kinematics follower term's
-    differences, :meth:`~vfem.contact.large.LargeDeformationContact._normals_at`: a loaded
-    node on the patch's edge that a perturbation moves past it would otherwise turn its
+    differences, :meth:`~vfem.contact.formulations.large.LargeDeformationContact._normals_at`: a
+    loaded node on the patch's edge that a perturbation moves past it would otherwise turn its
     normal by 90 degrees over the perturbation). ``facet_normal``: the normal of the facet
     at the virtual node instead of the interpolated one (:func:`held_nodes`).
     """
@@ -189,8 +191,8 @@ def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: 
 
     The normal is the two surfaces' outward normals (the other surface's at the virtual node,
     minus the node's own), each weighted by its body's stiffness per unit length (the inverse
-    of :meth:`~vfem.contact.paired.PairSet._compliance_density`): where the bodies are pressed
-    together the stiffer surface keeps its shape and the interface takes its normal, and two
+    of :meth:`~vfem.contact.formulations.paired.PairSet._compliance_density`): where the bodies are
+    pressed together the stiffer surface keeps its shape and the interface takes its normal, and two
     equally stiff ones meet on the mean plane. Swapping the roles gives the same line.
     **Why**: with the other surface's normal alone, a stiff flat made the compatibility side of
     the Hertz problem took the cylinder's normals, tilted by up to a/R, and a horizontal
@@ -199,7 +201,7 @@ def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: 
 
     A node at the end of its own patch (its body's corner or edge: a rotated punch's lowest
     corner, a tilted box's edge), or on an edge inside it (its facets there turning by more
-    than :data:`~vfem.contact.surface.FEATURE_ANGLE`: a block's corner whose top and side
+    than :data:`~vfem.contact.geometry.surface.FEATURE_ANGLE`: a block's corner whose top and side
     both face a disk's flank), keeps the other surface's normal too: its own surface has no
     normal there that the interface could take (its nodal normal is only a bisector), and the
     corner presses into the other face along that face's normal. **Why**: the blend, turned
@@ -334,8 +336,8 @@ def approach_gaps(sf: ContactSurface, sc: ContactSurface, geo: Overlap,
     """(m,) the compatibility side's gaps along the pair's normal n (``geo.normal``, the
     common normal, :func:`common_normal`), each scaled so that it closes where the node,
     moving relative to its virtual node along ``approach`` ((m, dim) a: the loads' relative
-    motion, :meth:`~vfem.contact.paired.PairSet._approach`), crosses the line (plane) of the
-    other surface's facet at its virtual node: g_m (n.a) / (m.a), m that facet's normal and
+    motion, :meth:`~vfem.contact.formulations.paired.PairSet._approach`), crosses the line (plane)
+    of the other surface's facet at its virtual node: g_m (n.a) / (m.a), m that facet's normal and
     g_m the node's distance from its line (small kinematics, undeformed; issue 37). Only where
     the node approaches clearly (a within 60 degrees of -n and of -m) and the ray along a
     meets the other surface at all (:func:`ray_entry`: not past the other body's edge, where
@@ -393,8 +395,8 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     side) then sinks into a softer, finer surface between its nodes, and a node of the
     softer surface just past the stiff body's edge slides under it (the tilted cube of issue
     37: a corner 9.2e-3 inside). Held only where it would penetrate
-    (:func:`~vfem.contact.complementarity.linear_complementarity`'s ``reserve``), such a node
-    changes nothing where the two surfaces fit (a flat interface, a convex compatibility
+    (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`'s ``reserve``), such a
+    node changes nothing where the two surfaces fit (a flat interface, a convex compatibility
     side) and gives the force where they do not.
     """
     if nodes is None:
@@ -466,9 +468,9 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     gap, as its nodes are.
 
     Where ``approach`` is given (``approach(read, read_other, normal)``, the loads' relative
-    motion, :meth:`~vfem.contact.paired.PairSet._relative_motion`), a point that approaches
-    its closest facet clearly (within 60 degrees of its inward normal) is read where the ray
-    along that motion enters the other patch (:func:`ray_facet`): the facet under it, and its
+    motion, :meth:`~vfem.contact.formulations.paired.PairSet._relative_motion`), a point that
+    approaches its closest facet clearly (within 60 degrees of its inward normal) is read where the
+    ray along that motion enters the other patch (:func:`ray_facet`): the facet under it, and its
     pairing; others at their closest point, and only where they lie over (or under) that
     facet, not off its edge past a corner of the other surface.
 
@@ -684,8 +686,8 @@ def _edge_approach(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, ed
     ``t``, at ``points``) approaches the other patch ``opatch``, nan where it does not clearly
     (within 60 degrees of the closest facet's inward normal) or ``approach`` is None.
     ``approach(read, read_other, normal)``: the relative motion under the loads
-    (:meth:`~vfem.contact.paired.PairSet._relative_motion`) given how to read a field of
-    each side's candidate nodes at the points and at their closest points."""
+    (:meth:`~vfem.contact.formulations.paired.PairSet._relative_motion`) given how to read a field
+    of each side's candidate nodes at the points and at their closest points."""
     out = np.full(points.shape, np.nan)
     if approach is None:
         return out

@@ -28,18 +28,18 @@ import logging
 
 import numpy as np
 
-from ..errors import RindViolation
-from .capabilities import Capabilities
-from .corrections import (
+from ...errors import RindViolation
+from ..capabilities import Capabilities
+from ..geometry import traction_from_forces
+from ..laws import (
     compatibility_displacement,
     equilibrium_force,
     relaxation,
     release_tension,
 )
-from .group import SurfaceGroup, bordered_solve
-from .iteration import Check, iterate
-from .search import outward_normals, project_points
-from .state import (  # noqa: F401 - the shared types, here too for those who import them here
+from ..search import outward_normals, project_points
+from ..solvers import Check, bordered_solve, iterate
+from ..state import (  # noqa: F401 - the shared types, here too for those who import them here
     ContactState,
     CycleWatch,
     IterationRecord,
@@ -47,7 +47,7 @@ from .state import (  # noqa: F401 - the shared types, here too for those who im
     SolveResult,
     closing_motion,
 )
-from .transfer import traction_from_forces
+from .group import SurfaceGroup
 
 log = logging.getLogger(__name__)
 
@@ -312,7 +312,7 @@ class VirtualElementContact(SurfaceGroup):
 
     def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
         """Iterate from ``state`` (modified in place) until the contact state has converged
-        (:func:`~vfem.contact.iteration.iterate`); ``on_iteration`` gets every record.
+        (:func:`~vfem.contact.solvers.iteration.iterate`); ``on_iteration`` gets every record.
 
         Stopping rules (``ContactSettings.convergence``):
 

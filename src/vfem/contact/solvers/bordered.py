@@ -1,8 +1,8 @@
 """The platen's bordered system, which every formulation's compatibility correction solves
 (:func:`bordered_solve`), and the dense pair matrix's factors kept while it recurs
 (:class:`ReusedFactor`): the solvers' dense linear algebra, below the formulations, so that
-they, the complementarity solver and the matrix-free operator (:mod:`vfem.contact.matrix_free`)
-share it without importing each other."""
+they, the complementarity solver and the matrix-free operator
+(:mod:`vfem.contact.solvers.matrix_free`) share it without importing each other."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 import scipy.linalg as sla
 
-from ..threads import dense_threads
+from ...threads import dense_threads
 
 
 def bordered_solve(W: np.ndarray, column: np.ndarray, row: np.ndarray, corner: float,

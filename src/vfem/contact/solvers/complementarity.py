@@ -7,7 +7,7 @@ q >= 0, penetration <= 0 and one of the two zero. The thesis's iteration finds t
 correction at a time, each correction a back-substitution through every body (§4.3-4.5; Hertz
 7, 4, 4, 4, 4 corrections per step). Here the set is found on the condensed system alone, by
 small dense solves: under small kinematics W is exact, so one correction of the bodies then
-meets every condition, and under large kinematics (:mod:`vfem.contact.large`) it is the
+meets every condition, and under large kinematics (:mod:`vfem.contact.formulations.large`) it is the
 linearised problem of one Newton correction.
 """
 
@@ -45,15 +45,15 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
     values set to zero.
 
     ``W``: the matrix (:class:`DenseSystem`), or an operator with its ``matvec`` and ``solve``
-    (:class:`~vfem.contact.matrix_free.PairOperator`, issue 22). ``factor``: with a matrix,
+    (:class:`~vfem.contact.solvers.matrix_free.PairOperator`, issue 22). ``factor``: with a matrix,
     keep the LU factors of the last set's matrix (:class:`ReusedFactor`; a step whose set is
     the last step's solves with the same factors); without it, every set's bordered system is
     solved by least squares.
 
     ``reserve`` (bool over the nodes): nodes held back until the others' set is found — the
-    held nodes (issue 37, :func:`~vfem.contact.pairing.held_nodes`), even those that carried
-    force before. Only if one of them then penetrates do they take part in the pivoting, so where
-    none would (a flat interface, a convex compatibility side) the answer is the
+    held nodes (issue 37, :func:`~vfem.contact.geometry.pairing.held_nodes`), even those that
+    carried force before. Only if one of them then penetrates do they take part in the pivoting, so
+    where none would (a flat interface, a convex compatibility side) the answer is the
     compatibility side's set alone, unchanged; a held node that only touches within
     round-off, whose condition repeats its neighbours', never makes a set's matrix singular.
     ``rounds``: of held nodes joining (default :data:`STAGES`; 0: the reserve nodes never
@@ -222,7 +222,7 @@ class DenseSystem:
     """W formed (the dense route): its products, and each set's system solved with the LU
     factors of :class:`ReusedFactor` where given (else least squares for a bordered set,
     ``numpy.linalg.solve`` for a plain one). The matrix-free route's counterpart is
-    :class:`~vfem.contact.matrix_free.PairOperator` (issue 22)."""
+    :class:`~vfem.contact.solvers.matrix_free.PairOperator` (issue 22)."""
 
     def __init__(self, W: np.ndarray, factor: ReusedFactor | None = None):
         self.W = W
@@ -235,7 +235,8 @@ class DenseSystem:
               ) -> tuple[np.ndarray, float]:
         """The values on set ``a`` that close its gaps: ``W[a, a] x = rhs``, or with
         ``border`` = (column, row, corner, extra) the platen's bordered system
-        (:func:`~vfem.contact.group.bordered_solve`). ``x0`` (a first guess) is not needed."""
+        (:func:`~vfem.contact.formulations.group.bordered_solve`). ``x0`` (a first guess) is not
+        needed."""
         W, factor = self.W, self.factor
         if border is not None:
             column, row, corner, extra = border

@@ -2,12 +2,12 @@
 
 The incremental driver (:class:`vfem.solver.Analysis`) runs the steps; a formulation resolves the
 contact of one step. Every formulation — the paired variant with small
-(:class:`~vfem.contact.paired.PairedContact`) or large displacements
-(:class:`~vfem.contact.large.LargeDeformationContact`), the thesis's plain reading
-(:class:`~vfem.contact.algorithm.VirtualElementContact`) and the classical baselines
-(:class:`~vfem.contact.baselines.GlobalContact`) — implements :class:`ContactFormulation`, and
-declares what it can do as data (:class:`Capabilities`), which the model's checks read
-(:func:`check_capabilities`) instead of a hand-written rule per formulation.
+(:class:`~vfem.contact.formulations.paired.PairedContact`) or large displacements
+(:class:`~vfem.contact.formulations.large.LargeDeformationContact`), the thesis's plain reading
+(:class:`~vfem.contact.formulations.algorithm.VirtualElementContact`) and the classical baselines
+(:class:`~vfem.contact.formulations.baselines.GlobalContact`) — implements
+:class:`ContactFormulation`, and declares what it can do as data (:class:`Capabilities`), which the
+model's checks read (:func:`check_capabilities`) instead of a hand-written rule per formulation.
 
 :func:`formulation_class` picks the formulation of a model's settings and kinematics.
 """
@@ -17,13 +17,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Protocol
 
-from ..errors import InputError
-from .capabilities import Capabilities
+from ...errors import InputError
+from ..capabilities import Capabilities
 
 if TYPE_CHECKING:
-    from ..bodies.results import BodyStepResult
-    from .state import ContactState, IterationRecord, SolveResult
-    from .surface import ContactSurface
+    from ...bodies.results import BodyStepResult
+    from ..geometry import ContactSurface
+    from ..state import ContactState, IterationRecord, SolveResult
 
 
 class ContactFormulation(Protocol):

@@ -3,8 +3,8 @@
 Each body is reduced to its contact end: a displacement along the line of contact, the reaction
 the body develops there, and a stiffness. The iteration is the same as in two dimensions
 (predict, check compatibility and equilibrium, correct with eqs. 4.2.4 and 4.2.7 from
-:mod:`vfem.contact.corrections`, re-solve), which makes this module the clearest statement of the
-method and a check of the shared formulas against the thesis's worked example (§4.2.1).
+:mod:`vfem.contact.laws.corrections`, re-solve), which makes this module the clearest statement of
+the method and a check of the shared formulas against the thesis's worked example (§4.2.1).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import logging
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from .corrections import compatibility_displacement, equilibrium_force
+from ..laws import compatibility_displacement, equilibrium_force
 
 log = logging.getLogger(__name__)
 

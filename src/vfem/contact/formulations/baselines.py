@@ -15,11 +15,11 @@ as the virtual finite element method (bodies, meshes, supports, loads, platen, l
   alphabetical order; so the choice never depends on the order of the bodies) and its candidate
   nodes are the constraints; the other surface's candidate facets are the *master segments*.
   Each slave node is projected on its closest master segment in the undeformed configuration
-  (:func:`~vfem.contact.search.project_points`, a KD-tree), once: small displacements,
+  (:func:`~vfem.contact.search.closest.project_points`, a KD-tree), once: small displacements,
   frictionless; a node over a vertex takes the facet it lies over, then the one facing it
   (:func:`master_projection`: mirrored nodes, mirrored facets). A node whose projection falls
   beyond the end of the master's candidate surface is not over it and has no row
-  (:func:`~vfem.contact.surface.beyond` of the master's surface ends: its gap would be
+  (:func:`~vfem.contact.geometry.surface.beyond` of the master's surface ends: its gap would be
   measured to the last facet's line extended, which passes through every node of a surface
   collinear with it), and a node that is the slave of several bodies (a block under two
   punches) keeps only its row on the closest (:func:`closest_master`): one node constrained
@@ -52,9 +52,9 @@ no node touches it: then its closest node is put in the active set, as a seed.
 
 The results are the :class:`~vfem.result_types.AnalysisResult` of vfem: nodal contact forces on both
 bodies, the nominal pressure read as vfem reads it (a node's normal contact force over its
-undeformed tributary length on its :class:`~vfem.contact.surface.ContactSurface`; on a master
-node the normal is the master's own node normal), the slave nodes' gaps as ``penetration`` (0 on
-master nodes, where none is measured). See ``docs/baselines.md``.
+undeformed tributary length on its :class:`~vfem.contact.geometry.surface.ContactSurface`; on a
+master node the normal is the master's own node normal), the slave nodes' gaps as ``penetration`` (0
+on master nodes, where none is measured). See ``docs/baselines.md``.
 """
 
 from __future__ import annotations
@@ -66,13 +66,13 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..bodies import COMPONENTS, curve_key, superpose
-from ..errors import ActiveSetNotSettled, AnalysisError, SingularSystem
-from ..linalg import factorize
-from ..memory import memory_guard
-from .capabilities import Capabilities
-from .state import BaselineState, IterationRecord, SolveResult
-from .surface import ContactSurface, beyond
+from ...bodies import COMPONENTS, curve_key, superpose
+from ...errors import ActiveSetNotSettled, AnalysisError, SingularSystem
+from ...linalg import factorize
+from ...memory import memory_guard
+from ..capabilities import Capabilities
+from ..geometry import ContactSurface, beyond
+from ..state import BaselineState, IterationRecord, SolveResult
 
 log = logging.getLogger(__name__)
 
@@ -290,8 +290,8 @@ class _Refined:
 class GlobalContact:
     """A classical baseline (``model.contact.method``: penalty, lagrange or augmented) on the
     global system of the model's bodies; see the module docstring. A contact formulation
-    (:class:`~vfem.contact.formulation.ContactFormulation`) whose step is one global solve
-    with its active set, run on the solver's own steps."""
+    (:class:`~vfem.contact.formulations.formulation.ContactFormulation`) whose step is one global
+    solve with its active set, run on the solver's own steps."""
 
     capabilities = Capabilities(
         name="classical", orders=(1,), kinematics=("small",), dimensions=(2,),
@@ -676,7 +676,7 @@ class GlobalContact:
         candidate nodes (nc, 2). ``friction`` (frictional lagrange): per row the tangential
         force ``shear``, the step's slip ``increment``, the ``accumulated`` slip and the
         ``status`` (0 free, 1 stick, 2 slip), which add the friction's fields."""
-        from ..bodies.results import BodyStepResult, add_reactions
+        from ...bodies.results import BodyStepResult, add_reactions
 
         U = self.T @ q + self.at(load_factor, self.U_prescribed)
         f_slave = self.c.B_slave.T @ Lam

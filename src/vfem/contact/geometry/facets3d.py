@@ -1,6 +1,6 @@
 """Closest points on the facets of a 3D contact surface (issue 21, commit C5 of the 3D plan).
 
-The 3D counterpart of :func:`vfem.contact.search.project_points`: for each query point, the
+The 3D counterpart of :func:`vfem.contact.search.closest.project_points`: for each query point, the
 nearest of a set of surface facets, the local coordinates and position of the closest point on
 it, the distance, the facet's unit outward normal there and the unclamped local coordinates that
 tell whether the point lies beyond the facet. Nothing in the 2D code calls it yet (C6 builds the
@@ -84,7 +84,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 #: up to this many point-facet pairs the candidates come from all centre distances at once,
-#: above it from a KD-tree on the facets' centres (as :data:`vfem.contact.search.DIRECT_PAIRS`)
+#: above it from a KD-tree on the facets' centres (as
+#: :data:`vfem.contact.search.closest.DIRECT_PAIRS`)
 DIRECT_PAIRS = 8192
 
 #: two distances within this fraction of the largest facet are a tie
@@ -107,8 +108,8 @@ FEW_PAIRS = 4096  # up to this many pairs the Newton stages on curved facets run
 @dataclass(frozen=True)
 class FacetShape:
     """The reference shape of a 3D surface facet: its nodes, reference domain and edges (the
-    geometry that :class:`vfem.contact.facets.Triangle` and ``Quad``, the facet kinds the
-    contact code sees, wrap; named apart from :class:`~vfem.contact.facets.FacetKind`).
+    geometry that :class:`vfem.contact.geometry.facets.Triangle` and ``Quad``, the facet kinds the
+    contact code sees, wrap; named apart from :class:`~vfem.contact.geometry.facets.FacetKind`).
 
     Attributes:
         name: "T3", "Q4", "T6" or "Q9".

@@ -24,7 +24,7 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
     ``N[i, k] = int phi_i(y) psi_k(y) dy`` (the compatibility side, eq. 4.4.11) and
     ``T[c, k] = int phi_c(proj(y)) psi_k(y) dy`` (the equilibrium side: the same traction
     re-integrated with its shape functions), ``psi_k`` the traction's interpolation
-    (:meth:`~vfem.contact.facets.FacetKind.traction_shape`: the shape functions, piecewise
+    (:meth:`~vfem.contact.geometry.facets.FacetKind.traction_shape`: the shape functions, piecewise
     linear on 3-node segments), both over the part of the patch ``fpatch`` of
     ``sf`` that lies over the patch ``cpatch`` of ``sc`` (points beyond its ends count
     nothing). Since the shape functions of each side sum to one, the two sides' forces are
@@ -33,15 +33,16 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
 
     ``ends`` is the coarse patch's boundary (:meth:`ContactSurface.patch_boundary`). The
     quadrature is the fine side's kind's
-    (:meth:`~vfem.contact.facets.FacetKind.overlap_quadrature`); for segments: over the fine
-    facets, split where the projection onto the coarse patch passes one of its vertices (seen
+    (:meth:`~vfem.contact.geometry.facets.FacetKind.overlap_quadrature`); for segments: over the
+    fine facets, split where the projection onto the coarse patch passes one of its vertices (seen
     along its nodal normal), with a Gauss rule exact to degree 5 on each piece: exact for the
     piecewise polynomial integrand (degree 4 at most, with quadratic elements) on straight
     facets, so a uniform traction crosses exactly. On curved (quadratic) facets the points and
     weights follow the curve; the splits are found on the chords. Positions ``xf``, ``xc`` may
     be deformed; the measure stays the fine side's undeformed length (the traction is
     nominal). For triangles and quadrilaterals (3D, linear facets): the clipped overlaps of
-    :mod:`~vfem.contact.overlap3d`, exact on a flat interface (``Triangle.overlap_quadrature``).
+    :mod:`~vfem.contact.geometry.overlap3d`, exact on a flat interface
+    (``Triangle.overlap_quadrature``).
     """
     # points farther than this from the coarse surface face something else (``gap``: the
     # largest gap of the pair's nodes)

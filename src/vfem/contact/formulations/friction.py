@@ -49,8 +49,9 @@ more traction field per contact pair:
   :meth:`FrictionalPairedContact._correct_frictional`); the friction's errors add the slip
   across σ. A roller plane through the contact holds one tangent of its nodes only.
 
-Small kinematics here (large: :mod:`vfem.contact.large_friction`, 2D): the pairs, normals and
-tangents are those of the undeformed configuration, as for the frictionless paired variant.
+Small kinematics here (large: :mod:`vfem.contact.formulations.large_friction`, 2D): the pairs,
+normals and tangents are those of the undeformed configuration, as for the frictionless paired
+variant.
 """
 
 from __future__ import annotations
@@ -60,12 +61,11 @@ import logging
 
 import numpy as np
 
-from .corrections import relaxation
-from .group import bordered_matrix
-from .iteration import Check, iterate
+from ..geometry import symmetry_planes  # noqa: F401 - its home was here
+from ..laws import relaxation
+from ..solvers import Check, bordered_matrix, iterate
+from ..state import ContactState, FrictionState, IterationRecord, SolveResult
 from .paired import PairedContact
-from .state import ContactState, FrictionState, IterationRecord, SolveResult
-from .surface import symmetry_planes  # noqa: F401 - its home was here
 
 log = logging.getLogger(__name__)
 

@@ -5,7 +5,7 @@ Everything that knows the shape of a facet — its shape functions and their der
 outward normal, the closest point on a set of such facets, where a patch of them ends and when a
 point lies beyond it, where a facet is read against the other surface, and the quadrature of the
 overlap of two surfaces for the exact transfer — lives behind one object, a :class:`FacetKind`,
-held by each :class:`~vfem.contact.surface.ContactSurface` as ``kind``. The contact core
+held by each :class:`~vfem.contact.geometry.surface.ContactSurface` as ``kind``. The contact core
 (pairing, paired, large, large friction, transfer) reaches facets through it (or through the
 surface's methods that delegate to it), so it never branches on the dimension.
 
@@ -14,10 +14,10 @@ surface's methods that delegate to it), so it never branches on the dimension.
   facet's first node and 1 at its second.
 
 * :class:`Triangle` and :class:`Quad` (``order`` 1 or 2): the 3-/6-node and 4-/9-node facets
-  of a 3D surface (T3, T6, Q4, Q9 of :mod:`vfem.contact.facets3d`, whose kernels they call),
-  ``xi`` two numbers per point in scikit-fem's reference domains. Their patch boundary is an
-  edge table. Their overlap quadrature is :mod:`vfem.contact.overlap3d`'s (linear facets only);
-  the friction anchor's material points are not theirs yet (C13 of the 3D plan).
+  of a 3D surface (T3, T6, Q4, Q9 of :mod:`vfem.contact.geometry.facets3d`, whose kernels they
+  call), ``xi`` two numbers per point in scikit-fem's reference domains. Their patch boundary is an
+  edge table. Their overlap quadrature is :mod:`vfem.contact.geometry.overlap3d`'s (linear facets
+  only); the friction anchor's material points are not theirs yet (C13 of the 3D plan).
 
 Callers treat ``xi`` and the patch boundary as opaque.
 """
@@ -28,14 +28,15 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
+from ..search import normal_of_tangent, outward_normals, project_points
 from . import facets3d
-from .search import normal_of_tangent, outward_normals, project_points
 
-#: Where a facet is read against the other surface (:func:`~vfem.contact.pairing.read_facets`),
-#: in a segment's local coordinate: its midpoint and near its ends. A facet partly under the
-#: other body, its midpoint just past the other's corner, faces that corner's side at its
-#: midpoint only (read there alone, such a facet was dropped and the contact missed altogether:
-#: a punch overhanging a block's edge, tests/test_fuzz_placement.py).
+#: Where a facet is read against the other surface
+#: (:func:`~vfem.contact.geometry.pairing.read_facets`), in a segment's local coordinate: its
+#: midpoint and near its ends. A facet partly under the other body, its midpoint just past the
+#: other's corner, faces that corner's side at its midpoint only (read there alone, such a facet was
+#: dropped and the contact missed altogether: a punch overhanging a block's edge,
+#: tests/test_fuzz_placement.py).
 FACET_READINGS = (0.5, 0.05, 0.95)
 
 
@@ -62,7 +63,8 @@ class FacetKind:
     #: T6: a uniform pressure puts no force on a corner, and a varying one a force of either
     #: sign), each corner with the midpoints of its two edges, as columns of ``facets``: its
     #: nodal force cannot tell whether it is in contact, nor its tributary read its pressure
-    #: (:func:`vfem.contact.group.quadratic_status`, ``consistent_pressure``); empty elsewhere
+    #: (:func:`vfem.contact.formulations.group.quadratic_status`, ``consistent_pressure``); empty
+    #: elsewhere
     weightless_corners: tuple[tuple[int, int, int], ...] = ()
 
     def shape(self, xi: np.ndarray) -> np.ndarray:
@@ -240,7 +242,7 @@ class Segment(FacetKind):
         """The chords give the facet, a first t and ``t_free``, the unclamped coordinate along
         the chord (outside [0, 1]: the point lies beyond that end of the facet); on curved
         facets a few Newton steps then find the closest point on the curve. Ties between facets
-        are broken by ``point_normals`` (:func:`~vfem.contact.search.project_points`)."""
+        are broken by ``point_normals`` (:func:`~vfem.contact.search.closest.project_points`)."""
         a, b = x[facets[ids, 0]], x[facets[ids, 1]]
         local, t, dist, t_free = project_points(points, a, b, point_normals, free=True)
         seg = ids[local] if len(ids) else local
@@ -335,11 +337,11 @@ class Segment(FacetKind):
 
 
 class _Facet3D(FacetKind):
-    """Facets of a 3D surface: the kernels of :mod:`vfem.contact.facets3d` (``geometry``, its
-    :class:`~vfem.contact.facets3d.FacetShape`) behind the :class:`FacetKind` interface. A facet
-    is oriented when its corners run counter-clockwise seen from outside: ``x_ξ × x_η`` is then
-    the outward normal. ``xi`` is (n, 2). The patch boundary is an (nf, edges) table: True
-    where an edge (in ``geometry.edges``' order) of a patch facet is an edge of no other facet
+    """Facets of a 3D surface: the kernels of :mod:`vfem.contact.geometry.facets3d` (``geometry``,
+    its :class:`~vfem.contact.geometry.facets3d.FacetShape`) behind the :class:`FacetKind`
+    interface. A facet is oriented when its corners run counter-clockwise seen from outside: ``x_ξ ×
+    x_η`` is then the outward normal. ``xi`` is (n, 2). The patch boundary is an (nf, edges) table:
+    True where an edge (in ``geometry.edges``' order) of a patch facet is an edge of no other facet
     of the patch (facets off the patch: all False)."""
 
     dim = 3
@@ -434,8 +436,8 @@ class _Facet3D(FacetKind):
         return (np.linalg.norm(jn, axis=1).reshape(nf, nq) * W[None, :]).sum(axis=1)
 
     def closest(self, points, x, facets, ids, point_normals=None):
-        """:func:`~vfem.contact.facets3d.closest_on_facets` on the facets ``ids``: its facet
-        (a row of ``facets``), ``xi``, distance, unit outward normal and ``xi_free``."""
+        """:func:`~vfem.contact.geometry.facets3d.closest_on_facets` on the facets ``ids``: its
+        facet (a row of ``facets``), ``xi``, distance, unit outward normal and ``xi_free``."""
         ids = np.asarray(ids, dtype=np.int64)
         proj = facets3d.closest_on_facets(points, x, np.asarray(facets)[ids], point_normals)
         seg = ids[proj.facet] if len(ids) else proj.facet
@@ -469,7 +471,7 @@ class _Facet3D(FacetKind):
 
     def beyond(self, facets, seg, xi_free, boundary):
         """Past (by more than 1e-9 in local coordinates) an edge of facet ``seg`` that is on the
-        patch boundary (:func:`~vfem.contact.facets3d.outside`)."""
+        patch boundary (:func:`~vfem.contact.geometry.facets3d.outside`)."""
         past = facets3d.outside(self.geometry, np.reshape(xi_free, (-1, 2)))
         return (past & boundary[seg]).any(axis=1)
 
@@ -504,17 +506,16 @@ class _Facet3D(FacetKind):
         return pieces, parent, np.tile(c[:, 0], (m, 1)), np.tile(axes, (m, 1, 1))
 
     def overlap_quadrature(self, sf, fpatch, sc, cpatch, cnormals, reach, xf, xc):
-        """:func:`~vfem.contact.overlap3d.overlap_quadrature` on the facets of ``fpatch``
+        """:func:`~vfem.contact.geometry.overlap3d.overlap_quadrature` on the facets of ``fpatch``
         against those of ``cpatch`` whose bounding spheres come within ``reach``
-        (:func:`~vfem.contact.overlap3d.candidate_pairs`): each coarse facet projected along
-        the fine facet's normal onto its plane (not along ``cnormals``: exact on a flat
+        (:func:`~vfem.contact.geometry.overlap3d.candidate_pairs`): each coarse facet projected
+        along the fine facet's normal onto its plane (not along ``cnormals``: exact on a flat
         interface, second order on a curved one, overlap3d's docstring), clipped by the fine
         facet, fanned into triangles with a Gauss rule exact for ``phi_f phi_f`` and ``phi_f
         psi_c`` on flat parallelograms and triangles. The weights are the fine side's measure
         at ``xf``, rescaled to its undeformed measure (the traction is nominal) where ``xf``
         is not the undeformed ``sf.X``. Linear facets (T3, Q4) only."""
         from . import overlap3d
-
         for kind in (self, sc.kind):
             if kind.order != 1 and not kind.geometry.simplex:
                 raise NotImplementedError(

@@ -2,18 +2,18 @@
 
 The dense route condenses each body to its contact candidates (PARDISO's Schur complement,
 inverted: ``ContactSurface.G``, (dim nc)^2 numbers) and forms the pair matrix W over every pair
-node from it (:meth:`~vfem.contact.paired.PairedContact._full_flexibility`). Both grow as the
-square of the contact zone: a 3D flat-on-flat interface of 100 x 100 facets has some 30,000
+node from it (:meth:`~vfem.contact.formulations.paired.PairedContact._full_flexibility`). Both grow
+as the square of the contact zone: a 3D flat-on-flat interface of 100 x 100 facets has some 30,000
 contact dofs, 7 GB for one body's block and minutes of dense factorization.
 
 Here neither is formed. A body's flexibility on its candidates is applied to a set of nodal
 forces by one back-substitution through its own (plain) factorization
-(:class:`~vfem.contact.flexibility.SurfaceFlexibility`), and W to a vector of traction values
-by one such back-substitution per body (:class:`PairOperator`): the forces the traction values
-make (the same sparse ``N`` and ``T`` rows the dense route uses, eq. 4.4.11), each body's motion
-under them, read at the pair nodes and their virtual nodes along the directions (eq. 4.2.4 in
+(:class:`~vfem.contact.geometry.flexibility.SurfaceFlexibility`), and W to a vector of traction
+values by one such back-substitution per body (:class:`PairOperator`): the forces the traction
+values make (the same sparse ``N`` and ``T`` rows the dense route uses, eq. 4.4.11), each body's
+motion under them, read at the pair nodes and their virtual nodes along the directions (eq. 4.2.4 in
 matrix form). The linear complementarity problem of the correction
-(:func:`~vfem.contact.complementarity.linear_complementarity`) is then solved with the same
+(:func:`~vfem.contact.solvers.complementarity.linear_complementarity`) is then solved with the same
 block principal pivoting, each set's system by GMRES on this operator (W is not symmetric: the
 paired variant reads penetrations at the virtual nodes but applies forces through N and T, so
 conjugate gradients do not apply), preconditioned by an estimate of W's diagonal from each
@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator, gmres
 
-from ..executor import SERIAL
+from ...executor import SERIAL
 from .bordered import bordered_solve
 
 log = logging.getLogger(__name__)
@@ -50,10 +50,10 @@ class PairOperator:
     unit traction value) as the dense route has them.
 
     ``dF``: per body, the sparse nodal forces on its candidate dofs per unit traction value
-    ((dim nc, m), :meth:`~vfem.contact.paired.PairedContact._force_rows`); ``flex``: per body its
-    :class:`~vfem.contact.flexibility.SurfaceFlexibility`; ``pairs``, ``directions``,
-    ``offsets``: how the unknowns are laid out (pair by pair, direction by direction, node by
-    node).
+    ((dim nc, m), :meth:`~vfem.contact.formulations.paired.PairedContact._force_rows`); ``flex``:
+    per body its :class:`~vfem.contact.geometry.flexibility.SurfaceFlexibility`; ``pairs``,
+    ``directions``, ``offsets``: how the unknowns are laid out (pair by pair, direction by
+    direction, node by node).
     """
 
     def __init__(self, surfaces, flex, dF, pairs, directions, offsets, executor=SERIAL):
@@ -148,8 +148,8 @@ class PairOperator:
               ) -> tuple[np.ndarray, float]:
         """The traction values on unknowns ``index`` (zero elsewhere) with W's block there
         times them equal to ``rhs``; with ``border`` = (column, row, corner, extra) the bordered
-        system of :func:`~vfem.contact.group.bordered_solve` (the platen's motion the last
-        unknown). GMRES to :data:`RTOL`, preconditioned by the diagonal."""
+        system of :func:`~vfem.contact.formulations.group.bordered_solve` (the platen's motion the
+        last unknown). GMRES to :data:`RTOL`, preconditioned by the diagonal."""
         index = np.asarray(index, dtype=int)
         na = len(index)
         bordered = border is not None

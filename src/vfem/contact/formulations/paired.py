@@ -27,8 +27,8 @@ the coarser side's, mapped through the virtual nodes and the traction transfer).
 uses only its own factorization; the corrections are still forces applied at the global level.
 For a fixed set of contact nodes one correction closes every gap exactly, so what is left to find
 is which nodes touch: each correction finds that set by complementarity on W over every pair node
-(:mod:`vfem.contact.complementarity`, small dense solves) before the bodies see it, and a linear
-step ends after one correction (docs/method.md §5).
+(:mod:`vfem.contact.solvers.complementarity`, small dense solves) before the bodies see it, and a
+linear step ends after one correction (docs/method.md §5).
 
 Small-strain analyses pair the surfaces in the undeformed configuration (linear kinematics: the
 virtual nodes, normals and transfer are fixed, the gap is linear in the displacements).
@@ -41,32 +41,32 @@ import logging
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import PlatenUnheld, PlatenUnpaired, RindViolation
-from .bordered import ReusedFactor, bordered_matrix, bordered_solve
-from .capabilities import Capabilities
-from .complementarity import linear_complementarity
-from .corrections import relaxation, release_tension
-from .group import SurfaceGroup
-from .iteration import Check, iterate
-from .pairing import (  # noqa: F401 - the pairing's parts, here too for those who import them here
+from ...errors import PlatenUnheld, PlatenUnpaired, RindViolation
+from ..capabilities import Capabilities
+from ..geometry import (
     EDGE_RATIO,
-    FACET_READINGS,
-    FACING,
     ContactPair,
+    ContactSurface,
     Overlap,
     approach_gaps,
-    beyond,
     common_normal,
     facing,
     held_edges,
     held_force_directions,
     held_nodes,
     overlap,
-    patch_ends,
     read_facets,
-    virtual_nodes,
 )
-from .state import (
+from ..laws import relaxation, release_tension
+from ..solvers import (
+    Check,
+    ReusedFactor,
+    bordered_matrix,
+    bordered_solve,
+    iterate,
+    linear_complementarity,
+)
+from ..state import (
     ContactState,
     IterationRecord,
     Pairing,
@@ -74,7 +74,7 @@ from .state import (
     TractionState,
     closing_motion,
 )
-from .surface import ContactSurface
+from .group import SurfaceGroup
 
 log = logging.getLogger(__name__)
 
@@ -103,7 +103,7 @@ class PairSet(SurfaceGroup):
     values that are its unknowns, the forces they make, its errors and its output fields.
 
     :class:`PairedContact` (small displacements) and
-    :class:`~vfem.contact.large.LargeDeformationContact` are built on it."""
+    :class:`~vfem.contact.formulations.large.LargeDeformationContact` are built on it."""
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
                  backend: str | None = None, sides: dict | None = None, executor=None):
@@ -160,7 +160,7 @@ class PairSet(SurfaceGroup):
     _forced = None
 
     #: whether the equilibrium side's nodes are held too, where they would penetrate the
-    #: compatibility side (issue 37, :func:`~vfem.contact.pairing.held_nodes`): the
+    #: compatibility side (issue 37, :func:`~vfem.contact.geometry.pairing.held_nodes`): the
     #: small-displacement frictionless variant
     both_surfaces = False
 
@@ -170,8 +170,8 @@ class PairSet(SurfaceGroup):
         """The pair of bodies i < j (both with candidate facets), from their compliance
         densities against each other (:meth:`_compliance_density`), or None where they do not
         face each other; and with :attr:`both_surfaces` the nodes held by point forces (pairs
-        with ``point`` set, :func:`~vfem.contact.pairing.held_nodes`): the equilibrium side's,
-        and the compatibility side's beyond the other patch's ends.
+        with ``point`` set, :func:`~vfem.contact.geometry.pairing.held_nodes`): the equilibrium
+        side's, and the compatibility side's beyond the other patch's ends.
 
         Where the side the rules choose leaves no node paired at all (neither its own nodes
         over the other surface nor the other's held against it: a tilted box's corner over a
@@ -326,7 +326,7 @@ class PairSet(SurfaceGroup):
         """(m, dim) how the pair's nodes move relative to their virtual nodes under the
         loads alone (small kinematics, at load factor 1): the loads' and prescribed
         displacements' motion, or where that is none, the platen's, in the sense that closes
-        the gap (:func:`~vfem.contact.pairing.approach_gaps`)."""
+        the gap (:func:`~vfem.contact.geometry.pairing.approach_gaps`)."""
         nc = self.surfaces[coarse].nc
         return self._relative_motion(fine, coarse, lambda f: f[geo.nodes],
                                      lambda f: geo.interp @ f[:nc], geo.normal)
@@ -500,7 +500,8 @@ class PairSet(SurfaceGroup):
     def contact_sets(self, traction_values: list[np.ndarray]
                      ) -> list[tuple[str, np.ndarray, np.ndarray]]:
         """Per pair, the compatibility side's (body name, node numbers, carrying-force mask):
-        what :class:`~vfem.contact.algorithm.CycleWatch` compares between iterations."""
+        what :class:`~vfem.contact.formulations.algorithm.CycleWatch` compares between
+        iterations."""
         out = []
         for pair, q in zip(self.contact_pairs, traction_values):
             sf = self.surfaces[pair.fine]
@@ -634,7 +635,7 @@ class PairedContact(PairSet):
     def relative_displacements(self, state: ContactState) -> list[np.ndarray]:
         """Per pair, (nodes, dim) each fine node's displacement less its virtual node's
         (linear kinematics): along the normal it makes the penetration, along the tangent the
-        friction's slip (:mod:`vfem.contact.friction`)."""
+        friction's slip (:mod:`vfem.contact.formulations.friction`)."""
         x = self.positions(state)
         out = []
         for pair in self.contact_pairs:
@@ -674,7 +675,7 @@ class PairedContact(PairSet):
 
     def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
         """Correct the traction values until every pair's compatibility holds
-        (:func:`~vfem.contact.iteration.iterate`); the forces follow from them, equal and
+        (:func:`~vfem.contact.solvers.iteration.iterate`); the forces follow from them, equal and
         opposite by construction (see the module docstring)."""
         cfg = self.settings
         tol = self.penetration_tolerance
@@ -743,7 +744,7 @@ class PairedContact(PairSet):
     def _correct_complementarity(self, state: ContactState, pens: list[np.ndarray]) -> None:
         """The traction values of every pair's nodes that close every gap at once: the linear
         complementarity problem on the pair matrix W over all pair nodes
-        (:func:`~vfem.contact.complementarity.linear_complementarity`; issue 20, item 6).
+        (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`; issue 20, item 6).
 
         Under small kinematics W is exact (the pairs' geometry is fixed and each body linear),
         so the penetrations after this one correction are those the dense solves predicted: a
@@ -1033,13 +1034,13 @@ class PairedContact(PairSet):
         The body forces per unit traction value are sparse (a node's traction reaches the few
         nodes of its facets and of the opposing facets under it), so each body's motion is its
         flexibility C times a sparse matrix, computed once. Where the surfaces' flexibility is
-        applied, not formed (issue 22), W is the :class:`~vfem.contact.matrix_free.PairOperator`
-        that applies it.
+        applied, not formed (issue 22), W is the
+        :class:`~vfem.contact.solvers.matrix_free.PairOperator` that applies it.
         """
         directions, offsets, dF = self._force_rows()
         m = int(offsets[-1])
         if any(s.matrix_free for s in self.surfaces):
-            from .matrix_free import PairOperator
+            from ..solvers import PairOperator
 
             W = PairOperator(self.surfaces, [s.flexibility for s in self.surfaces], dF,
                              self.contact_pairs, directions, offsets, self.executor)
@@ -1111,7 +1112,7 @@ class PairedContact(PairSet):
 
     def _tangent_platen_rate(self, k: int, tangent: np.ndarray) -> np.ndarray:
         """The change of pair k's relative tangential displacement t.(u_f - u_c) per unit
-        platen motion (with friction: :mod:`vfem.contact.friction`)."""
+        platen motion (with friction: :mod:`vfem.contact.formulations.friction`)."""
         pair, v = self.contact_pairs[k], self.platen_motion
         return np.einsum("id,id->i", tangent, pair.fine_read(v[pair.fine])
                          - pair.interp @ v[pair.coarse])

@@ -1,9 +1,9 @@
 """Overlap quadrature for the exact transfer in 3D (issue 21, item 3; plan C8).
 
-The 3D counterpart of the point generation in :func:`vfem.contact.transfer.transfer_matrices`:
-quadrature points on the part of each facet of the *compatibility* side that lies over the
-*opposing* (equilibrium) side, with the opposing facet and local coordinates of each point, so
-that one point set integrates both
+The 3D counterpart of the point generation in
+:func:`vfem.contact.geometry.transfer.transfer_matrices`: quadrature points on the part of each
+facet of the *compatibility* side that lies over the *opposing* (equilibrium) side, with the
+opposing facet and local coordinates of each point, so that one point set integrates both
 
 * ``N[i, k] = int phi_i(y) phi_k(y) dy`` (the compatibility side with itself, eq. 4.4.11) and
 * ``T[c, k] = int psi_c(pi(y)) phi_k(y) dy`` (the opposing side's shape functions at the
@@ -16,8 +16,8 @@ round-off for any geometry (the two sides' forces ``N q`` and ``-T q`` balance),
 rule is exact a uniform traction crosses non-matching meshes exactly.
 
 :func:`transfer_matrices` reaches it through the ``Triangle``/``Quad`` facet kinds'
-``overlap_quadrature`` (:mod:`vfem.contact.facets`, plan C8), which keeps the points and the
-compatibility side's local coordinates and weights.
+``overlap_quadrature`` (:mod:`vfem.contact.geometry.facets`, plan C8), which keeps the points and
+the compatibility side's local coordinates and weights.
 
 **Facets.** Linear triangles ``(nf, 3)`` and bilinear quadrilaterals ``(nf, 4)``, one kind per
 surface, corners numbered around the facet (either way: a compatibility facet's frame follows
@@ -309,9 +309,9 @@ def overlap_matrices(quad: OverlapQuadrature, comp_facets: np.ndarray, opp_facet
                      n_comp: int, n_opp: int) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """``N`` (n_comp, n_comp) and ``T`` (n_opp, n_comp), CSR, from the points of
     :func:`overlap_quadrature`: ``N[i, k] = sum w phi_i phi_k`` and ``T[c, k] = sum w psi_c
-    phi_k`` — 2D's layout (:func:`vfem.contact.transfer.transfer_matrices`): the compatibility
-    side's forces ``N q``, the opposing side's ``-T q`` for the nodal traction values ``q`` of
-    the compatibility side; ``T``'s columns sum like ``N``'s."""
+    phi_k`` — 2D's layout (:func:`vfem.contact.geometry.transfer.transfer_matrices`): the
+    compatibility side's forces ``N q``, the opposing side's ``-T q`` for the nodal traction values
+    ``q`` of the compatibility side; ``T``'s columns sum like ``N``'s."""
     comp_facets = np.asarray(comp_facets)
     opp_facets = np.asarray(opp_facets)
     kc, ko = comp_facets.shape[1], opp_facets.shape[1]
