@@ -189,7 +189,7 @@ def test_cli_runs_hertz_with_a_baseline(tmp_path, capsys):
 def test_a_body_only_contact_could_hold_but_none_can_touch_is_refused():
     """A puck pulled away from a block by its platen: no candidates, so nothing holds it
     (singular). Pushed towards the block from the same gap, it finds it (the candidates are
-    looked for where the platen brings it, vfem.contact.geometry.surface.platen_approach)."""
+    looked for where the platen brings it, vfem.contact.geometry.placement.platen_approach)."""
     from test_no_contact import puck
 
     away = puck(+1e6)

@@ -6,7 +6,7 @@ stiff square turned 10 degrees, pushed corner first 0.02 into a block 2000 times
 "converged" with its corner 6.5e-3 below the block's deformed surface (a third of the push),
 every invariant passing; pushed 0.002 (here) it stopped at its first step, invariant (b). Its
 nodes are now held by point forces where they would penetrate
-(``vfem.contact.geometry.pairing.held_nodes``).
+(``vfem.contact.geometry.held.held_nodes``).
 
 Each check here is read from the full-mesh results alone: the depth of every node of the
 square below the block's deformed top (the polyline through its nodes at X + u), each body's

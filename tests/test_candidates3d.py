@@ -11,16 +11,14 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
-from vfem.contact.geometry.surface import (
-    ContactSurface,
+from vfem.contact.geometry.bodymesh import exterior_facets, locate_in_simplices, simplices
+from vfem.contact.geometry.placement import (
     check_initial_overlap,
-    exterior_facets,
-    locate_in_simplices,
     platen_approach,
     predicted_translation,
     select_candidate_facets,
-    simplices,
 )
+from vfem.contact.geometry.surface import ContactSurface
 from vfem.errors import InputError
 from vfem.materials import LinearElastic
 from vfem.mesh.solids import box

@@ -8,7 +8,7 @@ node lay 3.5e-7 inside where invariant (b) allowed less, and the step was cut si
 the analysis stopped (random model 2d-132 of ``benchmarks/random_models.py``). The solver now
 has the formulation hold that node and solves the step again
 (``vfem.solver.Analysis._enforce``, ``vfem.contact.formulations.paired.PairedContact.enforce``).
-Since a stiffer surface's own features are held whatever their guard (``pairing.held_nodes``), the
+Since a stiffer surface's own features are held whatever their guard (``held.held_nodes``), the
 fillet's vertices are held from the start; the mechanism is tested with the guard as before.
 
 The depth is read from the full-mesh results alone: every boundary node of the punch at
@@ -54,14 +54,14 @@ def guard_as_before(monkeypatch):
     """Held nodes paired at their closest points and excused by their guard whatever their own
     surface does, as when this mechanism came (a stiff surface's own features, the punch's
     fillet vertices, are held now whatever their guard, and paired where the loads' approach
-    meets the other surface: ``pairing.held_nodes``)."""
-    import vfem.contact.formulations.paired as paired
-    made_by = paired.held_nodes
+    meets the other surface: ``held.held_nodes``)."""
+    import vfem.contact.formulations.pairset as pairset
+    made_by = pairset.held_nodes
 
     def as_before(*args, **kwargs):
         return made_by(*args, **{**kwargs, "features": False, "approach": None})
 
-    monkeypatch.setattr(paired, "held_nodes", as_before)
+    monkeypatch.setattr(pairset, "held_nodes", as_before)
 
 
 def test_alone_it_holds_the_node_and_solves_the_step(monkeypatch):

@@ -14,10 +14,10 @@ from scipy.spatial import cKDTree
 from skfem import ElementQuad1, ElementQuad2, ElementTriP1, ElementTriP2
 
 from vfem.contact.geometry import facets3d
+from vfem.contact.geometry.closest3d import closest_on_facets
 from vfem.contact.geometry.facets3d import (
     KINDS,
     check_facets,
-    closest_on_facets,
     closest_on_triangles,
     facet_shape,
     outside,

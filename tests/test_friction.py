@@ -16,8 +16,9 @@ import pytest
 from resume_check import assert_resumed_equals_whole
 from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
 from vfem.contact.formulations.formulation import formulation_class
-from vfem.contact.formulations.friction import FrictionalPairedContact, coulomb_status, tangents
+from vfem.contact.formulations.friction import FrictionalPairedContact
 from vfem.contact.formulations.paired import PairedContact
+from vfem.contact.laws import coulomb_status, tangents
 from vfem.contact.settings import ContactSettings
 from vfem.contact.state import FrictionState
 from vfem.errors import InputError

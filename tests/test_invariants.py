@@ -17,7 +17,8 @@ from skfem import MeshQuad, MeshTri
 
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.cli import main
-from vfem.contact.invariants.check import InvariantCheck, _Boundary, _Polygon, step_invariants
+from vfem.contact.invariants.check import InvariantCheck, step_invariants
+from vfem.contact.invariants.polygon import _Boundary, _Polygon
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InvariantViolation
 from vfem.io import checkpoint

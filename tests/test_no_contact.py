@@ -2,7 +2,7 @@
 item 8: "the stop diagnosis names the real cause").
 
 A body pushed by a platen (force control) towards another from a gap wider than the contact
-search distance finds it (:func:`vfem.contact.geometry.surface.platen_approach`): Hertz with a gap
+search distance finds it (:func:`vfem.contact.geometry.placement.platen_approach`): Hertz with a gap
 gives Hertz's answer. Bodies that no load brings together are named with their distance, and an
 analysis that fails for lack of contact says so rather than "allow more iterations".
 """
@@ -15,7 +15,7 @@ import pytest
 
 import vfem
 from vfem.config import check
-from vfem.contact.geometry.surface import platen_approach
+from vfem.contact.geometry.placement import platen_approach
 from vfem.examples.hertz import HertzParameters, build
 from vfem.io.input import loads
 
@@ -120,7 +120,7 @@ def test_a_platen_whose_bodies_meet_edge_or_corner_first_is_held_on_either_side(
     box on the compatibility side none of its nodes' facets carry traction over the block, and
     before the box's corner node was held as a point (``PairSet._make_pair``: a compatibility
     node over the other patch whose facets carry none of its traction) and the edges of both
-    bodies where they cross the other's facets (``pairing.held_edges``), nothing held the
+    bodies where they cross the other's facets (``held.held_edges``), nothing held the
     platen: the analysis stopped with "no node of either body lies over the other's surface"
     (``PlatenUnpaired``). Now either side, forced or by default, converges with every
     invariant, the platen's force carried."""

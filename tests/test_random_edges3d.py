@@ -9,11 +9,11 @@ Measured before (2026-11-30, at 59efe15), the deepest point inside the other bod
 
 - 3d-14: a soft block's rim 0.47 below a stiff sphere-ended punch's cap, read by its closest
   point at rest, under a facet near the cap's lowest point: 0.90 (now the rim is read where
-  the ray along the loads' motion meets the cap, ``pairing.held_edges``);
+  the ray along the loads' motion meets the cap, ``held.held_edges``);
 - 3d-47: a soft block's rim under an overhanging stiff tilted box, its crossing of the box's
   edge 0.13 of a block facet from a rim node beyond the box, left to that node: 0.028;
 - 3d-59: a stiff flat cylinder's rim across a soft block's twisted hexahedron faces, between
-  two held crossings of one face: 0.051 (now held at the midpoint too, ``pairing._twisted``);
+  two held crossings of one face: 0.051 (now held at the midpoint too, ``held._twisted``);
 - 3d-17: a stiff tilted box's corner over a soft block's corner, the box's corner node over
   the block's top but its facets carrying none of the traction there: not held, 0.45 once
   the box's edge was no longer held against the block's side 0.42 below its top (an
@@ -24,7 +24,7 @@ The first three are quick enough for every run; the slow set holds the others of
 Not tuned for (seed 2): 3d-5, a stiff block's edge under a soft flat cylinder's face, crossed
 two of the cylinder's facet edges 0.19 of a facet apart, between two of ``held_edges``'
 samples; one bisection found one of them, and the edge lay 2.08 % of the push inside the
-cylinder at the other (now both, ``pairing._crossings``: 0.30 %).
+cylinder at the other (now both, ``held._crossings``: 0.30 %).
 """
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ import numpy as np
 import pytest
 
 import vfem
-from vfem.contact.geometry.pairing import _crossings
+from vfem.contact.geometry.held import _crossings
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import random_models  # noqa: E402

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, Support, Traction
-from vfem.contact.invariants.check import _symmetry_facets
+from vfem.contact.invariants.polygon import _symmetry_facets
 from vfem.errors import InputError
 from vfem.io.input import dumps, loads
 from vfem.io.replot import Folder, read_contact_csv

@@ -9,7 +9,7 @@ import pytest
 
 from vfem import linalg
 from vfem.bodies import Body, Support
-from vfem.contact.geometry import facets3d
+from vfem.contact.geometry import closest3d, facets3d
 from vfem.contact.geometry.facets import Quad, Segment, Triangle, kind_of
 from vfem.contact.geometry.surface import ContactSurface, element_volumes, simplices
 from vfem.materials import LinearElastic
@@ -118,7 +118,7 @@ def test_closest_points_are_facets3ds(cells, order):
     normals = rng.normal(size=(300, 3))
     normals /= np.linalg.norm(normals, axis=1)[:, None]
     seg, xi, dist, n, xi_free = s.closest(points, point_normals=normals)
-    ref = facets3d.closest_on_facets(points, s.X, s.facets, normals)
+    ref = closest3d.closest_on_facets(points, s.X, s.facets, normals)
     np.testing.assert_array_equal(seg, ref.facet)
     np.testing.assert_array_equal(xi, ref.xi)
     np.testing.assert_array_equal(dist, ref.distance)
@@ -129,7 +129,7 @@ def test_closest_points_are_facets3ds(cells, order):
     # a subset: the top face's facets, numbered as the surface numbers them
     top = np.flatnonzero(np.isin(s.facet_ids, s.body.mesh.boundaries["top"]))
     seg, xi, dist, _, _ = s.closest(points, facets=top)
-    ref = facets3d.closest_on_facets(points, s.X, s.facets[top])
+    ref = closest3d.closest_on_facets(points, s.X, s.facets[top])
     np.testing.assert_array_equal(seg, top[ref.facet])
     np.testing.assert_array_equal(xi, ref.xi)
     np.testing.assert_array_equal(dist, ref.distance)

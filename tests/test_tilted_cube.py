@@ -8,7 +8,7 @@ nodes only (the cube's edge may pass between them) gives a lower bound of the fo
 cube's edge too wherever it crosses a line of the block's nodes an upper one (the elastic cube
 only lowers it, by about its shortening, 0.1 % of the push). vfem's default answer — the block on
 the compatibility side, the cube's vertices held, and its edge held where it crosses the block's
-facets (``pairing.held_edges``) — must read more than the lower one and within 2 % of the upper
+facets (``held.held_edges``) — must read more than the lower one and within 2 % of the upper
 one, not below it by more: the block's nodes just past the cube's edge are held along the direction
 to it where the reference holds them against the cube's side face, which can put it a little above
 (measured: 0.999, 1.010 and 0.999 of it on the 24, 36 and 48 blocks, 1.014 and 1.008 on 12 x 12 x 4

@@ -75,7 +75,7 @@ class Model:
 
         Depends on the meshes only, so it is also part of ``vfem check``: bodies that start
         deeper into each other than the outer layer of elements are refused here
-        (:func:`~vfem.contact.geometry.surface.check_initial_overlap`).
+        (:func:`~vfem.contact.geometry.placement.check_initial_overlap`).
         """
         index = {b.name: i for i, b in enumerate(self.bodies)}
         if self.contact_pairs is None:

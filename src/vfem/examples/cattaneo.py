@@ -30,7 +30,7 @@ import numpy as np
 
 from ..bodies import Platen, PrescribedDisplacement, Support
 from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.formulations import coulomb_status, tangents
+from ..contact.laws import coulomb_status, tangents
 from ..contact.settings import ContactSettings
 from ..errors import InputError
 from ..io.runner import friction_line, run_headline

@@ -441,8 +441,8 @@ def progress_summary(model: Model, steps: list[StepResult], status: str, message
 def step_record(step: StepResult) -> dict:
     """The fields every example's ``summary.json`` gives per step; ``invariants``: the
     independent checks of the converged state
-    (:meth:`vfem.contact.invariants.check.Invariants.record`; empty when the step was not checked);
-    the forces on each body (:func:`force_record`)."""
+    (:meth:`vfem.contact.invariants.measures.Invariants.record`; empty when the step was not
+    checked); the forces on each body (:func:`force_record`)."""
     last = step.history[-1] if step.history else None
     return {"step": step.step, "load_factor": step.load_factor, "iterations": step.iterations,
             "converged": step.converged, "cuts": step.cuts,

@@ -8,7 +8,6 @@ The public face of this stage: code outside it imports these names from here
 
 from .baselines import GlobalContact
 from .formulation import check_capabilities, formulation_class
-from .friction import coulomb_status, tangents
 from .group import SurfaceGroup
 from .large import LargeDeformationContact
 from .onedim import SecantSpring, Step1D, solve_step
@@ -16,7 +15,6 @@ from .paired import PairedContact
 
 __all__ = [
     "check_capabilities",
-    "coulomb_status",
     "formulation_class",
     "GlobalContact",
     "LargeDeformationContact",
@@ -25,5 +23,4 @@ __all__ = [
     "solve_step",
     "Step1D",
     "SurfaceGroup",
-    "tangents",
 ]

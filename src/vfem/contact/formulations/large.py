@@ -76,7 +76,7 @@ from ..capabilities import Capabilities
 from ..geometry import ContactSurface, overlap, virtual_nodes
 from ..solvers import Check, iterate, linear_complementarity
 from ..state import ContactState, IterationRecord, SolveResult, closing_motion
-from .paired import PairSet
+from .pairset import PairSet
 
 log = logging.getLogger(__name__)
 

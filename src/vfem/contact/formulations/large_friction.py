@@ -50,17 +50,10 @@ import numpy as np
 
 from ...errors import AnalysisError
 from ..geometry import virtual_nodes
+from ..laws import CONE_TOLERANCE, columns, magnitudes, tangent_axes, tangents
 from ..state import ContactState, FrictionState
-from .friction import (
-    CONE_TOLERANCE,
-    HELD,
-    FrictionHistory,
-    columns,
-    magnitudes,
-    plane_normals,
-    tangent_axes,
-    tangents,
-)
+from .friction import HELD, plane_normals
+from .friction_history import FrictionHistory
 from .large import LargeDeformationContact
 
 log = logging.getLogger(__name__)

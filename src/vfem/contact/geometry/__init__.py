@@ -1,13 +1,16 @@
-"""The contact surfaces and what is read on them: facet kinds (the dimension lives here), a body's
-surface and its flexibility, the pairing of nodes with virtual nodes on the other surface, and
-the transfer of tractions across it.
+"""The contact surfaces and what is read on them: facet kinds (the dimension lives here), what
+contact reads of a body's mesh and where the bodies lie (the candidates), a body's surface and
+its flexibility, the pairing of nodes with virtual nodes on the other surface, and the transfer
+of tractions across it.
 
 The public face of this stage: code outside it imports these names from here
 (``tests/test_architecture.py``).
 """
 
+from .bodymesh import exterior_facets, symmetry_planes
+from .closest3d import closest_on_facets
 from .facets import FACET_READINGS, kind_of
-from .facets3d import closest_on_facets
+from .held import held_edges, held_force_directions, held_nodes
 from .pairing import (
     EDGE_RATIO,
     FACING,
@@ -16,22 +19,12 @@ from .pairing import (
     approach_gaps,
     common_normal,
     facing,
-    held_edges,
-    held_force_directions,
-    held_nodes,
     overlap,
     read_facets,
     virtual_nodes,
 )
-from .surface import (
-    ContactSurface,
-    beyond,
-    check_initial_overlap,
-    exterior_facets,
-    patch_ends,
-    select_candidate_facets,
-    symmetry_planes,
-)
+from .placement import check_initial_overlap, select_candidate_facets
+from .surface import ContactSurface, beyond, patch_ends
 from .transfer import traction_from_forces
 
 __all__ = [

@@ -29,7 +29,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
 from ..search import normal_of_tangent, outward_normals, project_points
-from . import facets3d
+from . import closest3d, facets3d
 
 #: Where a facet is read against the other surface
 #: (:func:`~vfem.contact.geometry.pairing.read_facets`), in a segment's local coordinate: its
@@ -436,10 +436,10 @@ class _Facet3D(FacetKind):
         return (np.linalg.norm(jn, axis=1).reshape(nf, nq) * W[None, :]).sum(axis=1)
 
     def closest(self, points, x, facets, ids, point_normals=None):
-        """:func:`~vfem.contact.geometry.facets3d.closest_on_facets` on the facets ``ids``: its
+        """:func:`~vfem.contact.geometry.closest3d.closest_on_facets` on the facets ``ids``: its
         facet (a row of ``facets``), ``xi``, distance, unit outward normal and ``xi_free``."""
         ids = np.asarray(ids, dtype=np.int64)
-        proj = facets3d.closest_on_facets(points, x, np.asarray(facets)[ids], point_normals)
+        proj = closest3d.closest_on_facets(points, x, np.asarray(facets)[ids], point_normals)
         seg = ids[proj.facet] if len(ids) else proj.facet
         return seg, proj.xi, proj.distance, proj.normal, proj.xi_free
 

@@ -5,6 +5,7 @@ The public face of this stage: code outside it imports these names from here
 (``tests/test_architecture.py``).
 """
 
-from .check import InvariantCheck, Invariants, step_invariants
+from .check import InvariantCheck, step_invariants
+from .measures import Invariants
 
 __all__ = ["InvariantCheck", "Invariants", "step_invariants"]

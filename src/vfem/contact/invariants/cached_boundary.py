@@ -1,5 +1,5 @@
 """What the invariants' boundary geometries share in 2D
-(:class:`vfem.contact.invariants.check._Polygon`) and 3D
+(:class:`vfem.contact.invariants.polygon._Polygon`) and 3D
 (:class:`vfem.contact.invariants.check3d.Surface3`): a body's boundary at positions ``x``, each
 quantity computed on first use and kept, the surface (the facets off symmetry planes) and the
 bounding box."""

@@ -138,7 +138,7 @@ def _barycentric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> 
 
 class Surface3(CachedBoundary):
     """A 3D body's boundary at positions ``x`` ((nb, 3), local numbering); what is asked is
-    computed on first use (the API of :class:`~vfem.contact.invariants.check._Polygon`)."""
+    computed on first use (the API of :class:`~vfem.contact.invariants.polygon._Polygon`)."""
 
     @property
     def corners(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -51,7 +51,7 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
     solved by least squares.
 
     ``reserve`` (bool over the nodes): nodes held back until the others' set is found — the
-    held nodes (issue 37, :func:`~vfem.contact.geometry.pairing.held_nodes`), even those that
+    held nodes (issue 37, :func:`~vfem.contact.geometry.held.held_nodes`), even those that
     carried force before. Only if one of them then penetrates do they take part in the pivoting, so
     where none would (a flat interface, a convex compatibility side) the answer is the
     compatibility side's set alone, unchanged; a held node that only touches within

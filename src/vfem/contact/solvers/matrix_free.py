@@ -2,7 +2,7 @@
 
 The dense route condenses each body to its contact candidates (PARDISO's Schur complement,
 inverted: ``ContactSurface.G``, (dim nc)^2 numbers) and forms the pair matrix W over every pair
-node from it (:meth:`~vfem.contact.formulations.paired.PairedContact._full_flexibility`). Both grow
+node from it (:func:`~vfem.contact.solvers.pair_flexibility.pair_matrix`). Both grow
 as the square of the contact zone: a 3D flat-on-flat interface of 100 x 100 facets has some 30,000
 contact dofs, 7 GB for one body's block and minutes of dense factorization.
 
@@ -50,7 +50,7 @@ class PairOperator:
     unit traction value) as the dense route has them.
 
     ``dF``: per body, the sparse nodal forces on its candidate dofs per unit traction value
-    ((dim nc, m), :meth:`~vfem.contact.formulations.paired.PairedContact._force_rows`); ``flex``:
+    ((dim nc, m), :func:`~vfem.contact.solvers.pair_flexibility.force_rows`); ``flex``:
     per body its :class:`~vfem.contact.geometry.flexibility.SurfaceFlexibility`; ``pairs``,
     ``directions``, ``offsets``: how the unknowns are laid out (pair by pair, direction by
     direction, node by node).

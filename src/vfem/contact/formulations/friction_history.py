@@ -1,0 +1,192 @@
+"""What the frictional formulations share (:class:`FrictionHistory`, small and large kinematics
+alike): each pair's Coulomb law (thesis §1.10, :mod:`vfem.contact.laws`), the history carried in
+the state (tangential tractions, anchors, accumulated slip, which nodes slide), the friction's
+errors and its output fields.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..laws import (
+    columns,
+    magnitudes,
+    tangent_by_tangent,
+    tangents,
+)
+from ..state import ContactState, FrictionState, SolveResult
+
+
+class FrictionHistory:
+    """What the frictional formulations (small and large kinematics) share: each pair's law,
+    the history in the state (tangential tractions, anchors, accumulated slip, which nodes
+    slide), the friction's errors and its output fields."""
+
+    def _init_friction(self, settings) -> None:
+        """Each pair's law: (mu of a slipping node, mu at which a sticking node starts to slip,
+        1 / slip stiffness: 0 where it sticks rigidly); the last step's slip increments."""
+        self.laws = [settings.pair_friction(self.surfaces[p.fine].body.name,
+                                            self.surfaces[p.coarse].body.name).coefficients
+                     for p in self.contact_pairs]
+        #: per pair, the slip increments of the last converged step (for :meth:`fields`)
+        self._increments = [self._zeros(k) for k in range(len(self.contact_pairs))]
+
+    def tangent(self, k: int) -> np.ndarray:
+        """Pair k's unit tangent at its nodes (2D: the normal turned by +90 degrees)."""
+        return tangents(self.contact_pairs[k].normal)[0]
+
+    def tangent_basis(self, k: int) -> list[np.ndarray]:
+        """Pair k's unit tangents at its nodes, dim - 1 of them (:func:`tangents`)."""
+        return tangents(self.contact_pairs[k].normal)
+
+    def _zeros(self, k: int) -> np.ndarray:
+        """Zeros for pair k's tangential array: (n,) in 2D (one tangent; the storage the 2D
+        checkpoints have), (n, 2) in 3D (:func:`columns` sees both as (n, ntan))."""
+        pair = self.contact_pairs[k]
+        ntan = pair.normal.shape[1] - 1
+        return np.zeros(len(pair.nodes) if ntan == 1 else (len(pair.nodes), ntan))
+
+    def _values(self, state: FrictionState, name: str, k: int, dtype=float) -> np.ndarray:
+        """Pair k's array ``name`` of the state's history, zeros until first set."""
+        table = getattr(state, name)
+        if k not in table:
+            table[k] = np.zeros(len(self.contact_pairs[k].nodes), dtype=dtype)
+        return table[k]
+
+    def shear(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's tangential traction values at its compatibility-side nodes, one per
+        tangent: (n,) in 2D, (n, 2) in 3D."""
+        table = state.shear
+        if k not in table:
+            table[k] = self._zeros(k)
+        return table[k]
+
+    def anchor(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's relative tangential displacements at the last converged step (as
+        :meth:`shear`, one per tangent)."""
+        table = state.anchor
+        if k not in table:
+            table[k] = self._zeros(k)
+        return table[k]
+
+    def tangential_traction(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's tangential traction vectors (n, dim) at its nodes: sum of s_j t_j."""
+        s = self.shear(state, k)
+        if s.ndim == 1:
+            return s[:, None] * self.tangent(k)
+        return sum(s[:, j, None] * t for j, t in enumerate(self.tangent_basis(k)))
+
+    def accumulated_slip(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's slip accumulated over the converged steps (length, per node)."""
+        return self._values(state, "slip", k)
+
+    def sliding(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's nodes that slipped in the last correction."""
+        return self._values(state, "sliding", k, bool)
+
+    def status(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's nodes: 0 free (no normal traction), 1 sticking, 2 slipping."""
+        on = self.tractions(state, k) > 0
+        return np.where(on, np.where(self.sliding(state, k), 2, 1), 0)
+
+    def friction_errors(self, state: FrictionState, slips: list[np.ndarray]
+                        ) -> tuple[float, float, int, int]:
+        """The largest tangential compatibility error (a sticking node's slip within the step,
+        or a slipping node's slip against the direction its traction opposes), the largest
+        excess of a tangential traction over its cone (relative to the largest mu q), and the
+        nodes sticking and slipping."""
+        err, excess, stick, slip = 0.0, 0.0, 0, 0
+        scale = max((self.laws[k][1] * float(self.tractions(state, k).max(initial=0.0))
+                     for k in range(len(self.contact_pairs))), default=0.0)
+        for k, dw in enumerate(slips):
+            q, s = self.tractions(state, k), self.shear(state, k)
+            status = self.status(state, k)
+            held = self._held_components(k)
+            if held is not None and held.any():  # 3D: a sticking node's slip along a held
+                dw = dw.copy()  # tangent is the supports', as the solve has it
+                dw[held & (status == 1)[:, None]] = 0.0
+            stick += int((status == 1).sum())
+            slip += int((status == 2).sum())
+            if (status == 1).any():
+                err = max(err, float(magnitudes(dw[status == 1]).max()))
+            on = status == 2
+            if on.any() and s.ndim == 1:
+                sigma = -np.sign(s[on])
+                err = max(err, float(np.maximum(-sigma * dw[on], 0.0).max()))
+            # 3D: the slip along sigma, and none across it. A node that slips with no traction
+            # (a frictionless pair's) has no direction to measure its slip against: it is free
+            # (in 2D sigma is then 0); dividing by its |s| = 0 made NaN errors (issue 37)
+            on &= magnitudes(s) > 0
+            if on.any() and s.ndim > 1:
+                sigma = -s[on] / magnitudes(s[on])[:, None]
+                along = np.einsum("ij,ij->i", sigma, dw[on])
+                across = magnitudes(dw[on] - along[:, None] * sigma)
+                err = max(err, float(np.maximum(-along, 0.0).max()), float(across.max()))
+            outside = magnitudes(s) - self.laws[k][1] * np.maximum(q, 0.0)
+            if len(outside) and scale > 0:
+                excess = max(excess, float(outside.max()) / scale)
+            elif np.any(s != 0):
+                excess = np.inf  # a tangential traction without a normal one
+        return err, excess, stick, slip
+
+    def _held_components(self, k: int) -> np.ndarray | None:
+        """3D: pair k's (n, ntan) tangential components whose relative motion no traction moves
+        (:data:`HELD`: supports on both bodies along that tangent); None in 2D (a held node
+        there has no tangential unknown at all, and its slip is round-off) or before the first
+        correction has set up the pair matrix. A sticking node's slip along a held tangent is
+        the supports' (a prescribed motion, as the press fit's pushed end faces), not an error
+        the iteration could correct."""
+        if getattr(self, "_ntan", 1) == 1 or getattr(self, "_full", None) is None:
+            return None  # (2D; or the large-kinematics variant, 2D only, without them)
+        n, base = len(self.contact_pairs[k].nodes), self._full[3][k]
+        return self._held[base + n: base + (1 + self._ntan) * n].reshape(self._ntan, n).T
+
+    def _unknowns(self, state: FrictionState) -> np.ndarray:
+        """Every pair's normal then tangential traction values, in the pair matrix's order."""
+        return np.concatenate([np.concatenate([self.tractions(state, k),
+                                               tangent_by_tangent(self.shear(state, k))])
+                               for k in range(len(self.contact_pairs))] or [np.zeros(0)])
+
+    def _sets(self, state: FrictionState) -> list[tuple[str, np.ndarray, np.ndarray]]:
+        """The contact set, the slipping nodes and their directions, for the cycle watch."""
+        out = []
+        for k, pair in enumerate(self.contact_pairs):
+            sf = self.surfaces[pair.fine]
+            status = self.status(state, k)
+            nodes = sf.nodes[pair.nodes]
+            out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2)]
+            out += [(sf.body.name, nodes, c < 0) for c in columns(self.shear(state, k)).T]
+        return out
+
+    def fields(self, state: ContactState, result: SolveResult) -> dict:
+        """The frictionless fields, and the friction's at each pair's compatibility-side nodes
+        (:class:`~vfem.bodies.results.BodyStepResult`: tangential traction, slip increment,
+        accumulated slip, stick or slip)."""
+        out = super().fields(state, result)
+        increments = self._increments
+        for s in self.surfaces:
+            r = out[s.body.name]
+            n = s.body.npoints
+            r.contact_shear, r.slip_increment = np.zeros((n, s.dim)), np.zeros(n)
+            r.accumulated_slip = np.zeros(n)
+            r.friction_force = np.zeros((n, s.dim))
+            r.friction_status = np.full(n, -1)  # not a compatibility-side node of a pair
+        for k, pair in enumerate(self.contact_pairs):
+            sf = self.surfaces[pair.fine]
+            r = out[sf.body.name]
+            points = sf.nodes[pair.nodes]
+            traction = self.tangential_traction(state, k)
+            r.contact_shear[points] = traction
+            # 2D: signed along the tangent; 3D: the length of the slip increment
+            r.slip_increment[points] = (increments[k] if increments[k].ndim == 1 else
+                                        magnitudes(increments[k]))
+            r.accumulated_slip[points] = self.accumulated_slip(state, k)
+            r.friction_status[points] = self.status(state, k)
+            # the nodal forces of the tangential traction alone, on both sides (as
+            # assemble_forces makes them)
+            sc = self.surfaces[pair.coarse]
+            out[sf.body.name].friction_force[sf.nodes[: sf.nc]] += \
+                pair.mass[:, pair.nodes] @ traction
+            out[sc.body.name].friction_force[sc.nodes[: sc.nc]] -= \
+                pair.transfer[:, pair.nodes] @ traction
+        return out
