@@ -10,7 +10,7 @@ import itertools
 import numpy as np
 import pytest
 
-from vfem.contact.formulations.large import linear_complementarity
+from vfem.contact.solvers import linear_complementarity
 from vfem.examples import gasket
 from vfem.solver import Analysis
 

@@ -468,15 +468,18 @@ class Analysis:
         step, so = max(found, key=lambda f: f[1]["beyond"])
         quadratic = any(b.order > 1 for b in self.model.bodies
                         if b.name in (so["body"], so["into"]))
+        remedy = 'kinematics = "total"' + (" (with linear elements)" if quadratic else "")
+        if "total" not in getattr(self.contact.capabilities, "kinematics", ("total",)):
+            # the thesis variant and the baselines: small kinematics only
+            remedy = f"the paired variant (the default contact method) with {remedy}"
         log.warning("step %d (load factor %.6g): node %d of body %r lies %.3g inside body %r on "
                     "the deformed geometry, beyond the %.3g allowed for faceting and linear "
                     "theory's second-order terms, while small kinematics reads it %.3g %s: the "
                     "answer holds as linear theory reads it, its deformed geometry is off by "
-                    "about that depth; kinematics = \"total\"%s reads the deformed geometry",
+                    "about that depth; %s reads the deformed geometry",
                     step.step, step.load_factor, so["node"], so["body"], so["deformed_depth"],
                     so["into"], so["allowed"], abs(so["linearised_depth"]),
-                    "inside" if so["linearised_depth"] > 0 else "outside",
-                    " (with linear elements)" if quadratic else "")
+                    "inside" if so["linearised_depth"] > 0 else "outside", remedy)
 
     def solve_step(self, start: ContactState, load_factor: float, history_out: list
                    ) -> tuple[ContactState, SolveResult]:

@@ -1,6 +1,6 @@
 """The contact formulations, composed from the stages below: the paired variant (small and large
-kinematics, frictionless and Coulomb), the thesis variant, the classical baselines and the one-
-dimensional springs; ``formulation_class`` chooses one by the model's settings.
+kinematics, frictionless and Coulomb), the thesis variant, the classical baselines and the
+one-dimensional springs; ``formulation_class`` chooses one by the model's settings.
 
 The public face of this stage: code outside it imports these names from here
 (``tests/test_architecture.py``).

@@ -39,9 +39,8 @@ from ..laws import (
 )
 from ..search import outward_normals, project_points
 from ..solvers import Check, bordered_solve, iterate
-from ..state import (  # noqa: F401 - the shared types, here too for those who import them here
+from ..state import (
     ContactState,
-    CycleWatch,
     IterationRecord,
     Pairing,
     SolveResult,

@@ -41,14 +41,14 @@ more traction field per contact pair:
   dependent, and a step that is cut starts again from the last converged state, anchors
   included (they are part of the state the checkpoints save).
 
-* **3D** (issue 21, C13): two tangents per node (:func:`~vfem.contact.laws.coulomb.tangents`), the
-tangential arrays
-  (n, 2) where 2D keeps (n,) (:func:`~vfem.contact.laws.coulomb.columns` sees both as (n, ntan));
-  |s| is the row norm and the cone a disk; a slipping node's direction σ = -s / |s| is a unit vector
-  (±1 in 2D), and it turns: besides the tie along σ its traction has a part across σ, solved for
-  with the row that asks its slip across σ to vanish, linearised (a semismooth Newton step on the
-  disk, in :meth:`FrictionalPairedContact._correct_frictional`); the friction's errors add the slip
-  across σ. A roller plane through the contact holds one tangent of its nodes only.
+* **3D** (issue 21, C13): two tangents per node (:func:`~vfem.contact.laws.coulomb.tangents`),
+  the tangential arrays (n, 2) where 2D keeps (n,) (:func:`~vfem.contact.laws.coulomb.columns` sees
+  both as (n, ntan)); |s| is the row norm and the cone a disk; a slipping node's direction σ = -s /
+  |s| is a unit vector (±1 in 2D), and it turns: besides the tie along σ its traction has a part
+  across σ, solved for with the row that asks its slip across σ to vanish, linearised (a semismooth
+  Newton step on the disk, in :meth:`FrictionalPairedContact._correct_frictional`); the friction's
+  errors add the slip across σ. A roller plane through the contact holds one tangent of its nodes
+  only.
 
 Small kinematics here (large: :mod:`vfem.contact.formulations.large_friction`, 2D): the pairs,
 normals and tangents are those of the undeformed configuration, as for the frictionless paired

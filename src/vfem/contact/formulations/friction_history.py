@@ -131,11 +131,11 @@ class FrictionHistory:
 
     def _held_components(self, k: int) -> np.ndarray | None:
         """3D: pair k's (n, ntan) tangential components whose relative motion no traction moves
-        (:data:`HELD`: supports on both bodies along that tangent); None in 2D (a held node
-        there has no tangential unknown at all, and its slip is round-off) or before the first
-        correction has set up the pair matrix. A sticking node's slip along a held tangent is
-        the supports' (a prescribed motion, as the press fit's pushed end faces), not an error
-        the iteration could correct."""
+        (:data:`~vfem.contact.formulations.friction.HELD`: supports on both bodies along that
+        tangent); None in 2D (a held node there has no tangential unknown at all, and its slip is
+        round-off) or before the first correction has set up the pair matrix. A sticking node's slip
+        along a held tangent is the supports' (a prescribed motion, as the press fit's pushed end
+        faces), not an error the iteration could correct."""
         if getattr(self, "_ntan", 1) == 1 or getattr(self, "_full", None) is None:
             return None  # (2D; or the large-kinematics variant, 2D only, without them)
         n, base = len(self.contact_pairs[k].nodes), self._full[3][k]

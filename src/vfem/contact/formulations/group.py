@@ -4,8 +4,9 @@ tracked nodes are, and the force-controlled platen.
 :class:`SurfaceGroup` is the shared part of the thesis variant
 (:class:`~vfem.contact.formulations.algorithm.VirtualElementContact`) and the paired variant (small
 and large displacements, :mod:`vfem.contact.formulations.paired`,
-:mod:`vfem.contact.formulations.large`); :func:`bordered_solve` is the platen's bordered system that
-each of them solves in its compatibility correction.
+:mod:`vfem.contact.formulations.large`); the platen's bordered system that each of them solves in
+its compatibility correction is the solvers'
+(:func:`~vfem.contact.solvers.bordered.bordered_solve`).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ amount of sliding of the touching surfaces without requiring rediscretization"),
 
 1. **re-pairs** the surfaces on the current geometry: every compatibility-side node finds its
    virtual node on the opposing surface as it now lies, with that surface's current normal
-   (continuous along it, :func:`~vfem.contact.formulations.paired.virtual_nodes`); the transfer of
+   (continuous along it, :func:`~vfem.contact.geometry.pairing.virtual_nodes`); the transfer of
    the traction to the opposing nodes is re-integrated over the current overlap of the two surfaces.
    Tractions stay nominal (per undeformed length of the compatibility side), so the two sides'
    forces remain equal and opposite in total, and act along the current normals;
@@ -19,8 +19,9 @@ amount of sliding of the touching surfaces without requiring rediscretization"),
    the global level on the contact dofs): each body's correction with its contact forces held,
    plus its tangent flexibility times the change of those forces; the traction values solve the
    linearised contact problem on the contact dofs, complementarity included
-   (:func:`linear_complementarity`: traction >= 0, penetration <= tolerance, one of the two zero),
-   so the set of touching nodes is found on the tangent model, by small dense solves.
+   (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`: traction >= 0, penetration
+   <= tolerance, one of the two zero), so the set of touching nodes is found on the tangent model,
+   by small dense solves.
 
 It stops when the penetrations are within tolerance, no node is in tension and every body is in
 equilibrium (residual within ``BODY_TOLERANCE`` of its reference force); each body is then
@@ -578,7 +579,8 @@ class LargeDeformationContact(PairSet):
                           p: np.ndarray, tol: float, sets: list[np.ndarray], rate, dR,
                           stiffness: float, need: float) -> tuple[np.ndarray, float]:
         """The traction values of the linearised contact problem (and the platen's motion):
-        complementarity on the normal ones (:func:`linear_complementarity`)."""
+        complementarity on the normal ones
+        (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`)."""
         return linear_complementarity(W, q0, p, tol, rate, dR, stiffness, need)
 
     def _motion_along(self, pair, direction: np.ndarray, u: np.ndarray, nodes: np.ndarray
@@ -637,4 +639,4 @@ class LargeDeformationContact(PairSet):
             state.released[pair.fine][pair.nodes] = False
 
 
-__all__ = ["LargeDeformationContact", "BODY_TOLERANCE", "MAX_DAMPING", "linear_complementarity"]
+__all__ = ["LargeDeformationContact", "BODY_TOLERANCE", "MAX_DAMPING"]

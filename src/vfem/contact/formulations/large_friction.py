@@ -76,7 +76,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         super().__init__(surfaces, pairs, settings, backend, executor=executor)
         self._init_friction(settings)
         #: 3D: per pair and node, the global axis whose projection on the current tangent plane
-        #: is the first tangent (:func:`~vfem.contact.formulations.friction.tangents`): the one
+        #: is the first tangent (:func:`~vfem.contact.laws.coulomb.tangents`): the one
         #: least aligned with the node's own undeformed outward normal (on a symmetry plane, in the
         #: plane), so the tangents follow the turning normal smoothly and the choice depends on
         #: nothing but the mesh (not on where the pairing first put the node: a node beyond the

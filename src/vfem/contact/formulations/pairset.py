@@ -56,7 +56,7 @@ class PairSet(SurfaceGroup):
     (which side carries compatibility, their nodes, normals, gaps and transfer), the traction
     values that are its unknowns, the forces they make, its errors and its output fields.
 
-    :class:`PairedContact` (small displacements) and
+    :class:`~vfem.contact.formulations.paired.PairedContact` (small displacements) and
     :class:`~vfem.contact.formulations.large.LargeDeformationContact` are built on it."""
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
@@ -104,13 +104,16 @@ class PairSet(SurfaceGroup):
     keep_all_nodes = False
 
     #: (unknowns,) the held nodes that found no contact set with the others in the last
-    #: correction (:meth:`_correct_complementarity`), or None
+    #: correction
+    #: (:meth:`~vfem.contact.formulations.paired.PairedContact._correct_complementarity`), or None
     _refused = None
     _stale_mask = None
     _stale_changes = 0
-    #: :meth:`_reserve`, once found
+    #: :meth:`~vfem.contact.formulations.paired.PairedContact._reserve`, once found
     _reserved = None
-    #: (unknowns,) bool: the held nodes :meth:`enforce` holds however their guard stands
+    #: (unknowns,) bool: the held nodes that
+    #: :meth:`~vfem.contact.formulations.paired.PairedContact.enforce` holds however their
+    #: guard stands
     _forced = None
 
     #: whether the equilibrium side's nodes are held too, where they would penetrate the
@@ -397,7 +400,7 @@ class PairSet(SurfaceGroup):
 
     def _forced_of(self, start: int, n: int) -> np.ndarray:
         """(n,) bool: which of the unknowns ``start:start + n``
-        :meth:`PairedContact.enforce` holds."""
+        :meth:`~vfem.contact.formulations.paired.PairedContact.enforce` holds."""
         if self._forced is None:
             return np.zeros(n, dtype=bool)
         return self._forced[start:start + n]
@@ -409,10 +412,13 @@ class PairSet(SurfaceGroup):
         surface protrudes by the faceting of the compatibility side, and holding it too would
         make two conditions of nearly one (measured on a press fit with facets at other
         angles, when every such node was left out: the held shaft nodes took the load from
-        the hub's and its mean pressure moved 1.4 %) — unless :meth:`enforce` holds it,
-        invariant (b) having found it deeper than faceting explains; and every held node
-        refused in the last correction: stale (slid off its facet, :meth:`_stale`) or
-        finding no contact set with the others (:meth:`_correct_complementarity`). Held,
+        the hub's and its mean pressure moved 1.4 %) — unless
+        :meth:`~vfem.contact.formulations.paired.PairedContact.enforce` holds it, invariant (b)
+        having found it deeper than faceting explains; and every held node refused in the last
+        correction: stale (slid off its facet,
+        :meth:`~vfem.contact.formulations.paired.PairedContact._stale`) or finding no contact set
+        with the others
+        (:meth:`~vfem.contact.formulations.paired.PairedContact._correct_complementarity`). Held,
         then: the equilibrium side's nodes where the compatibility side's around them do not
         all touch (a stiff corner or edge, a convex body's first touch between the other's
         nodes), and the compatibility side's past the other patch's ends."""
@@ -454,7 +460,7 @@ class PairSet(SurfaceGroup):
     def contact_sets(self, traction_values: list[np.ndarray]
                      ) -> list[tuple[str, np.ndarray, np.ndarray]]:
         """Per pair, the compatibility side's (body name, node numbers, carrying-force mask):
-        what :class:`~vfem.contact.formulations.algorithm.CycleWatch` compares between
+        what :class:`~vfem.contact.state.CycleWatch` compares between
         iterations."""
         out = []
         for pair, q in zip(self.contact_pairs, traction_values):

@@ -339,10 +339,10 @@ class Segment(FacetKind):
 class _Facet3D(FacetKind):
     """Facets of a 3D surface: the kernels of :mod:`vfem.contact.geometry.facets3d` (``geometry``,
     its :class:`~vfem.contact.geometry.facets3d.FacetShape`) behind the :class:`FacetKind`
-    interface. A facet is oriented when its corners run counter-clockwise seen from outside: ``x_ξ ×
-    x_η`` is then the outward normal. ``xi`` is (n, 2). The patch boundary is an (nf, edges) table:
-    True where an edge (in ``geometry.edges``' order) of a patch facet is an edge of no other facet
-    of the patch (facets off the patch: all False)."""
+    interface. A facet is oriented when its corners run counter-clockwise seen from outside:
+    ``x_ξ × x_η`` is then the outward normal. ``xi`` is (n, 2). The patch boundary is an
+    (nf, edges) table: True where an edge (in ``geometry.edges``' order) of a patch facet is an
+    edge of no other facet of the patch (facets off the patch: all False)."""
 
     dim = 3
     #: the name of the kind (``Triangle``, ``Quad``)

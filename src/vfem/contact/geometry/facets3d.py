@@ -1,10 +1,7 @@
-"""Closest points on the facets of a 3D contact surface (issue 21, commit C5 of the 3D plan).
-
-The 3D counterpart of :func:`vfem.contact.search.closest.project_points`: for each query point, the
-nearest of a set of surface facets, the local coordinates and position of the closest point on
-it, the distance, the facet's unit outward normal there and the unclamped local coordinates that
-tell whether the point lies beyond the facet. Nothing in the 2D code calls it yet (C6 builds the
-3D ``ContactSurface`` on it).
+"""The facets of a 3D contact surface (issue 21, commit C5 of the 3D plan): their kinds, shape
+functions, maps and normals, the checks of a facet set, the bounds of a facet's warp and
+curvature, and the candidate facets of each query point, on which
+:mod:`vfem.contact.geometry.closest3d` finds the closest points.
 
 **Facets.** One kind per call, told by the number of nodes per facet (``facets.shape[1]``):
 

@@ -26,10 +26,10 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     (the thesis's device, §4.3, the other way round), or, beyond the patch's end, the end
     itself with the direction to it as normal, if it lies within two facets of it; the gap
     along the normal of the other surface's facet there, the line the node must not cross
-    (not the pair's common normal, :func:`common_normal`: at a stiff body's corner that is
-    its own nodal normal, the bisector of its two faces, along which the corner could still
-    slide into the other surface: measured 4 % of the push on a turned square; nor the
-    normal interpolated between the facet's nodal normals: a node held along a direction
+    (not the pair's common normal, :func:`~vfem.contact.geometry.pairing.common_normal`: at a stiff
+    body's corner that is its own nodal normal, the bisector of its two faces, along which the
+    corner could still slide into the other surface: measured 4 % of the push on a turned square;
+    nor the normal interpolated between the facet's nodal normals: a node held along a direction
     turned from the facet's by an angle a reads the facet's motion d across it as n.d, short
     of the true approach by about |d| sin(a) — the block's corner under a coarse quarter disk
     faceted at 5 degrees sank 1e-3 (all of the push) through a gap of 0.13); and as transfer a point
@@ -119,7 +119,7 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     gap, as its nodes are.
 
     Where ``approach`` is given (``approach(read, read_other, normal)``, the loads' relative
-    motion, :meth:`~vfem.contact.formulations.paired.PairSet._relative_motion`), a point that
+    motion, :meth:`~vfem.contact.formulations.pairset.PairSet._relative_motion`), a point that
     approaches its closest facet clearly (within 60 degrees of its inward normal) is read where the
     ray along that motion enters the other patch (:func:`ray_facet`): the facet under it, and its
     pairing; others at their closest point, and only where they lie over (or under) that
@@ -337,7 +337,7 @@ def _edge_approach(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, ed
     ``t``, at ``points``) approaches the other patch ``opatch``, nan where it does not clearly
     (within 60 degrees of the closest facet's inward normal) or ``approach`` is None.
     ``approach(read, read_other, normal)``: the relative motion under the loads
-    (:meth:`~vfem.contact.formulations.paired.PairSet._relative_motion`) given how to read a field
+    (:meth:`~vfem.contact.formulations.pairset.PairSet._relative_motion`) given how to read a field
     of each side's candidate nodes at the points and at their closest points."""
     out = np.full(points.shape, np.nan)
     if approach is None:
@@ -475,10 +475,10 @@ def held_force_directions(s: ContactSurface, patch: np.ndarray, held: Overlap, c
                           c_other: float) -> np.ndarray:
     """The directions of the held nodes' point forces (:func:`held_nodes`; their gaps read
     along ``held.normal``, the other facet's normal): over the other surface, the pair's
-    common normal (:func:`common_normal`: the other facet's normal blended with minus the
-    node's own, each weighted by its body's stiffness per unit length, ``c`` the compliance
-    densities), so that a stiff body's node pushes along its own face as the compatibility
-    side's nodes around it do; beyond the other patch's end, the direction to it.
+    common normal (:func:`~vfem.contact.geometry.pairing.common_normal`: the other facet's normal
+    blended with minus the node's own, each weighted by its body's stiffness per unit length, ``c``
+    the compliance densities), so that a stiff body's node pushes along its own face as the
+    compatibility side's nodes around it do; beyond the other patch's end, the direction to it.
 
     **Why**: the force along the other facet's normal turned a stiff gasket's held nodes'
     forces 20 degrees off its face's normal when the gaskets had slid by several elements.

@@ -79,10 +79,9 @@ class ContactSurface:
             tracked nodes' with ``rind_rows``, else only the candidates', nr = nc) for the
             candidate dofs.
         platen_row: (2 nc,) the platen reaction per unit contact force on the candidate dofs.
-        kind: the :class:`~vfem.contact.geometry.facets.FacetKind` of the facets: ``Segment(order)``
-        in
-            2D (set from ``facets`` when not given), ``Triangle(order)`` or ``Quad(order)`` in
-            3D (None for a 3D surface without candidate facets).
+        kind: the :class:`~vfem.contact.geometry.facets.FacetKind` of the facets:
+            ``Segment(order)`` in 2D (set from ``facets`` when not given), ``Triangle(order)`` or
+            ``Quad(order)`` in 3D (None for a 3D surface without candidate facets).
     """
 
     body: Body

@@ -67,9 +67,6 @@ import scipy.sparse.linalg as spla
 
 from ..search import project_points
 from .check3d import CORNER_ANGLE
-
-if TYPE_CHECKING:
-    from ...bodies import Body
 from .measures import (
     FORCE_BALANCE_TOLERANCE,
     QUADRATIC_TENSION_TOLERANCE,
@@ -78,6 +75,9 @@ from .measures import (
     Invariants,
 )
 from .polygon import _Boundary, _Polygon, _scatter_add, _symmetry_facets
+
+if TYPE_CHECKING:
+    from ...bodies import Body
 
 
 class InvariantCheck:

@@ -9,8 +9,8 @@ along its first diagonal) in place of its boundary polygon:
   faces' normals at a vertex: exact for a closed surface, Bærentzen & Aanæs 2005); the whole
   closed boundary is used, symmetry planes included.
 * **depth**: the distance to the boundary without its symmetry planes (roller supports held
-  normal to a flat boundary, any axis, :func:`~vfem.contact.invariants.check._symmetry_facets`); the
-  facet's size L is its longest side.
+  normal to a flat boundary, any axis, :func:`~vfem.contact.invariants.polygon._symmetry_facets`);
+  the facet's size L is its longest side.
 * **allowance** (L/2)·tan(α/2), α twice the largest angle between the node's normal and the
   normal of a boundary node within L of it on the convex side (the 2D "convex turning within
   L": a box's edge turns 90°), at most 90°, the allowance at most the longer of L/2 and the
@@ -80,7 +80,7 @@ class Boundary3:
     @classmethod
     def of(cls, body: Body, symmetry: np.ndarray) -> Boundary3:
         """``symmetry``: the body's facets on a symmetry plane
-        (:func:`vfem.contact.invariants.check._symmetry_facets`)."""
+        (:func:`vfem.contact.invariants.polygon._symmetry_facets`)."""
         mesh = body.mesh
         bf = mesh.boundary_facets()
         fp = body.facet_points(bf).copy()

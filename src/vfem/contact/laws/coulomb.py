@@ -23,9 +23,9 @@ def tangents(normal: np.ndarray, axes: np.ndarray | None = None) -> list[np.ndar
     the undeformed normals, so a node's tangents are fixed; where a symmetry plane through the
     contact (a roller) holds an axis, the axis is the tangent ``t1`` (a normal within the plane
     has no component along it) and the plane's motion stays one tangential unknown, which
-    :data:`HELD` finds. Under large kinematics the normals turn: ``axes`` kept from the
-    undeformed ones make the tangents a smooth function of the current normal (the least
-    aligned axis itself jumps between two axes as a normal near a third tilts)."""
+    :data:`~vfem.contact.formulations.friction.HELD` finds. Under large kinematics the normals turn:
+    ``axes`` kept from the undeformed ones make the tangents a smooth function of the current normal
+    (the least aligned axis itself jumps between two axes as a normal near a third tilts)."""
     if normal.shape[1] == 2:
         return [np.column_stack([-normal[:, 1], normal[:, 0]])]
     axis = tangent_axes(normal) if axes is None else axes

@@ -235,7 +235,7 @@ class DenseSystem:
               ) -> tuple[np.ndarray, float]:
         """The values on set ``a`` that close its gaps: ``W[a, a] x = rhs``, or with
         ``border`` = (column, row, corner, extra) the platen's bordered system
-        (:func:`~vfem.contact.formulations.group.bordered_solve`). ``x0`` (a first guess) is not
+        (:func:`~vfem.contact.solvers.bordered.bordered_solve`). ``x0`` (a first guess) is not
         needed."""
         W, factor = self.W, self.factor
         if border is not None:

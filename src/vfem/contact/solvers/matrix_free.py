@@ -148,7 +148,7 @@ class PairOperator:
               ) -> tuple[np.ndarray, float]:
         """The traction values on unknowns ``index`` (zero elsewhere) with W's block there
         times them equal to ``rhs``; with ``border`` = (column, row, corner, extra) the bordered
-        system of :func:`~vfem.contact.formulations.group.bordered_solve` (the platen's motion the
+        system of :func:`~vfem.contact.solvers.bordered.bordered_solve` (the platen's motion the
         last unknown). GMRES to :data:`RTOL`, preconditioned by the diagonal."""
         index = np.asarray(index, dtype=int)
         na = len(index)
