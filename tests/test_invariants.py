@@ -275,6 +275,40 @@ def test_a_node_inside_only_on_the_deformed_geometry_is_recorded_not_failed(monk
     assert inv.record()["second_order"] == w
 
 
+@pytest.mark.parametrize("kinematics, order, remedy", [
+    (("small", "total"), 1, 'reads it 0.002 outside: the answer holds as linear theory reads '
+     'it, its deformed geometry is off by about that depth; kinematics = "total" reads'),
+    (("small", "total"), 2, 'kinematics = "total" (with linear elements) reads'),
+    (("small",), 1, 'the paired variant (the default contact method) with kinematics = "total" '
+     "reads")])
+def test_the_second_order_warning_names_the_step_node_and_a_remedy_the_model_can_take(
+        caplog, kinematics, order, remedy):
+    """Once per run, at the step furthest beyond (not the first): large kinematics for the
+    paired variant, linear elements where a body is quadratic, and for a formulation with
+    small kinematics only (the thesis variant, the baselines) the paired variant."""
+    def step(k, beyond):
+        return SimpleNamespace(step=k, load_factor=k / 4, invariants={"second_order": {
+            "body": "upper", "node": 10 + k, "into": "lower", "deformed_depth": 1e-3 + beyond,
+            "linearised_depth": -2e-3, "allowed": 1e-3, "beyond": beyond}})
+
+    analysis = SimpleNamespace(
+        model=SimpleNamespace(bodies=[SimpleNamespace(name="upper", order=order),
+                                      SimpleNamespace(name="lower", order=1)]),
+        contact=SimpleNamespace(capabilities=SimpleNamespace(kinematics=kinematics)))
+    steps = [step(1, 1e-4), step(2, 3e-4), SimpleNamespace(step=3, invariants={}),
+             step(4, 2e-4)]
+    with caplog.at_level(logging.WARNING, logger="vfem"):
+        Analysis.warn_second_order(analysis, steps)
+    messages = [r.getMessage() for r in caplog.records]
+    assert len(messages) == 1
+    assert messages[0].startswith("step 2 (load factor 0.5): node 12 of body 'upper' lies "
+                                  "0.0013 inside body 'lower'")
+    assert remedy in messages[0]
+    caplog.clear()
+    Analysis.warn_second_order(analysis, steps[2:3])  # nothing recorded: nothing said
+    assert not caplog.records
+
+
 # -- the solver ---------------------------------------------------------------------------------
 
 
