@@ -469,7 +469,7 @@ class Analysis:
         quadratic = any(b.order > 1 for b in self.model.bodies
                         if b.name in (so["body"], so["into"]))
         remedy = 'kinematics = "total"' + (" (with linear elements)" if quadratic else "")
-        if "total" not in getattr(self.contact.capabilities, "kinematics", ("total",)):
+        if "total" not in self.contact.capabilities.kinematics:
             # the thesis variant and the baselines: small kinematics only
             remedy = f"the paired variant (the default contact method) with {remedy}"
         log.warning("step %d (load factor %.6g): node %d of body %r lies %.3g inside body %r on "
