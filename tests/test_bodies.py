@@ -5,6 +5,7 @@ import pytest
 from skfem import MeshQuad, MeshTri
 
 from vfem.bodies import Body, PrescribedDisplacement, Support, Traction
+from vfem.bodies.loads import boundary_dofs
 from vfem.bodies.stresses import stress
 from vfem.errors import InputError
 from vfem.materials import LinearElastic
@@ -42,7 +43,7 @@ def test_prescribed_displacement_and_flexibility_is_the_inverse_stiffness():
                 supports=(Support("left"),),
                 prescribed=(PrescribedDisplacement("right", "x", 0.01),))
     body.setup()
-    right = body._boundary_dofs("right", "x")
+    right = boundary_dofs(body, "right", "x")
     np.testing.assert_allclose(body.u_load[right], 0.01)
     dofs = body.free_dofs[:7]
     cols = body.flexibility_columns(dofs)

@@ -74,7 +74,7 @@ def test_total_and_updated_lagrangian_agree(crushed):
 @pytest.mark.parametrize("model", ["sliding", "gasket"])
 def test_follower_stiffness_coloured_equals_one_coordinate_at_a_time(model, monkeypatch):
     """Perturbing together the coordinates that move the normals of disjoint sets of loaded
-    nodes (``LargeDeformationContact._follower_moves``) gives the follower stiffness of one
+    nodes (``follower.follower_moves``) gives the follower stiffness of one
     perturbation per coordinate, to the round-off of the latter's difference of whole force
     vectors: in every iteration of a slide (the punch's corner region passing over the block's
     facets) and of the crushed gasket (curved against curved, the contact zone growing). A

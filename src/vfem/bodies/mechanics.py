@@ -27,6 +27,7 @@ from ..errors import AnalysisError
 from ..linalg import factorize
 from ..materials import NeoHookean, SaintVenantKirchhoff
 from ..nonlinear import NonlinearBody
+from .loads import boundary_dofs
 from .stresses import cauchy_stress, small_strain_stress
 
 log = logging.getLogger(__name__)
@@ -118,8 +119,8 @@ class LargeMechanics:
         dofs = np.array(sorted(fixed), dtype=int)
         if len(dofs):
             nl.prescribe(dofs, np.array([fixed[d] for d in dofs.tolist()]))
-        for pd in body.prescribed:  # later ones win, as in Body._constraints
-            dofs = body._boundary_dofs(pd.boundary, pd.component)
+        for pd in body.prescribed:  # later ones win, as in loads.constraints
+            dofs = boundary_dofs(body, pd.boundary, pd.component)
             nl.prescribe(dofs, _ramp(pd, len(dofs)))
         self._platen_value = 0.0
         self._tangent_analysis = None  # the last tangent's factorization (its ordering reused)
