@@ -12,7 +12,7 @@ import json
 import shutil
 import sys
 
-from vfem.tools.bench import calculix_rows
+from vfem_tools.bench import calculix_rows
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])

@@ -6,7 +6,7 @@
     python benchmarks/cattaneo.py --baseline 16 23 40 57   # against the Lagrange baseline
     python benchmarks/cattaneo.py --cycle 12 17 24 34 48 68  # Mindlin-Deresiewicz's c'
 
-Two elastically similar cylinders (``vfem.examples.cattaneo``) pressed by P, then sheared with
+Two elastically similar cylinders (``vfem_examples.cattaneo``) pressed by P, then sheared with
 P held. Per step of the shear: Q/(mu P); the stick zone's half-width c of the theory
 (a sqrt(1 - Q/(mu P))) and the outermost sticking node, in contact facets; the shear traction
 values against Cattaneo-Mindlin's, largest error over |x| < 0.8 a and RMS over |x| < a, in % of
@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from vfem.examples import cattaneo
+from vfem_examples import cattaneo
 
 
 def main(pairs: list[tuple[int, int]]) -> None:

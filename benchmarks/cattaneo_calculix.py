@@ -3,10 +3,10 @@
     python benchmarks/cattaneo_calculix.py [UPPER LOWER ...] [--stick-slope S ...] [--penalty K]
                                            [--threads N] [--ccx PATH] [--timeout S] [--keep DIR]
 
-The example ``vfem.examples.cattaneo`` (two alike half disks pressed by P, then sheared with P
+The example ``vfem_examples.cattaneo`` (two alike half disks pressed by P, then sheared with P
 held; mu = 0.3) for each pair of contact-facet counts (default 17 24 and 43 61: about 20k and
 100k dofs), solved by vfem (``cattaneo.solve``) and by ccx on the same nodes and elements
-(``vfem.tools.calculix.write_deck(steps="curves", friction=mu)``: the platen's approach, the
+(``vfem_tools.calculix.write_deck(steps="curves", friction=mu)``: the platen's approach, the
 press and the shear as three ccx steps, the shear's increments at vfem's load factors; penalty
 contact, the lower body, vfem's finer compatibility side, the slave).
 
@@ -14,7 +14,7 @@ One table per mesh: per shear increment, for each code, Q/(mu P) (Q: the sideway
 the moved flat side in ccx, the lower body's contact force in vfem), the stick zone's
 half-width c/a of the theory at that Q (sqrt(1 - Q/(mu P))), the outermost sticking node x/a
 (vfem: its friction status; ccx writes none: a slave node in contact sticks where its nodal
-|CSHEAR| < mu CPRESS (1 - 1e-4), :func:`vfem.tools.calculix.sticking`), the peak shear traction
+|CSHEAR| < mu CPRESS (1 - 1e-4), :func:`vfem_tools.calculix.sticking`), the peak shear traction
 over mu p0 and Cattaneo-Mindlin's (the largest over x of the closed form at that Q), and the
 shear's RMS error against the closed form over |x| < a, % of mu p0 (vfem: its nodal tractions,
 ``cattaneo.evaluate``; ccx: its nodal CSHEAR). Then the totals: wall time (vfem:
@@ -38,8 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from vfem.errors import VfemError
-from vfem.examples import cattaneo
-from vfem.tools.calculix import run, sticking, write_deck
+from vfem_examples import cattaneo
+from vfem_tools.calculix import run, sticking, write_deck
 
 
 def peak_theory(p: cattaneo.Parameters, tangential: float) -> float:

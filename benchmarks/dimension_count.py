@@ -71,8 +71,7 @@ GROUPS = (
     ("the classical baselines", ("contact/formulations/baselines.py",)),
     ("the rest of the contact core", ("contact/",)),
     ("meshes", ("mesh/",)),
-    ("examples (2D models)", ("examples/",)),
-    ("figures, files and tools", ("io/", "tools/", "cli.py")),
+    ("figures, files and the command line", ("io/", "cli/")),
     ("elsewhere", ("",)),
 )
 

@@ -24,9 +24,9 @@ import time
 import numpy as np
 
 from vfem import linalg
-from vfem.examples.hertz import build
 from vfem.linalg.pardiso import PardisoFactorization
-from vfem.tools.bench import hertz_parameters, parse_size
+from vfem_examples.hertz import build
+from vfem_tools.bench import hertz_parameters, parse_size
 
 
 class PartialSolve(PardisoFactorization):

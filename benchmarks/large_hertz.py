@@ -12,8 +12,8 @@ import dataclasses
 import sys
 import time
 
-from vfem.examples import hertz
 from vfem.solver import Analysis
+from vfem_examples import hertz
 
 
 def run(fraction: float, kinematics: str) -> tuple[float, int, float]:

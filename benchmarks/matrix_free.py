@@ -33,8 +33,8 @@ import numpy as np
 
 def one(divisions: int, route: str, out: str) -> None:
     """Run one size on one route in this process; write its figures and answers to ``out``."""
-    from vfem.examples import stack
     from vfem.solver import Analysis
+    from vfem_examples import stack
 
     p = stack.Parameters(blocks=2, divisions=divisions, thickness=0.1, shrink=0.2,
                          press=0.0005, flexibility=route)

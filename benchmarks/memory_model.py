@@ -31,7 +31,7 @@ def model(kind: str, order: int, n: int):
     from vfem.mesh import rectangle
 
     if kind == "sphere":
-        from vfem.examples.sphere import SphereParameters, build
+        from vfem_examples.sphere import SphereParameters, build
 
         return build(SphereParameters(facets_per_radius=n, steps=1))
 

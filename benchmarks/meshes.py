@@ -4,7 +4,7 @@
     python benchmarks/meshes.py hertz_100k hertz_1M --repeat 3
     PYTHONPATH=/tmp/mesh_head/src python benchmarks/meshes.py hertz_1M   # another tree
 
-The cases: the Hertz example at about 100k and 1M dofs (:func:`vfem.tools.bench.
+The cases: the Hertz example at about 100k and 1M dofs (:func:`vfem_tools.bench.
 hertz_parameters`, as the large-run benchmarks size it), the 1M one's mesh also with quadratic
 elements (``hertz_1M_order2``: four times the dofs), and at its defaults, linear and
 quadratic; the wedge, block, gasket, punch and sliding examples and the patch test's cases at
@@ -30,8 +30,8 @@ import sys
 
 def configs(case: str) -> list:
     """The model descriptions (:class:`vfem.config.ModelConfig`) of one case."""
-    from vfem.examples import block, gasket, hertz, patch, punch, sliding, wedge
-    from vfem.tools.bench import hertz_parameters
+    from vfem_examples import block, gasket, hertz, patch, punch, sliding, wedge
+    from vfem_tools.bench import hertz_parameters
 
     cases = {
         "hertz_100k": lambda: [hertz.config(hertz_parameters(100_000))],

@@ -18,8 +18,8 @@ from skfem import MeshTri
 
 import vfem
 from vfem.bodies import Body, Platen, Support
-from vfem.examples.hertz import HertzParameters, build, theory
 from vfem.solver import Model
+from vfem_examples.hertz import HertzParameters, build, theory
 
 
 def errors(result, a: float, p0: float) -> dict[str, np.ndarray]:

@@ -37,8 +37,8 @@ import numpy as np
 def one(args, out: str) -> None:
     """Solve the model in this process (one rank of an MPI run or the serial run)."""
     from vfem import parallel
-    from vfem.examples import stack
     from vfem.solver import Analysis
+    from vfem_examples import stack
 
     ranks = parallel.start()
     p = stack.Parameters(blocks=args.blocks, divisions=args.divisions, layers=args.layers,

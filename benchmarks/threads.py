@@ -20,7 +20,7 @@ import sys
 CASE = """
 import json, sys, time
 import vfem.linalg, vfem.threads
-from vfem.examples import hertz
+from vfem_examples import hertz
 from vfem.solver import Analysis
 if sys.argv[1] != "auto":
     vfem.linalg.use(sys.argv[1])

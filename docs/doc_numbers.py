@@ -242,7 +242,7 @@ def method_pressure_reading() -> str:
     bench = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench)
     import vfem
-    from vfem.examples.hertz import HertzParameters, build, theory
+    from vfem_examples.hertz import HertzParameters, build, theory
 
     rows = ["| facets across a | reading | p_max | largest error, abs(x) < 0.8a | RMS, abs(x) < a "
             "| at x = 0 |", "|---|---|---|---|---|---|"]
@@ -264,8 +264,8 @@ def baselines_hertz() -> str:
     """docs/baselines.md: each method on the Hertz example's default mesh (level 0), the
     penalty and augmented Lagrangian at several penalties."""
     from vfem.contact.settings import ContactSettings
-    from vfem.examples.hertz import HertzParameters, build, evaluate
     from vfem.solver import Analysis
+    from vfem_examples.hertz import HertzParameters, build, evaluate
 
     default = ContactSettings.penalty_factor
     cases = [("vfem (paired, for reference)", "vfem", None),
@@ -378,8 +378,8 @@ def examples_sphere() -> str:
 def examples_sphere_study() -> str:
     """docs/examples.md, Sphere: the refinement study, the whole sphere and the bodies listed
     the other way round (``tests/test_sphere.py``'s slow study; about five minutes)."""
-    from vfem.examples import sphere
     from vfem.solver import Analysis
+    from vfem_examples import sphere
 
     rows = ["| model | facets across a | dofs | p_max error | flat's p_max error | "
             "contact radius error / facet | edge's spread / facet | RMS over r < a |",
@@ -438,8 +438,8 @@ def examples_cattaneo3d_study() -> str:
     acceptance; about three minutes)."""
     import numpy as np
 
-    from vfem.examples import cattaneo3d
     from vfem.solver import Analysis
+    from vfem_examples import cattaneo3d
 
     rows = ["| facets across a | dofs | Q/(μP) | c/a | outermost sticking node / a | off c "
             "(facets) | shear error, largest / RMS (% of μp0) | iterations | invariants |",
@@ -479,8 +479,8 @@ def examples_cattaneo3d_study() -> str:
 def examples_circular_punch() -> str:
     """docs/examples.md, Circular punch: the default run (``vfem run circular_punch``) and the
     rim facets' study (``tests/test_circular_punch3d.py``'s slow study; about two minutes)."""
-    from vfem.examples import circular_punch
     from vfem.solver import Analysis
+    from vfem_examples import circular_punch
 
     s = _summary("circular_punch")
     b = s["boussinesq"]

@@ -30,7 +30,6 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("vfem.solver",),
     ("vfem.config",),
     ("vfem.io",),
-    ("vfem.examples", "vfem.tools"),
     ("vfem.cli", "vfem.__main__", "vfem"),
 )
 
@@ -201,7 +200,7 @@ def test_the_layer_rule_finds_an_upward_import():
     assert upward({"vfem.contact.formulations.paired": {"vfem.parallel", "vfem.bodies"},
                    "vfem.bodies": set(), "vfem.parallel": {"vfem.bodies"}}) == [
         "vfem.contact.formulations.paired (layer 3) imports vfem.parallel (layer 4)"]
-    assert layer("vfem.bodies.results") == 2 and layer("vfem") == 9
+    assert layer("vfem.bodies.results") == 2 and layer("vfem") == 8
 
 
 def test_the_cycle_finder_finds_a_cycle():
@@ -215,14 +214,39 @@ def test_nothing_under_contact_imports_the_solver():
                 if m.startswith("vfem.contact") and "vfem.solver" in targets]
 
 
-def test_the_core_never_imports_the_tools():
-    """Benchmarking and the CalculiX comparison are tools around the solver (vfem.tools): only
-    the command line (its bench and study commands) and the tools themselves import them."""
-    graph = import_graph()
-    users = sorted(m for m, targets in graph.items()
-                   if any(t.startswith("vfem.tools") for t in targets)
-                   and not m.startswith("vfem.tools"))
-    assert users == ["vfem.cli"]
+def outside_imports(module_path: Path) -> set[str]:
+    """The top-level packages other than ``vfem`` a module imports (at module level or inside
+    a function, those under ``TYPE_CHECKING`` too)."""
+    tree = ast.parse(module_path.read_text(encoding="utf-8"))
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out |= {a.name.split(".")[0] for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            out.add(node.module.split(".")[0])
+    return out - {"vfem"}
+
+
+#: the packages beside the library (issue 38): the built-in examples and the tools around the
+#: solver (benchmarks, the CalculiX comparison), which only the command line loads
+BESIDE = ("vfem_examples", "vfem_tools")
+
+
+def test_the_library_never_imports_the_examples_or_the_tools():
+    """The examples and the tools are packages beside the library (``src/vfem_examples``,
+    ``src/vfem_tools``), out of its import path: nothing under ``vfem`` imports them but the
+    command line (``vfem run hertz``, ``vfem bench``), which loads them; they import the
+    library, never the other way."""
+    users = sorted(f.relative_to(ROOT).as_posix() for f in ROOT.rglob("*.py")
+                   if outside_imports(f) & set(BESIDE))
+    assert users and all(u.startswith("cli/") for u in users), users
+    assert not (ROOT / "examples").exists() and not (ROOT / "tools").exists()
+
+
+def test_the_examples_never_import_the_tools():
+    """The tools use the examples (the bench times Hertz and the sphere), not the other way."""
+    examples = ROOT.parent / "vfem_examples"
+    assert not [f.name for f in examples.rglob("*.py") if "vfem_tools" in outside_imports(f)]
 
 
 def test_no_module_of_contact_or_bodies_is_longer_than_600_lines_but_the_known_ones():

@@ -11,8 +11,8 @@ import pytest
 import vfem
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
-from vfem.examples import hertz, patch
 from vfem.solver import Analysis
+from vfem_examples import hertz, patch
 
 METHODS = ("penalty", "lagrange", "augmented")
 

@@ -6,7 +6,7 @@ import shutil
 import pytest
 
 from vfem.cli import main
-from vfem.tools import bench
+from vfem_tools import bench
 
 needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None,
                                reason="CalculiX (ccx) is not installed")
@@ -24,7 +24,7 @@ def test_sphere_parameters_follow_the_dofs():
 
 @pytest.mark.parametrize("facets,dofs", bench._SPHERE_DOFS[:3])
 def test_sphere_dofs_table_is_measured(facets, dofs):
-    from vfem.examples.sphere import SphereParameters, build
+    from vfem_examples.sphere import SphereParameters, build
 
     model = build(SphereParameters(facets_per_radius=facets, steps=1))
     assert sum(3 * b.mesh.p.shape[1] for b in model.bodies) == dofs

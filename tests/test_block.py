@@ -6,9 +6,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from vfem.examples import block
 from vfem.result_types import largest_penetrations
 from vfem.solver import Analysis
+from vfem_examples import block
 
 
 @pytest.fixture(scope="module")

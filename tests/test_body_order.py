@@ -8,8 +8,8 @@ import dataclasses
 import pytest
 
 from vfem.contact.formulations.onedim import SecantSpring, solve_step
-from vfem.examples import block, hertz, patch
 from vfem.solver import Analysis
+from vfem_examples import block, hertz, patch
 
 
 def _both_orders(module, params, evaluate):

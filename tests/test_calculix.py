@@ -1,4 +1,4 @@
-"""vfem.tools.calculix: the Hertz model as a CalculiX deck (always checked), and run in ccx when it
+"""vfem_tools.calculix: the Hertz model as a CalculiX deck (always checked), and run in ccx when it
 is installed (p_max against Hertz, the force balance)."""
 
 import shutil
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from vfem.errors import InputError, VfemError
-from vfem.examples import hertz
-from vfem.tools.calculix import run, write_deck
+from vfem_examples import hertz
+from vfem_tools.calculix import run, write_deck
 
 HAVE_CCX = shutil.which("ccx") is not None
 needs_ccx = pytest.mark.skipif(not HAVE_CCX, reason="CalculiX (ccx) is not installed")
@@ -138,14 +138,14 @@ def test_ccx_failure_is_reported(level0, tmp_path):
 
 
 def test_bench_rows_without_ccx():
-    from vfem.tools.bench import calculix_rows
+    from vfem_tools.bench import calculix_rows
 
     assert calculix_rows([0], ccx="no-such-ccx-here") == []
 
 
 @needs_ccx
 def test_bench_rows():
-    from vfem.tools.bench import calculix_rows
+    from vfem_tools.bench import calculix_rows
 
     lines = []
     (row,) = calculix_rows([0], print_row=lines.append)
@@ -158,7 +158,7 @@ def test_bench_rows():
 
 @pytest.fixture(scope="module")
 def cattaneo_deck(tmp_path_factory):
-    from vfem.examples import cattaneo
+    from vfem_examples import cattaneo
 
     p = cattaneo.Parameters(facets_upper=6, facets_lower=8, press_steps=2, shear_steps=4)
     model = cattaneo.build(p)
@@ -196,7 +196,7 @@ def test_ccx_cattaneo_with_friction(cattaneo_deck):
     the model has an increment; the press carries P; the shear's reaction rises to mu P at
     full slip (measured 0.9938 mu P: ccx's stick slope) and not beyond, with the stick zone
     shrinking."""
-    from vfem.tools.calculix import sticking
+    from vfem_tools.calculix import sticking
 
     p, model, deck = cattaneo_deck
     r = run(deck)

@@ -1,4 +1,4 @@
-"""vfem.tools.calculix in 3D: the sphere example as a CalculiX deck of C3D8/C3D4 elements (always
+"""vfem_tools.calculix in 3D: the sphere example as a CalculiX deck of C3D8/C3D4 elements (always
 checked), and run in ccx when it is installed (the total contact force against the applied one)."""
 
 import numpy as np
@@ -7,8 +7,8 @@ from skfem import MeshHex, MeshTet
 
 from test_calculix import blocks as cards  # the deck's cards, as the 2D tests read them
 from test_calculix import needs_ccx
-from vfem.examples import sphere
-from vfem.tools.calculix import (
+from vfem_examples import sphere
+from vfem_tools.calculix import (
     C3D4_FACES,
     C3D8_FACES,
     _positive_solids,

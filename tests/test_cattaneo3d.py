@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from vfem.errors import InputError
-from vfem.examples import cattaneo3d
 from vfem.mesh import solids
 from vfem.solver import Analysis
+from vfem_examples import cattaneo3d
 
 FAST = cattaneo3d.Parameters(facets_per_radius=5, shear_steps=3, shift=0.03)
 

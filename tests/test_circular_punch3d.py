@@ -36,9 +36,9 @@ from vfem.bodies import Platen, Support
 from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
-from vfem.examples import circular_punch
 from vfem.materials import LinearElastic
 from vfem.solver import Analysis
+from vfem_examples import circular_punch
 
 A, P, E = 1.0, 10.0, 1000.0
 ROOT = Path(__file__).resolve().parents[1]

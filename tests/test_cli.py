@@ -64,7 +64,7 @@ def test_bad_input_from_the_shell_has_no_traceback():
 def test_a_body_without_supports_is_one_message_and_exit_2(monkeypatch, capsys, tmp_path):
     import dataclasses
 
-    import vfem.examples.hertz as hertz
+    import vfem_examples.hertz as hertz
 
     real_build = hertz.build
 
@@ -92,7 +92,7 @@ def test_bench_prints_and_saves_the_table(tmp_path, capsys):
 def test_bench_times_the_whole_run_against_a_plain_run_writing_the_same_files(tmp_path, capsys):
     """``--whole-run``: the run end to end beside a plain linear run of the same bodies that
     writes the same VTU series (one file per body and step), with the run's phases."""
-    from vfem.tools.bench import plain_run
+    from vfem_tools.bench import plain_run
 
     path = tmp_path / "whole.json"
     assert main(["bench", "hertz", "--whole-run", "--levels", "0", "--json", str(path)]) == 0
@@ -102,7 +102,7 @@ def test_bench_times_the_whole_run_against_a_plain_run_writing_the_same_files(tm
     assert row["run_s"] > 0 and row["plain_run_s"] > 0
     assert row["ratio"] == pytest.approx(row["run_s"] / row["plain_run_s"])
     assert abs(sum(row["phase_shares"].values()) - 1) < 1e-9 and "figures" in row["phases"]
-    from vfem.examples.hertz import HertzParameters
+    from vfem_examples.hertz import HertzParameters
 
     plain_run(HertzParameters(), tmp_path / "plain", "superlu")
     assert main(["-q", "run", "hertz", "--out", str(tmp_path / "run")]) == 0

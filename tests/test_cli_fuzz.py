@@ -25,9 +25,9 @@ from pathlib import Path
 
 import pytest
 
-import vfem.cli as cli
+import vfem.cli.run as cli_run
 from vfem.cli import main
-from vfem.examples import EXAMPLES, load
+from vfem_examples import EXAMPLES, load
 
 ROOT = Path(__file__).parent.parent
 HOSTILE = ["0", "-1", "-1e300", "1e300", "nan", "inf", "-inf", "1e-300", "abc", "", "true",
@@ -62,7 +62,7 @@ def test_the_fuzzer_covers_every_parameter_of_every_example():
 @pytest.fixture
 def no_solve(monkeypatch):
     """The run checked up to the solve, which is not done (the figures and files neither)."""
-    monkeypatch.setattr(cli, "_solve_and_report", lambda *args, **kwargs: 0)
+    monkeypatch.setattr(cli_run, "_solve_and_report", lambda *args, **kwargs: 0)
 
 
 @pytest.mark.parametrize("chunk", range(8))

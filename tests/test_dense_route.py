@@ -8,10 +8,10 @@ import pytest
 
 from vfem import linalg
 from vfem.contact.solvers.bordered import ReusedFactor
-from vfem.examples.hertz import HertzParameters, build
 from vfem.linalg.common import mirror, spd_inverse, spd_inverse_in_place
 from vfem.memory import factor_entries
 from vfem.solver import Analysis
+from vfem_examples.hertz import HertzParameters, build
 
 
 def _setup(rind_rows: bool, backend: str | None = None):
@@ -119,7 +119,7 @@ def test_large_kinematics_honours_a_search_distance_along_the_whole_path():
     the punch's path are candidates, those well beyond either end of it are not."""
     import dataclasses
 
-    from vfem.examples import sliding
+    from vfem_examples import sliding
 
     p = sliding.Parameters()
     config = sliding.config(p)

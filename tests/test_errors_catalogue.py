@@ -33,6 +33,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src" / "vfem"
+#: the packages beside the library whose messages the user reads too (module names relative to
+#: ``src``): the built-in examples and the tools
+BESIDE = ("vfem_examples", "vfem_tools")
 CATALOGUE = ROOT / "docs" / "errors.md"
 
 #: call -> index of the argument holding the message
@@ -53,10 +56,10 @@ SHORT_FRAGMENT = 8  # ... or, failing that, the longest fragment of the message
 
 #: messages with no fragment of their own, (module, message source as written) -> why
 _WRAPPERS_AS_WRITTEN = {
-    ("cli.py", 'f"{path}{changes}: {exc}"'):
+    ("cli/run.py", 'f"{path}{changes}: {exc}"'):
         "vfem check/run prefix the input file's path (and its --set changes) to a model error "
         "(catalogued at its source)",
-    ("cli.py", 'f"vfem: {why}"'):
+    ("cli/commands.py", 'f"vfem: {why}"'):
         "vfem plot: the line vfem.io.replot.unfinished_example makes on an example's unfinished "
         "run (catalogued under 'Results directories and vfem plot')",
     ("config.py", 'f"body {self.name!r}: {exc}"'):
@@ -66,9 +69,9 @@ _WRAPPERS_AS_WRITTEN = {
     ("io/input.py", "message"):
         "_Problem(where, str(exc)): a configuration class whose constructor refuses its values "
         "(the shape-parameter checks of config.py, catalogued where they raise)",
-    ("examples/wedge.py", 'f"wedge: {message}"'):
+    ("vfem_examples/wedge.py", 'f"wedge: {message}"'):
         "prefixes 'wedge: ' to the need(...) messages of wedge.validate (catalogued there)",
-    ("examples/wedge.py", 'f"wedge: {exc}"'):
+    ("vfem_examples/wedge.py", 'f"wedge: {exc}"'):
         "prefixes 'wedge: ' to a mesh shape's ValueError (catalogued in mesh/shapes.py)",
     ("solver.py", "message"):
         "failure(message): a failed contact solve's SolveResult message (with the platen's "
@@ -174,8 +177,10 @@ def _function_strings(module: str, func: ast.FunctionDef):
 
 def message_sites():
     """(module, line, message expression) of every message (see the module docstring)."""
-    for path in sorted(SRC.rglob("*.py")):
-        module = path.relative_to(SRC).as_posix()
+    paths = [(path, path.relative_to(SRC).as_posix()) for path in sorted(SRC.rglob("*.py"))]
+    paths += [(path, path.relative_to(SRC.parent).as_posix()) for package in BESIDE
+              for path in sorted((SRC.parent / package).rglob("*.py"))]
+    for path, module in paths:
         tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
         raised = {id(n.exc) for n in ast.walk(tree) if isinstance(n, ast.Raise) and n.exc}
         for node in ast.walk(tree):
@@ -196,7 +201,7 @@ def message_sites():
                 elif message:
                     yield module, node.lineno, message[0]
                 continue
-            if module == "cli.py" and _is_stderr_print(node) and node.args:
+            if module.startswith("cli/") and _is_stderr_print(node) and node.args:
                 yield module, node.lineno, node.args[0]
                 continue
             if index is not None and len(node.args) > index:
@@ -210,9 +215,9 @@ def test_the_scan_finds_the_messages():
     """A guard on the scan itself: the catalogue test below is only as good as what it sees."""
     assert len(SITES) > 150
     modules = {m for m, _, _ in SITES}
-    assert {"cli.py", "config.py", "solver.py", "bodies/validation.py", "io/input.py",
+    assert {"cli/run.py", "config.py", "solver.py", "bodies/validation.py", "io/input.py",
             "mesh/imports.py", "mesh/shapes.py", "contact/formulations/paired.py",
-            "nonlinear.py"} <= modules
+            "nonlinear.py", "vfem_examples/wedge.py"} <= modules
 
 
 def test_every_message_is_in_the_catalogue():

@@ -2,7 +2,7 @@
 step (issue 16, acceptance: "a test runs them all").
 
 The cases are every ``examples/**/*.toml`` and every built-in example (``vfem run NAME``,
-:mod:`vfem.examples`) whose model is not one of those files. A built-in example's models are
+:mod:`vfem_examples`) whose model is not one of those files. A built-in example's models are
 its ``config(Parameters())`` (``configs(...)`` for several: the patch test's twelve mesh pairs,
 the wedge's five cases); ``vfem export`` writes them as the files, so a built-in whose model
 equals its file is solved once, as the file (:func:`test_builtin_examples_are_their_files`
@@ -50,8 +50,8 @@ import pytest
 
 import vfem
 from invariant_record import step_violations
-from vfem.examples import EXAMPLES
-from vfem.examples import load as load_example
+from vfem_examples import EXAMPLES
+from vfem_examples import load as load_example
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES_DIR = ROOT / "examples"

@@ -246,7 +246,7 @@ def test_coulomb_status_and_tangents():
 # -- Cattaneo-Mindlin: partial slip of two elastically similar cylinders --------------------------
 
 def test_cattaneo_mindlin_partial_slip_of_similar_cylinders():
-    """Two identical cylinders (vfem.examples.cattaneo: R = 1, E = 1e6, nu = 0.2; 12 and 17
+    """Two identical cylinders (vfem_examples.cattaneo: R = 1, E = 1e6, nu = 0.2; 12 and 17
     contact facets across a, non-matching) pressed by P, then sheared by a growing sideways
     motion of the upper one's flat side, P held. Elastically similar bodies symmetric about the
     contact plane: the normal and tangential problems uncouple, so Hertz holds throughout
@@ -254,7 +254,7 @@ def test_cattaneo_mindlin_partial_slip_of_similar_cylinders():
     p_max/p0 - 1 = 0.11 %; the last sticking node inside c at every step, by at most 1.09
     contact facets (the node just inside c slips early); Q reaches mu P to 1e-4 when every
     node slips."""
-    from vfem.examples import cattaneo
+    from vfem_examples import cattaneo
 
     p = cattaneo.Parameters()
     result, readings = cattaneo.solve(p)
@@ -289,7 +289,7 @@ def test_mindlin_deresiewicz_unloading_and_the_hysteresis_loop():
     the contact forces took from the bodies over the cycle is the loop's area, within 3 % with
     10 steps per branch and 1.5 % with 20 (measured: 2.0 and 0.76 %; 0.34 % with 40)."""
     from vfem.bodies import multiplier
-    from vfem.examples import cattaneo
+    from vfem_examples import cattaneo
 
     errors = {}
     for steps in (10, 20):
@@ -649,7 +649,7 @@ def test_cattaneo_does_not_depend_on_the_order_of_its_bodies():
     """The Cattaneo model with its bodies listed the other way round: every contact force of
     every step the same to 1e-8 of the largest (the role rule and the friction depend on the
     geometry and stiffness alone)."""
-    from vfem.examples import cattaneo
+    from vfem_examples import cattaneo
 
     config = cattaneo.config()
     forces = []
@@ -671,8 +671,8 @@ def test_a_model_with_friction_only_in_a_pair_entry_writes_the_friction_output(t
     the press, whose contact grows with (in theory) no slip, dissipates next to nothing: the
     tangential forces' work only (the normal forces' end-of-step work on closing gaps read as
     friction before, as much at mu = 1e-3 as at 0.3)."""
-    from vfem.examples import cattaneo
     from vfem.io import runner
+    from vfem_examples import cattaneo
 
     text = BLOCKS.format(mu=0.0, shift=0.1).replace(
         "[[bodies]]", '[[contact.pairs]]\nbodies = ["lower", "upper"]\nfriction = 0.2\n'
@@ -734,7 +734,7 @@ def test_the_lagrange_baseline_reads_cattaneo_with_its_stick_zone_near_c():
     meshes: its outermost sticking node 0.29 facets outside c to 0.80 inside), where vfem's is
     0.50 to 1.09 inside; in 47 linear solves and 33 factorizations of the global system
     against vfem's 16 corrections on 2 factorizations."""
-    from vfem.examples import cattaneo
+    from vfem_examples import cattaneo
 
     p = cattaneo.Parameters()
     model = cattaneo.build(p)

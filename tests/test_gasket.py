@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from vfem.errors import InputError
-from vfem.examples import gasket
 from vfem.solver import Analysis
+from vfem_examples import gasket
 
 COARSE = gasket.Parameters(n_around=60)
 

@@ -5,8 +5,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from vfem.examples.hertz import HertzParameters, build, evaluate, theory
 from vfem.solver import Analysis
+from vfem_examples.hertz import HertzParameters, build, evaluate, theory
 
 
 def test_theory_matches_the_method_notes():

@@ -10,8 +10,8 @@ import pytest
 
 import vfem
 from vfem.cli import main
-from vfem.examples import block, gasket, hertz, patch, punch, sliding, wedge
 from vfem.io.input import dumps, load, loads, reference
+from vfem_examples import block, gasket, hertz, patch, punch, sliding, wedge
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"

@@ -260,7 +260,7 @@ def test_vfem_export_of_a_3d_example_runs_as_the_example(tmp_path):
     """``vfem export sphere`` (a coarse quarter, one step) read back is the example's own
     configuration, and ``vfem run`` of the file writes the example's contact and reaction
     tables byte for byte."""
-    from vfem.examples import sphere
+    from vfem_examples import sphere
 
     sets = ["--set", "facets_per_radius=4", "--set", "steps=1"]
     path = tmp_path / "sphere.toml"

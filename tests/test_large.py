@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from vfem.bodies import PrescribedDisplacement
-from vfem.examples import hertz, sliding
 from vfem.result_types import largest_penetrations
 from vfem.solver import Analysis
+from vfem_examples import hertz, sliding
 
 
 def _with_kinematics(config, kinematics):

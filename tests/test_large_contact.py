@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from vfem.contact.solvers import linear_complementarity
-from vfem.examples import gasket
 from vfem.solver import Analysis
+from vfem_examples import gasket
 
 
 def test_linear_complementarity_finds_the_touching_set():
@@ -80,7 +80,7 @@ def test_follower_stiffness_coloured_equals_one_coordinate_at_a_time(model, monk
     facets) and of the crushed gasket (curved against curved, the contact zone growing). A
     coordinate whose reach were drawn too small would miss entries of the size of the matrix."""
     from vfem.contact.formulations.large import LargeDeformationContact
-    from vfem.examples import sliding
+    from vfem_examples import sliding
 
     if model == "sliding":
         p = sliding.Parameters(block_columns=60, block_rows=8, punch_columns=24, punch_rows=6,

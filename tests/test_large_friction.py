@@ -190,7 +190,7 @@ def test_the_sliding_example_with_friction_slips_at_mu_in_the_contact_frame():
     the slide over the punch's curved face (a pressure not symmetric about its lowest point:
     measured 0.0071 rad on the example's mesh and 0.0066 on one twice as fine, a ratio of
     0.2922 and 0.2927); with materials alike, 0.0042 (0.2953)."""
-    from vfem.examples import sliding
+    from vfem_examples import sliding
 
     p = sliding.Parameters(block_columns=60, block_rows=8, punch_columns=24, punch_rows=6,
                            slide=1.0, press_steps=3, slide_steps=5, start=-0.5, friction=0.3)
@@ -222,7 +222,7 @@ def test_the_sliding_reactions_tend_to_mu_as_the_indentation_shrinks():
     with mu = 0.3, measured tilts 0.0071 / 0.0032 / 0.0009 rad and ratios 0.2922 / 0.2965 /
     0.2990 at depths 0.05 / 0.025 / 0.0125 (2026-11-27). At a quarter of the example's depth
     the ratio is within 1 % of mu, as the issue asks of steady sliding."""
-    from vfem.examples import sliding
+    from vfem_examples import sliding
 
     tilts = {}
     for depth in (0.05, 0.0125):

@@ -16,9 +16,9 @@ import scipy.sparse as sp
 from vfem import linalg
 from vfem.cli import main
 from vfem.errors import AnalysisError, InputError
-from vfem.examples.hertz import HertzParameters, build
 from vfem.mesh import rectangle
 from vfem.solver import Analysis
+from vfem_examples.hertz import HertzParameters, build
 
 INSTALLED = linalg.available()
 

@@ -18,8 +18,8 @@ from test_patch3d import stacked
 from vfem.contact.formulations import pairset
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
-from vfem.examples import load, stack
 from vfem.solver import Analysis
+from vfem_examples import load, stack
 
 RTOL = 1e-8
 

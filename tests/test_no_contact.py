@@ -16,8 +16,8 @@ import pytest
 import vfem
 from vfem.config import check
 from vfem.contact.geometry.placement import platen_approach
-from vfem.examples.hertz import HertzParameters, build
 from vfem.io.input import loads
+from vfem_examples.hertz import HertzParameters, build
 
 PUCK = """
 name = "puck"

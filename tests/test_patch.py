@@ -7,7 +7,7 @@ achieves, so that a change that makes it worse fails.
 
 import pytest
 
-from vfem.examples.patch import Parameters, run
+from vfem_examples.patch import Parameters, run
 
 
 @pytest.fixture(scope="module")

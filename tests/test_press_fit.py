@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from vfem.errors import InputError
-from vfem.examples import press_fit
 from vfem.solver import Analysis
+from vfem_examples import press_fit
 
 
 def solve(**kw):

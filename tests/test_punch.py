@@ -17,7 +17,7 @@ import pytest
 
 import vfem
 from vfem.cli import build_parameters, main
-from vfem.examples import punch
+from vfem_examples import punch
 
 EXAMPLES = Path(__file__).parent.parent / "examples" / "punch"
 
@@ -25,7 +25,7 @@ EXAMPLES = Path(__file__).parent.parent / "examples" / "punch"
 @pytest.fixture(scope="module")
 def reference():
     """The block alone, its top nodes with |x| <= 0.5 moved down 0.01, free sideways
-    (:func:`vfem.examples.punch.reference_force`, what ``vfem run punch`` compares with)."""
+    (:func:`vfem_examples.punch.reference_force`, what ``vfem run punch`` compares with)."""
     return punch.reference_force()
 
 

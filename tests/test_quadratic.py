@@ -8,13 +8,13 @@ from skfem import Basis, ElementTriP2, ElementVector, MeshQuad, MeshTri
 
 from vfem.bodies import Body, Support
 from vfem.errors import InputError
-from vfem.examples import patch
-from vfem.examples.hertz import HertzParameters, build, evaluate
 from vfem.io.results import ResultsWriter
 from vfem.materials import LinearElastic
 from vfem.mesh import graded_quarter_disk
 from vfem.mesh.quadratic import curved
 from vfem.solver import Analysis
+from vfem_examples import patch
+from vfem_examples.hertz import HertzParameters, build, evaluate
 
 
 @pytest.fixture(scope="module")

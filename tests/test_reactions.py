@@ -169,12 +169,12 @@ def test_summary_csv_and_vtu_hold_the_same_numbers(solved):
 
 
 def test_the_closing_screen_shows_reactions_and_the_balance(solved):
-    from vfem.cli import _results_line
+    from vfem.cli.run import results_line
     from vfem.io.folders import ResultsFolder, run_description
 
     _, _, summary, out = solved
     ResultsFolder(out, run_description("test", "test", [])).update()  # the run's own files
-    lines = _results_line(runner.report(summary, out), out)  # the screen vfem run prints
+    lines = results_line(runner.report(summary, out), out)  # the screen vfem run prints
     punch = next(x for x in lines if x.strip().startswith("punch:"))
     assert "contact force (" in punch and ", reactions (" in punch
     fx, fy = summary["bodies"]["punch"]["reactions"]

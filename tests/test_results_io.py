@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 
 from vfem.errors import InputError
-from vfem.examples.patch import Parameters, build
 from vfem.io.replot import plot_results
 from vfem.io.results import (
     CONTACT_COLUMNS,
@@ -21,6 +20,7 @@ from vfem.io.results import (
     step_record,
     write_summary,
 )
+from vfem_examples.patch import Parameters, build
 
 POINT_FIELDS = ("displacement", "contact_force", "contact_pressure", "contact_status",
                 "penetration")

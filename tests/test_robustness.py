@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 
 from vfem.contact.state import CycleWatch, SolveResult
-from vfem.examples import gasket, hertz, wedge
 from vfem.io import checkpoint
 from vfem.io.results import run_writing
 from vfem.solver import Analysis
+from vfem_examples import gasket, hertz, wedge
 
 
 def _arrays(cp) -> dict[str, np.ndarray]:

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import vfem
-from vfem.examples.hertz import HertzParameters, build, theory
+from vfem_examples.hertz import HertzParameters, build, theory
 
 PUNCH = Path(__file__).parent.parent / "examples" / "punch"
 

@@ -22,7 +22,7 @@ from skfem import MeshQuad
 
 import vfem
 from vfem.mesh.shapes import filleted_punch, graded_nodes
-from vfem.tools.calculix import write_deck
+from vfem_tools.calculix import write_deck
 
 EXAMPLE = Path(__file__).parent.parent / "examples" / "punch" / "rounded_punch.toml"
 TANGENT = 0.4  # x of the right tangent point
@@ -235,7 +235,7 @@ def test_calculix_on_the_fine_mesh(tmp_path):
     """Issue 16, item 8: "and with CalculiX when installed". Not yet run here (no ccx on the
     machine that wrote it): total force within 1 %, the nodal p_max (K u per tributary length,
     as vfem's) within 2 % of vfem's on the same meshes."""
-    from vfem.tools.calculix import run
+    from vfem_tools.calculix import run
 
     load, peak, _ = check_symmetric(vfem.solve(fine_model("vfem", **FINE)))
     deck = write_deck(fine_model("vfem", **FINE), tmp_path / "rounded_punch.inp", penalty=1e14)

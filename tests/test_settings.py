@@ -11,9 +11,9 @@ from vfem.contact.formulations.algorithm import VirtualElementContact
 from vfem.contact.geometry.surface import ContactSurface
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
-from vfem.examples.hertz import build, evaluate
 from vfem.materials import LinearElastic
 from vfem.solver import Analysis, Model
+from vfem_examples.hertz import build, evaluate
 
 
 @pytest.mark.parametrize("changes", [

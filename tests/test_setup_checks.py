@@ -91,7 +91,7 @@ def test_fill_model_in_3d_is_close_to_superlus_factors():
     tetrahedral sphere cautious (the fill of tetrahedra, fewer neighbours a node, is lower);
     the stiffness's structural count exact (the 2D law, before, gave a 3D body's factors 5 to
     7 times too few entries)."""
-    from vfem.examples import sphere
+    from vfem_examples import sphere
 
     for cells in ("hex", "tet"):
         p = sphere.Parameters(facets_per_radius=3, steps=1, sphere_cells=cells)
@@ -115,7 +115,7 @@ def test_pardiso_3d_bytes_per_factor_entry():
     nnz(L): PARDISO's own count of its memory agrees, to within the indices' share, which
     falls as the supernodes grow (measured, the Schur block included: 11.6 to 11.9 bytes at
     13k dofs a body, here; 10.9 to 11.1 at 25k; 9.0 to 9.6 from 187k to 889k)."""
-    from vfem.examples import sphere
+    from vfem_examples import sphere
 
     analysis = Analysis(sphere.build(sphere.Parameters(facets_per_radius=6, steps=1)),
                         "pardiso")

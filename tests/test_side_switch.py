@@ -129,7 +129,7 @@ def test_the_docs_large_gasket_runs_through_on_the_other_side():
     few of the contact iteration's penetration tolerances (the two runs stop their contact
     iterations at different states within it; hyperelastic bodies and frictionless contact
     leave nothing else to the path)."""
-    from vfem.examples import gasket
+    from vfem_examples import gasket
 
     cfg = gasket.config(gasket.GasketParameters(kinematics="total", order=1, n_through=3,
                                                 back_motion=0.5))

@@ -2,8 +2,8 @@
 
 import pytest
 
-from vfem.examples.hertz import HertzParameters, build, evaluate
 from vfem.solver import Analysis
+from vfem_examples.hertz import HertzParameters, build, evaluate
 
 
 @pytest.mark.slow

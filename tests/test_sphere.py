@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from vfem.errors import InputError
-from vfem.examples import sphere
 from vfem.solver import Analysis
+from vfem_examples import sphere
 
 COARSE = sphere.Parameters(facets_per_radius=4, steps=2)
 

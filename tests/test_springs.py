@@ -2,7 +2,7 @@
 
 import pytest
 
-from vfem.examples.springs import run
+from vfem_examples.springs import run
 
 
 @pytest.fixture(scope="module")

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from vfem.errors import InputError
-from vfem.examples import wedge
-from vfem.examples.wedge import THESIS_ITERATIONS, Parameters, planned_steps, report, run, validate
+from vfem_examples import wedge
+from vfem_examples.wedge import THESIS_ITERATIONS, Parameters, planned_steps, report, run, validate
 
 KEYS = ("plate_share", "wedge_share", "contact_force", "contact_force_plate",
         "plate_support_reaction")

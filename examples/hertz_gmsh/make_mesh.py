@@ -1,6 +1,6 @@
 """Build the Hertz example's two bodies with Gmsh and write them to one ``.msh`` (format 4.1).
 
-The geometry is that of the built-in example (``vfem.examples.hertz``, ``vfem.mesh.parametric``):
+The geometry is that of the built-in example (``vfem_examples.hertz``, ``vfem.mesh.parametric``):
 
 * ``cylinder``: the lower-right quarter of a disc of radius 1 centred at (0, 1), touching the x
   axis at the origin; triangles. Physical curves ``contact`` (the arc from (0, 0) to (1, 1)),
@@ -33,7 +33,7 @@ import os
 import sys
 from pathlib import Path
 
-HALF_WIDTH = 0.061168  # Hertz's contact half-width of the built-in example (vfem.examples.hertz)
+HALF_WIDTH = 0.061168  # Hertz's contact half-width of the built-in example (vfem_examples.hertz)
 
 
 def build(path: str | os.PathLike, size: float | None = None, *,

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import examples as _examples  # noqa: F401, I001 - registers their figure sets (io.replot)
 from ._version import __version__  # noqa: F401 (vfem.__version__)
 from .bodies import Body, Platen, PrescribedDisplacement, Support, Traction
 from .config import BodyConfig, MeshSpec, ModelConfig, Steps

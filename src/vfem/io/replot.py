@@ -462,8 +462,9 @@ def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> lis
 
 #: the built-in examples whose figure sets a results folder may name, and the loader of their
 #: modules (each with ``figures(folder)``, or without, drawing none): handed in by
-#: :mod:`vfem.examples` when it is imported (:func:`register_examples`), since the writers sit
-#: below the examples and do not import them (issue 38); none until then
+#: :mod:`vfem_examples` when it is imported (:func:`register_examples`; the ``vfem`` command
+#: imports it), since the examples are a package beside the library, which never imports them
+#: (issue 38); none until then
 _examples: tuple[tuple[str, ...], Callable[[str], object]] = ((), lambda name: None)
 
 
@@ -503,8 +504,9 @@ def plot_results(directory: Path | str) -> list[Path]:
         log.info("%s", why)  # vfem plot says so (cli.cmd_plot)
     if name not in (None, "input"):
         if name not in EXAMPLES:
+            known = ", ".join(EXAMPLES) or "none loaded: import vfem_examples first"
             raise InputError(f"{folder.directory}/summary.json: figure_set {name!r} is not a "
-                             f"built-in example ({', '.join(EXAMPLES)}) nor 'input'")
+                             f"built-in example ({known}) nor 'input'")
         draw = getattr(load(name), "figures", None)
         written = draw(folder) if draw is not None else []
     else:

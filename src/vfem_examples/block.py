@@ -30,13 +30,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import PrescribedDisplacement, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..io.runner import run_headline
-from ..materials import LinearElastic
-from ..result_types import largest_penetrations
-from ..solver import AnalysisResult, Model
+from vfem.bodies import PrescribedDisplacement, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.io.runner import run_headline
+from vfem.materials import LinearElastic
+from vfem.result_types import largest_penetrations
+from vfem.solver import AnalysisResult, Model
 
 
 @dataclass(frozen=True)
@@ -84,7 +84,7 @@ def build(p: Parameters) -> Model:
 
 def validate(p: Parameters) -> None:
     """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
-    from ..errors import InputError
+    from vfem.errors import InputError
 
     if p.small_half_width >= p.large_half_width:
         raise InputError("block: small_half_width must be less than large_half_width (the "
@@ -132,7 +132,7 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
-    from ..io.results import example_summary
+    from vfem.io.results import example_summary
 
     summary = example_summary("block", result, p)
     if result.complete:  # (also the thesis variant's run, not converged: issue 37)
@@ -143,12 +143,12 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
 def run(p: Parameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     def draw(model, result, summary):
         """What the figures need beyond the results files: the linear prediction (contact
         ignored, as extra VTU files) and the windows (``summary.json``'s ``figure_data``)."""
-        from ..io.replot import write_frames
+        from vfem.io.replot import write_frames
 
         if not result.steps:
             return
@@ -170,7 +170,7 @@ def figures(folder) -> list[Path]:
     draws and ``vfem plot`` redraws: thesis Figs. 5.14-5.16 (``initial.png``,
     ``prediction.png``, ``final.png``), ``corner.png``, ``pressure.png`` (the small block's
     top, the last step's VTU) and ``von_mises.png``."""
-    from ..io import plots, replot
+    from vfem.io import plots, replot
 
     s = folder.summary
     if not folder.has_steps or "figure_data" not in s:

@@ -31,10 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies.condensation import solve_with
-from ..examples.hertz import HertzParameters, build, evaluate, theory
-from ..linalg import factorize, resolve
-from ..solver import Analysis
+from vfem.bodies.condensation import solve_with
+from vfem.linalg import factorize, resolve
+from vfem.solver import Analysis
+from vfem_examples.hertz import HertzParameters, build, evaluate, theory
 
 #: named sizes of ``vfem bench hertz --dofs``
 SIZES = {"10k": 10_000, "30k": 30_000, "100k": 100_000, "300k": 300_000, "1M": 1_000_000}
@@ -53,7 +53,7 @@ def parse_size(text: str) -> int:
     try:
         value = int(float(number) * scale)
     except ValueError:
-        from ..errors import InputError
+        from vfem.errors import InputError
 
         raise InputError(f"--dofs: expected a number of dofs such as 10k, 100k or 1M, got "
                          f"{text!r}") from None
@@ -103,8 +103,8 @@ def plain_run(p: HertzParameters, out: Path, backend: str) -> dict[str, float]:
     write the same VTU series and PVD the vfem run writes: one file per body and
     step (displacement, reaction, stresses; the contact fields zero), a linear run's fields
     scaled by each step's load factor. Seconds, by part."""
-    from ..io.results import ResultsWriter
-    from ..result_types import BodyStepResult, StepResult
+    from vfem.io.results import ResultsWriter
+    from vfem.result_types import BodyStepResult, StepResult
 
     t0 = time.perf_counter()
     model = build(p)
@@ -149,8 +149,8 @@ def whole_run_case(p: HertzParameters, backend: str | None = None, repeat: int =
     """``vfem run hertz`` end to end (mesh, set-up, steps, VTU, summary, figures: what a user
     waits for) against :func:`plain_run` of the same bodies, alternately, ``repeat`` times, the
     fastest of each kept; the whole run's phases (``summary.json``'s ``phases``)."""
-    from ..config import _shape_mesh
-    from ..examples import hertz
+    from vfem.config import _shape_mesh
+    from vfem_examples import hertz
 
     backend = resolve(backend)
     best, plain, summary = None, None, None
@@ -266,7 +266,7 @@ SPHERE_PENALTY = 1e9
 def sphere_parameters(dofs: int | None = None, level: int | None = None):
     """The sphere example (quarter model, one step) at about ``dofs`` degrees of freedom (more
     facets across the contact radius, the bulk's elements kept), or at refinement ``level``."""
-    from ..examples.sphere import SphereParameters
+    from vfem_examples.sphere import SphereParameters
 
     if level is not None:
         return SphereParameters(refinement=level, steps=1)
@@ -280,8 +280,8 @@ def sphere_parameters(dofs: int | None = None, level: int | None = None):
 def sphere_case(p, backend: str | None = None, repeat: int = 1) -> dict:
     """:func:`hertz_case` for the sphere example: vfem's analysis time against one plain
     linear solve of the same bodies with the same backend, iterations, p_max error."""
-    from ..examples.sphere import build as build_sphere
-    from ..examples.sphere import evaluate as evaluate_sphere
+    from vfem_examples.sphere import build as build_sphere
+    from vfem_examples.sphere import evaluate as evaluate_sphere
 
     backend = resolve(backend)
     vfem_s = plain = peak = None
@@ -331,7 +331,7 @@ def sphere_case(p, backend: str | None = None, repeat: int = 1) -> dict:
 def patch_case(method: str = "vfem", backend: str | None = None) -> dict:
     """The patch test (every case of the patch example) with contact ``method``: the largest
     deviation of the contact pressure from the exact uniform one, over the cases."""
-    from ..examples import patch
+    from vfem_examples import patch
 
     p = patch.Parameters()
     worst, iterations = 0.0, 0
@@ -352,10 +352,10 @@ def run_isolated(kind: str, **kwargs) -> dict:
     writes to a file)."""
     with tempfile.TemporaryDirectory(prefix="vfem-bench-") as tmp:
         row = Path(tmp) / "row.json"
-        out = subprocess.run([sys.executable, "-m", "vfem.tools.bench", json.dumps([kind, kwargs]),
+        out = subprocess.run([sys.executable, "-m", "vfem_tools.bench", json.dumps([kind, kwargs]),
                               str(row)], capture_output=True, text=True, check=False)
         if out.returncode != 0 or not row.exists():
-            from ..errors import AnalysisError
+            from vfem.errors import AnalysisError
 
             tail = (out.stderr or out.stdout).strip().splitlines()[-3:]
             raise AnalysisError(f"benchmark case {kind} {kwargs} failed: {' | '.join(tail)}")
@@ -373,7 +373,7 @@ def _warm_up(backend: str | None, method: str) -> None:
 def _case(kind: str, kwargs: dict) -> dict:
     _warm_up(kwargs.get("backend"), kwargs.get("method", "vfem"))
     if kind == "sphere":  # and a tiny 3D model: the 3D code paths' first calls
-        from ..examples.sphere import SphereParameters
+        from vfem_examples.sphere import SphereParameters
 
         sphere_case(SphereParameters(facets_per_radius=2, max_element_size=4.0, steps=1),
                     kwargs.get("backend"))
@@ -569,14 +569,15 @@ def sphere_calculix_row(size: dict, vfem: dict, ccx: str = "ccx", threads: int =
     (deck writing and result reading excluded), its increments and iterations (the
     contact-making first step's included in ``ccx_iterations_total``), its p_max error read
     two ways, ccx's own CPRESS ("raw") and the sphere's nodal contact forces ``K u`` per
-    undeformed tributary area (vfem's reading, :func:`vfem.tools.calculix.nodal_reading`), the
+    undeformed tributary area (vfem's reading, :func:`vfem_tools.calculix.nodal_reading`), the
     RMS of that reading's difference from Hertz's over r < a (over p0, as
-    :func:`vfem.examples.sphere.evaluate` measures vfem's), and its total contact force against
+    :func:`vfem_examples.sphere.evaluate` measures vfem's), and its total contact force against
     the applied one. A ccx run stopped at ``timeout`` seconds
     gives a row with ``ccx_timed_out`` and NaN readings. ``keep``: a folder for ccx's files."""
-    from ..errors import VfemError
-    from ..examples.sphere import build as build_sphere
-    from ..examples.sphere import theory as sphere_theory
+    from vfem.errors import VfemError
+    from vfem_examples.sphere import build as build_sphere
+    from vfem_examples.sphere import theory as sphere_theory
+
     from .calculix import run, write_deck
 
     p = sphere_parameters(**size)
@@ -658,7 +659,7 @@ def sphere_calculix_markdown(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-if __name__ == "__main__":  # one case: python -m vfem.tools.bench '["hertz", {...}]' ROW.json
+if __name__ == "__main__":  # one case: python -m vfem_tools.bench '["hertz", {...}]' ROW.json
     import logging
 
     logging.basicConfig(level=logging.WARNING)

@@ -23,8 +23,8 @@ CalculiX*):
   nodal contact pressure on the slave surface (CPRESS of ``*CONTACT FILE, CSTR``: "raw"), the
   total contact force ccx reports, and the slave body's nodal contact forces recomputed as
   ``K u`` (its stiffness, the same elements as ccx's, times ccx's displacements) per undeformed
-  tributary length (3D: area), the reading :func:`vfem.examples.hertz.evaluate` (and
-  :func:`vfem.examples.sphere.evaluate`) makes of vfem's results;
+  tributary length (3D: area), the reading :func:`vfem_examples.hertz.evaluate` (and
+  :func:`vfem_examples.sphere.evaluate`) makes of vfem's results;
   and per increment (``history``) the slave nodes' contact stresses and slips (CPRESS, CSHEAR1,
   CSHEAR2, COPEN, CSLIP1, CSLIP2), their ``K u`` forces, the reactions of the held boundaries
   and ccx's total contact force: what benchmarks/cattaneo_calculix.py compares with vfem's
@@ -50,11 +50,11 @@ from skfem import Basis, ElementVector, FacetBasis, LinearForm, MeshHex, MeshTri
 from skfem.io.meshio import HEX_MAPPING
 from skfem.models.elasticity import linear_elasticity
 
-from ..contact.search import project_points
-from ..errors import InputError, VfemError
+from vfem.contact.search import project_points
+from vfem.errors import InputError, VfemError
 
 if TYPE_CHECKING:
-    from ..solver import Model
+    from vfem.solver import Model
 
 DOF = {"x": 1, "y": 2, "z": 3}
 
@@ -237,7 +237,7 @@ def _initial_gap(s, m) -> float:
     none)."""
     pts = s.X[: s.nc]
     if pts.shape[1] == 3:
-        from ..contact.geometry import closest_on_facets
+        from vfem.contact.geometry import closest_on_facets
 
         if not len(pts) or not len(m.facets):
             return 0.0
@@ -325,7 +325,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     _, surfaces = model.contact_surfaces()
     size = max(float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in model.bodies)
 
-    out = ["*HEADING", f"vfem model {model.name!r} written by vfem.tools.calculix"]
+    out = ["*HEADING", f"vfem model {model.name!r} written by vfem_tools.calculix"]
     decks: list[BodyDeck] = []
     node_off = elem_off = 0
     for b, s in zip(model.bodies, surfaces):
@@ -612,7 +612,7 @@ def _stiffness(body):
     elements ccx's are."""
     lam, mu = body.material.lame()
     if body.mesh.p.shape[0] == 3:  # as Body.assemble does (scikit-fem's loop is slow in 3D)
-        from ..bodies.assembly import elasticity_stiffness
+        from vfem.bodies.assembly import elasticity_stiffness
 
         return elasticity_stiffness(body.mesh, body.element(), lam, mu)
     basis = Basis(body.mesh, ElementVector(body.element()))
@@ -638,9 +638,9 @@ def nodal_reading(body, facets: np.ndarray, u: np.ndarray, stiffness=None) -> di
     ``u``: (npoints, 2) displacements (3D: (npoints, 3)). On a contact node the only forces
     besides contact are the reactions of its constrained components, which are left out; the
     pressure is the size of what remains over the node's undeformed tributary length (half of
-    each facet it ends), as :func:`vfem.examples.hertz.evaluate` reads vfem's; in 3D over its
+    each facet it ends), as :func:`vfem_examples.hertz.evaluate` reads vfem's; in 3D over its
     undeformed tributary area (the integral of its shape function over the facets, as vfem's
-    nominal pressure, :func:`vfem.examples.sphere.evaluate`). ``residual`` is the largest
+    nominal pressure, :func:`vfem_examples.sphere.evaluate`). ``residual`` is the largest
     ``|K u|`` on a free dof off the contact surface (zero in exact arithmetic: the check that the
     elements and the displacements read back are ccx's), relative to the largest nodal contact
     force.

@@ -30,13 +30,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import Platen, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import run_headline
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model
+from vfem.bodies import Platen, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model
 
 #: Where the acceptance reads the pressure: r < INNER a (the rim's singularity excluded).
 INNER = 0.8
@@ -161,7 +161,7 @@ def evaluate(result: AnalysisResult, p: CircularPunchParameters) -> dict:
 def summarize(result: AnalysisResult, p: CircularPunchParameters) -> dict:
     """The ``summary.json`` dictionary of a run: :func:`~vfem.io.results.example_summary` with
     the bodies' sizes and, at full load, ``boussinesq``."""
-    from ..io.results import solid_summary
+    from vfem.io.results import solid_summary
 
     return solid_summary("circular_punch", result, p, "boussinesq", evaluate)
 
@@ -169,7 +169,7 @@ def summarize(result: AnalysisResult, p: CircularPunchParameters) -> dict:
 def run(p: CircularPunchParameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p), figures, on_step, resume)
 
@@ -180,7 +180,7 @@ def figures(folder) -> list[Path]:
     reads the same); ``pressure_map.png``: the block's
     pressure seen from above (clipped at three times the mean: the rim's nodes carry the
     singularity)."""
-    from ..io import plots
+    from vfem.io import plots
 
     s = folder.summary
     if not folder.has_steps or "boussinesq" not in s:

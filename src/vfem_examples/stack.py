@@ -37,13 +37,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..bodies import PrescribedDisplacement, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import FLEXIBILITY_ROUTES, ContactSettings
-from ..errors import InputError
-from ..io.runner import run_headline
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model
+from vfem.bodies import PrescribedDisplacement, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import FLEXIBILITY_ROUTES, ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model
 
 
 @dataclass(frozen=True)
@@ -187,14 +187,14 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
     """The ``summary.json`` dictionary of a stack run."""
-    from ..io.results import solid_summary
+    from vfem.io.results import solid_summary
 
     return solid_summary("stack", result, p, "stack", evaluate)
 
 
 def run(p: Parameters, out, on_step=None, figures: bool = True, resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step and ``summary.json`` to ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p), None, on_step, resume)
 

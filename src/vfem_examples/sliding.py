@@ -36,14 +36,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import PrescribedDisplacement, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import friction_line, run_headline
-from ..materials import LinearElastic
-from ..result_types import largest_penetrations
-from ..solver import AnalysisResult, Model
+from vfem.bodies import PrescribedDisplacement, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import friction_line, run_headline
+from vfem.materials import LinearElastic
+from vfem.result_types import largest_penetrations
+from vfem.solver import AnalysisResult, Model
 
 
 @dataclass(frozen=True)
@@ -203,7 +203,7 @@ def _friction_reading(result: AnalysisResult, p: Parameters, steady: np.ndarray,
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
-    from ..io.results import example_summary
+    from vfem.io.results import example_summary
 
     summary = example_summary("sliding", result, p)
     if result.steps:
@@ -214,7 +214,7 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
 def run(p: Parameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p),
                        (lambda model, result, summary: _figure_data(model, result, summary, p))
@@ -248,7 +248,7 @@ def figures(folder) -> list[Path]:
     draws and ``vfem plot`` redraws: ``reactions.png``, the punch's reactions against the
     slide (``summary.json``'s ``sliding.reactions``); the deformed bodies at three moments
     (``pressed.png``, ``halfway.png``, ``slid.png``); ``von_mises.png``, slid."""
-    from ..io import plots, replot
+    from vfem.io import plots, replot
 
     s = folder.summary
     if not folder.has_steps or "sliding" not in s or "figure_data" not in s:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import importlib
 
-from ..io import replot
+from vfem.io import replot
 
 EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
             "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack")

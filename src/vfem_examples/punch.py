@@ -27,13 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import PrescribedDisplacement, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import run_headline
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model
+from vfem.bodies import PrescribedDisplacement, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model
 
 #: the magnification of the displacements in ``deformed.png``
 MAGNIFICATION = 10.0
@@ -197,7 +197,7 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
-    from ..io.results import example_summary
+    from vfem.io.results import example_summary
 
     summary = example_summary("punch", result, p)
     summary["pressure_measure"] = "nominal: nodal contact force / undeformed tributary length"
@@ -209,7 +209,7 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
 def run(p: Parameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p),
                        (lambda model, result, summary: _figure_data(summary, p)) if figures
@@ -233,7 +233,7 @@ def figures(folder) -> list[Path]:
     (the last step's VTU) against Sadowsky's shape for the computed force (``summary.json``'s
     ``punch``); ``deformed.png``, the right corner, displacements magnified; ``von_mises.png``,
     the same corner filled by the von Mises stress."""
-    from ..io import plots, replot
+    from vfem.io import plots, replot
 
     s = folder.summary
     if not folder.has_steps or "punch" not in s:  # the full indentation was not reached

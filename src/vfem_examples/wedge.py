@@ -45,12 +45,12 @@ from pathlib import Path
 import numpy as np
 from skfem import MeshQuad, MeshTri
 
-from ..bodies import Body, PrescribedDisplacement, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import CONVERGENCE_CRITERIA, VARIANTS, ContactSettings
-from ..errors import InputError
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model, StepResult
+from vfem.bodies import Body, PrescribedDisplacement, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import CONVERGENCE_CRITERIA, VARIANTS, ContactSettings
+from vfem.errors import InputError
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model, StepResult
 
 #: Wedge/plate modulus ratio of the thesis's five cases, in its numbering.
 RATIOS = (1000.0, 2.0, 1.0, 0.5, 0.001)
@@ -266,7 +266,7 @@ def solve_case(model: Model, out: Path | None = None, on_step=None, resume: bool
     """Run one case's model, writing its VTU files into ``out`` if given: (result, the body
     whose surface carries compatibility in the paired variant, else None). A case that does not
     converge ends with the solver's message once its step cuts run out (``max_step_cuts``)."""
-    from ..io.results import run_writing
+    from vfem.io.results import run_writing
 
     analysis, result = run_writing(model, out, on_step, resume)
     pairs = getattr(analysis.contact, "contact_pairs", None)
@@ -350,7 +350,7 @@ def summarize_case(p: WedgeParameters, case: int, model: Model, steps: list[Step
 
 def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False) -> dict:
     """Run the cases, writing ``out/caseN/`` (VTU/PVD), the figures and ``summary.json``."""
-    from ..io.results import write_summary
+    from vfem.io.results import write_summary
 
     start = time.perf_counter()
     out = Path(out) if out is not None else None
@@ -396,7 +396,7 @@ def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False) -> dic
     if out is not None:
         write_summary(out, summary)
         if p.figures:
-            from ..io.replot import draw_run, write_frames
+            from vfem.io.replot import draw_run, write_frames
 
             summary["figure_data"] = {
                 "first_case": cases(p)[0],
@@ -413,7 +413,7 @@ def figures(folder) -> list[Path]:
     draws and ``vfem plot`` redraws: the thesis's figures 5.4 to 5.13 (those whose cases
     reached the full motion; each case's results in ``caseN/``) and ``von_mises_caseN.png``,
     each such case's final state filled by the von Mises stress."""
-    from ..io import plots, replot
+    from vfem.io import plots, replot
 
     s = folder.summary
     data = s.get("figure_data")

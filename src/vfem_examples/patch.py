@@ -23,12 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..bodies import PrescribedDisplacement, Support
-from ..bodies.stresses import stress
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..materials import LinearElastic
-from ..solver import Analysis, AnalysisResult, Model
+from vfem.bodies import PrescribedDisplacement, Support
+from vfem.bodies.stresses import stress
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.materials import LinearElastic
+from vfem.solver import Analysis, AnalysisResult, Model
 
 PAIRS = ((4, 7), (2, 10), (1, 5))
 
@@ -163,7 +163,7 @@ def run(p: Parameters, out=None, on_step=None) -> dict:
         "timings": {"total_s": time.perf_counter() - start},
     }
     if out is not None:
-        from ..io.results import write_summary
+        from vfem.io.results import write_summary
 
         write_summary(out, summary)
     return summary

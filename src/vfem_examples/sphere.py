@@ -25,13 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import Platen, Support
-from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import run_headline
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model
+from vfem.bodies import Platen, Support
+from vfem.config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model
 
 #: The contact region's proportions, over the sphere's radius.
 CYLINDER_RADIUS, CYLINDER_HEIGHT = 0.6, 0.5
@@ -204,7 +204,7 @@ def evaluate(result: AnalysisResult, p: SphereParameters) -> dict:
 def summarize(result: AnalysisResult, p: SphereParameters) -> dict:
     """The ``summary.json`` dictionary of a sphere run: :func:`~vfem.io.results.example_summary`
     with the platen's motion per step, the bodies' sizes and, at full load, ``hertz``."""
-    from ..io.results import solid_summary
+    from vfem.io.results import solid_summary
 
     summary = solid_summary("sphere", result, p, "hertz", evaluate)
     for record, step in zip(summary["steps"], result.steps):
@@ -215,7 +215,7 @@ def summarize(result: AnalysisResult, p: SphereParameters) -> dict:
 def run(p: SphereParameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p), figures, on_step, resume)
 
@@ -226,7 +226,7 @@ def figures(folder) -> list[Path]:
     contact zone seen from below, with Hertz's circle r = a; ``pressure.png``, p/p0 against
     r/a at both bodies' contact candidate nodes with Hertz's ellipse; ``deformed.png``, the
     symmetry plane y = 0 near the contact, deformed, true scale."""
-    from ..io import plots
+    from vfem.io import plots
 
     s = folder.summary
     if not folder.has_steps or "hertz" not in s:
@@ -255,7 +255,7 @@ def figures(folder) -> list[Path]:
                        f"dashed: Hertz's r = a; contact edge radius {sph['a_estimate'] / a:.3f} a"
                        f" (spread {sph['contour_spread'] / a:.3f} a)")
     # the contact region in the symmetry plane y = 0 (the whole model: its mid-plane nodes)
-    from ..io.replot import plane_section
+    from vfem.io.replot import plane_section
 
     sections = []
     for b in last.bodies:

@@ -20,13 +20,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import Platen, Support
-from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import run_headline
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model
+from vfem.bodies import Platen, Support
+from vfem.config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model
 
 
 @dataclass(frozen=True)
@@ -216,7 +216,7 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
     """The ``summary.json`` dictionary of a Hertz run."""
     from dataclasses import asdict
 
-    from ..io.results import step_record
+    from vfem.io.results import step_record
 
     summary = {
         "example": "hertz",
@@ -246,7 +246,7 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
 def run(p: HertzParameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p), figures, on_step, resume)
 
@@ -256,7 +256,7 @@ def figures(folder) -> list[Path]:
     draws and ``vfem plot`` redraws: ``pressure.png``, p/p0 against x/a at the last step's
     contact candidate nodes (``contact.csv``) with Hertz's ellipse (a and p0 from
     ``summary.json``'s ``hertz``); ``deformed.png``, the contact region; ``von_mises.png``."""
-    from ..io import plots, replot
+    from vfem.io import plots, replot
 
     s = folder.summary
     if not folder.has_steps or "hertz" not in s:  # the full load was not reached

@@ -34,14 +34,14 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..bodies import Body, PrescribedDisplacement, Support
-from ..config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.search import project_points
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import run_headline
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model, StepResult
+from vfem.bodies import Body, PrescribedDisplacement, Support
+from vfem.config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.search import project_points
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model, StepResult
 
 
 @dataclass(frozen=True)
@@ -316,7 +316,7 @@ def force_history(summary: dict) -> np.ndarray:
 
 def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
     """The ``summary.json`` dictionary of a gasket run."""
-    from ..io.results import step_record
+    from vfem.io.results import step_record
 
     model = result.model
     steps = scheduled_steps(result)
@@ -390,7 +390,7 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
 def run(p: GasketParameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p),
                        (lambda model, r, summary: figure_data(r, summary, out)) if figures
@@ -404,7 +404,7 @@ def figure_data(result: AnalysisResult, summary: dict, out) -> None:
     predictions of the steps drawn (:data:`SHOWN_STEPS`)."""
     from pathlib import Path
 
-    from ..io.replot import write_frames
+    from vfem.io.replot import write_frames
 
     model = result.model
     steps = scheduled_steps(result)
@@ -430,7 +430,7 @@ def figures(folder) -> list:
     drawn through their midpoints); the soft gasket first, so each keeps its colour or line
     style in every figure.
     """
-    from ..io import plots, replot
+    from vfem.io import plots, replot
 
     s = folder.summary
     data = s.get("figure_data")

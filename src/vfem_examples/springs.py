@@ -14,7 +14,7 @@ import logging
 import time
 from dataclasses import asdict, dataclass
 
-from ..contact.formulations import SecantSpring, Step1D, solve_step
+from vfem.contact.formulations import SecantSpring, Step1D, solve_step
 
 log = logging.getLogger(__name__)
 
@@ -81,7 +81,7 @@ def run(params: SpringsParameters | None = None, out=None, on_step=None) -> dict
         "timings": {"total_s": time.perf_counter() - start},
     }
     if out is not None:
-        from ..io.results import write_summary
+        from vfem.io.results import write_summary
 
         write_summary(out, summary)
     return summary

@@ -27,13 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import PrescribedDisplacement, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import run_headline
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model
+from vfem.bodies import PrescribedDisplacement, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model
 
 
 @dataclass(frozen=True)
@@ -177,7 +177,7 @@ def evaluate(result: AnalysisResult, p: PressFitParameters) -> dict:
 def summarize(result: AnalysisResult, p: PressFitParameters) -> dict:
     """The ``summary.json`` dictionary of a press fit run: :func:`~vfem.io.results.
     example_summary` with the bodies' sizes and ``lame``."""
-    from ..io.results import solid_summary
+    from vfem.io.results import solid_summary
 
     return solid_summary("press_fit", result, p, "lame", evaluate)
 
@@ -185,7 +185,7 @@ def summarize(result: AnalysisResult, p: PressFitParameters) -> dict:
 def run(p: PressFitParameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example, writing VTU/PVD per step, ``summary.json`` and the figures to ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p), figures, on_step, resume)
 
@@ -193,7 +193,7 @@ def run(p: PressFitParameters, out, on_step=None, figures: bool = True,
 def figures(folder) -> list[Path]:
     """``pressure.png``: both bodies' nodal contact pressure over Lame's against the angle
     around the axis, every layer of nodes, at the fit (before a push)."""
-    from ..io import plots
+    from vfem.io import plots
 
     s = folder.summary
     if not folder.has_steps or "lame" not in s:

@@ -31,13 +31,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import Platen, PrescribedDisplacement, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import friction_line, run_headline
-from ..materials import LinearElastic
-from ..solver import AnalysisResult, Model
+from vfem.bodies import Platen, PrescribedDisplacement, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import friction_line, run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import AnalysisResult, Model
+
 from .sphere import CYLINDER_HEIGHT, CYLINDER_RADIUS, FLAT_DEPTH, FLAT_HALF_WIDTH, PLATEAU, contour
 
 #: The load factors nearest which the figures draw the stick zone and the shear profile.
@@ -202,7 +203,7 @@ def stick_slip(result: AnalysisResult, step) -> dict:
     nodes carry the friction status): undeformed x, y, the friction status (0 free, 1 stick,
     2 slip), the normal traction, the shear traction's x component on the flat and its y
     component; and the edge between sticking and other nodes (midpoints of the facet edges,
-    as :func:`vfem.examples.sphere.contour`)."""
+    as :func:`vfem_examples.sphere.contour`)."""
     fine = next(n for n, r in step.bodies.items() if (r.friction_status >= 0).any())
     body = next(b for b in result.model.bodies if b.name == fine)
     boundary = "contact" if fine == "sphere" else "top"
@@ -271,7 +272,7 @@ def picks(rows: list[dict]) -> list[int]:
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
-    from ..io.results import example_summary
+    from vfem.io.results import example_summary
 
     summary = example_summary("cattaneo3d", result, p)
     if result.steps:
@@ -295,7 +296,7 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
 def run(p: Parameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p), figures, on_step, resume)
 
@@ -306,7 +307,7 @@ def figures(folder) -> list[Path]:
     and 0.9: ``stick_map.png``, the compatibility side's nodes seen from below, sticking or
     slipping, with Mindlin's circle r = c and Hertz's r = a; ``shear.png``, the shear traction
     along x over mu p0 against x/a along y = 0, with Mindlin's."""
-    from ..io import plots, replot
+    from vfem.io import plots, replot
 
     s = folder.summary
     data = s.get("figure_data")

@@ -28,14 +28,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bodies import Platen, PrescribedDisplacement, Support
-from ..config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from ..contact.laws import coulomb_status, tangents
-from ..contact.settings import ContactSettings
-from ..errors import InputError
-from ..io.runner import friction_line, run_headline
-from ..materials import LinearElastic
-from ..solver import Analysis, AnalysisResult, Model
+from vfem.bodies import Platen, PrescribedDisplacement, Support
+from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
+from vfem.contact.laws import coulomb_status, tangents
+from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
+from vfem.io.runner import friction_line, run_headline
+from vfem.materials import LinearElastic
+from vfem.solver import Analysis, AnalysisResult, Model
 
 
 @dataclass(frozen=True)
@@ -96,7 +96,7 @@ def shear_curve(p: Parameters) -> tuple[tuple[float, float], ...]:
 
 def shear_multiplier(p: Parameters, load_factor: float) -> float:
     """The sideways motion at ``load_factor``, over ``shift``."""
-    from ..bodies import multiplier
+    from vfem.bodies import multiplier
 
     return float(multiplier(shear_curve(p), load_factor))
 
@@ -259,7 +259,7 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
 
 
 def summarize(result: AnalysisResult, p: Parameters) -> dict:
-    from ..io.results import example_summary
+    from vfem.io.results import example_summary
 
     summary = example_summary("cattaneo", result, p)
     if result.steps:
@@ -270,7 +270,7 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
 def run(p: Parameters, out, on_step=None, figures: bool = True,
         resume: bool = False) -> dict:
     """Run the example: VTU/PVD per step, ``summary.json`` and the figures in ``out``."""
-    from ..io.results import run_example
+    from vfem.io.results import run_example
 
     return run_example(build(p), out, lambda r: summarize(r, p),
                        (lambda model, result, summary: _figure_data(result, summary, p))
@@ -298,7 +298,7 @@ def figures(folder) -> list[Path]:
     ``loop.png``, Q/(mu P) against the motion (the hysteresis loop with ``cycle``);
     ``stick.png``, the stick zone's half-width of the theory and the outermost sticking node
     against the load factor; ``von_mises.png``, the contact at the last step."""
-    from ..io import plots, replot
+    from vfem.io import plots, replot
 
     s = folder.summary
     data = s.get("figure_data")
