@@ -93,7 +93,7 @@ from .kinematics import (
     strain_increment,
     updated_strain_increment,
 )
-from .materials.hyperelastic import NeoHookean, SaintVenantKirchhoff
+from .materials.protocol import Material
 
 log = logging.getLogger(__name__)
 
@@ -214,6 +214,7 @@ class _State:
     S: np.ndarray  # (dim, dim, ne, nq) 2nd Piola–Kirchhoff stress relative to that reference
     moduli: Callable[[], np.ndarray]  # gives D
     S33: np.ndarray | None  # (ne, nq) out-of-plane S_33 (plane strain); None in 3D
+    material_state: dict = field(default_factory=dict)  # what this iterate would commit
 
     @functools.cached_property
     def D(self) -> np.ndarray:
@@ -281,7 +282,9 @@ class NonlinearBody:
         mesh: a scikit-fem ``MeshTri1`` or ``MeshQuad1`` (or their quadratic-geometry ``MeshTri2``
             / ``MeshQuad2``), or in 3D ``MeshTet1`` / ``MeshHex1`` (``MeshTet2`` / ``MeshHex2``);
             named boundaries are used by :meth:`boundary_dofs`.
-        material: :class:`SaintVenantKirchhoff` or :class:`NeoHookean`.
+        material: :class:`SaintVenantKirchhoff`, :class:`NeoHookean`, or any law with the
+            :class:`~vfem.materials.Material` protocol: its state (none for these two) is
+            carried from step to step, committed by :meth:`accept`.
         order: 1 (P1/Q1) or 2 (P2/Q2). Elements are isoparametric: with ``order=2`` a linear mesh is
             given quadratic geometry (``MeshTri2.from_mesh``), so that the updated formulation can
             move the midside nodes with the displacement.
@@ -293,11 +296,12 @@ class NonlinearBody:
     with :meth:`add_nodal_forces`, then call :meth:`solve`.
     """
 
-    def __init__(self, mesh: Mesh, material: SaintVenantKirchhoff | NeoHookean, *, order: int = 1,
+    def __init__(self, mesh: Mesh, material: Material, *, order: int = 1,
                  formulation: str = TOTAL, name: str = "body"):
         self.name = name
-        if not isinstance(material, (SaintVenantKirchhoff, NeoHookean)):
+        if not isinstance(material, Material):
             raise InputError(f"{name}: material must be SaintVenantKirchhoff or NeoHookean, "
+                             f"or a law with the methods of vfem.materials.Material, "
                              f"got {type(material).__name__}")
         material.validate(f"{name}: material")
         if formulation not in (TOTAL, UPDATED):
@@ -330,6 +334,8 @@ class NonlinearBody:
         self.steps: list[NewtonStep] = []
         # updated Lagrangian state: the current configuration C_1 and the pseudo-strain 11_1 E
         self._reset_updated_state()
+        # the material's converged state at the quadrature points (materials.protocol)
+        self.material_state = material.initial_state(dim, self.pseudo_strain.shape[2:])
 
     # -- set-up ---------------------------------------------------------------------------------
 
@@ -452,20 +458,20 @@ class NonlinearBody:
             F = deformation_gradient(G0 + g)
             self._check_orientation(F)
             E = strain_increment(G0, g).total
-            return _State(basis, F, self.material.second_piola(E),
-                          lambda: self.material.tangent(E), self.material.out_of_plane_stress(E))
+            r = self.material.response(E, self.material_state)
+            return _State(basis, F, r.stress, r.moduli, r.out_of_plane, r.state)
         basis = self.current_basis
         h = _ElementArrays.of(basis).gradient(delta)
         f = deformation_gradient(h)
         self._check_orientation(f)
         E_pseudo = updated_strain_increment(h, self.pseudo_strain).total
-        S, moduli, S33 = self._pushed_material(E_pseudo)
-        return _State(basis, f, S, moduli, S33)
+        S, moduli, S33, material_state = self._pushed_material(E_pseudo)
+        return _State(basis, f, S, moduli, S33, material_state)
 
     def _pushed_material(self, E_pseudo: np.ndarray
-                         ) -> tuple[np.ndarray, Callable[[], np.ndarray], np.ndarray]:
+                         ) -> tuple[np.ndarray, Callable[[], np.ndarray], np.ndarray, dict]:
         """Stress and tangent conjugate to the pseudo-strain in ``C_1``, per unit volume of ``C_1``
-        (the tangent as a function, :class:`_State`).
+        (the tangent as a function, :class:`_State`), and the material state to commit.
 
         With ``F_1`` the deformation gradient of ``C_1`` the material sees the Green–Lagrange
         strain ``E = F_1^T E_pseudo F_1`` (eq. 2.8.9 read backwards) and the conjugate stress in
@@ -474,15 +480,15 @@ class NonlinearBody:
         """
         V, J1 = self._left_stretch()
         E = mul(V, mul(E_pseudo, V))
-        S = self.material.second_piola(E)
-        S_c = mul(V, mul(S, V)) / J1
+        r = self.material.response(E, self.material_state)
+        S_c = mul(V, mul(r.stress, V)) / J1
 
         def D_c() -> np.ndarray:
-            D = self.material.tangent(E)
+            D = r.moduli()
             return np.einsum("iI...,jJ...,IJKL...,kK...,lL...->ijkl...", V, V, D, V, V) / J1
 
-        S33 = self.material.out_of_plane_stress(E)
-        return S_c, D_c, (None if S33 is None else S33 / J1)
+        S33 = r.out_of_plane
+        return S_c, D_c, (None if S33 is None else S33 / J1), r.state
 
     def _left_stretch(self) -> tuple[np.ndarray, np.ndarray]:
         """``V_1 = b_1^(1/2)`` and ``J_1 = det V_1`` from the carried pseudo-strain (Almansi).
@@ -689,6 +695,10 @@ class NonlinearBody:
         """Make the last trial state (see :meth:`equilibrate`) the converged state."""
         if not self._trial_converged:
             raise AnalysisError(f"{self.name}: no converged trial state to accept")
+        if self.material_state:  # a law with history: the converged iterate's state
+            trial = self._trial_state if self._trial_state is not None else \
+                self._state(self._delta)
+            self.material_state = trial.material_state
         self._accept(self._delta)
         self.load_factor = self._trial_load_factor
         self.discard()
@@ -704,6 +714,7 @@ class NonlinearBody:
         """The converged state as arrays (step cutting restores it, checkpoints store it):
         everything the next step depends on; :meth:`restore_state` puts it back exactly."""
         state = {"load_factor": np.array(self.load_factor), "u": self._u_at_current.copy()}
+        state.update({f"material_{k}": v.copy() for k, v in self.material_state.items()})
         if self.formulation == UPDATED:
             state["pseudo_strain"] = self.pseudo_strain.copy()
             state["current_doflocs"] = self.current_mesh.doflocs.copy()
@@ -720,6 +731,7 @@ class NonlinearBody:
         self._u_at_current = np.array(state["u"], dtype=float)
         self.displacement = self._u_at_current.copy()
         self.load_factor = float(state["load_factor"])
+        self.material_state = {k: np.array(state[f"material_{k}"]) for k in self.material_state}
 
     def trial_displacement(self) -> np.ndarray:
         """Total displacement (ndofs) of the trial state (the converged one without a trial)."""
@@ -832,8 +844,9 @@ class NonlinearBody:
         return green_lagrange(self.basis0.interpolate(self.displacement).grad)
 
     def second_piola_kirchhoff(self) -> np.ndarray:
-        """(dim, dim, nelems, nqp) 2nd Piola–Kirchhoff stress relative to the initial mesh."""
-        return self.material.second_piola(self.green_lagrange_strain())
+        """(dim, dim, nelems, nqp) 2nd Piola–Kirchhoff stress relative to the initial mesh (the
+        material at its converged state)."""
+        return self.material.response(self.green_lagrange_strain(), self.material_state).stress
 
     def stress(self) -> np.ndarray:
         """(nelems, dim, dim) element averages (over the current volume) of the Cauchy stress."""

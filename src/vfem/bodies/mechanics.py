@@ -25,7 +25,7 @@ import scipy.sparse as sp
 
 from ..errors import AnalysisError
 from ..linalg import factorize
-from ..materials import NeoHookean, SaintVenantKirchhoff
+from ..materials import LAWS
 from ..nonlinear import NonlinearBody
 from .loads import boundary_dofs
 from .stresses import cauchy_stress, small_strain_stress
@@ -112,8 +112,7 @@ class LargeMechanics:
         starts from.
         """
         self.body = body
-        law = {"saint-venant-kirchhoff": SaintVenantKirchhoff, "neo-hookean": NeoHookean}[body.law]
-        material = law(body.material.youngs_modulus, body.material.poissons_ratio)
+        material = LAWS[body.law](body.material.youngs_modulus, body.material.poissons_ratio)
         nl = NonlinearBody(body.mesh, material, formulation=body.kinematics,
                            name=f"body {body.name!r}")
         dofs = np.array(sorted(fixed), dtype=int)

@@ -10,6 +10,7 @@ import numpy as np
 from skfem import MeshHex, MeshQuad, MeshTet, MeshTri
 
 from ..errors import InputError
+from ..materials import LAWS
 from ..mesh.checks import check_mesh
 from .discretisation import COMPONENTS, MESHES
 from .loads import _shown, check_amplitude, constraints
@@ -48,9 +49,9 @@ def validate(body) -> None:
     if body.kinematics not in ("small", "total", "updated"):
         raise InputError(f"{where}: kinematics must be 'small', 'total' or 'updated', "
                          f"got {body.kinematics!r}")
-    if body.law not in ("saint-venant-kirchhoff", "neo-hookean"):
-        raise InputError(f"{where}: law must be 'saint-venant-kirchhoff' or 'neo-hookean', "
-                         f"got {body.law!r}")
+    if body.law not in LAWS:
+        names = " or ".join(repr(name) for name in LAWS)
+        raise InputError(f"{where}: law must be {names}, got {body.law!r}")
     if body.dim == 3 and body.material.plane != "strain":
         raise InputError(f"{where}: plane = {body.material.plane!r} is an assumption of 2D "
                          "bodies; a 3D body (tetrahedra or hexahedra) has none: leave "

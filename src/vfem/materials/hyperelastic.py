@@ -28,6 +28,7 @@ import numpy as np
 from ..kinematics import determinant as _det
 from ..kinematics import inverse as _inv
 from .elastic import check_elastic_constants
+from .protocol import Response, State
 
 
 def _eye_like(E: np.ndarray) -> np.ndarray:
@@ -64,7 +65,8 @@ def _sym_outer(A: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class _Isotropic:
-    """The two constants of an isotropic law, as in :class:`LinearElastic`."""
+    """The two constants of an isotropic hyperelastic law, as in :class:`LinearElastic`, and
+    its answer to the :class:`~vfem.materials.protocol.Material` protocol (no state)."""
 
     youngs_modulus: float
     poissons_ratio: float
@@ -76,6 +78,17 @@ class _Isotropic:
     def lame(self) -> tuple[float, float]:
         """(Small-strain) Lamé constants (lambda, mu), plane strain."""
         return _lame(self.youngs_modulus, self.poissons_ratio)
+
+    # -- the Material protocol (vfem.materials.protocol): a hyperelastic law has no history ----
+
+    def initial_state(self, dim: int, points: tuple[int, int]) -> State:
+        """No state: the stress is a function of the strain alone."""
+        return {}
+
+    def response(self, E: np.ndarray, state: State) -> Response:
+        """``S(E)``, ``dS/dE`` when asked, ``S_33`` in plane strain; ``state`` unchanged."""
+        return Response(self.second_piola(E), lambda: self.tangent(E),
+                        self.out_of_plane_stress(E), state)
 
 
 @dataclass(frozen=True)
@@ -195,4 +208,8 @@ class NeoHookean(_Isotropic):
 
 HyperelasticMaterial = SaintVenantKirchhoff | NeoHookean
 
-__all__ = ["SaintVenantKirchhoff", "NeoHookean", "HyperelasticMaterial"]
+#: the hyperelastic laws by the name a body's ``law`` gives (``[bodies.law]`` in an input file)
+LAWS: dict[str, type] = {"saint-venant-kirchhoff": SaintVenantKirchhoff,
+                         "neo-hookean": NeoHookean}
+
+__all__ = ["SaintVenantKirchhoff", "NeoHookean", "HyperelasticMaterial", "LAWS"]

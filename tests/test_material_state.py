@@ -1,0 +1,188 @@
+"""A material law with history drops into the bodies through the ``Material`` protocol
+(``vfem.materials.protocol``; issue 38, the seam issue 41's plastic laws need): its state is
+carried at the quadrature points, committed only when a step converges, left untouched by a
+discarded trial, saved and restored bit for bit, and a contact analysis runs it unchanged.
+
+The laws here are test laws, not physical ones, chosen for closed forms:
+
+* :class:`Damage`: Saint Venant-Kirchhoff scaled by ``1 - d``, ``d = min(D_MAX, RATE * kappa)``
+  with ``kappa`` the largest norm of the Green-Lagrange strain reached so far (at converged
+  states, and the iterate's own). Every dof of the block it is tried on is prescribed (a
+  homogeneous stretch), so Newton needs no tangent and the numbers are exact: under prescribed
+  displacements alone a uniformly scaled stress leaves the displacement as it is and scales the
+  reactions by ``1 - d``; back at a smaller stretch the reactions remember the largest one.
+* :class:`Recording`: Saint Venant-Kirchhoff whose state records ``kappa`` and nothing else, for
+  a contact analysis: the answers are Saint Venant-Kirchhoff's to the last digit, and the state
+  after each step is the largest strain norm of the steps' converged fields.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from vfem.bodies import Body, PrescribedDisplacement, Support
+from vfem.contact.settings import ContactSettings
+from vfem.materials import LAWS, LinearElastic, Material, Response, SaintVenantKirchhoff
+from vfem.mesh.shapes import rectangle
+from vfem.nonlinear import NonlinearBody
+from vfem.solver import Analysis, Model
+
+RATE, D_MAX = 20.0, 0.6
+E_MOD, NU = 1000.0, 0.3
+
+
+def strain_norm(E):
+    return np.sqrt(np.einsum("ij...,ij...->...", E, E))
+
+
+@dataclass(frozen=True)
+class Recording(SaintVenantKirchhoff):
+    """Saint Venant-Kirchhoff with a state that records the largest strain norm reached."""
+
+    def initial_state(self, dim, points):
+        return {"kappa": np.zeros(points)}
+
+    def response(self, E, state):
+        r = super().response(E, state)
+        r.state = {"kappa": np.maximum(state["kappa"], strain_norm(E))}
+        return r
+
+
+@dataclass(frozen=True)
+class Damage(Recording):
+    """Saint Venant-Kirchhoff times ``1 - d(kappa)`` (see the module docstring); its tangent is
+    the secant one (the tests prescribe every dof: Newton solves nothing)."""
+
+    def damage(self, kappa):
+        return np.minimum(D_MAX, RATE * kappa)
+
+    def response(self, E, state):
+        kappa = np.maximum(state["kappa"], strain_norm(E))
+        scale = 1.0 - self.damage(kappa)
+        S33 = self.out_of_plane_stress(E)
+        return Response(scale * self.second_piola(E), lambda: scale * self.tangent(E),
+                        None if S33 is None else scale * S33, {"kappa": kappa})
+
+
+def stretched(law, formulation: str) -> NonlinearBody:
+    """A unit square of 3 x 3 quadrilaterals, every node's displacement prescribed as a uniform
+    stretch ``(0.01 x, -0.004 y)`` times the load factor: a homogeneous strain."""
+    mesh = rectangle(nx=3, ny=3)
+    body = NonlinearBody(mesh, law, formulation=formulation, name="block")
+    x, y = body.mesh.doflocs
+    nodes = np.arange(body.mesh.nvertices)
+    body.prescribe(body.node_dofs(nodes, "x"), 0.01 * x)
+    body.prescribe(body.node_dofs(nodes, "y"), -0.004 * y)
+    return body
+
+
+def test_both_hyperelastic_laws_keep_the_protocol_without_state():
+    for law in LAWS.values():
+        material = law(E_MOD, NU)
+        assert isinstance(material, Material)
+        assert material.initial_state(2, (4, 3)) == {}
+        E = np.zeros((2, 2, 4, 3))
+        E[0, 0] = 0.01
+        r = material.response(E, {})
+        assert np.array_equal(r.stress, material.second_piola(E))
+        assert np.array_equal(r.moduli(), material.tangent(E))
+        assert r.state == {}
+    assert not isinstance(LinearElastic(E_MOD, NU), Material)  # no response: small strain only
+
+
+@pytest.mark.parametrize("formulation", ["total", "updated"])
+def test_the_state_is_committed_by_a_converged_step_only(formulation):
+    law = Damage(E_MOD, NU)
+    body = stretched(law, formulation)
+    ref = stretched(SaintVenantKirchhoff(E_MOD, NU), formulation)
+    eps = np.finfo(float).eps
+    for lf in (1.0, 2.0):
+        body.solve([lf])
+        ref.solve([lf])
+        # the displacement is prescribed everywhere: the same field for both laws
+        assert np.array_equal(body.displacement, ref.displacement)
+        norm = strain_norm(body.green_lagrange_strain())
+        # committed: the strain norm of the converged field (it only grows here)
+        assert np.allclose(body.material_state["kappa"], norm, rtol=1e-12, atol=0.0)
+        # the reactions scaled by the damage at that strain (uniform)
+        d = float(law.damage(norm).mean())
+        r, r0 = body.reactions(), ref.reactions()
+        assert np.abs(r - (1.0 - d) * r0).max() <= 1e3 * eps * np.abs(r0).max()
+
+    saved = body.saved_state()
+    assert np.array_equal(saved["material_kappa"], body.material_state["kappa"])
+    before = body.material_state["kappa"].copy()
+    body.equilibrate(3.0)  # a trial beyond the step, then dropped (a cut step)
+    body.discard()
+    assert np.array_equal(body.material_state["kappa"], before)
+    body.equilibrate(3.0)
+    body.accept()
+    assert (body.material_state["kappa"] > before).all()
+    # restored from the saved arrays, the next step is the same bit for bit
+    first = body.displacement.copy(), body.reactions().copy(), body.material_state["kappa"]
+    body.restore_state(saved)
+    assert np.array_equal(body.material_state["kappa"], before)
+    body.equilibrate(3.0)
+    body.accept()
+    assert np.array_equal(body.displacement, first[0])
+    assert np.array_equal(body.reactions(), first[1])
+    assert np.array_equal(body.material_state["kappa"], first[2])
+
+
+def test_unloading_remembers_the_largest_strain():
+    """Path dependence, which no hyperelastic law has: back at load factor 1 after 2, the
+    reactions are those of the Saint Venant-Kirchhoff block at 1 scaled by ``1 - d`` of the
+    strain at 2, not of the strain at 1 as on the way up."""
+    law = Damage(E_MOD, NU)
+    body = stretched(law, "total")
+    ref = stretched(SaintVenantKirchhoff(E_MOD, NU), "total")
+    ref.solve([1.0])
+    body.solve([1.0])
+    d1 = float(law.damage(strain_norm(body.green_lagrange_strain())).mean())
+    body.solve([2.0])
+    d2 = float(law.damage(strain_norm(body.green_lagrange_strain())).mean())
+    body.solve([1.0])
+    assert d2 > d1 + 0.1
+    eps = np.finfo(float).eps
+    r0 = ref.reactions()
+    assert np.abs(body.reactions() - (1.0 - d2) * r0).max() <= 1e3 * eps * np.abs(r0).max()
+
+
+def test_a_contact_analysis_carries_the_law_unchanged(monkeypatch):
+    """A block of a law with state under large kinematics, pressed by a stiffer punch in
+    three steps (down, further, back up): contact sees only the body's mechanics, so the
+    answers are Saint Venant-Kirchhoff's bit for bit, and after the run the body's saved state
+    holds the largest strain norm of the steps' converged fields, computed here from the steps'
+    displacements."""
+    monkeypatch.setitem(LAWS, "recording", Recording)
+
+    def run(law):
+        block = Body("block", rectangle(-1.0, -1.0, 2.0, 1.0, nx=10, ny=5),
+                     LinearElastic(E_MOD, NU), supports=(Support("bottom"),),
+                     contact_boundaries=("top",), kinematics="total", law=law)
+        punch = Body("punch", rectangle(-0.35, 0.0, 0.7, 0.3, nx=5, ny=2),
+                     LinearElastic(20 * E_MOD, NU),
+                     prescribed=(PrescribedDisplacement("top", "y", -0.02),),
+                     supports=(Support("top", ("x",)),), contact_boundaries=("bottom",))
+        model = Model("damage", [block, punch], load_factors=[1.0, 2.0, 1.0])
+        model.contact = ContactSettings()
+        result = Analysis(model).run()
+        assert result.converged, result.message
+        return result, block
+
+    recorded, block = run("recording")
+    plain, _ = run("saint-venant-kirchhoff")
+    for a, b in zip(recorded.steps, plain.steps):
+        assert np.array_equal(a.bodies["block"].displacement, b.bodies["block"].displacement)
+        assert np.array_equal(a.bodies["punch"].contact_force, b.bodies["punch"].contact_force)
+    nl = block.nonlinear
+    kappa = np.zeros_like(nl.material_state["kappa"])
+    for step in recorded.steps:
+        grad = nl.basis0.interpolate(np.ravel(step.bodies["block"].displacement)).grad
+        E = 0.5 * (grad + np.einsum("ij...->ji...", grad)
+                   + np.einsum("ki...,kj...->ij...", grad, grad))
+        kappa = np.maximum(kappa, strain_norm(E))
+    assert kappa.max() > 0.01
+    assert np.allclose(block.saved_state()["material_kappa"], kappa, rtol=1e-9,
+                       atol=1e-12 * kappa.max())
