@@ -7,6 +7,7 @@ converged state breaks one; summary.json and checkpoints carrying the measures p
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 from types import SimpleNamespace
@@ -18,6 +19,7 @@ from skfem import MeshQuad, MeshTri
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.cli import main
 from vfem.contact.invariants.check import InvariantCheck, step_invariants
+from vfem.contact.invariants.plane import PLANE
 from vfem.contact.invariants.polygon import _Boundary, _Polygon
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InvariantViolation
@@ -254,15 +256,16 @@ def test_a_node_inside_only_on_the_deformed_geometry_is_recorded_not_failed(monk
     here to say 1e-3 outside while the upper block lies 1e-3 inside the lower one."""
     bodies = blocks()
     shift = 1e-3
-    real = InvariantCheck._linearised_depth
+    real = PLANE.linearised_depth
 
-    def outside(self, i, j, node, cur):
-        depth, second = real(self, i, j, node, cur)
+    def outside(reference, i, j, node, cur):
+        depth, second = real(reference, i, j, node, cur)
         return depth - 2 * shift, second
 
     fields = state(bodies, shift=shift, pressure=0.0)
     assert step_invariants(bodies, None, fields, TOL).second_order is None  # read alike
-    monkeypatch.setattr(InvariantCheck, "_linearised_depth", outside)
+    monkeypatch.setattr(InvariantCheck, "kind", property(
+        lambda self: dataclasses.replace(PLANE, linearised_depth=outside)))
     inv = step_invariants(bodies, None, fields, TOL)
     assert inv.separated and inv.ok
     w = inv.second_order

@@ -62,11 +62,9 @@ import time
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-from ..search import project_points
-from .check3d import CORNER_ANGLE
+from .check3d import SOLID
+from .kind import SurfaceKind
 from .measures import (
     FORCE_BALANCE_TOLERANCE,
     QUADRATIC_TENSION_TOLERANCE,
@@ -74,7 +72,7 @@ from .measures import (
     TENSION_TOLERANCE,
     Invariants,
 )
-from .polygon import _Boundary, _Polygon, _scatter_add, _symmetry_facets
+from .plane import PLANE
 
 if TYPE_CHECKING:
     from ...bodies import Body
@@ -125,20 +123,30 @@ class InvariantCheck:
         self.tension_tolerance = float(tension_tolerance)
         self.quadratic_tension_tolerance = float(quadratic_tension_tolerance)
         self.tension_measure = tension_measure
-        self._boundaries: list[_Boundary] | None = None
-        self._reference: list[_Polygon] | None = None
+        self._kind: SurfaceKind | None = None
+        self._boundaries: list | None = None
+        self._reference: list | None = None
 
     @property
-    def boundaries(self) -> list[_Boundary]:
+    def kind(self) -> SurfaceKind:
+        """What the invariants read of these bodies (:mod:`.kind`): 3D surfaces if any body
+        is 3D, 2D polygons otherwise; the one place the checker asks the dimension."""
+        if self._kind is None:
+            self._kind = SOLID if any(b.dim == 3 for b in self.bodies) else PLANE
+        return self._kind
+
+    @property
+    def boundaries(self) -> list:
+        """Each body's boundary, from its undeformed mesh (``kind.boundary``)."""
         if self._boundaries is None:
-            self._boundaries = [_Boundary.of(b) for b in self.bodies]
+            self._boundaries = [self.kind.boundary(b) for b in self.bodies]
         return self._boundaries
 
     @property
-    def reference(self) -> list[_Polygon]:
-        """Each body's boundary undeformed."""
+    def reference(self) -> list:
+        """Each body's boundary undeformed (``kind.surface``)."""
         if self._reference is None:
-            self._reference = [_Polygon(g, b.points[:, g.nodes].T)
+            self._reference = [self.kind.surface(g, b.points[:, g.nodes].T)
                                for b, g in zip(self.bodies, self.boundaries)]
         return self._reference
 
@@ -146,68 +154,42 @@ class InvariantCheck:
                  force_tolerance: float | None = None,
                  enforced: tuple[str, ...] | None = None) -> Invariants:
         """The invariants of a state: ``fields[body name]`` has ``displacement`` and
-        ``contact_force`` ((npoints, 2) each, at ``Body.points``). ``extra_allowance`` is added
-        to every allowed depth, ``force_tolerance`` replaces (a)'s and ``enforced`` names the
-        invariants that decide ``ok`` (default all three; the thesis variant's residual
-        errors)."""
+        ``contact_force`` ((npoints, dim) each, at ``Body.points``). ``extra_allowance`` is
+        added to every allowed depth, ``force_tolerance`` replaces (a)'s and ``enforced`` names
+        the invariants that decide ``ok`` (default all three; the thesis variant's residual
+        errors). One reading for 2D and 3D: the dimension's parts are the kind's."""
         t0 = time.perf_counter()
+        kind = self.kind
         out = Invariants(force_tolerance=self.force_tolerance if force_tolerance is None
                          else float(force_tolerance),
                          tension_measure=self.tension_measure)
         if enforced is not None:
             out.enforced = tuple(enforced)
-        if any(b.dim == 3 for b in self.bodies):
-            return self._three_d(fields, out, extra_allowance, t0)
-        ref = self.reference
-        u = [np.asarray(fields[b.name].displacement)[g.nodes]
-             for b, g in zip(self.bodies, self.boundaries)]
-        cur = [r if not np.any(ui) else _Polygon(r.b, r.x + ui) for r, ui in zip(ref, u)]
-        F = [np.asarray(fields[b.name].contact_force, dtype=float) for b in self.bodies]
-        Fb = [f[g.nodes] for f, g in zip(F, self.boundaries)]
-        self._force_balance(F, out)
-        self._interpenetration(cur, out, extra_allowance, Fb)
-        # (c)'s normals: the deformed ones under large kinematics, the undeformed ones (linear
-        # theory's) under small
-        own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
-        if self.tension_measure == "nodal":
-            self._tension_nodal(Fb, own, out)
-        else:
-            self._tension_consistent(Fb, own, out)
-        out.seconds = time.perf_counter() - t0
-        return out
-
-    def _three_d(self, fields: dict, out: Invariants, extra: float, t0: float
-                 ) -> Invariants:
-        """The invariants of 3D bodies (:mod:`vfem.contact.invariants.check3d`: boundaries of
-        triangles and quadrilaterals). Bodies that touch nothing (no pair, no contact force) are not
-        visited: (a) their forces, all zero, balance; (b) and (c) hold."""
-        from . import check3d
         F = [np.asarray(fields[b.name].contact_force, dtype=float) for b in self.bodies]
         self._force_balance(F, out)
-        if not self.pairs and not any(np.any(f) for f in F):
-            out.allowed = self.penetration_tolerance + extra  # as where no node is inside
+        if kind.skips_untouched and not self.pairs and not any(np.any(f) for f in F):
+            # nothing may touch and no force acts: (a) balances, (b) and (c) hold
+            out.allowed = self.penetration_tolerance + extra_allowance
             out.tension_tolerance = min((self._tolerance(b) for b in self.bodies),
                                         default=self.tension_tolerance)
             out.seconds = time.perf_counter() - t0
             return out
-        if self.tension_measure != "nodal":
-            raise NotImplementedError("the consistent tension measure in 3D is not implemented "
-                                      "(tension_measure='nodal' is)")
-        if self._reference is None:
-            boundaries = [check3d.Boundary3.of(b, _symmetry_facets(b)) for b in self.bodies]
-            self._boundaries = boundaries
-            self._reference = [check3d.Surface3(g, b.points[:, g.nodes].T)
-                               for b, g in zip(self.bodies, boundaries)]
-        ref = self._reference
+        if self.tension_measure not in kind.tension_measures:
+            raise NotImplementedError(f"the {self.tension_measure} tension measure in "
+                                      f"{kind.name} is not implemented (tension_measure="
+                                      f"{' or '.join(repr(m) for m in kind.tension_measures)} "
+                                      "is)")
+        ref = self.reference
         u = [np.asarray(fields[b.name].displacement)[g.nodes]
-             for b, g in zip(self.bodies, self._boundaries)]
-        cur = [r if not np.any(ui) else check3d.Surface3(r.b, r.x + ui) for r, ui in zip(ref, u)]
-        Fb = [f[g.nodes] for f, g in zip(F, self._boundaries)]
-        self._interpenetration(cur, out, extra, Fb, lambda i, j, node, cur:
-                               check3d.linearised_depth(ref, i, j, node, cur))
+             for b, g in zip(self.bodies, self.boundaries)]
+        cur = [r if not np.any(ui) else kind.surface(r.b, r.x + ui) for r, ui in zip(ref, u)]
+        Fb = [f[g.nodes] for f, g in zip(F, self.boundaries)]
+        self._interpenetration(cur, out, extra_allowance, Fb)
+        # (c)'s normals: the deformed ones under large kinematics, the undeformed ones (linear
+        # theory's) under small
         own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
-        out.tension, out.tension_tolerance, out.tension_where = check3d.tension(
-            self.bodies, self._tolerance, self.tension_tolerance, Fb, own)
+        out.tension, out.tension_tolerance, out.tension_where = kind.tension(
+            self.bodies, self._tolerance, self.tension_tolerance, Fb, own, self.tension_measure)
         out.seconds = time.perf_counter() - t0
         return out
 
@@ -226,14 +208,11 @@ class InvariantCheck:
     # -- (b) ------------------------------------------------------------------------------------
 
     def _interpenetration(self, cur: list, out: Invariants, extra: float,
-                          forces: list[np.ndarray] | None = None, linearised_depth=None) -> None:
-        """(b) on the current surfaces ``cur`` (2D :class:`_Polygon` s, or 3D
+                          forces: list[np.ndarray] | None = None) -> None:
+        """(b) on the current surfaces ``cur`` (2D :class:`~.polygon._Polygon` s, or 3D
         :class:`~vfem.contact.invariants.check3d.Surface3` s, which answer the same questions: box,
-        inside, depth, turning_within, adjacent); ``linearised_depth`` (i, j, node, cur) ->
-        (depth, second-order allowance): small kinematics' reading, 2D's
-        :meth:`_linearised_depth` by default."""
-        if linearised_depth is None:
-            linearised_depth = self._linearised_depth
+        inside, depth, turning_within, adjacent); small kinematics' reading of a depth is the
+        kind's (``kind.linearised_depth``)."""
         tol = self.penetration_tolerance + extra
         # per body: its boundary nodes that carry contact force or neighbour one that does
         touched = None if forces is None else [_loaded_or_next(g.b.segments, f)
@@ -261,7 +240,8 @@ class InvariantCheck:
                 L = np.where(touched[j][ends].any(axis=1), L, 0.0)
             deformed, linearised, second = depth, None, 0.0
             if not (gi.b.large or gj.b.large):
-                linearised, second = linearised_depth(i, j, node, cur)
+                linearised, second = self.kind.linearised_depth(self.reference, i, j, node,
+                                                                cur)
                 depth = np.minimum(depth, linearised)
             alpha = np.minimum(gi.turning_within(node, L), 0.5 * np.pi)
             allowed = tol + second + np.minimum(0.5 * L * np.tan(0.5 * alpha),
@@ -314,177 +294,10 @@ class InvariantCheck:
             "deformed_depth": float(deformed[k]), "linearised_depth": float(linearised[k]),
             "allowed": float(allowed[k]), "beyond": float(over[k])}
 
-    def _linearised_depth(self, i: int, j: int, node: np.ndarray, cur: list[_Polygon]
-                          ) -> np.ndarray:
-        """Small kinematics: the depth of body i's boundary ``node`` (local numbers) into body
-        j as linear theory reads it. With X_c the closest point on j's undeformed surface and
-        u_c the displacement there (linear along the segment), r = X + u - (X_c + u_c) is the
-        node's offset from it; the depth is -n . r with n the outward normal of the segment,
-        and where X_c is a vertex, |r| with the sign of -r . (the sum of the vertex's two
-        normals): a node beside a corner is not read along the extension of one of its
-        facets. A node that lies on a vertex of j (distance 0: a tie) is read against the
-        facet that faces its own surface (the face of a punch, not its side). Off the
-        vertices the depth is the smaller of the readings along j's facet normal and along
-        i's own outward normal (the formulation may measure along either, or between them;
-        after a slip they differ by the slip times the angle between the surfaces).
-
-        Returns the depth and its second-order allowance: the slip along j's facet times the
-        angle the facet has turned through (linear theory holds the gap at the material point
-        the node faced undeformed, and cannot do better; measured on the wedge, 30 % strain:
-        a slip of 1.9e-3 on a facet turned 0.023 rad put a plate node 2.4e-5 inside). The slip
-        is counted from the closest point plus the undeformed distance times the tangent of the
-        angle between the surfaces (the material point faced along the node's own normal)."""
-        ri, rj = self.reference[i], self.reference[j]
-        keep = rj.surface
-        seg_nodes = rj.b.segments[keep]
-        A, B = (e[keep] for e in rj.ends)
-        normals = rj.unit_normals[keep]
-        vertex_normal = rj._get("surface_vertex_normals", lambda: _scatter_add(
-            len(rj.x), seg_nodes, normals))
-        # a node on a vertex of j's surface (the block's node under a punch's corner) is read
-        # against the facet that faces its own surface, not the other one through the vertex
-        seg, t, dist, tf = project_points(ri.x[node], A, B, point_normals=ri.normals[node],
-                                          free=True)
-        c = A[seg] + t[:, None] * (B[seg] - A[seg])
-        uj = cur[j].x - rj.x
-        ends = seg_nodes[seg]
-        uc = (1 - t)[:, None] * uj[ends[:, 0]] + t[:, None] * uj[ends[:, 1]]
-        r = cur[i].x[node] - (c + uc)
-        # linear theory measures the gap along one normal per pair; which one (j's facet's,
-        # i's own, or a blend of the two, as the paired formulation's common normal) is a
-        # choice of the formulation, and after a slip s along surfaces that meet at an angle
-        # the readings differ by s times that angle: a penetration counts only if both
-        # surfaces' normals see it
-        # (not along i's own normal at a convex corner of i, turning by more than
-        # CORNER_ANGLE: its nodal normal is only a bisector there, along which no contact is
-        # measured, and a slide along j's facet read along it is a large false gap; a block's
-        # corner slid 0.016 along a quarter disk's flank, 1.3e-5 inside it, read 7.4e-3 outside)
-        own = np.einsum("ij,ij->i", r, ri.normals[node])
-        own[ri.turning[node] > CORNER_ANGLE] = np.inf
-        depth = np.minimum(-np.einsum("ij,ij->i", r, normals[seg]), own)
-        # or along j's smoothed normal there (its vertex normals, the mean of the adjacent
-        # facets' unit normals, interpolated along the facet: the usual normal field of
-        # node-to-segment contact, tilted off a straight facet next to a kink)
-        unit = vertex_normal / np.maximum(np.linalg.norm(vertex_normal, axis=1), 1e-300)[:, None]
-        tt = np.clip(t, 0.0, 1.0)[:, None]
-        smooth = (1 - tt) * unit[ends[:, 0]] + tt * unit[ends[:, 1]]
-        smooth /= np.maximum(np.linalg.norm(smooth, axis=1), 1e-300)[:, None]
-        depth = np.minimum(depth, -np.einsum("ij,ij->i", r, smooth))
-        at = np.where(t <= 0, ends[:, 0], ends[:, 1])
-        # beside a vertex: outside the strip of the nearest facet (a node right under a vertex
-        # of a straight stretch lies on both strips' edges and is read along the normal; read
-        # as a distance, its slip along the surface would count as depth)
-        vertex = ((tf < -1e-9) | (tf > 1 + 1e-9)) & (dist > 1e-12 * np.maximum(
-            np.linalg.norm(B[seg] - A[seg], axis=1), 1e-300))
-        outside = np.einsum("ij,ij->i", r, vertex_normal[at]) > 0
-        depth[vertex] = np.where(outside, -1.0, 1.0)[vertex] * np.linalg.norm(r, axis=1)[vertex]
-        # second order: linear theory holds the gap at the material point the node faced
-        # undeformed; after a slip s along a facet that has turned through theta, the node
-        # sits s * theta off the facet as it now lies, whichever normal is read
-        d0 = B[seg] - A[seg]
-        d1 = cur[j].x[ends[:, 1]] - cur[j].x[ends[:, 0]]
-        theta = np.abs(np.arctan2(d0[:, 0] * d1[:, 1] - d0[:, 1] * d1[:, 0],
-                                  np.einsum("ij,ij->i", d0, d1)))
-        slip = np.abs(np.einsum("ij,ij->i", r, d0)) / np.maximum(
-            np.linalg.norm(d0, axis=1), 1e-300)
-        # the material point a formulation pairs the node with lies between the closest point
-        # and the point along the node's own normal: dist * tan(beta) apart, beta the angle
-        # between the two surfaces' normals
-        cos_beta = np.clip(-np.einsum("ij,ij->i", normals[seg], ri.normals[node]), 1e-3, 1.0)
-        slip = slip + dist * np.sqrt(1.0 - cos_beta**2) / cos_beta
-        # and a quadratic facet's sag: the formulation interpolates over it quadratically, this
-        # check linearly over its two half chords; they part by up to an eighth of the
-        # displacements' second difference |u_a - 2 u_m + u_b| / 8 along the normal (random
-        # quadratic models 2d-75, 2d-122, 2d-297 stopped 13-27 % beyond a tolerance of 3e-7)
-        sag = np.zeros(len(node))
-        nf = len(rj.b.facets)
-        if rj.b.facets.shape[1] == 3:
-            f = rj.b.facets[keep[seg] % nf]
-            bend = uj[f[:, 0]] - 2.0 * uj[f[:, 2]] + uj[f[:, 1]]
-            sag = 0.125 * np.abs(np.einsum("ij,ij->i", bend, normals[seg]))
-        return depth, np.where(vertex, 0.0, slip * theta) + sag
-
     # -- (c) ------------------------------------------------------------------------------------
 
     def _tolerance(self, body: Body) -> float:
         return self.quadratic_tension_tolerance if body.order != 1 else self.tension_tolerance
-
-    def _tension_nodal(self, F: list[np.ndarray], own: list[_Polygon], out: Invariants) -> None:
-        scale = max((float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in F),
-                    default=0.0)
-        out.tension_tolerance = min((self._tolerance(b) for b in self.bodies),
-                                    default=self.tension_tolerance)
-        if scale == 0:
-            return
-        worst = None  # (value / scale / tolerance, value, body, local node)
-        for b, f, g in zip(self.bodies, F, own):
-            fn = np.einsum("ij,ij->i", f, g.normals)
-            if g.b.facets.shape[1] == 3:
-                # quadratic facets: a vertex with the midpoints of its facets (weights
-                # 1 - phi_far_end >= 0 on each facet), a midpoint alone (4 t (1 - t) >= 0)
-                mid = g.b.facets[:, 2]
-                patch = fn.copy()
-                for col in (0, 1):
-                    np.add.at(patch, g.b.facets[:, col], fn[mid])
-                patch[mid] = fn[mid]
-                fn = patch
-            if not len(fn):
-                continue
-            k = int(np.argmax(fn))
-            ratio = fn[k] / scale / self._tolerance(b)
-            if fn[k] > 0 and (worst is None or ratio > worst[0]):
-                worst = (ratio, float(fn[k]), b, k)
-        if worst is not None:
-            _, value, b, k = worst
-            out.tension = value / scale
-            out.tension_tolerance = self._tolerance(b)
-            out.tension_where = {"body": b.name, "node": int(own[self.bodies.index(b)].b.nodes[k]),
-                                 "value": value}
-
-    def _tension_consistent(self, F: list[np.ndarray], own: list[_Polygon],
-                            out: Invariants) -> None:
-        recovered = []
-        for b, f, g in zip(self.bodies, F, own):
-            fn = np.einsum("ij,ij->i", f, g.normals)
-            carries = np.linalg.norm(f, axis=1) > 0
-            # the facets whose every node carries force: where the traction is not zero
-            fac = g.b.facets[carries[g.b.facets].all(axis=1)]
-            if not len(fac):
-                continue
-            used = np.unique(fac)
-            local = np.full(len(f), -1)
-            local[used] = np.arange(len(used))
-            M = _boundary_mass(g.x, fac, local, len(used))
-            p = spla.spsolve(M.tocsc(), -fn[used])
-            recovered.append((b, g.b.nodes[used], np.atleast_1d(p)))
-        out.tension_tolerance = self.tension_tolerance
-        scale = max((float(np.abs(p).max(initial=0.0)) for _, _, p in recovered), default=0.0)
-        if scale == 0:
-            return
-        worst = None
-        for b, nodes, p in recovered:
-            k = int(np.argmin(p))
-            if p[k] < 0 and (worst is None or -p[k] > worst[0]):
-                worst = (float(-p[k]), b.name, int(nodes[k]), float(p[k]))
-        if worst is not None:
-            out.tension = worst[0] / scale
-            out.tension_where = {"body": worst[1], "node": worst[2], "value": worst[3]}
-
-
-def _boundary_mass(x: np.ndarray, facets: np.ndarray, local: np.ndarray, n: int
-                   ) -> sp.csr_matrix:
-    """The mass matrix ∫φφᵀ over straight boundary facets (2 or 3 nodes: ends, midpoint)."""
-    L = np.linalg.norm(x[facets[:, 1]] - x[facets[:, 0]], axis=1)
-    if facets.shape[1] == 2:
-        ref = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
-    else:
-        ref = np.array([[4.0, -1.0, 2.0], [-1.0, 4.0, 2.0], [2.0, 2.0, 16.0]]) / 30.0
-    k = facets.shape[1]
-    rows = np.repeat(local[facets], k, axis=1).ravel()
-    cols = np.tile(local[facets], (1, k)).ravel()
-    vals = (L[:, None, None] * ref[None]).ravel()
-    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
-
 
 def _loaded_or_next(segments: np.ndarray, forces: np.ndarray) -> np.ndarray:
     """(nb,) the boundary nodes that carry a contact force (``forces``, (nb, 2)) or share a

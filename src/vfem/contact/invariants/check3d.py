@@ -44,6 +44,8 @@ from scipy.spatial import cKDTree
 
 from ..geometry import closest_on_facets, kind_of
 from .cached_boundary import CachedBoundary
+from .kind import SurfaceKind
+from .polygon import _symmetry_facets
 
 if TYPE_CHECKING:
     from ...bodies import Body
@@ -347,7 +349,7 @@ def linearised_depth(reference: list[Surface3], i: int, j: int, node: np.ndarray
                      cur: list[Surface3]) -> tuple[np.ndarray, np.ndarray]:
     """Small kinematics: the depth of body i's boundary ``node`` (local numbers) into body j as
     linear theory reads it, and its second-order allowance (2D:
-    :meth:`~vfem.contact.invariants.check.InvariantCheck._linearised_depth`)."""
+    :func:`vfem.contact.invariants.plane.linearised_depth`)."""
     ri, rj = reference[i], reference[j]
     keep = rj.surface
     tri, lam, c, dist = rj._closest(ri.x[node], keep, point_normals=ri.normals[node])
@@ -395,7 +397,8 @@ def linearised_depth(reference: list[Surface3], i: int, j: int, node: np.ndarray
 
 
 def tension(bodies: list[Body], tolerance: Callable[[Body], float], least: float,
-            F: list[np.ndarray], own: list[Surface3]) -> tuple[float, float, dict | None]:
+            F: list[np.ndarray], own: list[Surface3], measure: str = "nodal"
+            ) -> tuple[float, float, dict | None]:
     """(c), the nodal measure, on 3D bodies: F·n at every node of linear facets. On quadratic
     triangles (T6) a corner's shape function L (2 L - 1) is negative near the far edge, so a
     compressive traction can put a tensile force on a corner (none at all under a uniform one);
@@ -404,7 +407,8 @@ def tension(bodies: list[Body], tolerance: Callable[[Body], float], least: float
     (a midpoint's own phi = 4 L x >= 0: alone), and a body with quadratic elements takes the
     quadratic tolerance, as in 2D (:mod:`vfem.contact.invariants.check`'s docstring).
 
-    ``tolerance(body)``: a body's tolerance (``least`` where there are no bodies). Returns the
+    ``tolerance(body)``: a body's tolerance (``least`` where there are no bodies); ``measure``:
+    the nodal one, the only one in 3D (:data:`SOLID`). Returns the
     largest tensile measure over the largest nodal force (0 where none), its tolerance (the
     least of the bodies' where none) and where it is (``{"body", "node", "value"}``, or None).
     """
@@ -431,3 +435,15 @@ def tension(bodies: list[Body], tolerance: Callable[[Body], float], least: float
         return 0.0, least, None
     _, value, b, node = worst
     return value / scale, tolerance(b), {"body": b.name, "node": node, "value": value}
+
+
+def _boundary(body: Body) -> Boundary3:
+    """A 3D body's boundary, its symmetry planes left out of what contact may touch."""
+    return Boundary3.of(body, _symmetry_facets(body))
+
+
+#: 3D bodies: boundaries of triangles and quadrilaterals, the nodal tension measure, a model in
+#: which nothing may touch answered without building them
+SOLID = SurfaceKind(name="3D", boundary=_boundary, surface=Surface3,
+                    linearised_depth=linearised_depth, tension=tension,
+                    tension_measures=("nodal",), skips_untouched=True)
