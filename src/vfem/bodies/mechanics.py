@@ -10,6 +10,12 @@ One interface, :class:`BodyMechanics`, two implementations:
   (Newton's system and the tangent flexibility on the contact dofs, :class:`Linearization`),
   moved, committed or discarded step by step.
 
+A formulation that corrects the bodies by Newton's method (contact's large kinematics) asks every
+body for its trial displacement, its linearisation and its equilibration; a linear body answers
+None to each (its displacement is the contact state's), so the formulation never asks which
+kind of body it has: a body with another response (a plastic one, say) is a third
+implementation of the same questions.
+
 :class:`~vfem.bodies.Body` keeps the description (mesh, material, supports, loads) and its
 assembly, and hands every kinematics-dependent question to its ``mechanics``.
 """
@@ -59,6 +65,26 @@ class BodyMechanics(Protocol):
     def restore_state(self, state: dict[str, np.ndarray]) -> None:
         """Put back a state from :meth:`saved_state` exactly."""
 
+    # -- what a formulation that corrects the bodies by Newton's method asks (contact's large
+    # kinematics, vfem.contact.formulations.large); a body whose response is linear in its
+    # contact forces answers None: its displacement is the contact state's
+
+    def trial_displacement(self) -> np.ndarray | None:
+        """The displacement (ndofs) of the body's own trial state, or None where the body has
+        none (its displacement follows from the contact forces, :meth:`displacement`)."""
+
+    def linearize(self, load_factor: float, platen_displacement: float,
+                  contact_force: np.ndarray, condensed_dofs: np.ndarray,
+                  candidate_dofs: np.ndarray, backend: str | None = None
+                  ) -> Linearization | None:
+        """Newton's system at the trial state under the contact forces held; None where the
+        body's response is linear (nothing to correct but the contact forces)."""
+
+    def equilibrate(self, load_factor: float, platen_displacement: float,
+                    contact_force: np.ndarray) -> np.ndarray | None:
+        """Equilibrate the trial state under the given contact forces; None where the body is
+        always in equilibrium with them."""
+
 
 class LinearMechanics:
     """Small kinematics: the body's response is linear, its state the contact state's (the
@@ -92,6 +118,18 @@ class LinearMechanics:
 
     def restore_state(self, state: dict[str, np.ndarray]) -> None:
         pass
+
+    def trial_displacement(self) -> None:
+        return None  # the contact state's: load, platen and contact force superposed
+
+    def linearize(self, load_factor: float, platen_displacement: float,
+                  contact_force: np.ndarray, condensed_dofs: np.ndarray,
+                  candidate_dofs: np.ndarray, backend: str | None = None) -> None:
+        return None  # linear: its flexibility is the condensed one, constant
+
+    def equilibrate(self, load_factor: float, platen_displacement: float,
+                    contact_force: np.ndarray) -> None:
+        return None  # always in equilibrium with its contact forces
 
 
 #: A large body whose tangent is not positive definite takes its flexibility by
@@ -243,6 +281,10 @@ class LargeMechanics:
         """
         self.nonlinear.move(correction)
         self._equilibrated = None
+
+    def trial_displacement(self) -> np.ndarray:
+        """The displacement (ndofs) of the trial state (the converged one without a trial)."""
+        return self.nonlinear.trial_displacement()
 
     def commit(self) -> None:
         """A step converged: its trial state becomes the start of the next."""

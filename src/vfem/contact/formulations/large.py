@@ -130,8 +130,8 @@ class LargeDeformationContact(PairSet):
         the linear response of the others."""
         x = super().positions(state)
         for i, s in enumerate(self.surfaces):
-            if s.body.large:
-                u = s.body.nonlinear.trial_displacement()
+            u = s.body.mechanics.trial_displacement()
+            if u is not None:  # a body with its own trial state (the linear ones have none)
                 x[i] = s.X + u[s.tracked_dofs].reshape(-1, s.dim)
         return x
 
@@ -225,24 +225,19 @@ class LargeDeformationContact(PairSet):
         return self.contact_sets(traction_values)
 
     def _linearize(self, state: ContactState) -> list:
-        """Newton's system of every large-kinematics body (None for the others)."""
-        out = []
-        for i, (s, F) in enumerate(zip(self.surfaces, state.forces)):
-            if not s.body.large:
-                out.append(None)
-                continue
-            out.append(s.body.linearize(state.load_factor, state.platen_displacement,
-                                        self._full_force(i, F), s.condensed_dofs,
-                                        s.candidate_dofs, self.backend))
-        return out
+        """Newton's system of every body whose response is not linear (None for the others,
+        :meth:`~vfem.bodies.mechanics.BodyMechanics.linearize`)."""
+        return [s.body.mechanics.linearize(state.load_factor, state.platen_displacement,
+                                           self._full_force(i, F), s.condensed_dofs,
+                                           s.candidate_dofs, self.backend)
+                for i, (s, F) in enumerate(zip(self.surfaces, state.forces))]
 
     def _finish(self, state: ContactState) -> None:
         """Equilibrate every large-kinematics body under the converged contact forces (what
         the solver commits; one correction at most)."""
         for i, (s, F) in enumerate(zip(self.surfaces, state.forces)):
-            if s.body.large:
-                s.body.equilibrate(state.load_factor, state.platen_displacement,
-                                   self._full_force(i, F))
+            s.body.mechanics.equilibrate(state.load_factor, state.platen_displacement,
+                                         self._full_force(i, F))
 
     def _platen_on_force(self, state: ContactState, need: float) -> bool:
         """Whether the platen's reaction is on its force: ``need`` (:meth:`_platen_terms`)
