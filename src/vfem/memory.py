@@ -177,7 +177,7 @@ def estimate(surfaces, pairs=(), backend: str | None = None, matrix_free: bool =
             * float(m) ** 2
         parts["stiffness"] += (PARDISO_3D_STIFFNESS_BYTES if backend == "pardiso"
                                and body.dim == 3 else STIFFNESS_BYTES) * stiffness_entries(body)
-        if body.large:
+        if body.iterates:  # its tangent's factor and flexibility, each iteration
             parts["large"] += LARGE_BYTES * ndofs * 2.0 * s.nc
     for pair in pairs:
         i, j = sorted(pair)

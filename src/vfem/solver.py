@@ -320,9 +320,9 @@ class Analysis:
             # variant on its owner only (vfem.parallel)
             shared = self.model.contact.variant != "paired"
             if ranks.parallel:  # each body on its own rank (vfem.parallel, issue 22)
-                if any(b.large for b in bodies):
+                if any(b.iterates for b in bodies):
                     raise InputError("a run over MPI ranks serves small kinematics; body "
-                                     f"{next(b.name for b in bodies if b.large)!r} has large "
+                                     f"{next(b.name for b in bodies if b.iterates)!r} has large "
                                      "kinematics: run it in one process")
                 set_up_bodies(ranks, bodies, lambda i: bodies[i].setup(
                     self.backend, condensed_dofs=None if self.matrix_free
@@ -386,7 +386,7 @@ class Analysis:
 
     def _formulation(self) -> type:
         """The formulation class of the model's contact settings and kinematics."""
-        return formulation_class(self.model.contact, any(b.large for b in self.model.bodies))
+        return formulation_class(self.model.contact, any(b.iterates for b in self.model.bodies))
 
     def _invariant_check(self) -> InvariantCheck:
         """The invariants every converged step must satisfy (:mod:`vfem.contact.invariants.check`),

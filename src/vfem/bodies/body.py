@@ -90,8 +90,18 @@ class Body:
 
     @property
     def large(self) -> bool:
-        """Whether the body is analysed under large displacements (see ``kinematics``)."""
+        """Whether the body is analysed under large displacements (see ``kinematics``): its
+        geometry is the deformed one (where contact pairs it, how the invariants read it)."""
         return self.kinematics != "small"
+
+    @property
+    def iterates(self) -> bool:
+        """Whether the body's response to its contact forces is nonlinear, so that contact
+        corrects it by Newton's method (:meth:`.mechanics.BodyMechanics.linearize`) instead of
+        through its constant flexibility: under large kinematics today; a material with
+        history (issue 41) makes a small-kinematics body iterate too. Where the code asks how
+        a body responds it reads this; where it asks which geometry, :attr:`large`."""
+        return self.large
 
     # -- set-up (vfem.bodies.condensation) --------------------------------------------------------
 

@@ -25,7 +25,7 @@ from skfem.models.elasticity import linear_elasticity
 from ..linalg import factorize
 from .assembly import elasticity_stiffness
 from .loads import constraints, load_cases
-from .mechanics import LargeMechanics, LinearMechanics, _platen_stiffness
+from .mechanics import _platen_stiffness, mechanics_for
 from .validation import check_supported, validate
 
 log = logging.getLogger(__name__)
@@ -123,7 +123,7 @@ def setup(body, backend: str | None = None, condensed_dofs: np.ndarray | None = 
         body.platen_load_reaction = sum(c.platen_reaction for c in body.load_cases)
         body.platen_stiffness = _platen_stiffness(body.K, body.u_platen, platen_dofs)
     # how the body answers its contact forces: linearly, or under large kinematics
-    body.mechanics = LargeMechanics(body, fixed) if body.large else LinearMechanics(body)
+    body.mechanics = mechanics_for(body, fixed)
     body.timings.update(constraints_s=body.timings["constraints_s"] + t2 - t1,
                         factorize_s=t3 - t2, load_cases_s=time.perf_counter() - t3)
     log.info("body %s: %d points, %d dofs (%d fixed)", body.name, body.ndofs // body.dim,

@@ -132,6 +132,14 @@ class LinearMechanics:
         return None  # always in equilibrium with its contact forces
 
 
+def mechanics_for(body, fixed: dict[int, float]) -> BodyMechanics:
+    """The mechanics of an assembled body: Newton's (:class:`LargeMechanics`) where its response
+    is nonlinear (:attr:`~vfem.bodies.Body.iterates`), else the linear superposition. The one
+    place a body's kind of response is chosen. ``fixed``: the prescribed value of every
+    constrained dof (:func:`~vfem.bodies.loads.constraints`)."""
+    return LargeMechanics(body, fixed) if body.iterates else LinearMechanics(body)
+
+
 #: A large body whose tangent is not positive definite takes its flexibility by
 #: back-substitutions, this many candidate dofs at a time.
 FALLBACK_COLUMNS = 128

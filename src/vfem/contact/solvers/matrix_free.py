@@ -210,7 +210,7 @@ def matrix_free_refusal(settings, bodies) -> str | None:
         return f"the {settings.method} baseline solves one global system"
     if settings.variant != "paired":
         return "the thesis variant reads the flexibility node by node"
-    large = [b.name for b in bodies if b.large]
+    large = [b.name for b in bodies if b.iterates]
     if large:
         return f"body {large[0]!r} has large kinematics"
     if settings.frictional:
