@@ -232,7 +232,7 @@ def fake_model(order=1, dim=2, large=False, corners=4, **settings):
     """Two alike bodies that may touch (``contact_pairs`` None: every pair): a body that may
     touch none is not the contact formulation's to refuse (``bodies_that_may_touch``).
     ``corners``: of an element (3D: 4 tetrahedra, 8 hexahedra)."""
-    bodies = [SimpleNamespace(name=name, order=order, large=large, platen=None,
+    bodies = [SimpleNamespace(name=name, order=order, large=large, iterates=large, platen=None,
                               mesh=SimpleNamespace(p=np.zeros((dim, 3)),
                                                    t=np.zeros((corners, 1), dtype=int)))
               for name in "ab"]
