@@ -7,22 +7,20 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from skfem import MeshQuad, MeshTri
 
-from vfem.bodies import Body, Support
+from models import strip_surfaces
 from vfem.contact.formulations.algorithm import VirtualElementContact
 from vfem.contact.formulations.baselines import GlobalContact
 from vfem.contact.formulations.formulation import check_capabilities, formulation_class
 from vfem.contact.formulations.large import LargeDeformationContact
 from vfem.contact.formulations.paired import PairedContact
 from vfem.contact.geometry.pairing import overlap
-from vfem.contact.geometry.surface import ContactSurface, beyond, patch_ends
+from vfem.contact.geometry.surface import beyond, patch_ends
 from vfem.contact.settings import ContactSettings
 from vfem.contact.solvers import bordered_solve
 from vfem.contact.solvers.iteration import Check, iterate
 from vfem.contact.state import IterationRecord
 from vfem.errors import ContactCycling, ContactNotConverged, InputError
-from vfem.materials import LinearElastic
 
 # -- the iteration loop ----------------------------------------------------------------------------
 
@@ -101,24 +99,9 @@ def test_a_singular_bordered_system_gets_its_least_squares_answer():
 # -- surfaces: two non-matching blocks, the lower one's top against the upper one's bottom ---------
 
 
-def block(cls, y0, y1, nx, name):
-    m = cls.init_tensor(np.linspace(0, 1, nx + 1), np.linspace(y0, y1, 3))
-    t = 1e-9
-    m = m.with_boundaries({"top": lambda x: x[1] > y1 - t, "bottom": lambda x: x[1] < y0 + t})
-    return Body(name, m, LinearElastic(1e9, 0.3),
-                supports=(Support("bottom" if y0 < 0 else "top"),))
-
-
 @pytest.fixture(scope="module")
 def surfaces():
-    out = []
-    for b, side in ((block(MeshQuad, -0.5, 0.0, 3, "lower"), "top"),
-                    (block(MeshTri, 0.0, 0.5, 7, "upper"), "bottom")):
-        b.setup()
-        s = ContactSurface.build(b, b.mesh.boundaries[side])
-        s.compute_flexibility()
-        out.append(s)
-    return out
+    return strip_surfaces(3, 7)
 
 
 @pytest.mark.parametrize("fine", [0, 1])

@@ -3,29 +3,16 @@ an executor (the solver hands them the run's MPI ranks) and, built without one, 
 with the same answers."""
 
 import numpy as np
-from skfem import MeshQuad, MeshTri
 
+from models import strip_surfaces
 from vfem import parallel
-from vfem.bodies import Body, Support
 from vfem.contact.formulations.paired import PairedContact
-from vfem.contact.geometry.surface import ContactSurface
 from vfem.contact.settings import ContactSettings
 from vfem.executor import SERIAL
-from vfem.materials import LinearElastic
 
 
 def surfaces():
-    out = []
-    for cls, y0, y1, n, face, held in ((MeshQuad, -0.5, 0.0, 4, "top", "bottom"),
-                                       (MeshTri, 0.0, 0.5, 7, "bottom", "top")):
-        m = cls.init_tensor(np.linspace(0, 1, n + 1), np.linspace(y0, y1, 3)).with_boundaries(
-            {"top": lambda x, y1=y1: x[1] > y1 - 1e-9, "bottom": lambda x, y0=y0: x[1] < y0 + 1e-9})
-        b = Body(face, m, LinearElastic(1e3, 0.3), supports=(Support(held),))
-        b.setup()
-        s = ContactSurface.build(b, m.boundaries[face])
-        s.compute_flexibility()
-        out.append(s)
-    return out
+    return strip_surfaces(4, 7, E=1e3, names=("top", "bottom"))
 
 
 def test_a_formulation_built_without_an_executor_runs_serially_and_alike():

@@ -13,6 +13,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from models import (
+    Raw,
+    block_on_base,
+    built,
+    input_file,
+    platen,
+    pressed,
+    rectangle_mesh,
+    slid,
+    support,
+    toml_body,
+    traction,
+)
 from resume_check import assert_resumed_equals_whole
 from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
 from vfem.contact.formulations.formulation import formulation_class
@@ -26,62 +39,16 @@ from vfem.io.input import loads
 from vfem.io.results import frictional_work
 from vfem.solver import Analysis, Model
 
-BLOCKS = """
-name = "sliding block"
-[contact]
-friction = {mu}
-[[bodies]]
-name = "lower"
-contact_boundaries = ["top"]
-[bodies.mesh]
-shape = "rectangle"
-x0 = -1.0
-y0 = -1.0
-width = 2.0
-height = 1.0
-nx = 12
-ny = 6
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "bottom"
-[[bodies]]
-name = "upper"
-contact_boundaries = ["bottom"]
-[bodies.mesh]
-shape = "rectangle"
-x0 = -0.5
-y0 = 0.0
-width = 1.0
-height = 0.5
-nx = 7
-ny = 4
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.prescribed]]
-boundary = "top"
-component = "y"
-value = -0.01
-amplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]
-[[bodies.prescribed]]
-boundary = "top"
-component = "x"
-value = {shift}
-amplitude = [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]
-[steps]
-load_factors = [0.25, 0.5, 0.625, 0.75, 0.875, 1.0]
-"""
+BLOCKS = block_on_base(
+    "sliding block", rectangle_mesh(-1.0, -1.0, 2.0, 1.0, 12, 6),
+    rectangle_mesh(-0.5, 0.0, 1.0, 0.5, 7, 4), pressed(-0.01), slid(Raw("{shift}")),
+    friction=Raw("{mu}"), load_factors=[0.25, 0.5, 0.625, 0.75, 0.875, 1.0])
 
 
 def blocks(mu: float, shift: float, swap: bool = False) -> Model:
     """A block pressed down on a wider one (non-matching meshes, 7 against 12 across), then
     moved sideways by ``shift`` with the press held."""
-    config = loads(BLOCKS.format(mu=mu, shift=shift))
-    if swap:
-        config = dataclasses.replace(config, bodies=config.bodies[::-1])
-    return config.build()
+    return built(BLOCKS.format(mu=mu, shift=shift), swap)
 
 
 def forces(model: Model):
@@ -411,64 +378,19 @@ def test_friction_output_and_a_resumed_run_equal_to_an_uninterrupted_one(tmp_pat
 
 # -- the friction patch test ---------------------------------------------------------------------
 
-PATCH = """
-name = "friction patch {n_lower}/{n_upper}"
-[contact]
-friction = {mu}
-[[bodies]]
-name = "lower"
-contact_boundaries = ["top"]
-[bodies.mesh]
-shape = "rectangle"
-x0 = 0.0
-y0 = -1.0
-width = 1.0
-height = 1.0
-nx = {n_lower}
-ny = {n_lower}
-[bodies.material]
-youngs_modulus = 1.0e6
-poissons_ratio = 0.0
-[[bodies.supports]]
-boundary = "bottom"
-{sides}
-[[bodies]]
-name = "upper"
-contact_boundaries = ["bottom"]
-[bodies.mesh]
-shape = "rectangle"
-x0 = 0.0
-y0 = 0.0
-width = 1.0
-height = 1.0
-nx = {n_upper}
-ny = {n_upper}
-[bodies.material]
-youngs_modulus = 1.0e6
-poissons_ratio = 0.0
-[[bodies.prescribed]]
-boundary = "top"
-component = "x"
-value = {shift}
-amplitude = [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]
-[bodies.platen]
-boundary = "top"
-component = "y"
-force = {pressure}
-amplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]
-{sides}
-[steps]
-load_factors = [0.5, 1.0]
-"""
+PATCH = input_file(
+    "friction patch {n_lower}/{n_upper}",
+    toml_body("lower", rectangle_mesh(0.0, -1.0, 1.0, 1.0, Raw("{n_lower}"), Raw("{n_lower}")),
+              support("bottom"), Raw("{sides}"), E=Raw("1.0e6"), nu=0.0,
+              contact_boundaries=["top"]),
+    toml_body("upper", rectangle_mesh(0.0, 0.0, 1.0, 1.0, Raw("{n_upper}"), Raw("{n_upper}")),
+              slid(Raw("{shift}")),
+              platen("top", "y", Raw("{pressure}"), amplitude=[[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]),
+              Raw("{sides}"), E=Raw("1.0e6"), nu=0.0, contact_boundaries=["bottom"]),
+    contact={"friction": Raw("{mu}")}, load_factors=[0.5, 1.0])
 
-SIDES = """[[bodies.tractions]]
-boundary = "left"
-value = [0.0, {minus}]
-amplitude = [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]
-[[bodies.tractions]]
-boundary = "right"
-value = [0.0, {plus}]
-amplitude = [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]"""
+SIDES = "\n".join(traction(side, [0.0, Raw(value)], [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]])
+                  for side, value in (("left", "{minus}"), ("right", "{plus}")))
 
 
 @pytest.mark.parametrize("n_lower, n_upper", [(4, 7), (7, 4), (2, 10), (10, 2), (1, 5), (5, 1)])

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from skfem import Basis, MeshHex1, MeshHex2, MeshTet1, MeshTet2
 
+from models import Raw, input_file, prescribed, rollers, support, table, toml_body
 from vfem.cli import main
 from vfem.errors import InputError
 from vfem.mesh.imports import read_mesh
@@ -226,46 +227,13 @@ def test_abaqus_quadratic_tetrahedra(tmp_path):
 # -- the patch test from files ---------------------------------------------------------------------
 
 
-PATCH = """
-name = "patch3d_files"
-[[bodies]]
-name = "lower"
-contact_boundaries = ["top"]
-[bodies.mesh]
-{lower_mesh}
-[bodies.material]
-youngs_modulus = {E}
-poissons_ratio = {NU}
-[[bodies.supports]]
-boundary = "bottom"
-components = ["z"]
-[[bodies.supports]]
-boundary = "left"
-components = ["x"]
-[[bodies.supports]]
-boundary = "front"
-components = ["y"]
-[[bodies]]
-name = "upper"
-contact_boundaries = ["bottom"]
-[bodies.mesh]
-{upper_mesh}
-[bodies.material]
-youngs_modulus = {E}
-poissons_ratio = {NU}
-[[bodies.supports]]
-boundary = "left"
-components = ["x"]
-[[bodies.supports]]
-boundary = "front"
-components = ["y"]
-[[bodies.prescribed]]
-boundary = "top"
-component = "z"
-value = {minus_D}
-[contact]
-variant = "paired"
-"""
+PATCH = input_file(
+    "patch3d_files",
+    toml_body("lower", Raw("{lower_mesh}"), support("bottom", ["z"]), rollers(), E=Raw("{E}"),
+              nu=Raw("{NU}"), contact_boundaries=["top"]),
+    toml_body("upper", Raw("{upper_mesh}"), rollers(), prescribed("top", "z", Raw("{minus_D}")),
+              E=Raw("{E}"), nu=Raw("{NU}"), contact_boundaries=["bottom"]),
+    table("[contact]", variant="paired"))
 
 
 def patch_file(path, lower_mesh, upper_mesh) -> Path:

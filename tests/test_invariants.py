@@ -8,6 +8,7 @@ converged state breaks one; summary.json and checkpoints carrying the measures p
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import logging
 from types import SimpleNamespace
@@ -16,6 +17,7 @@ import numpy as np
 import pytest
 from skfem import MeshQuad, MeshTri
 
+import models
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.cli import main
 from vfem.contact.invariants.check import InvariantCheck, step_invariants
@@ -32,11 +34,8 @@ MAT = LinearElastic(1000.0, 0.3)
 TOL = 1e-8  # the penetration tolerance of the hand-made states
 
 
-def rect(cls, x0, x1, y0, y1, nx, ny, order=1):
-    m = cls.init_tensor(np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1))
-    t = 1e-9
-    return m.with_boundaries({"bottom": lambda x: x[1] < y0 + t, "top": lambda x: x[1] > y1 - t,
-                              "left": lambda x: x[0] < x0 + t})
+#: the tensor meshes here have their left side marked too
+rect = functools.partial(models.rect, boundaries=("bottom", "top", "left"))
 
 
 def blocks(order=1):

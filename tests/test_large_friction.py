@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 
+from models import Raw, block_on_base, built, pressed, rectangle_mesh, slid
 from resume_check import assert_resumed_equals_whole
 from vfem.contact.formulations.formulation import formulation_class
 from vfem.contact.formulations.large_friction import FrictionalLargeContact
@@ -21,55 +22,11 @@ from vfem.io.input import loads
 from vfem.io.results import frictional_work
 from vfem.solver import Analysis, Model
 
-SLIDE = """
-name = "large slide"
-[contact]
-friction = {mu}
-[[bodies]]
-name = "base"
-contact_boundaries = ["top"]
-kinematics = "{kinematics}"
-[bodies.mesh]
-shape = "rectangle"
-x0 = -1.0
-y0 = -0.5
-width = 2.0
-height = 0.5
-nx = 24
-ny = 6
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "bottom"
-[[bodies]]
-name = "block"
-contact_boundaries = ["bottom"]
-kinematics = "{kinematics}"
-[bodies.mesh]
-shape = "rectangle"
-x0 = -0.8
-y0 = 0.0
-width = 0.5
-height = 0.25
-nx = 7
-ny = 4
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.prescribed]]
-boundary = "top"
-component = "y"
-value = -0.005
-amplitude = [[0.0, 0.0], [0.5, 1.0], [2.0, 1.0]]
-[[bodies.prescribed]]
-boundary = "top"
-component = "x"
-value = {shift}
-amplitude = [[0.0, 0.0], [0.5, 0.0], [2.0, 1.0]]
-[steps]
-load_factors = {factors}
-"""
+SLIDE = block_on_base(
+    "large slide", rectangle_mesh(-1.0, -0.5, 2.0, 0.5, 24, 6),
+    rectangle_mesh(-0.8, 0.0, 0.5, 0.25, 7, 4),
+    pressed(-0.005, end=2.0), slid(Raw("{shift}"), end=2.0), names=("base", "block"),
+    friction=Raw("{mu}"), kinematics="{kinematics}", load_factors=Raw("{factors}"))
 
 #: pressed in two steps, then slid in ten (the shift over load factors 0.5 to 2)
 FACTORS = [0.25, 0.5, 0.55, 0.65, 0.8, 0.95, 1.1, 1.25, 1.4, 1.55, 1.7, 2.0]
@@ -79,10 +36,7 @@ def slide(mu: float = 0.3, shift: float = 1.0, kinematics: str = "total", swap: 
           factors=FACTORS) -> Model:
     """A block pressed on a wider base, then slid ``shift`` along it (12 of the base's facets
     for 1.0), both bodies under total Lagrangian kinematics (or ``kinematics``)."""
-    config = loads(SLIDE.format(mu=mu, shift=shift, kinematics=kinematics, factors=factors))
-    if swap:
-        config = dataclasses.replace(config, bodies=config.bodies[::-1])
-    return config.build()
+    return built(SLIDE.format(mu=mu, shift=shift, kinematics=kinematics, factors=factors), swap)
 
 
 def run(model: Model):

@@ -4,16 +4,11 @@ import numpy as np
 import pytest
 from skfem import MeshQuad, MeshTri
 
+from models import rect
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.contact.settings import ContactSettings
 from vfem.materials import LinearElastic
 from vfem.solver import Analysis, Model
-
-
-def rect(cls, x0, x1, y0, y1, nx, ny):
-    m = cls.init_tensor(np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1))
-    t = 1e-9
-    return m.with_boundaries({"bottom": lambda x: x[1] < y0 + t, "top": lambda x: x[1] > y1 - t})
 
 
 def model(order, variant="paired"):

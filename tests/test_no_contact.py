@@ -14,49 +14,19 @@ import numpy as np
 import pytest
 
 import vfem
+from models import Raw, input_file, platen, support, toml_body
 from vfem.config import check
 from vfem.contact.geometry.placement import platen_approach
 from vfem.io.input import loads
 from vfem_examples.hertz import HertzParameters, build
 
-PUCK = """
-name = "puck"
-[[bodies]]
-name = "block"
-[bodies.mesh]
-shape = "rectangle"
-width = 2.0
-height = 1.0
-nx = 8
-ny = 4
-x0 = -1.0
-y0 = -1.0
-[bodies.material]
-youngs_modulus = 1e9
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "bottom"
-[[bodies]]
-name = "puck"
-[bodies.mesh]
-shape = "rectangle"
-width = 0.5
-height = 0.5
-nx = 4
-ny = 4
-x0 = -0.25
-y0 = 0.2
-[bodies.material]
-youngs_modulus = 1e9
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "top"
-components = ["x"]
-[bodies.platen]
-boundary = "top"
-component = "y"
-force = FORCE
-"""
+PUCK = input_file(
+    "puck",
+    toml_body("block", dict(shape="rectangle", width=2.0, height=1.0, nx=8, ny=4, x0=-1.0,
+                            y0=-1.0), support("bottom"), E=Raw("1e9")),
+    toml_body("puck", dict(shape="rectangle", width=0.5, height=0.5, nx=4, ny=4, x0=-0.25,
+                           y0=0.2), support("top", ["x"]), platen("top", "y", Raw("FORCE")),
+              E=Raw("1e9")))
 
 
 def puck(force: float, y0: float = 0.2):

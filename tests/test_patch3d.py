@@ -14,6 +14,7 @@ with a message (``check_capabilities``). Friction in 3D: tests/test_friction3d.p
 import numpy as np
 import pytest
 
+from models import Raw, box_mesh, input_file, prescribed, support, toml_body
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.bodies.stresses import stress
 from vfem.contact.settings import ContactSettings
@@ -94,53 +95,13 @@ def test_the_thesis_variant_stays_2d():
         stacked(("hex", 3), ("hex", 5), variant="thesis").validate()
 
 
-STIFF_PUNCH = """
-name = "stiff_punch_3d"
-[[bodies]]
-name = "base"
-[bodies.mesh]
-shape = "box"
-x0 = -1.0
-y0 = -1.0
-z0 = -1.0
-width = 2.0
-depth = 2.0
-height = 1.0
-nx = {n}
-ny = {n}
-nz = 4
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "bottom"
-[[bodies]]
-name = "punch"
-[bodies.mesh]
-shape = "box"
-x0 = -0.37
-y0 = -0.29
-z0 = 0.01
-width = 0.6
-depth = 0.5
-height = 0.4
-nx = 5
-ny = 4
-nz = 2
-tetrahedra = true
-[bodies.material]
-youngs_modulus = 100000.0
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "top"
-components = ["x", "y"]
-[[bodies.prescribed]]
-boundary = "top"
-component = "z"
-value = -0.03
-[steps]
-load_factors = [0.25, 0.5, 0.75, 1.0]
-"""
+STIFF_PUNCH = input_file(
+    "stiff_punch_3d",
+    toml_body("base", box_mesh(-1.0, -1.0, -1.0, 2.0, 2.0, 1.0, Raw("{n}"), Raw("{n}"), 4),
+              support("bottom")),
+    toml_body("punch", box_mesh(-0.37, -0.29, 0.01, 0.6, 0.5, 0.4, 5, 4, 2, tetrahedra=True),
+              support("top", ["x", "y"]), prescribed("top", "z", -0.03), E=100000.0),
+    load_factors=[0.25, 0.5, 0.75, 1.0])
 
 
 @pytest.mark.parametrize("n", [9, 18])

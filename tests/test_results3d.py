@@ -16,6 +16,7 @@ import meshio
 import numpy as np
 import pytest
 
+from models import box_mesh, input_file, rollers, support, toml_body, traction
 from vfem.bodies import Body, Support, Traction
 from vfem.contact.invariants.polygon import _symmetry_facets
 from vfem.errors import InputError
@@ -237,35 +238,9 @@ def test_resume_keeps_the_3d_files(run, tmp_path):
         assert (again / name).read_bytes() == data, name
 
 
-BOX_TOML = """
-name = "box3d"
-[[bodies]]
-name = "box"
-[bodies.mesh]
-shape = "box"
-width = 1.0
-depth = 2.0
-height = 1.5
-nx = 2
-ny = 2
-nz = 2
-tetrahedra = true
-[bodies.material]
-youngs_modulus = 200.0
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "left"
-components = ["x"]
-[[bodies.supports]]
-boundary = "front"
-components = ["y"]
-[[bodies.supports]]
-boundary = "bottom"
-components = ["z"]
-[[bodies.tractions]]
-boundary = "top"
-value = [0.0, 0.0, -2.0]
-"""
+BOX_TOML = input_file("box3d", toml_body(
+    "box", box_mesh(width=1.0, depth=2.0, height=1.5, nx=2, ny=2, nz=2, tetrahedra=True),
+    rollers(), support("bottom", ["z"]), traction("top", [0.0, 0.0, -2.0]), E=200.0))
 
 
 def test_a_3d_input_file_runs_and_writes_its_summary(tmp_path):

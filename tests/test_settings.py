@@ -4,14 +4,11 @@ import dataclasses
 
 import numpy as np
 import pytest
-from skfem import MeshQuad, MeshTri
 
-from vfem.bodies import Body, Support
+from models import strip_surfaces
 from vfem.contact.formulations.algorithm import VirtualElementContact
-from vfem.contact.geometry.surface import ContactSurface
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
-from vfem.materials import LinearElastic
 from vfem.solver import Analysis, Model
 from vfem_examples.hertz import build, evaluate
 
@@ -33,21 +30,8 @@ def test_other_settings_reach_the_same_hertz_answer(hertz_level0, changes):
 
 
 def two_blocks():
-    def block(cls, y0, y1, nx, name, support):
-        m = cls.init_tensor(np.linspace(0, 1, nx + 1), np.linspace(y0, y1, 3))
-        m = m.with_boundaries({"top": lambda x: x[1] > y1 - 1e-9,
-                               "bottom": lambda x: x[1] < y0 + 1e-9})
-        return Body(name, m, LinearElastic(1e3, 0.3), supports=(Support(support),))
-
-    bodies = [block(MeshQuad, -0.5, 0.0, 4, "lower", "bottom"),
-              block(MeshTri, 0.0, 0.5, 5, "upper", "top")]
-    surfaces = []
-    for b, name in zip(bodies, ("top", "bottom")):
-        b.setup()
-        s = ContactSurface.build(b, b.mesh.boundaries[name])
-        s.compute_flexibility()
-        surfaces.append(s)
-    return VirtualElementContact(surfaces, {frozenset((0, 1))}, ContactSettings(variant="thesis"))
+    return VirtualElementContact(strip_surfaces(4, 5, E=1e3), {frozenset((0, 1))},
+                                 ContactSettings(variant="thesis"))
 
 
 def test_a_tensile_force_is_released_over_two_iterations():

@@ -5,6 +5,7 @@ import pytest
 
 import vfem.linalg.pardiso
 import vfem.memory
+from models import Raw, input_file, prescribed, rectangle_mesh, support, toml_body
 from vfem import Body, LinearElastic, Model, PrescribedDisplacement, Support
 from vfem.cli import main
 from vfem.errors import AnalysisError, InputError
@@ -162,39 +163,12 @@ def test_running_out_of_memory_anyway_is_a_clear_analysis_error(monkeypatch):
 def test_the_command_line_reports_it_without_a_traceback(monkeypatch, tmp_path, capsys):
     monkeypatch.setattr(vfem.memory, "available_memory", lambda: 2**20)
     path = tmp_path / "model.toml"
-    path.write_text("""
-name = "two blocks"
-[[bodies]]
-name = "lower"
-contact_boundaries = ["top"]
-[bodies.mesh]
-shape = "rectangle"
-y0 = -1.0
-nx = 2
-ny = 2
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.0
-[[bodies.supports]]
-boundary = "bottom"
-[[bodies]]
-name = "upper"
-contact_boundaries = ["bottom"]
-[bodies.mesh]
-shape = "rectangle"
-nx = 3
-ny = 3
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.0
-[[bodies.supports]]
-boundary = "left"
-components = ["x"]
-[[bodies.prescribed]]
-boundary = "top"
-component = "y"
-value = -1e-3
-""")
+    path.write_text(input_file(
+        "two blocks",
+        toml_body("lower", rectangle_mesh(y0=-1.0, nx=2, ny=2), support("bottom"), nu=0.0,
+                  contact_boundaries=["top"]),
+        toml_body("upper", rectangle_mesh(nx=3, ny=3), support("left", ["x"]),
+                  prescribed("top", "y", Raw("-1e-3")), nu=0.0, contact_boundaries=["bottom"])))
     assert main(["-q", "run", str(path), "--out", str(tmp_path / "out")]) == 1
     err = capsys.readouterr().err
     assert "needs about" in err and "Traceback" not in err

@@ -2,35 +2,17 @@
 
 import numpy as np
 import pytest
-from skfem import MeshQuad, MeshTri
 
-from vfem.bodies import Body, Support
+from models import strip_surfaces
 from vfem.contact.formulations.algorithm import VirtualElementContact
-from vfem.contact.geometry.surface import ContactSurface
 from vfem.contact.geometry.transfer import traction_from_forces
 from vfem.contact.settings import ContactSettings
-from vfem.materials import LinearElastic
-
-
-def block(cls, y0, y1, nx, name):
-    m = cls.init_tensor(np.linspace(0, 1, nx + 1), np.linspace(y0, y1, 3))
-    t = 1e-9
-    m = m.with_boundaries({"top": lambda x: x[1] > y1 - t, "bottom": lambda x: x[1] < y0 + t})
-    support = "bottom" if y0 < 0 else "top"
-    # stiff enough that the test forces leave the surfaces unstretched (to ~1e-9)
-    return Body(name, m, LinearElastic(1e9, 0.3), supports=(Support(support),))
 
 
 @pytest.mark.parametrize(("n_lower", "n_upper"), [(2, 10), (10, 2), (3, 7)])
 def test_uniform_traction_crosses_non_matching_meshes_exactly(n_lower, n_upper):
-    lower = block(MeshQuad, -0.5, 0.0, n_lower, "lower")
-    upper = block(MeshTri, 0.0, 0.5, n_upper, "upper")
-    surfaces = []
-    for b, name in ((lower, "top"), (upper, "bottom")):
-        b.setup()
-        s = ContactSurface.build(b, b.mesh.boundaries[name])
-        s.compute_flexibility()
-        surfaces.append(s)
+    # stiff (E = 1e9) enough that the test forces leave the surfaces unstretched (to ~1e-9)
+    surfaces = strip_surfaces(n_lower, n_upper)
     contact = VirtualElementContact(surfaces, {frozenset((0, 1))}, ContactSettings())
     state = contact.new_state()
     # the upper body carries a uniform pressure 1 from the lower one: consistent nodal loads

@@ -26,122 +26,32 @@ import numpy as np
 import pytest
 
 import vfem
+from models import Raw, block_on_base, box_mesh, platen, prescribed, pressed, rectangle_mesh
 from vfem.cli import main
 from vfem.io.input import dumps, loads
 from vfem_examples.hertz import config as hertz_config
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 
+#: a platen's load curve: its force times ZERO (filled in by :func:`solve`) during the press
+AFTER_PRESS = [[0.0, Raw("ZERO")], [0.5, Raw("ZERO")], [1.0, 1.0]]
+
 #: a block pressed on a wider base by moving its top down over load factors 0 to 0.5, held in x
 #: only by a platen on its left face: its force zero during the press, then pushing it sideways
 #: (load factors 0.5 to 1) below the friction's limit (mu = 0.3 of a normal force near 9.4)
-PRESS_2D = """
-name = "press_then_push"
-[contact]
-friction = 0.3
-[[bodies]]
-name = "base"
-contact_boundaries = ["top"]
-[bodies.mesh]
-shape = "rectangle"
-x0 = -1.0
-y0 = -1.0
-width = 2.0
-height = 1.0
-nx = 24
-ny = 12
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "bottom"
-[[bodies]]
-name = "block"
-contact_boundaries = ["bottom"]
-[bodies.mesh]
-shape = "rectangle"
-x0 = -0.5
-y0 = 0.0
-width = 1.0
-height = 0.5
-nx = 14
-ny = 7
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.prescribed]]
-boundary = "top"
-component = "y"
-value = -0.01
-amplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]
-[bodies.platen]
-boundary = "left"
-component = "x"
-force = 1.0
-amplitude = [[0.0, ZERO], [0.5, ZERO], [1.0, 1.0]]
-[steps]
-load_factors = [0.25, 0.5, 0.75, 1.0]
-"""
+PRESS_2D = block_on_base(
+    "press_then_push", rectangle_mesh(-1.0, -1.0, 2.0, 1.0, 24, 12),
+    rectangle_mesh(-0.5, 0.0, 1.0, 0.5, 14, 7), pressed(-0.01),
+    platen("left", "x", 1.0, amplitude=AFTER_PRESS),
+    names=("base", "block"), friction=0.3, load_factors=[0.25, 0.5, 0.75, 1.0])
 
 #: the same in 3D: a box pressed on a wider one (z), held along y by its top and along x by a
 #: platen on its left face, zero during the press, then pushing it (0.2 at the end)
-PRESS_3D = """
-name = "press_then_push_3d"
-[contact]
-friction = 0.3
-[[bodies]]
-name = "base"
-contact_boundaries = ["top"]
-[bodies.mesh]
-shape = "box"
-x0 = -1.0
-y0 = -1.0
-z0 = -0.5
-width = 2.0
-depth = 2.0
-height = 0.5
-nx = 8
-ny = 8
-nz = 2
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.supports]]
-boundary = "bottom"
-[[bodies]]
-name = "block"
-contact_boundaries = ["bottom"]
-[bodies.mesh]
-shape = "box"
-x0 = -0.68
-y0 = -0.5
-z0 = 0.0
-width = 0.5
-depth = 0.5
-height = 0.25
-nx = 4
-ny = 4
-nz = 2
-[bodies.material]
-youngs_modulus = 1000.0
-poissons_ratio = 0.3
-[[bodies.prescribed]]
-boundary = "top"
-component = "z"
-value = -0.005
-amplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]
-[[bodies.prescribed]]
-boundary = "top"
-component = "y"
-value = 0.0
-[bodies.platen]
-boundary = "left"
-component = "x"
-force = 0.2
-amplitude = [[0.0, ZERO], [0.5, ZERO], [1.0, 1.0]]
-[steps]
-load_factors = [0.25, 0.5, 0.75, 1.0]
-"""
+PRESS_3D = block_on_base(
+    "press_then_push_3d", box_mesh(-1.0, -1.0, -0.5, 2.0, 2.0, 0.5, 8, 8, 2),
+    box_mesh(-0.68, -0.5, 0.0, 0.5, 0.5, 0.25, 4, 4, 2), pressed(-0.005, "z"),
+    prescribed("top", "y", 0.0), platen("left", "x", 0.2, amplitude=AFTER_PRESS),
+    names=("base", "block"), friction=0.3, load_factors=[0.25, 0.5, 0.75, 1.0])
 
 
 def solve(text: str, zero: float = 0.0, *changes: str):
