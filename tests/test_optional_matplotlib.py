@@ -51,9 +51,10 @@ def hertz(tmp_path_factory) -> tuple[Path, subprocess.CompletedProcess]:
 def test_every_module_imports_without_matplotlib():
     code = ("import sys, importlib, pkgutil\n"
             "sys.modules['matplotlib'] = None\n"
-            "import vfem, vfem.solver, vfem.cli\n"
-            "for m in pkgutil.walk_packages(vfem.__path__, 'vfem.'):\n"
-            "    importlib.import_module(m.name)\n"
+            "import vfem, vfem.solver, vfem.cli, vfem_examples, vfem_tools\n"
+            "for package in (vfem, vfem_examples, vfem_tools):\n"
+            "    for m in pkgutil.walk_packages(package.__path__, package.__name__ + '.'):\n"
+            "        importlib.import_module(m.name)\n"
             "from vfem.io.plots import matplotlib_missing\n"
             "print(matplotlib_missing())\n")
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
