@@ -30,8 +30,12 @@ import sys
 
 def configs(case: str) -> list:
     """The model descriptions (:class:`vfem.config.ModelConfig`) of one case."""
-    from vfem_examples import block, gasket, hertz, patch, punch, sliding, wedge
-    from vfem_tools.bench import hertz_parameters
+    try:
+        from vfem_examples import block, gasket, hertz, patch, punch, sliding, wedge
+        from vfem_tools.bench import hertz_parameters
+    except ImportError:  # a tree from before the examples moved beside the library
+        from vfem.examples import block, gasket, hertz, patch, punch, sliding, wedge
+        from vfem.tools.bench import hertz_parameters
 
     cases = {
         "hertz_100k": lambda: [hertz.config(hertz_parameters(100_000))],

@@ -27,7 +27,10 @@ import sys
 CASE = """
 import dataclasses, json, sys, time
 import vfem.linalg
-from vfem_examples import hertz
+try:
+    from vfem_examples import hertz
+except ImportError:  # a tree from before the examples moved beside the library
+    from vfem.examples import hertz
 from vfem.solver import Analysis
 if sys.argv[1] != "auto":
     vfem.linalg.use(sys.argv[1])

@@ -1,0 +1,98 @@
+"""The Hertz example and the 3D sphere timed on two source trees in one run (issue 38: "a
+benchmark run before/after on Hertz 100k and the sphere 100k: no slowdown over 3 %").
+
+    git worktree add /tmp/before <commit>
+    python benchmarks/trees_speed.py /tmp/before/src src [--dofs 100k] [--repeat 5]
+        [--cases hertz sphere]
+
+Each run is one case on one tree in a fresh subprocess (that tree first on the path), the trees
+taking turns ``--repeat`` times per case; the clock covers the analysis alone
+(``Analysis(model).run()``: search, assembly, factorization and condensation, every step with its
+invariants), the model being built before it starts. The sizes are those of ``vfem bench
+--dofs`` (the Hertz example with its contact facets and largest element scaled together; the
+sphere with more facets across the contact radius). Printed: each run's seconds, then per case
+the two trees' medians, their ratio (second over first) and whether the two trees' answers (the
+sum of every body's nodal contact forces, a checksum) are the same to 1e-10. A tree from before
+the examples moved beside the library (``vfem.examples`` rather than ``vfem_examples``) is run
+as it is.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+CASE = """
+import importlib, json, sys, time
+import numpy as np
+try:
+    from vfem_tools import bench
+    import vfem_examples as examples
+except ImportError:  # a tree from before the examples moved beside the library
+    from vfem.tools import bench
+    import vfem.examples as examples
+from vfem.solver import Analysis
+case, dofs = sys.argv[1], int(sys.argv[2])
+parameters = bench.hertz_parameters(dofs) if case == "hertz" else bench.sphere_parameters(dofs)
+model = importlib.import_module(examples.__name__ + "." + case).build(parameters)
+t0 = time.perf_counter()
+result = Analysis(model).run()
+seconds = time.perf_counter() - t0
+assert result.converged, result.message
+checksum = float(sum(np.abs(np.asarray(b.contact_force)).sum()
+                     for b in result.steps[-1].bodies.values()))
+print(json.dumps({"seconds": seconds, "checksum": checksum,
+                  "dofs": sum(b.ndofs for b in model.bodies)}))
+"""
+
+SIZES = {"10k": 10_000, "30k": 30_000, "100k": 100_000, "300k": 300_000, "1M": 1_000_000}
+
+
+def run(tree: str, case: str, dofs: int) -> dict:
+    """One case on ``tree`` in a subprocess of its own."""
+    env = dict(os.environ, PYTHONPATH=tree)
+    done = subprocess.run([sys.executable, "-c", CASE, case, str(dofs)], env=env,
+                          capture_output=True, text=True, cwd=os.path.dirname(tree) or ".")
+    if done.returncode:
+        raise SystemExit(f"{tree}: {case} failed:\n{done.stderr}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("first", help="the first tree's src folder (before)")
+    parser.add_argument("second", help="the second tree's src folder (after)")
+    parser.add_argument("--dofs", default="100k", help="about this many dofs (10k, 100k, 1M)")
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--cases", nargs="+", default=["hertz", "sphere"],
+                        choices=("hertz", "sphere"))
+    args = parser.parse_args(argv)
+    text = args.dofs.lower()
+    dofs = SIZES.get(args.dofs) or int(float(text.rstrip("km")) * {"k": 1e3, "m": 1e6}.get(
+        text[-1:], 1))
+    trees = [os.path.abspath(args.first), os.path.abspath(args.second)]
+    times = {(c, t): [] for c in args.cases for t in trees}
+    sums = {}
+    for k in range(args.repeat):
+        for case in args.cases:
+            for tree in trees:
+                row = run(tree, case, dofs)
+                times[case, tree].append(row["seconds"])
+                sums.setdefault((case, tree), row["checksum"])
+                print(f"{k + 1} {case:6s} {row['dofs']:8d} dofs  {row['seconds']:8.3f} s  {tree}",
+                      flush=True)
+    for case in args.cases:
+        a, b = (statistics.median(times[case, t]) for t in trees)
+        same = abs(sums[case, trees[0]] - sums[case, trees[1]]) <= 1e-10 * abs(
+            sums[case, trees[0]])
+        print(f"{case}: median {a:.3f} s then {b:.3f} s, ratio {b / a:.3f} "
+              f"(answers {'the same' if same else 'DIFFERENT'})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
