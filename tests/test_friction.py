@@ -26,7 +26,7 @@ from models import (
     toml_body,
     traction,
 )
-from resume_check import assert_resumed_equals_whole
+from resume_check import as_written_before_columns, assert_resumed_equals_whole
 from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
 from vfem.contact.formulations.formulation import formulation_class
 from vfem.contact.formulations.friction import FrictionalPairedContact
@@ -203,7 +203,7 @@ def test_friction_history_is_in_the_state_and_its_copies():
 def test_coulomb_status_and_tangents():
     q = np.array([0.0, 1.0, 1.0, 2.0])
     s = np.array([0.0, 0.1, -0.3, 0.6])
-    np.testing.assert_array_equal(coulomb_status(q, s, 0.3), [0, 1, 2, 2])
+    np.testing.assert_array_equal(coulomb_status(q, s[:, None], 0.3), [0, 1, 2, 2])
     n = np.array([[0.0, 1.0], [0.6, -0.8]])
     (t,) = tangents(n)
     np.testing.assert_allclose(np.einsum("ij,ij->i", t, n), 0.0, atol=1e-15)
@@ -367,6 +367,9 @@ def test_friction_output_and_a_resumed_run_equal_to_an_uninterrupted_one(tmp_pat
     assert saved["frictional_work_total"] > 0
 
     assert_resumed_equals_whole(config, tmp_path, stop_after=3, whole=whole)
+    # and from checkpoints written before the tangential arrays were columns in 2D
+    assert_resumed_equals_whole(config, tmp_path, stop_after=3, whole=whole, folder="older",
+                                before_resume=as_written_before_columns)
 
     plain = runner.run(loads(BLOCKS.format(mu=0.0, shift=0.02)), tmp_path / "plain",
                        figures=False)

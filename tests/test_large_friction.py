@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from models import Raw, block_on_base, built, pressed, rectangle_mesh, slid
-from resume_check import assert_resumed_equals_whole
+from resume_check import as_written_before_columns, assert_resumed_equals_whole
 from vfem.contact.formulations.formulation import formulation_class
 from vfem.contact.formulations.large_friction import FrictionalLargeContact
 from vfem.contact.settings import ContactSettings, PairFriction
@@ -167,6 +167,10 @@ def test_a_resumed_large_frictional_run_equals_an_uninterrupted_one(tmp_path):
     factors = [0.25, 0.5, 0.6, 0.7, 0.8, 0.9]
     config = loads(SLIDE.format(mu=0.3, shift=0.5, kinematics="total", factors=factors))
     assert_resumed_equals_whole(config, tmp_path, stop_after=4)
+    # and from checkpoints written before the tangential arrays were columns in 2D (the
+    # anchors, material points, were (n,) and stay so)
+    assert_resumed_equals_whole(config, tmp_path, stop_after=4, folder="older",
+                                before_resume=as_written_before_columns)
 
 
 def test_the_sliding_reactions_tend_to_mu_as_the_indentation_shrinks():

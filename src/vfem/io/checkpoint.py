@@ -172,7 +172,8 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
         "state": {"load_factor": state.load_factor,
                   "platen_displacement": state.platen_displacement,
                   "platen_force": state.platen_force,
-                  "type": type(state).__name__, "unknowns": sorted(state.unknowns())},
+                  "type": type(state).__name__, "unknowns": sorted(state.unknowns()),
+                  "tangential": "columns"},
         "bodies": {b.name: sorted(checkpoint.bodies.get(b.name, {})) for b in model.bodies},
         "control": {"target": checkpoint.target, "level": checkpoint.level,
                     "easy": checkpoint.easy,
@@ -236,6 +237,8 @@ def _state(meta: dict, arrays: dict[str, np.ndarray], model: Model) -> ContactSt
     if "type" in meta:
         cls = STATE_TYPES.get(meta["type"], ContactState)
         unknowns = {k: arrays[f"unknown_{k}"] for k in meta["unknowns"]}
+        if meta["type"] == "FrictionState" and meta.get("tangential") != "columns":
+            unknowns = _tangential_columns(unknowns, model)
     else:
         old = {int(k): arrays[f"multiplier_{k}"] for k in meta.get("multipliers", [])}
         if model.contact.method != "vfem":
@@ -247,6 +250,20 @@ def _state(meta: dict, arrays: dict[str, np.ndarray], model: Model) -> ContactSt
             cls, unknowns = ContactState, {}
     fields = {f.name: getattr(base, f.name) for f in dataclasses.fields(ContactState)}
     return cls(**fields).with_unknowns(unknowns)
+
+
+def _tangential_columns(unknowns: dict[str, np.ndarray], model: Model) -> dict[str, np.ndarray]:
+    """A frictional checkpoint written before the tangential arrays were (n, ntan) in any
+    dimension (2026-11-30): a 2D model kept its tangential traction values (``shear_k``) and,
+    under small kinematics, its anchors (``anchor_k``: relative tangential displacements) as
+    (n,); they become one column. The large-kinematics anchors are material points of the other
+    surface, not tangential arrays, and stay as they are."""
+    small = not any(b.iterates for b in model.bodies)
+    out = dict(unknowns)
+    for key, value in unknowns.items():
+        if value.ndim == 1 and (key.startswith("shear_") or small and key.startswith("anchor_")):
+            out[key] = value[:, None]
+    return out
 
 
 def _step(meta: dict, arrays: dict[str, np.ndarray], model: Model,

@@ -42,9 +42,9 @@ more traction field per contact pair:
   included (they are part of the state the checkpoints save).
 
 * **3D** (issue 21, C13): two tangents per node (:func:`~vfem.contact.laws.coulomb.tangents`),
-  the tangential arrays (n, 2) where 2D keeps (n,) (:func:`~vfem.contact.laws.coulomb.columns` sees
-  both as (n, ntan)); |s| is the row norm and the cone a disk; a slipping node's direction σ = -s /
-  |s| is a unit vector (±1 in 2D), and it turns: besides the tie along σ its traction has a part
+  the tangential arrays (n, 2) where 2D has (n, 1) (one column per tangent); |s| is the row
+  norm and the cone a disk; a slipping node's direction σ = -s / |s| is a unit vector (±1 in
+  2D), and it turns: besides the tie along σ its traction has a part
   across σ, solved for with the row that asks its slip across σ to vanish, linearised (a semismooth
   Newton step on the disk, in :meth:`FrictionalPairedContact._correct_frictional`); the friction's
   errors add the slip across σ. A roller plane through the contact holds one tangent of its nodes
@@ -65,7 +65,6 @@ import numpy as np
 from ..geometry import symmetry_planes
 from ..laws import (
     CONE_TOLERANCE,
-    columns,
     magnitudes,
     relaxation,
     tangents,
@@ -143,10 +142,9 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
 
     def _tangential(self, vector: np.ndarray, k: int) -> np.ndarray:
         """Pair k's tangential rows of a vector over the pair matrix's unknowns, in the shape
-        of :meth:`shear`: (n,) in 2D, (n, 2) in 3D."""
+        of :meth:`shear`: (n, ntan)."""
         n, base, ntan = len(self.contact_pairs[k].nodes), self._full[3][k], len(self._tangents[k])
-        part = vector[base + n: base + (1 + ntan) * n]
-        return part if ntan == 1 else part.reshape(ntan, n).T
+        return vector[base + n: base + (1 + ntan) * n].reshape(ntan, n).T
 
     # -- state -----------------------------------------------------------------------------------
 
@@ -175,8 +173,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         ``w = t.(u_fine - u_virtual)`` (linear kinematics, as the penetrations; from
         ``relative``, :meth:`relative_displacements`, when given)."""
         relative = self.relative_displacements(state) if relative is None else relative
-        return [np.einsum("ij,ij->i", d, t[0]) if len(t) == 1 else
-                np.column_stack([np.einsum("ij,ij->i", d, tj) for tj in t])
+        return [np.column_stack([np.einsum("ij,ij->i", d, tj) for tj in t])
                 for d, t in zip(relative, self._tangents, strict=True)]
 
     def assemble_forces(self, state: ContactState) -> None:
@@ -293,7 +290,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         (what the direction updates of :meth:`_correct_frictional` remove)."""
         out = 0.0
         for k, w in enumerate(dw):
-            s, on = columns(self.shear(state, k)), self.status(state, k) == 2
+            s, on = self.shear(state, k), self.status(state, k) == 2
             on &= magnitudes(s) > 0  # (no direction without a traction: friction_errors)
             if on.any():
                 sigma = -s[on] / magnitudes(s[on])[:, None]
@@ -313,7 +310,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             on = self.tractions(state, k) > 0
             # where the node is, less its elastic slip (the elastoplastic law's s / k_t)
             new = w + self.laws[k][2] * self.shear(state, k)
-            increment = np.where(on if new.ndim == 1 else on[:, None], new - anchor, 0.0)
+            increment = np.where(on[:, None], new - anchor, 0.0)
             self.accumulated_slip(state, k)[:] += magnitudes(increment)
             self._increments.append(increment)
             anchor[:] = new
@@ -348,13 +345,13 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             n, base = len(pair.nodes), offsets[k]
             mu, mu_static, compliance = self.laws[k]
             p, s = pens[k], self.shear(state, k)
-            S = columns(s)  # (n, ntan) views
+            S = s  # (n, ntan)
             tension, contact = self._release_and_hold(state, k, p, platen_ok)
             q = self.tractions(state, k)
             was_sliding = self.sliding(state, k)
             self._torn[k] |= tension
             slip_k = dw[k].copy()
-            slip = columns(slip_k)
+            slip = slip_k
             # A node that comes into contact in the prediction (the first iteration of a step:
             # the new loads with the last contact forces held, linear along the step) touched
             # where its penetration, linear along that path, was zero: it sticks from there
@@ -375,7 +372,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
                 tau = np.where((before < 0) & (rise > 0), -before / np.where(rise > 0, rise, 1.0),
                                0.0)
                 tau = np.clip(tau, 0.0, 1.0)
-                columns(self.anchor(state, k))[fresh] += tau[:, None] * slip[fresh]
+                self.anchor(state, k)[fresh] += tau[:, None] * slip[fresh]
                 slip[fresh] *= (1.0 - tau)[:, None]
             # a node whose relative tangential motion the supports hold (a symmetry plane through
             # the contact, both bodies held along it) has no tangential unknown: its tangential

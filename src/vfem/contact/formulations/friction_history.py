@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..laws import (
-    columns,
     magnitudes,
     tangent_by_tangent,
     tangents,
@@ -40,11 +39,11 @@ class FrictionHistory:
         return tangents(self.contact_pairs[k].normal)
 
     def _zeros(self, k: int) -> np.ndarray:
-        """Zeros for pair k's tangential array: (n,) in 2D (one tangent; the storage the 2D
-        checkpoints have), (n, 2) in 3D (:func:`columns` sees both as (n, ntan))."""
+        """Zeros for pair k's tangential array, (n, ntan): one column per tangent of its
+        normals' space (checkpoints written before 2026-11-30 kept 2D's as (n,):
+        :func:`vfem.io.checkpoint.read` turns them into columns)."""
         pair = self.contact_pairs[k]
-        ntan = pair.normal.shape[1] - 1
-        return np.zeros(len(pair.nodes) if ntan == 1 else (len(pair.nodes), ntan))
+        return np.zeros((len(pair.nodes), pair.normal.shape[1] - 1))
 
     def _values(self, state: FrictionState, name: str, k: int, dtype=float) -> np.ndarray:
         """Pair k's array ``name`` of the state's history, zeros until first set."""
@@ -54,8 +53,8 @@ class FrictionHistory:
         return table[k]
 
     def shear(self, state: FrictionState, k: int) -> np.ndarray:
-        """Pair k's tangential traction values at its compatibility-side nodes, one per
-        tangent: (n,) in 2D, (n, 2) in 3D."""
+        """Pair k's tangential traction values at its compatibility-side nodes, one column per
+        tangent: (n, ntan)."""
         table = state.shear
         if k not in table:
             table[k] = self._zeros(k)
@@ -72,8 +71,6 @@ class FrictionHistory:
     def tangential_traction(self, state: FrictionState, k: int) -> np.ndarray:
         """Pair k's tangential traction vectors (n, dim) at its nodes: sum of s_j t_j."""
         s = self.shear(state, k)
-        if s.ndim == 1:
-            return s[:, None] * self.tangent(k)
         return sum(s[:, j, None] * t for j, t in enumerate(self.tangent_basis(k)))
 
     def accumulated_slip(self, state: FrictionState, k: int) -> np.ndarray:
@@ -109,15 +106,12 @@ class FrictionHistory:
             slip += int((status == 2).sum())
             if (status == 1).any():
                 err = max(err, float(magnitudes(dw[status == 1]).max()))
-            on = status == 2
-            if on.any() and s.ndim == 1:
-                sigma = -np.sign(s[on])
-                err = max(err, float(np.maximum(-sigma * dw[on], 0.0).max()))
-            # 3D: the slip along sigma, and none across it. A node that slips with no traction
-            # (a frictionless pair's) has no direction to measure its slip against: it is free
-            # (in 2D sigma is then 0); dividing by its |s| = 0 made NaN errors (issue 37)
-            on &= magnitudes(s) > 0
-            if on.any() and s.ndim > 1:
+            # a slipping node: its slip along sigma, the direction its traction opposes, and
+            # none across it (with one tangent, sigma = -sign(s) and nothing is across). A node
+            # that slips with no traction (a frictionless pair's) has no direction to measure its
+            # slip against: it is free; dividing by its |s| = 0 made NaN errors (issue 37)
+            on = (status == 2) & (magnitudes(s) > 0)
+            if on.any():
                 sigma = -s[on] / magnitudes(s[on])[:, None]
                 along = np.einsum("ij,ij->i", sigma, dw[on])
                 across = magnitudes(dw[on] - along[:, None] * sigma)
@@ -155,7 +149,7 @@ class FrictionHistory:
             status = self.status(state, k)
             nodes = sf.nodes[pair.nodes]
             out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2)]
-            out += [(sf.body.name, nodes, c < 0) for c in columns(self.shear(state, k)).T]
+            out += [(sf.body.name, nodes, c < 0) for c in self.shear(state, k).T]
         return out
 
     def fields(self, state: ContactState, result: SolveResult) -> dict:
@@ -177,9 +171,9 @@ class FrictionHistory:
             points = sf.nodes[pair.nodes]
             traction = self.tangential_traction(state, k)
             r.contact_shear[points] = traction
-            # 2D: signed along the tangent; 3D: the length of the slip increment
-            r.slip_increment[points] = (increments[k] if increments[k].ndim == 1 else
-                                        magnitudes(increments[k]))
+            # with one tangent (2D): signed along it; with two (3D): the increment's length
+            inc = increments[k]
+            r.slip_increment[points] = inc[:, 0] if inc.shape[1] == 1 else magnitudes(inc)
             r.accumulated_slip[points] = self.accumulated_slip(state, k)
             r.friction_status[points] = self.status(state, k)
             # the nodal forces of the tangential traction alone, on both sides (as

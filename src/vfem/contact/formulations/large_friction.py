@@ -50,7 +50,7 @@ import numpy as np
 
 from ...errors import AnalysisError
 from ..geometry import virtual_nodes
-from ..laws import CONE_TOLERANCE, columns, magnitudes, tangent_axes, tangents
+from ..laws import CONE_TOLERANCE, magnitudes, tangent_axes, tangents
 from ..state import ContactState, FrictionState
 from .friction import HELD, plane_normals
 from .friction_history import FrictionHistory
@@ -124,7 +124,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
     def _traction_vectors(self, state, k, on, normal):
         """``q n + s t`` at the nodes ``on`` (2D: t is ``normal`` turned by +90 degrees; 3D:
         ``q n + s1 t1 + s2 t2``, the tangents of :meth:`_basis`)."""
-        s = columns(self.shear(state, k))[on]
+        s = self.shear(state, k)[on]
         return self.tractions(state, k)[on, None] * normal + sum(
             s[:, j, None] * t for j, t in enumerate(self._basis(k, on, normal)))
 
@@ -154,7 +154,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         for k, s_ in enumerate(sets):
             n = len(s_)
             self.tractions(state, k)[s_] += dq[pos:pos + n]
-            shear = columns(self.shear(state, k))
+            shear = self.shear(state, k)
             for j in range(shear.shape[1]):
                 shear[s_, j] += dq[pos + (1 + j) * n:pos + (2 + j) * n]
             pos += (1 + shear.shape[1]) * n
@@ -192,15 +192,14 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
 
     def slips(self, state: FrictionState, x: list[np.ndarray] | None = None
               ) -> list[np.ndarray]:
-        """Per pair, each node's slip within the step: its distance from its anchor along the
-        current tangent ((n,) in 2D; along both, (n, 2), in 3D) (module docstring)."""
+        """Per pair, each node's slip within the step: its distance from its anchor along each
+        current tangent, (n, ntan) (module docstring)."""
         x = self.positions(state) if x is None else x
         out = []
         for k in range(len(self.contact_pairs)):
             d = self._relative(state, k, x)
-            t = self.tangent_basis(k)
-            out.append(np.einsum("ij,ij->i", d, t[0]) if len(t) == 1 else
-                       np.column_stack([np.einsum("ij,ij->i", d, tj) for tj in t]))
+            out.append(np.column_stack([np.einsum("ij,ij->i", d, tj)
+                                        for tj in self.tangent_basis(k)]))
         return out
 
     def _slip_now(self, state, k, s_, direction) -> np.ndarray:
@@ -264,7 +263,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         self._increments = []
         for k, (g, v) in enumerate(zip(slips, self._virtual_points(x))):
             on = self.tractions(state, k) > 0
-            increment = np.where(on if g.ndim == 1 else on[:, None], g, 0.0)
+            increment = np.where(on[:, None], g, 0.0)
             self.accumulated_slip(state, k)[:] += magnitudes(increment)
             self._increments.append(increment)
             self.anchor(state, k)[:] = v

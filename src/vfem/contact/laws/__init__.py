@@ -8,7 +8,6 @@ The public face of this stage: code outside it imports these names from here
 from .corrections import compatibility_displacement, equilibrium_force, relaxation, release_tension
 from .coulomb import (
     CONE_TOLERANCE,
-    columns,
     coulomb_status,
     magnitudes,
     tangent_axes,
@@ -17,7 +16,6 @@ from .coulomb import (
 )
 
 __all__ = [
-    "columns",
     "compatibility_displacement",
     "CONE_TOLERANCE",
     "coulomb_status",

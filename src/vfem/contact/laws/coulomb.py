@@ -1,7 +1,8 @@
 """Coulomb's law node by node, in any dimension (thesis §1.10: friction "modular", a law of its
 own beside the contact formulation): the tangent basis at a node, the magnitudes of tangential
-vectors stored as columns (one in 2D, two in 3D), and the status of each node — free, stuck
-within the cone |s| <= mu q, or slipping on it.
+vectors, and the status of each node — free, stuck within the cone |s| <= mu q, or slipping on
+it. A tangential array is ``(n, ntan)`` in any dimension: one column per tangent (one in 2D, two
+in 3D).
 """
 
 from __future__ import annotations
@@ -44,29 +45,22 @@ def tangent_axes(normal: np.ndarray) -> np.ndarray:
     return np.argmax(size <= size.min(axis=1, keepdims=True) + 1e-12, axis=1)
 
 
-def columns(a: np.ndarray) -> np.ndarray:
-    """A tangential array (2D: (n,), one tangent; 3D: (n, 2)) seen as (n, ntan): a view (also
-    of no nodes, which ``reshape(0, -1)`` cannot size)."""
-    return a[:, None] if a.ndim == 1 else a
-
-
 def magnitudes(a: np.ndarray) -> np.ndarray:
-    """Per node, the length of a tangential array's vector: |a| in 2D (the same bits as
-    ``np.abs``), the row norm in 3D."""
-    a = columns(a)
+    """Per node, the length of a tangential array's (n, ntan) vector: with one tangent |a|
+    (the same bits as ``np.abs``), else the row norm."""
     if a.shape[1] == 1:
         return np.abs(a[:, 0])
     return np.sqrt(np.einsum("ij,ij->i", a, a))
 
 
 def tangent_by_tangent(a: np.ndarray) -> np.ndarray:
-    """A tangential array in the pair matrix's order (tangent by tangent): 2D as it is."""
-    return a if a.ndim == 1 else a.T.ravel()
+    """A tangential array (n, ntan) in the pair matrix's order: tangent by tangent."""
+    return a.T.ravel()
 
 
 def coulomb_status(q: np.ndarray, s: np.ndarray, mu: float) -> np.ndarray:
     """Per node: 0 no contact (q <= 0), 1 stick (|s| inside the cone mu q), 2 slip (on it); s
-    (n,) in 2D, (n, 2) in 3D."""
+    (n, ntan)."""
     status = np.zeros(len(q), dtype=int)
     on = q > 0
     slipping = magnitudes(s) >= (1.0 - CONE_TOLERANCE) * mu * q
