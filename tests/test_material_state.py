@@ -12,8 +12,8 @@ The laws here are test laws, not physical ones, chosen for closed forms:
   displacements alone a uniformly scaled stress leaves the displacement as it is and scales the
   reactions by ``1 - d``; back at a smaller stretch the reactions remember the largest one.
 * :class:`Recording`: Saint Venant-Kirchhoff whose state records ``kappa`` and nothing else, for
-  a contact analysis: the answers are Saint Venant-Kirchhoff's to the last digit, and the state
-  after each step is the largest strain norm of the steps' converged fields.
+  a contact analysis: the answers are Saint Venant-Kirchhoff's (to the Newton tolerance), and
+  the state after each step is the largest strain norm of the steps' converged fields.
 """
 
 from dataclasses import dataclass
@@ -152,9 +152,9 @@ def test_unloading_remembers_the_largest_strain():
 def test_a_contact_analysis_carries_the_law_unchanged(monkeypatch):
     """A block of a law with state under large kinematics, pressed by a stiffer punch in
     three steps (down, further, back up): contact sees only the body's mechanics, so the
-    answers are Saint Venant-Kirchhoff's bit for bit, and after the run the body's saved state
-    holds the largest strain norm of the steps' converged fields, computed here from the steps'
-    displacements."""
+    answers are Saint Venant-Kirchhoff's (to the Newton tolerance), and after the run the
+    body's saved state holds the largest strain norm of the steps' converged fields, computed
+    here from the steps' displacements."""
     monkeypatch.setitem(LAWS, "recording", Recording)
 
     def run(law):
@@ -173,9 +173,14 @@ def test_a_contact_analysis_carries_the_law_unchanged(monkeypatch):
 
     recorded, block = run("recording")
     plain, _ = run("saint-venant-kirchhoff")
+    # the same arithmetic in both runs; a threaded factorization may round differently from
+    # run to run, and each converged state is exact only to the bodies' Newton tolerance (1e-8
+    # of the reference force, large.BODY_TOLERANCE): the answers agree within it
+    assert len(recorded.steps) == len(plain.steps)
     for a, b in zip(recorded.steps, plain.steps):
-        assert np.array_equal(a.bodies["block"].displacement, b.bodies["block"].displacement)
-        assert np.array_equal(a.bodies["punch"].contact_force, b.bodies["punch"].contact_force)
+        for name, field in (("block", "displacement"), ("punch", "contact_force")):
+            x, y = (np.asarray(getattr(r.bodies[name], field)) for r in (a, b))
+            assert np.abs(x - y).max() <= 1e-8 * np.abs(y).max()
     nl = block.nonlinear
     kappa = np.zeros_like(nl.material_state["kappa"])
     for step in recorded.steps:
