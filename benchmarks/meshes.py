@@ -30,12 +30,21 @@ import sys
 
 def configs(case: str) -> list:
     """The model descriptions (:class:`vfem.config.ModelConfig`) of one case."""
-    try:
-        from vfem_examples import block, gasket, hertz, patch, punch, sliding, wedge
-        from vfem_tools.bench import hertz_parameters
-    except ImportError:  # a tree from before the examples moved beside the library
-        from vfem.examples import block, gasket, hertz, patch, punch, sliding, wedge
-        from vfem.tools.bench import hertz_parameters
+    import importlib
+    import os
+
+    import vfem
+
+    # the tree's own examples: beside the library since issue 38, inside it before (an import
+    # that merely succeeds may come from an editable install's tree, later on the path)
+    tree = os.path.dirname(os.path.dirname(vfem.__file__))
+    beside = os.path.isdir(os.path.join(tree, "vfem_examples"))
+    ex = "vfem_examples" if beside else "vfem.examples"
+    block, gasket, hertz, patch, punch, sliding, wedge = (
+        importlib.import_module(f"{ex}.{name}")
+        for name in ("block", "gasket", "hertz", "patch", "punch", "sliding", "wedge"))
+    hertz_parameters = importlib.import_module(
+        "vfem_tools.bench" if beside else "vfem.tools.bench").hertz_parameters
 
     cases = {
         "hertz_100k": lambda: [hertz.config(hertz_parameters(100_000))],

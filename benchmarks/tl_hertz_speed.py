@@ -25,12 +25,13 @@ import subprocess
 import sys
 
 CASE = """
-import dataclasses, json, sys, time
-import vfem.linalg
-try:
-    from vfem_examples import hertz
-except ImportError:  # a tree from before the examples moved beside the library
-    from vfem.examples import hertz
+import dataclasses, importlib, json, os, sys, time
+import vfem, vfem.linalg
+# the tree's own examples: beside the library since issue 38, inside it before (an import
+# that merely succeeds may come from an editable install's tree, later on the path)
+tree = os.path.dirname(os.path.dirname(vfem.__file__))
+beside = os.path.isdir(os.path.join(tree, "vfem_examples"))
+hertz = importlib.import_module("vfem_examples.hertz" if beside else "vfem.examples.hertz")
 from vfem.solver import Analysis
 if sys.argv[1] != "auto":
     vfem.linalg.use(sys.argv[1])

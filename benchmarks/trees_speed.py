@@ -27,15 +27,16 @@ import subprocess
 import sys
 
 CASE = """
-import importlib, json, sys, time
+import importlib, json, os, sys, time
 import numpy as np
-try:
-    from vfem_tools import bench
-    import vfem_examples as examples
-except ImportError:  # a tree from before the examples moved beside the library
-    from vfem.tools import bench
-    import vfem.examples as examples
+import vfem
 from vfem.solver import Analysis
+# the tree's own examples and tools: beside the library since issue 38, inside it before (an
+# import that merely succeeds may come from an editable install's tree, later on the path)
+tree = os.path.dirname(os.path.dirname(vfem.__file__))
+beside = os.path.isdir(os.path.join(tree, "vfem_examples"))
+bench = importlib.import_module("vfem_tools.bench" if beside else "vfem.tools.bench")
+examples = importlib.import_module("vfem_examples" if beside else "vfem.examples")
 case, dofs = sys.argv[1], int(sys.argv[2])
 parameters = bench.hertz_parameters(dofs) if case == "hertz" else bench.sphere_parameters(dofs)
 model = importlib.import_module(examples.__name__ + "." + case).build(parameters)
@@ -48,9 +49,6 @@ checksum = float(sum(np.abs(np.asarray(b.contact_force)).sum()
 print(json.dumps({"seconds": seconds, "checksum": checksum,
                   "dofs": sum(b.ndofs for b in model.bodies)}))
 """
-
-SIZES = {"10k": 10_000, "30k": 30_000, "100k": 100_000, "300k": 300_000, "1M": 1_000_000}
-
 
 def run(tree: str, case: str, dofs: int) -> dict:
     """One case on ``tree`` in a subprocess of its own."""
@@ -71,9 +69,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--cases", nargs="+", default=["hertz", "sphere"],
                         choices=("hertz", "sphere"))
     args = parser.parse_args(argv)
-    text = args.dofs.lower()
-    dofs = SIZES.get(args.dofs) or int(float(text.rstrip("km")) * {"k": 1e3, "m": 1e6}.get(
-        text[-1:], 1))
+    from vfem_tools.bench import parse_size  # (vfem bench --dofs's sizes)
+
+    dofs = parse_size(args.dofs)
     trees = [os.path.abspath(args.first), os.path.abspath(args.second)]
     times = {(c, t): [] for c in args.cases for t in trees}
     sums = {}

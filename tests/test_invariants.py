@@ -277,14 +277,16 @@ def test_a_node_inside_only_on_the_deformed_geometry_is_recorded_not_failed(monk
     assert inv.record()["second_order"] == w
 
 
-@pytest.mark.parametrize("kinematics, order, remedy", [
-    (("small", "total"), 1, 'reads it 0.002 outside: the answer holds as linear theory reads '
+@pytest.mark.parametrize("settings, order, remedy", [
+    ({}, 1, 'reads it 0.002 outside: the answer holds as linear theory reads '
      'it, its deformed geometry is off by about that depth; kinematics = "total" reads'),
-    (("small", "total"), 2, 'kinematics = "total" (with linear elements) reads'),
-    (("small",), 1, 'the paired variant (the default contact method) with kinematics = "total" '
-     "reads")])
+    ({}, 2, 'kinematics = "total" (with linear elements) reads'),
+    ({"variant": "thesis"}, 1, 'the paired variant (the default contact method) with '
+     'kinematics = "total" reads'),
+    ({"method": "penalty"}, 1, 'the paired variant (the default contact method) with '
+     'kinematics = "total" reads')])
 def test_the_second_order_warning_names_the_step_node_and_a_remedy_the_model_can_take(
-        caplog, kinematics, order, remedy):
+        caplog, settings, order, remedy):
     """Once per run, at the step furthest beyond (not the first): large kinematics for the
     paired variant, linear elements where a body is quadratic, and for a formulation with
     small kinematics only (the thesis variant, the baselines) the paired variant."""
@@ -295,8 +297,8 @@ def test_the_second_order_warning_names_the_step_node_and_a_remedy_the_model_can
 
     analysis = SimpleNamespace(
         model=SimpleNamespace(bodies=[SimpleNamespace(name="upper", order=order),
-                                      SimpleNamespace(name="lower", order=1)]),
-        contact=SimpleNamespace(capabilities=SimpleNamespace(kinematics=kinematics)))
+                                      SimpleNamespace(name="lower", order=1)],
+                              contact=ContactSettings(**settings)))
     steps = [step(1, 1e-4), step(2, 3e-4), SimpleNamespace(step=3, invariants={}),
              step(4, 2e-4)]
     with caplog.at_level(logging.WARNING, logger="vfem"):

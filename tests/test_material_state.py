@@ -23,6 +23,7 @@ import pytest
 
 from vfem.bodies import Body, PrescribedDisplacement, Support
 from vfem.contact.settings import ContactSettings
+from vfem.errors import InputError
 from vfem.materials import LAWS, LinearElastic, Material, Response, SaintVenantKirchhoff
 from vfem.mesh.shapes import rectangle
 from vfem.nonlinear import NonlinearBody
@@ -91,7 +92,14 @@ def test_both_hyperelastic_laws_keep_the_protocol_without_state():
     assert not isinstance(LinearElastic(E_MOD, NU), Material)  # no response: small strain only
 
 
-@pytest.mark.parametrize("formulation", ["total", "updated"])
+def test_the_updated_formulation_refuses_a_law_with_history():
+    """The updated form stands the left stretch for the deformation gradient, exact for an
+    isotropic law without history only."""
+    with pytest.raises(InputError, match="takes a material without history"):
+        stretched(Damage(E_MOD, NU), "updated")
+
+
+@pytest.mark.parametrize("formulation", ["total"])
 def test_the_state_is_committed_by_a_converged_step_only(formulation):
     law = Damage(E_MOD, NU)
     body = stretched(law, formulation)

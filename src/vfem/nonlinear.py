@@ -93,7 +93,7 @@ from .kinematics import (
     strain_increment,
     updated_strain_increment,
 )
-from .materials.protocol import Material
+from .materials.protocol import Material, State
 
 log = logging.getLogger(__name__)
 
@@ -214,7 +214,7 @@ class _State:
     S: np.ndarray  # (dim, dim, ne, nq) 2nd Piola–Kirchhoff stress relative to that reference
     moduli: Callable[[], np.ndarray]  # gives D
     S33: np.ndarray | None  # (ne, nq) out-of-plane S_33 (plane strain); None in 3D
-    material_state: dict = field(default_factory=dict)  # what this iterate would commit
+    material_state: State  # what this iterate would commit (materials.protocol)
 
     @functools.cached_property
     def D(self) -> np.ndarray:
@@ -336,6 +336,12 @@ class NonlinearBody:
         self._reset_updated_state()
         # the material's converged state at the quadrature points (materials.protocol)
         self.material_state = material.initial_state(dim, self.pseudo_strain.shape[2:])
+        if formulation == UPDATED and self.material_state:
+            # the updated form carries the strain in C_1 and stands V_1 = b_1^(1/2) for F_1
+            # (_pushed_material): exact for an isotropic law without history only
+            raise InputError(f"{name}: the updated Lagrangian formulation takes a material "
+                             "without history; use formulation 'total' for "
+                             f"{type(material).__name__}")
 
     # -- set-up ---------------------------------------------------------------------------------
 
@@ -695,10 +701,7 @@ class NonlinearBody:
         """Make the last trial state (see :meth:`equilibrate`) the converged state."""
         if not self._trial_converged:
             raise AnalysisError(f"{self.name}: no converged trial state to accept")
-        if self.material_state:  # a law with history: the converged iterate's state
-            trial = self._trial_state if self._trial_state is not None else \
-                self._state(self._delta)
-            self.material_state = trial.material_state
+        self.material_state = self._trial_state.material_state  # (a converged trial's)
         self._accept(self._delta)
         self.load_factor = self._trial_load_factor
         self.discard()

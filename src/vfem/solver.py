@@ -469,8 +469,10 @@ class Analysis:
         quadratic = any(b.order > 1 for b in self.model.bodies
                         if b.name in (so["body"], so["into"]))
         remedy = 'kinematics = "total"' + (" (with linear elements)" if quadratic else "")
-        if "total" not in self.contact.capabilities.kinematics:
-            # the thesis variant and the baselines: small kinematics only
+        settings = self.model.contact
+        if settings.method != "vfem" or settings.variant != "paired":
+            # the thesis variant and the baselines: small kinematics only (the record exists
+            # only under small kinematics, so the running formulation cannot tell)
             remedy = f"the paired variant (the default contact method) with {remedy}"
         log.warning("step %d (load factor %.6g): node %d of body %r lies %.3g inside body %r on "
                     "the deformed geometry, beyond the %.3g allowed for faceting and linear "

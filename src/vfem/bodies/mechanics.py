@@ -85,6 +85,9 @@ class BodyMechanics(Protocol):
         """Equilibrate the trial state under the given contact forces; None where the body is
         always in equilibrium with them."""
 
+    def move(self, correction: np.ndarray) -> None:
+        """Add a Newton correction (ndofs) to the trial state; nothing where there is none."""
+
 
 class LinearMechanics:
     """Small kinematics: the body's response is linear, its state the contact state's (the
@@ -131,12 +134,16 @@ class LinearMechanics:
                     contact_force: np.ndarray) -> None:
         return None  # always in equilibrium with its contact forces
 
+    def move(self, correction: np.ndarray) -> None:
+        pass  # no trial state: its displacement is the contact state's
+
 
 def mechanics_for(body, fixed: dict[int, float]) -> BodyMechanics:
     """The mechanics of an assembled body: Newton's (:class:`LargeMechanics`) where its response
-    is nonlinear (:attr:`~vfem.bodies.Body.iterates`), else the linear superposition. The one
-    place a body's kind of response is chosen. ``fixed``: the prescribed value of every
-    constrained dof (:func:`~vfem.bodies.loads.constraints`)."""
+    is nonlinear (:attr:`~vfem.bodies.Body.iterates`), else the linear superposition: how
+    :func:`~vfem.bodies.condensation.setup` chooses (a body only assembled, a baseline's, and a
+    body on another MPI rank are linear, :attr:`Body.mechanics`, ``parallel``). ``fixed``: the
+    prescribed value of every constrained dof (:func:`~vfem.bodies.loads.constraints`)."""
     return LargeMechanics(body, fixed) if body.iterates else LinearMechanics(body)
 
 

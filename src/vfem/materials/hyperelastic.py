@@ -206,10 +206,8 @@ class NeoHookean(_Isotropic):
         return lam * self._right_cauchy_green(E)[1]
 
 
-HyperelasticMaterial = SaintVenantKirchhoff | NeoHookean
-
 #: the hyperelastic laws by the name a body's ``law`` gives (``[bodies.law]`` in an input file)
 LAWS: dict[str, type] = {"saint-venant-kirchhoff": SaintVenantKirchhoff,
                          "neo-hookean": NeoHookean}
 
-__all__ = ["SaintVenantKirchhoff", "NeoHookean", "HyperelasticMaterial", "LAWS"]
+__all__ = ["SaintVenantKirchhoff", "NeoHookean", "LAWS"]

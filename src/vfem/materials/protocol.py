@@ -1,5 +1,7 @@
-"""The contract between a material law and the bodies that evaluate it (issue 38: a plastic law
-drops in without touching the bodies' Newton iteration or contact).
+"""The contract between a material law and the bodies that evaluate it (issue 38: the seam a
+plastic law takes, without touching contact; under the total Lagrangian formulation, since the
+updated one stands the left stretch for the deformation gradient, which only a law without
+history allows, and refuses a law with state).
 
 A body under large kinematics (:class:`vfem.nonlinear.NonlinearBody`) asks its material, at every
 quadrature point of an iterate, for the second Piola-Kirchhoff stress ``S`` that answers the
@@ -49,19 +51,15 @@ class Response:
 class Material(Protocol):
     """A material law a large-kinematics body evaluates (see the module docstring).
 
-    ``youngs_modulus`` and ``poissons_ratio`` are its small-strain constants: the body's scale
-    of force (the floor of its Newton reference force) and the linear stiffness it starts from.
+    ``youngs_modulus`` is its small-strain modulus: the body's scale of force (the floor of its
+    Newton reference force).
     """
 
     youngs_modulus: float
-    poissons_ratio: float
 
     def validate(self, where: str = "material") -> None:
         """Raise :class:`~vfem.errors.InputError` naming ``where`` if the law's parameters are
         not admissible."""
-
-    def lame(self) -> tuple[float, float]:
-        """The small-strain Lamé constants (lambda, mu)."""
 
     def initial_state(self, dim: int, points: tuple[int, int]) -> State:
         """The state at rest over ``points = (nelements, nq)`` quadrature points of a ``dim``-D

@@ -344,14 +344,12 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         for k, pair in enumerate(self.contact_pairs):
             n, base = len(pair.nodes), offsets[k]
             mu, mu_static, compliance = self.laws[k]
-            p, s = pens[k], self.shear(state, k)
-            S = s  # (n, ntan)
+            p, S = pens[k], self.shear(state, k)  # S: (n, ntan)
             tension, contact = self._release_and_hold(state, k, p, platen_ok)
             q = self.tractions(state, k)
             was_sliding = self.sliding(state, k)
             self._torn[k] |= tension
-            slip_k = dw[k].copy()
-            slip = slip_k
+            slip = dw[k].copy()
             # A node that comes into contact in the prediction (the first iteration of a step:
             # the new loads with the last contact forces held, linear along the step) touched
             # where its penetration, linear along that path, was zero: it sticks from there
@@ -394,7 +392,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             # a node on the cone keeps slipping unless its slip has turned back: the static cone
             # for a node at rest, the dynamic one for a node that slips (the same for Coulomb);
             # sigma, its slip direction, is the one its traction opposes (2D: -sign(s))
-            size = magnitudes(s)
+            size = magnitudes(S)
             sigma = np.divide(-S, size[:, None], out=np.zeros_like(S), where=size[:, None] > 0)
             reach = size >= (1.0 - CONE_TOLERANCE) * q * np.where(was_sliding, mu, mu_static)
             on_cone = (q > 0) & reach & (size != 0)
@@ -404,7 +402,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             unit = np.divide(slip, amount[:, None], out=np.zeros_like(slip),
                              where=going[:, None])
             sigma[moving | driven] = unit[moving | driven]
-            along = np.einsum("ij,ij->i", sigma, slip) if ntan > 1 else sigma[:, 0] * slip[:, 0]
+            along = np.einsum("ij,ij->i", sigma, slip)
             slipping = contact & ((on_cone & (along >= -tol)) | moving)
             slipping &= ~node_held
             slipping |= driven

@@ -61,8 +61,10 @@ class FrictionHistory:
         return table[k]
 
     def anchor(self, state: FrictionState, k: int) -> np.ndarray:
-        """Pair k's relative tangential displacements at the last converged step (as
-        :meth:`shear`, one per tangent)."""
+        """Pair k's anchors at the last converged step: under small kinematics its relative
+        tangential displacements, (n, ntan) as :meth:`shear`; under large kinematics the
+        material points of the other surface its nodes faced
+        (:meth:`~vfem.contact.formulations.large_friction.FrictionalLargeContact._virtual_points`)."""
         table = state.anchor
         if k not in table:
             table[k] = self._zeros(k)

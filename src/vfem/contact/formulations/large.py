@@ -233,8 +233,8 @@ class LargeDeformationContact(PairSet):
                 for i, (s, F) in enumerate(zip(self.surfaces, state.forces))]
 
     def _finish(self, state: ContactState) -> None:
-        """Equilibrate every large-kinematics body under the converged contact forces (what
-        the solver commits; one correction at most)."""
+        """Equilibrate every body that iterates under the converged contact forces (what the
+        solver commits; one correction at most; a linear body is already in equilibrium)."""
         for i, (s, F) in enumerate(zip(self.surfaces, state.forces)):
             s.body.mechanics.equilibrate(state.load_factor, state.platen_displacement,
                                          self._full_force(i, F))
@@ -409,8 +409,7 @@ class LargeDeformationContact(PairSet):
                     W[rows] = self._motion_along(pair, direction, M, s_)
                     p[rows] = self._slip_now(state, k, s_, direction) + self._motion_along(
                         pair, direction, a, s_)
-                    # (one tangent in 2D, (n,); two in 3D, (n, 2): the j-th's values)
-                    q0[rows] = np.reshape(self.shear(state, k), (len(pair.nodes), -1))[s_, j - 1]
+                    q0[rows] = self.shear(state, k)[s_, j - 1]  # (n, ntan): the j-th's
                 row += len(s_)
         rate = _concatenate([r[s_] for r, s_ in zip(rates, sets)])
         dR = -motion @ A[off[self.platen_body]:off[self.platen_body + 1]] if platen else None
@@ -486,12 +485,12 @@ class LargeDeformationContact(PairSet):
             try:
                 for s, du in zip(self.surfaces, moves):
                     if du is not None:
-                        s.body.move(fraction * du)
+                        s.body.mechanics.move(fraction * du)
                         moved.append((s.body, du))
                 break
             except AnalysisError as exc:
                 for body, du in moved:
-                    body.move(-fraction * du)
+                    body.mechanics.move(-fraction * du)
                 if attempt == MAX_DAMPING:
                     raise
                 fraction *= 0.5

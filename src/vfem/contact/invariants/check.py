@@ -184,7 +184,7 @@ class InvariantCheck:
              for b, g in zip(self.bodies, self.boundaries)]
         cur = [r if not np.any(ui) else kind.surface(r.b, r.x + ui) for r, ui in zip(ref, u)]
         Fb = [f[g.nodes] for f, g in zip(F, self.boundaries)]
-        self._interpenetration(cur, out, extra_allowance, Fb)
+        self._interpenetration(cur, out, extra_allowance, Fb, ref)
         # (c)'s normals: the deformed ones under large kinematics, the undeformed ones (linear
         # theory's) under small
         own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
@@ -208,11 +208,15 @@ class InvariantCheck:
     # -- (b) ------------------------------------------------------------------------------------
 
     def _interpenetration(self, cur: list, out: Invariants, extra: float,
-                          forces: list[np.ndarray] | None = None) -> None:
+                          forces: list[np.ndarray] | None = None, ref: list | None = None
+                          ) -> None:
         """(b) on the current surfaces ``cur`` (2D :class:`~.polygon._Polygon` s, or 3D
         :class:`~vfem.contact.invariants.check3d.Surface3` s, which answer the same questions: box,
         inside, depth, turning_within, adjacent); small kinematics' reading of a depth is the
-        kind's (``kind.linearised_depth``)."""
+        kind's (``kind.linearised_depth``, from the undeformed surfaces ``ref``, by default
+        :attr:`reference`)."""
+        ref = self.reference if ref is None else ref
+        linearised_depth = self.kind.linearised_depth
         tol = self.penetration_tolerance + extra
         # per body: its boundary nodes that carry contact force or neighbour one that does
         touched = None if forces is None else [_loaded_or_next(g.b.segments, f)
@@ -240,8 +244,7 @@ class InvariantCheck:
                 L = np.where(touched[j][ends].any(axis=1), L, 0.0)
             deformed, linearised, second = depth, None, 0.0
             if not (gi.b.large or gj.b.large):
-                linearised, second = self.kind.linearised_depth(self.reference, i, j, node,
-                                                                cur)
+                linearised, second = linearised_depth(ref, i, j, node, cur)
                 depth = np.minimum(depth, linearised)
             alpha = np.minimum(gi.turning_within(node, L), 0.5 * np.pi)
             allowed = tol + second + np.minimum(0.5 * L * np.tan(0.5 * alpha),
@@ -263,8 +266,8 @@ class InvariantCheck:
         _, out.penetration, out.allowed, i, k, j, deformed, linearised = best
         pos = cur[i].x[k]
         out.where = {"body": self.bodies[i].name, "node": int(cur[i].b.nodes[k]),
-                     "into": self.bodies[j].name, "x": float(pos[0]), "y": float(pos[1]),
-                     **({"z": float(pos[2])} if len(pos) == 3 else {}),
+                     "into": self.bodies[j].name,
+                     **{c: float(v) for c, v in zip(("x", "y", "z"), pos)},
                      "deformed_depth": deformed, "linearised_depth": linearised}
 
     def _beyond_second_order(self, out: Invariants, i: int, j: int, node: np.ndarray,
@@ -300,7 +303,7 @@ class InvariantCheck:
         return self.quadratic_tension_tolerance if body.order != 1 else self.tension_tolerance
 
 def _loaded_or_next(segments: np.ndarray, forces: np.ndarray) -> np.ndarray:
-    """(nb,) the boundary nodes that carry a contact force (``forces``, (nb, 2)) or share a
+    """(nb,) the boundary nodes that carry a contact force (``forces``, (nb, dim)) or share a
     boundary segment with one that does."""
     loaded = np.abs(forces).sum(axis=1) > 0
     out = loaded.copy()

@@ -45,6 +45,7 @@ from scipy.spatial import cKDTree
 from ..geometry import closest_on_facets, kind_of
 from .cached_boundary import CachedBoundary
 from .kind import SurfaceKind
+from .measures import nodal_tension
 from .polygon import _symmetry_facets
 
 if TYPE_CHECKING:
@@ -412,29 +413,20 @@ def tension(bodies: list[Body], tolerance: Callable[[Body], float], least: float
     largest tensile measure over the largest nodal force (0 where none), its tolerance (the
     least of the bodies' where none) and where it is (``{"body", "node", "value"}``, or None).
     """
-    scale = max((float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in F), default=0.0)
-    least = min((tolerance(b) for b in bodies), default=least)
-    if scale == 0:
-        return 0.0, least, None
-    worst = None
-    for b, f, g in zip(bodies, F, own):
-        if not len(f):
-            continue
-        fn = np.einsum("ij,ij->i", f, g.tension_normals)
-        if g.b.corner_mid is not None:
-            corner, mid = g.b.corner_mid.T
-            patch = fn.copy()
-            np.add.at(patch, corner, 0.5 * fn[mid])
-            patch[mid] = fn[mid]
-            fn = patch
-        k = int(np.argmax(fn))
-        ratio = fn[k] / scale / tolerance(b)
-        if fn[k] > 0 and (worst is None or ratio > worst[0]):
-            worst = (ratio, float(fn[k]), b, int(g.b.nodes[k]))
-    if worst is None:
-        return 0.0, least, None
-    _, value, b, node = worst
-    return value / scale, tolerance(b), {"body": b.name, "node": node, "value": value}
+    return nodal_tension(bodies, tolerance, least, F, own, _nodal_measure)
+
+
+def _nodal_measure(g: Surface3, f: np.ndarray) -> np.ndarray:
+    """F·n at every node of a 3D boundary; a quadratic triangle's corner with half of each
+    midpoint of its edges from it (:func:`tension`)."""
+    fn = np.einsum("ij,ij->i", f, g.tension_normals)
+    if g.b.corner_mid is not None:
+        corner, mid = g.b.corner_mid.T
+        patch = fn.copy()
+        np.add.at(patch, corner, 0.5 * fn[mid])
+        patch[mid] = fn[mid]
+        fn = patch
+    return fn
 
 
 def _boundary(body: Body) -> Boundary3:

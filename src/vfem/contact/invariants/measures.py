@@ -7,7 +7,10 @@ checks themselves are :mod:`vfem.contact.invariants.check`'s.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+
+import numpy as np
 
 #: (a): the resultant of all contact forces, relative to the largest body's total contact force
 FORCE_BALANCE_TOLERANCE = 1e-8
@@ -128,3 +131,31 @@ class Invariants:
                 "failed": self.failed(),
                 "enforced": list(self.enforced),
                 "seconds": float(self.seconds)}
+
+
+def nodal_tension(bodies: list, tolerance: Callable, least: float, F: list[np.ndarray],
+                  own: list, measure: Callable[[object, np.ndarray], np.ndarray]
+                  ) -> tuple[float, float, dict | None]:
+    """Invariant (c), the nodal measure, for any dimension: ``measure(surface, forces)`` is a
+    body's tensile reading per boundary node (F·n, a quadratic facet's corner read with its
+    midpoints: the surface kind's, :mod:`.plane`, :mod:`.check3d`). Returns the largest over
+    the largest nodal force (0 where none), its body's tolerance (``tolerance(body)``; the
+    least of the bodies', or ``least`` where there are none, when nothing is tensile) and where
+    it is (``{"body", "node", "value"}``, or None)."""
+    scale = max((float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in F), default=0.0)
+    least = min((tolerance(b) for b in bodies), default=least)
+    if scale == 0:
+        return 0.0, least, None
+    worst = None  # (value / scale / tolerance, value, body, point number)
+    for b, f, g in zip(bodies, F, own):
+        if not len(f):
+            continue
+        fn = measure(g, f)
+        k = int(np.argmax(fn))
+        ratio = fn[k] / scale / tolerance(b)
+        if fn[k] > 0 and (worst is None or ratio > worst[0]):
+            worst = (ratio, float(fn[k]), b, int(g.b.nodes[k]))
+    if worst is None:
+        return 0.0, least, None
+    _, value, b, node = worst
+    return value / scale, tolerance(b), {"body": b.name, "node": node, "value": value}

@@ -17,6 +17,7 @@ import scipy.sparse.linalg as spla
 from ..search import project_points
 from .check3d import CORNER_ANGLE
 from .kind import SurfaceKind
+from .measures import nodal_tension
 from .polygon import _Boundary, _Polygon, _scatter_add
 
 if TYPE_CHECKING:
@@ -124,40 +125,22 @@ def tension(bodies: list[Body], tolerance: Callable[[Body], float], least: float
     (the consistent measure's, for every body)."""
     if measure == "consistent":
         return _tension_consistent(bodies, least, F, own)
-    return _tension_nodal(bodies, tolerance, least, F, own)
+    return nodal_tension(bodies, tolerance, least, F, own, _nodal_measure)
 
 
-def _tension_nodal(bodies: list[Body], tolerance: Callable[[Body], float], least: float,
-                   F: list[np.ndarray], own: list[_Polygon]) -> tuple[float, float, dict | None]:
-    """The nodal measure: F·n at every node, a quadratic facet's vertex with its midpoints."""
-    scale = max((float(np.linalg.norm(f, axis=1).max(initial=0.0)) for f in F),
-                default=0.0)
-    least = min((tolerance(b) for b in bodies), default=least)
-    if scale == 0:
-        return 0.0, least, None
-    worst = None  # (value / scale / tolerance, value, body, local node)
-    for b, f, g in zip(bodies, F, own):
-        fn = np.einsum("ij,ij->i", f, g.normals)
-        if g.b.facets.shape[1] == 3:
-            # quadratic facets: a vertex with the midpoints of its facets (weights
-            # 1 - phi_far_end >= 0 on each facet), a midpoint alone (4 t (1 - t) >= 0)
-            mid = g.b.facets[:, 2]
-            patch = fn.copy()
-            for col in (0, 1):
-                np.add.at(patch, g.b.facets[:, col], fn[mid])
-            patch[mid] = fn[mid]
-            fn = patch
-        if not len(fn):
-            continue
-        k = int(np.argmax(fn))
-        ratio = fn[k] / scale / tolerance(b)
-        if fn[k] > 0 and (worst is None or ratio > worst[0]):
-            worst = (ratio, float(fn[k]), b, k)
-    if worst is None:
-        return 0.0, least, None
-    _, value, b, k = worst
-    node = int(own[bodies.index(b)].b.nodes[k])
-    return value / scale, tolerance(b), {"body": b.name, "node": node, "value": value}
+def _nodal_measure(g: _Polygon, f: np.ndarray) -> np.ndarray:
+    """F·n at every node of a 2D boundary (its own normals); on quadratic facets a vertex with
+    the midpoints of its facets (weights 1 - phi_far_end >= 0 on each facet), a midpoint alone
+    (4 t (1 - t) >= 0)."""
+    fn = np.einsum("ij,ij->i", f, g.normals)
+    if g.b.facets.shape[1] == 3:
+        mid = g.b.facets[:, 2]
+        patch = fn.copy()
+        for col in (0, 1):
+            np.add.at(patch, g.b.facets[:, col], fn[mid])
+        patch[mid] = fn[mid]
+        fn = patch
+    return fn
 
 
 def _tension_consistent(bodies: list[Body], least: float, F: list[np.ndarray],
