@@ -43,6 +43,8 @@ from pathlib import Path
 import meshio
 import numpy as np
 
+from ..contact.laws import friction_law as contact_friction_law
+from ..contact.laws import law_bounds, law_record, law_text
 from ..errors import InputError
 from . import plots
 from .files import _safe, forget_vtus, write_summary, written_vtu
@@ -378,19 +380,11 @@ def contact_settings(model) -> dict:
 
 def friction_law(pair) -> dict:
     """One pair's friction (:class:`vfem.contact.settings.PairFriction`) as data: ``bodies``,
-    ``law`` and its coefficients by name — ``coulomb``: ``mu``; ``static_dynamic``:
-    ``mu_static`` (a sticking node starts to slip) and ``mu_dynamic`` (a slipping one);
-    ``elastoplastic``: ``mu`` and ``slip_stiffness``; ``frictionless`` where the pair has no
-    friction."""
-    out: dict = {"bodies": list(pair.bodies)}
-    mu, static, _ = pair.coefficients
-    if mu == 0 and static == 0:
-        return {**out, "law": "frictionless"}
-    if pair.law == "static_dynamic":
-        return {**out, "law": pair.law, "mu_static": static, "mu_dynamic": mu}
-    if pair.law == "elastoplastic":
-        return {**out, "law": pair.law, "mu": mu, "slip_stiffness": float(pair.slip_stiffness)}
-    return {**out, "law": pair.law, "mu": mu}
+    then what its law records of itself (:func:`vfem.contact.laws.law_record`: ``law`` and its
+    coefficients by name — ``coulomb``: ``mu``; ``static_dynamic``: ``mu_static`` (a sticking
+    node starts to slip) and ``mu_dynamic`` (a slipping one); ``elastoplastic``: ``mu`` and
+    ``slip_stiffness``; ``frictionless`` where the pair has no friction)."""
+    return {"bodies": list(pair.bodies), **law_record(contact_friction_law(pair))}
 
 
 def friction_laws_text(settings: dict | None) -> str:
@@ -398,19 +392,8 @@ def friction_laws_text(settings: dict | None) -> str:
     closing screen and the figures: "upper/lower: Coulomb, mu = 0.3" or "base/block: static
     mu = 0.3, dynamic mu = 0.2" (pairs joined by "; "); "" without friction."""
     friction = (settings or {}).get("friction") or {}
-    texts = []
-    for p in friction.get("pairs") or ():
-        law, who = p.get("law"), "/".join(p.get("bodies") or ())
-        if law == "static_dynamic":
-            texts.append(f"{who}: static mu = {p['mu_static']:g}, dynamic mu = {p['mu_dynamic']:g}")
-        elif law == "elastoplastic":
-            texts.append(f"{who}: elasto-plastic, mu = {p['mu']:g}, slip stiffness "
-                         f"{p['slip_stiffness']:g}")
-        elif law == "frictionless":
-            texts.append(f"{who}: frictionless")
-        else:
-            texts.append(f"{who}: Coulomb, mu = {p.get('mu', 0.0):g}")
-    return "; ".join(texts)
+    return "; ".join(f"{'/'.join(p.get('bodies') or ())}: {law_text(p)}"
+                     for p in friction.get("pairs") or ())
 
 
 #: set by :func:`defer`: runs write their results and leave the figures to ``vfem plot``
@@ -746,14 +729,7 @@ def body_friction_limits(summary: dict, body: str) -> list[tuple[str, float]]:
         pairs = [p for p in pairs if body in (p.get("bodies") or ())]
     out: list[tuple[str, float]] = []
     for p in pairs:
-        if p.get("law") == "static_dynamic":
-            found = [("mu_s q, stick limit", float(p["mu_static"])),
-                     ("mu_d q, slip", float(p["mu_dynamic"]))]
-        elif p.get("law") in ("coulomb", "elastoplastic") and p.get("mu"):
-            found = [("mu q, Coulomb limit", float(p["mu"]))]
-        else:
-            found = []
-        out += [x for x in found if x[1] > 0 and x not in out]
+        out += [x for x in law_bounds(p) if x[1] > 0 and x not in out]
     return out
 
 

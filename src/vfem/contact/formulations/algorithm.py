@@ -57,7 +57,7 @@ class VirtualElementContact(SurfaceGroup):
 
     capabilities = Capabilities(
         name="thesis", orders=(1,), kinematics=("small",), dimensions=(2,),
-        friction=("frictionless",), invariants="recorded", reads_rind=True)
+        invariants="recorded", reads_rind=True)
 
     def _platen_motion(self, nodes: np.ndarray, normal: np.ndarray) -> np.ndarray:
         """Normal displacement of candidate nodes of the platen body per unit platen motion."""

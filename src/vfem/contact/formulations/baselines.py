@@ -54,6 +54,7 @@ from ...linalg import factorize
 from ...memory import memory_guard
 from ..capabilities import Capabilities
 from ..geometry import ContactSurface
+from ..laws import friction_law
 from ..state import BaselineState, IterationRecord, SolveResult
 from .node_to_segment import (
     node_to_segment,
@@ -90,7 +91,7 @@ class GlobalContact:
 
     capabilities = Capabilities(
         name="classical", orders=(1,), kinematics=("small",), dimensions=(2,),
-        friction=("frictionless", "coulomb"), invariants="compared", cuts_steps=False)
+        friction_laws=("coulomb", "static_dynamic"), invariants="compared", cuts_steps=False)
 
     #: the methods that solve Coulomb friction (the Lagrange multipliers' saddle point)
     FRICTIONAL_METHODS = ("lagrange",)
@@ -178,11 +179,14 @@ class GlobalContact:
         moves (a symmetry plane through the contact), or of a frictionless pair, has no
         tangential unknown."""
         names = [b.name for b in self.model.bodies]
-        laws = [settings.pair_friction(names[a], names[b]).coefficients
+        # each row's pair's law (:class:`~vfem.contact.laws.FrictionLaw`), at no accumulated
+        # slip: the baseline keeps none per row, and its capabilities name only the laws whose
+        # coefficients do not depend on it (others are refused before, check_capabilities)
+        laws = [friction_law(settings.pair_friction(names[a], names[b]))
                 for a, b in zip(self.c.slave, self.c.master)]
-        self.mu = np.array([law[0] for law in laws])
-        self.mu_static = np.array([law[1] for law in laws])
-        # (the elasto-plastic law is refused before: check_capabilities)
+        none = np.zeros(1)
+        self.mu = np.array([law.dynamic(none)[0] for law in laws])
+        self.mu_static = np.array([law.static(none)[0] for law in laws])
         Bt = (self.c.Bt @ self.T).tocsr()
         Bt.eliminate_zeros()
         self.Btr = Bt

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from ...errors import InputError
 from ..capabilities import Capabilities
+from ..laws import friction_law
 
 if TYPE_CHECKING:
     from ...bodies.results import BodyStepResult
@@ -97,7 +98,9 @@ def check_capabilities(model) -> None:
         if unknown:
             raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: no "
                              f"body named {unknown[0]!r} (bodies: {', '.join(sorted(names))})")
-    if settings.frictional and ("coulomb" not in caps.friction or (
+    # each pair's law and its parameters (the laws check their own), whether or not it acts
+    laws = [(pair, friction_law(pair)) for pair in settings.pairs]
+    if settings.frictional and (not caps.friction_laws or (
             settings.method != "vfem"
             and settings.method not in getattr(cls, "FRICTIONAL_METHODS", ()))):
         what = (f"contact.method = {settings.method!r}" if settings.method != "vfem" else
@@ -108,15 +111,15 @@ def check_capabilities(model) -> None:
         raise InputError(f"model {model.name!r}: friction ({where}) is available with the "
                          f"paired variant and the lagrange baseline only, not yet with {what}; "
                          "set it to 0 for frictionless contact")
-    if settings.frictional and (large or settings.method != "vfem"):
-        # what the frictional large-kinematics variant and the lagrange baseline do not solve
-        what = "large kinematics" if large else f"contact.method = {settings.method!r}"
-        for pair in settings.pairs:
-            if pair.law == "elastoplastic" and pair.friction > 0:
+    if settings.frictional:
+        what = ("large kinematics" if large else f"contact.method = {settings.method!r}"
+                if settings.method != "vfem" else f"the {caps.name} variant")
+        for pair, law in laws:
+            if law.acts and law.name not in caps.friction_laws:
                 raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: "
-                                 "the elastoplastic friction law is available with the paired "
-                                 f"variant and small kinematics only, not yet with {what}; use "
-                                 "law = 'coulomb' or 'static_dynamic'")
+                                 f"the {law.name} friction law is not among those the "
+                                 f"{caps.name} formulation takes: not yet with {what}; use law = "
+                                 + " or ".join(repr(n) for n in caps.friction_laws))
         platen = next((b for b in model.bodies if b.platen is not None), None)
         if large and platen is not None:
             raise InputError(f"model {model.name!r}, body {platen.name!r}: a force-controlled "

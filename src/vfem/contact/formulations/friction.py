@@ -66,6 +66,7 @@ from ..geometry import symmetry_planes
 from ..laws import (
     CONE_TOLERANCE,
     magnitudes,
+    reaches_cone,
     relaxation,
     tangents,
 )
@@ -112,7 +113,8 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     """The paired variant with Coulomb friction, small displacements (module docstring)."""
 
     capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
-                                       friction=("frictionless", "coulomb"), orders_3d=(1,))
+                                       friction_laws=("coulomb", "static_dynamic",
+                                                      "elastoplastic"), orders_3d=(1,))
     state_type = FrictionState
     #: the equilibrium side's nodes are not held (issue 37): not yet with friction
     both_surfaces = False
@@ -164,7 +166,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         tangential traction over the slip stiffness (the elastoplastic law; nothing for the
         others). A sticking node holds it at zero; a slipping one moves it against its
         traction."""
-        return [w - self.anchor(state, k) + self.laws[k][2] * self.shear(state, k)
+        return [w - self.anchor(state, k) + self.laws[k].compliance * self.shear(state, k)
                 for k, w in enumerate(self.tangential_displacements(state, relative))]
 
     def tangential_displacements(self, state: ContactState,
@@ -250,7 +252,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         """
         tol = self.penetration_tolerance
         # each node's relative tangential displacement, from its free slip (free_slips)
-        relative = [d + self.anchor(state, k) - self.laws[k][2] * self.shear(state, k)
+        relative = [d + self.anchor(state, k) - self.laws[k].compliance * self.shear(state, k)
                     for k, d in enumerate(dw)]
         seen = set()
         for inner in range(self.settings.max_iterations):
@@ -268,7 +270,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             pens = [p - motion[r] + rate[r] * dplaten for p, r in zip(pens, normal)]
             relative = [w + self._tangential(motion, k) + self._tangential(rate, k) * dplaten
                         for k, w in enumerate(relative)]
-            dw = [w - self.anchor(state, k) + self.laws[k][2] * self.shear(state, k)
+            dw = [w - self.anchor(state, k) + self.laws[k].compliance * self.shear(state, k)
                   for k, w in enumerate(relative)]
             traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
             _, pen_err, _, tension = self.compatibility_errors(pens, traction_values)
@@ -309,7 +311,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             anchor = self.anchor(state, k)
             on = self.tractions(state, k) > 0
             # where the node is, less its elastic slip (the elastoplastic law's s / k_t)
-            new = w + self.laws[k][2] * self.shear(state, k)
+            new = w + self.laws[k].compliance * self.shear(state, k)
             increment = np.where(on[:, None], new - anchor, 0.0)
             self.accumulated_slip(state, k)[:] += magnitudes(increment)
             self._increments.append(increment)
@@ -343,7 +345,8 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         perp_s, perp_dir, perp_c, perp_rhs = [], [], [], []
         for k, pair in enumerate(self.contact_pairs):
             n, base = len(pair.nodes), offsets[k]
-            mu, mu_static, compliance = self.laws[k]
+            law = self.laws[k]
+            compliance, acts = law.compliance, law.acts
             p, S = pens[k], self.shear(state, k)  # S: (n, ntan)
             tension, contact = self._release_and_hold(state, k, p, platen_ok)
             q = self.tractions(state, k)
@@ -378,7 +381,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             # In 3D a node may be held along one tangent only (a roller plane): it slides along
             # the other.
             held = self._held[base + n: base + (1 + ntan) * n].reshape(ntan, n).T \
-                | (mu_static == 0.0)
+                | (not acts)
             node_held = held.all(axis=1)
             # 3D: a node the supports move along a held tangent (both bodies' dofs prescribed
             # there, but not alike: the press fit's shaft end faces pushed past the hub's held
@@ -386,15 +389,14 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             # the slip, a tie like any slipping node's, carried by the supports
             driven = np.zeros(n, dtype=bool)
             if ntan > 1:
-                driven = contact & (magnitudes(np.where(held, slip, 0.0)) > tol) \
-                    & (mu_static > 0.0)
+                driven = contact & (magnitudes(np.where(held, slip, 0.0)) > tol) & acts
                 slip[held & ~driven[:, None]] = 0.0  # (round-off: the supports hold it)
             # a node on the cone keeps slipping unless its slip has turned back: the static cone
             # for a node at rest, the dynamic one for a node that slips (the same for Coulomb);
             # sigma, its slip direction, is the one its traction opposes (2D: -sign(s))
             size = magnitudes(S)
             sigma = np.divide(-S, size[:, None], out=np.zeros_like(S), where=size[:, None] > 0)
-            reach = size >= (1.0 - CONE_TOLERANCE) * q * np.where(was_sliding, mu, mu_static)
+            reach = reaches_cone(size, q, self.onset(state, k))
             on_cone = (q > 0) & reach & (size != 0)
             amount = magnitudes(slip)
             moving = torn & (amount > tol)
@@ -407,7 +409,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             slipping &= ~node_held
             slipping |= driven
             sticking = contact & ~slipping & ~node_held
-            was_sliding[:] = slipping | (contact & (mu_static == 0.0))
+            was_sliding[:] = slipping | (contact & (not acts))
             # no tangential traction where held (and none off contact)
             free = (held & ~driven[:, None]) | ~contact[:, None]
             for j in range(ntan):
@@ -425,6 +427,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
                 for j, st in enumerate(stick):
                     elastic.append(base + (1 + j) * n + st)
                     compliances.append(np.full(len(st), compliance))
+            mu = self.dynamic(state, k)[slide]
             for j in range(ntan):
                 tie = -mu * sigma[slide, j]  # s follows q on the cone
                 jump[base + (1 + j) * n + slide] = tie * q[slide] - S[slide, j]

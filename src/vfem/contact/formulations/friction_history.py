@@ -1,7 +1,7 @@
 """What the frictional formulations share (:class:`FrictionHistory`, small and large kinematics
-alike): each pair's Coulomb law (thesis §1.10, :mod:`vfem.contact.laws`), the history carried in
-the state (tangential tractions, anchors, accumulated slip, which nodes slide), the friction's
-errors and its output fields.
+alike): each pair's friction law (thesis §1.10, :class:`vfem.contact.laws.FrictionLaw`), the
+history carried in the state (tangential tractions, anchors, accumulated slip, which nodes
+slide), the friction's errors and its output fields.
 """
 
 from __future__ import annotations
@@ -9,7 +9,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..laws import (
+    friction_law,
     magnitudes,
+    slip_onset,
     tangent_by_tangent,
     tangents,
 )
@@ -22,10 +24,10 @@ class FrictionHistory:
     slide), the friction's errors and its output fields."""
 
     def _init_friction(self, settings) -> None:
-        """Each pair's law: (mu of a slipping node, mu at which a sticking node starts to slip,
-        1 / slip stiffness: 0 where it sticks rigidly); the last step's slip increments."""
-        self.laws = [settings.pair_friction(self.surfaces[p.fine].body.name,
-                                            self.surfaces[p.coarse].body.name).coefficients
+        """Each pair's friction law (:class:`~vfem.contact.laws.FrictionLaw`: its static and
+        dynamic coefficients node by node, its compliance); the last step's slip increments."""
+        self.laws = [friction_law(settings.pair_friction(self.surfaces[p.fine].body.name,
+                                                         self.surfaces[p.coarse].body.name))
                      for p in self.contact_pairs]
         #: per pair, the slip increments of the last converged step (for :meth:`fields`)
         self._increments = [self._zeros(k) for k in range(len(self.contact_pairs))]
@@ -83,6 +85,22 @@ class FrictionHistory:
         """Pair k's nodes that slipped in the last correction."""
         return self._values(state, "sliding", k, bool)
 
+    def static(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's static coefficient at its nodes (the cone a sticking node lies within), by
+        its law from the slip each has accumulated."""
+        return self.laws[k].static(self.accumulated_slip(state, k))
+
+    def dynamic(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's dynamic coefficient at its nodes (a slipping node's traction over its
+        normal one), by its law from the slip each has accumulated."""
+        return self.laws[k].dynamic(self.accumulated_slip(state, k))
+
+    def onset(self, state: FrictionState, k: int) -> np.ndarray:
+        """Pair k's coefficient at its nodes that a traction must reach to slip: the dynamic
+        one where the node slid in the last correction, else the static one
+        (:func:`~vfem.contact.laws.slip_onset`)."""
+        return slip_onset(self.laws[k], self.sliding(state, k), self.accumulated_slip(state, k))
+
     def status(self, state: FrictionState, k: int) -> np.ndarray:
         """Pair k's nodes: 0 free (no normal traction), 1 sticking, 2 slipping."""
         on = self.tractions(state, k) > 0
@@ -95,7 +113,7 @@ class FrictionHistory:
         excess of a tangential traction over its cone (relative to the largest mu q), and the
         nodes sticking and slipping."""
         err, excess, stick, slip = 0.0, 0.0, 0, 0
-        scale = max((self.laws[k][1] * float(self.tractions(state, k).max(initial=0.0))
+        scale = max((float((self.static(state, k) * self.tractions(state, k)).max(initial=0.0))
                      for k in range(len(self.contact_pairs))), default=0.0)
         for k, dw in enumerate(slips):
             q, s = self.tractions(state, k), self.shear(state, k)
@@ -118,7 +136,7 @@ class FrictionHistory:
                 along = np.einsum("ij,ij->i", sigma, dw[on])
                 across = magnitudes(dw[on] - along[:, None] * sigma)
                 err = max(err, float(np.maximum(-along, 0.0).max()), float(across.max()))
-            outside = magnitudes(s) - self.laws[k][1] * np.maximum(q, 0.0)
+            outside = magnitudes(s) - self.static(state, k) * np.maximum(q, 0.0)
             if len(outside) and scale > 0:
                 excess = max(excess, float(outside.max()) / scale)
             elif np.any(s != 0):

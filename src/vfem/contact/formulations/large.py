@@ -100,7 +100,7 @@ class LargeDeformationContact(PairSet):
 
     capabilities = Capabilities(
         name="paired", orders=(1,), kinematics=("small", "large"), dimensions=(2, 3),
-        friction=("frictionless",), orders_3d=(1,))
+        orders_3d=(1,))
 
     keep_all_nodes = True  # which nodes are over the other surface changes as bodies slide
 

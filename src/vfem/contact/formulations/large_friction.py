@@ -50,7 +50,14 @@ import numpy as np
 
 from ...errors import AnalysisError
 from ..geometry import virtual_nodes
-from ..laws import CONE_TOLERANCE, magnitudes, tangent_axes, tangents
+from ..laws import (
+    CONE_TOLERANCE,
+    beyond_cone,
+    magnitudes,
+    reaches_cone,
+    tangent_axes,
+    tangents,
+)
 from ..state import ContactState, FrictionState
 from .friction import HELD, plane_normals
 from .friction_history import FrictionHistory
@@ -69,7 +76,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
 
     capabilities = dataclasses.replace(LargeDeformationContact.capabilities,
                                        name="paired, frictional",
-                                       friction=("frictionless", "coulomb"))
+                                       friction_laws=("coulomb", "static_dynamic"))
     state_type = FrictionState
 
     def __init__(self, surfaces, pairs, settings, backend: str | None = None, executor=None):
@@ -268,6 +275,18 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             self._increments.append(increment)
             self.anchor(state, k)[:] = v
 
+    def _coefficients(self, state: FrictionState, sets: list[np.ndarray]):
+        """Over the nodes of the linearised problem (each pair's ``sets`` in turn), per node:
+        its law's dynamic and static coefficients, the one its traction must reach to slip
+        (:meth:`onset`), and whether its pair has friction at all."""
+        def each(read) -> np.ndarray:
+            return np.concatenate([read(state, k)[s_] for k, s_ in enumerate(sets)]
+                                  or [np.zeros(0)])
+
+        acts = np.concatenate([np.full(len(s_), self.laws[k].acts) for k, s_ in enumerate(sets)]
+                              or [np.zeros(0, bool)])
+        return each(self.dynamic), each(self.static), each(self.onset), acts
+
     def _solve_linearised(self, state, W, q0, p, tol, sets, rate, dR, stiffness, need):
         """The normal and tangential traction values of the linearised problem.
 
@@ -289,22 +308,17 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         nrm = np.concatenate([starts[k] + np.arange(len(s_)) for k, s_ in enumerate(sets)]
                              or [np.zeros(0, int)]).astype(int)
         tng = nrm + np.repeat([len(s_) for s_ in sets], [len(s_) for s_ in sets]).astype(int)
-        mu = np.array([self.laws[k][0] for k in pair_of])
-        mu_static = np.array([self.laws[k][1] for k in pair_of])
-        was_sliding = np.concatenate([self.sliding(state, k)[s_] for k, s_ in enumerate(sets)]
-                                     or [np.zeros(0, bool)])
+        mu, mu_static, mu_now, acts = self._coefficients(state, sets)
         q, s = q0[nrm], q0[tng]
         contact = (q > 0) | (p[nrm] > tol)
-        mu_now = np.where(was_sliding, mu, mu_static)
-        slipping = contact & (q > 0) & (np.abs(s) >= (1.0 - CONE_TOLERANCE) * mu_now * q) \
-            & (s != 0) & (mu_static > 0)
+        slipping = contact & (q > 0) & reaches_cone(np.abs(s), q, mu_now) & (s != 0) & acts
         sigma = np.where(s != 0, -np.sign(s), np.sign(p[tng]))
         # a node whose relative tangential motion no traction moves (a symmetry plane through
         # the contact, both bodies held along it) has no tangential unknown, as under small
         # kinematics (HELD); nor has a frictionless pair's
         diagonal = np.abs(np.diag(W))
         held = diagonal[tng] <= HELD * diagonal.max(initial=0.0)
-        frictionless = (mu_static == 0.0) | held
+        frictionless = ~acts | held
         # a node that comes into contact and has moved along the other surface since the last
         # converged step slips the way it moved, until its traction says it sticks
         entering = contact & (q <= 0) & (np.abs(p[tng]) > tol) & ~frictionless
@@ -342,7 +356,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             qn, sn = x[nrm], x[tng]
             leave = contact & (qn < 0)
             join = ~contact & (pen > tol)
-            over = stick & (np.abs(sn) > (1.0 + CONE_TOLERANCE) * mu_static * qn)
+            over = stick & beyond_cone(np.abs(sn), qn, mu_static)
             back = slide & (sigma * slip < -tol)
             if not (leave.any() or join.any() or over.any() or back.any()):
                 break
@@ -390,14 +404,11 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
                              or [np.zeros(0, int)]).astype(int)
         offset = np.repeat(sizes, sizes).astype(int)
         tng = np.column_stack([nrm + offset, nrm + 2 * offset])  # (nodes, 2)
-        mu = np.array([self.laws[k][0] for k in pair_of])
-        mu_static = np.array([self.laws[k][1] for k in pair_of])
-        was_sliding = np.concatenate([self.sliding(state, k)[s_] for k, s_ in enumerate(sets)]
-                                     or [np.zeros(0, bool)])
+        mu, mu_static, mu_now, acts = self._coefficients(state, sets)
         q, S, P = q0[nrm], q0[tng], p[tng]
         diagonal = np.abs(np.diag(W))
         held = diagonal[tng] <= HELD * diagonal.max(initial=0.0)
-        free = ~held & (mu_static > 0.0)[:, None]  # the tangents friction acts along
+        free = ~held & acts[:, None]  # the tangents friction acts along
         rough = free.any(axis=1)
         both = free.all(axis=1)  # a slipping node's sigma may turn
 
@@ -407,10 +418,8 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             return np.divide(v, size[:, None], out=np.zeros_like(v), where=size[:, None] > 0)
 
         contact = (q > 0) | (p[nrm] > tol)
-        mu_now = np.where(was_sliding, mu, mu_static)
         size = magnitudes(np.where(free, S, 0.0))
-        slipping = contact & (q > 0) & (size >= (1.0 - CONE_TOLERANCE) * mu_now * q) \
-            & (size > 0) & rough
+        slipping = contact & (q > 0) & reaches_cone(size, q, mu_now) & (size > 0) & rough
         sigma = np.where((size > 0)[:, None], unit(-S), unit(P))
         # a node that comes into contact having moved along the other surface since the last
         # converged step slips the way it moved, until its traction says it sticks
@@ -475,8 +484,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             across = magnitudes(slip - along[:, None] * new_sigma)
             leave = contact & (qn < 0)
             join = ~contact & (pen > tol)
-            over = stick & (magnitudes(np.where(free, sn, 0.0)) > (1.0 + CONE_TOLERANCE)
-                            * mu_static * qn)
+            over = stick & beyond_cone(magnitudes(np.where(free, sn, 0.0)), qn, mu_static)
             back = slide & (along < -tol)
             crossing = slide & both & (across > tol)
             sigma = new_sigma

@@ -79,7 +79,7 @@ class PairedContact(PairSet):
 
     capabilities = Capabilities(
         name="paired", orders=(1, 2), kinematics=("small",), dimensions=(2, 3),
-        friction=("frictionless",), orders_3d=(1, 2))
+        orders_3d=(1, 2))
     both_surfaces = True
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,

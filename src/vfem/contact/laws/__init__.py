@@ -1,5 +1,6 @@
 """The contact laws node by node: the thesis's compatibility and equilibrium corrections (Eq.
-4.1-4.6), relaxation and the release of tension; Coulomb's law (§1.10) in any dimension.
+4.1-4.6), relaxation and the release of tension; Coulomb's law (§1.10) in any dimension, and the
+friction laws a pair may follow, node by node through one protocol (:class:`FrictionLaw`).
 
 The public face of this stage: code outside it imports these names from here
 (``tests/test_architecture.py``).
@@ -14,8 +15,28 @@ from .coulomb import (
     tangent_by_tangent,
     tangents,
 )
+from .friction_laws import (
+    FRICTION_LAWS,
+    FrictionLaw,
+    beyond_cone,
+    friction_law,
+    law_bounds,
+    law_record,
+    law_text,
+    reaches_cone,
+    slip_onset,
+)
 
 __all__ = [
+    "beyond_cone",
+    "FRICTION_LAWS",
+    "friction_law",
+    "FrictionLaw",
+    "law_bounds",
+    "law_record",
+    "law_text",
+    "reaches_cone",
+    "slip_onset",
     "compatibility_displacement",
     "CONE_TOLERANCE",
     "coulomb_status",
