@@ -38,7 +38,7 @@ import numpy as np
 
 from .bodies import multiplier
 from .bodies.stresses import max_strain
-from .contact.formulations import SurfaceGroup, formulation_class
+from .contact.formulations import formulation_class
 from .contact.geometry import exterior_facets
 from .contact.invariants import InvariantCheck, Invariants
 from .contact.search import project_points
@@ -513,15 +513,14 @@ class Analysis:
         """Where a solve ended with a force-controlled platen's reaction off its force (the
         last iteration's ``platen_error`` beyond the formulation's allowance, issue 37), what
         the message adds: by how much, and the force; "" otherwise."""
-        contact = self.contact
-        if not isinstance(contact, SurfaceGroup) or contact.platen_body is None \
-                or not res.history:
+        group = getattr(self.contact, "group", None)  # the virtual-element formulations'
+        if group is None or group.platen_body is None or not res.history:
             return ""  # (a baseline's global system: its own failure kinds)
         error = res.history[-1].platen_error
-        allowed = contact.platen_allowance(state)
+        allowed = group.platen_allowance(state)
         if abs(error) <= allowed:
             return ""
-        name = contact.surfaces[contact.platen_body].body.name
+        name = group.surfaces[group.platen_body].body.name
         return (f"the platen on body {name!r} is {abs(error):.3g} off its force "
                 f"{state.platen_force + 0.0:.6g} (allowed {allowed:.3g})")
 

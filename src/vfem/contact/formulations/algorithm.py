@@ -51,13 +51,32 @@ from .group import SurfaceGroup
 log = logging.getLogger(__name__)
 
 
-class VirtualElementContact(SurfaceGroup):
+class VirtualElementContact:
     """Frictionless contact between any number of linear bodies by the virtual element method:
     the thesis's plain reading (every node of both bodies checked for both conditions)."""
 
     capabilities = Capabilities(
         name="thesis", orders=(1,), kinematics=("small",), dimensions=(2,),
         invariants="recorded", reads_rind=True)
+
+    def __init__(self, surfaces, pairs: set[frozenset[int]], settings, backend: str | None = None,
+                 executor=None):
+        #: the bodies' surfaces, the platen and the full-mesh fields (its data by name too)
+        self.group = SurfaceGroup(surfaces, pairs, settings, backend, executor=executor)
+        self.group.adopt(self)
+
+    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
+                  ) -> ContactState:
+        """No contact force on any body."""
+        return self.group.new_state(ContactState, load_factor, platen_displacement)
+
+    def positions(self, state: ContactState) -> list[np.ndarray]:
+        """Current coordinates of every body's condensed nodes (the bodies' linear response)."""
+        return self.group.positions(state)
+
+    def fields(self, state: ContactState, result: SolveResult) -> dict:
+        """Full-mesh results of a converged state, per body."""
+        return self.group.fields(state, result)
 
     def _platen_motion(self, nodes: np.ndarray, normal: np.ndarray) -> np.ndarray:
         """Normal displacement of candidate nodes of the platen body per unit platen motion."""
@@ -74,7 +93,7 @@ class VirtualElementContact(SurfaceGroup):
     def _opposing(self, i: int, x: list[np.ndarray]):
         """The candidate facets of all bodies body i may touch, in current position."""
         owners, local, A, B = [], [], [], []
-        for j in self.opponents(i):
+        for j in self.group.opponents(i):
             a, b = self.surfaces[j].segments(x[j])
             owners.append(np.full(len(a), j))
             local.append(np.arange(len(a)))
@@ -281,9 +300,9 @@ class VirtualElementContact(SurfaceGroup):
         dF = np.zeros((s.nc, s.dim))
         b = s.body
         r_platen = b.platen_stiffness
-        need = (state.platen_force - self.platen_reaction(state)
+        need = (state.platen_force - self.group.platen_reaction(state)
                 - float(s.platen_row @ dF_other.ravel()))
-        off = abs(need) > self.platen_allowance(state)  # (a zero force: issue 37)
+        off = abs(need) > self.group.platen_allowance(state)  # (a zero force: issue 37)
         sel = comp.copy()
         if off:
             sel |= p.participating & (p.force >= 0) & (p.penetration > -self.penetration_tolerance)
@@ -335,9 +354,9 @@ class VirtualElementContact(SurfaceGroup):
         def check(k: int) -> Check:
             pairings = self.detect(state)
             pen, eq, eq_tol, contact, tension = self.errors(pairings)
-            platen_ok = self.platen_met(state)
+            platen_ok = self.group.platen_met(state)
             rec = IterationRecord(k, pen, eq, contact, tension,
-                                  platen_error=self.platen_reaction(state) - state.platen_force)
+                                  platen_error=self.group.platen_error(state))
             return Check(
                 rec, pen <= tol and eq <= eq_tol and tension == 0 and platen_ok,
                 lambda: [(s.body.name, s.nodes[: s.nc], p.participating & (p.force > 0))

@@ -208,9 +208,9 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             self._check_rind(pens)
             errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
             fric_err, excess, stick, slip = self.friction_errors(state, dw)
-            platen_ok = self.platen_met(state)
+            platen_ok = self.group.platen_met(state)
             rec = IterationRecord(it, max(pen_err, fric_err), 0.0, contact, tension,
-                                  platen_error=self.platen_reaction(state) - state.platen_force)
+                                  platen_error=self.group.platen_error(state))
             log.debug("friction: iteration %d, penetration %.3g, tangential %.3g, cone excess "
                       "%.3g, %d sticking, %d slipping", it, pen_err, fric_err, excess, stick,
                       slip)
@@ -275,7 +275,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
             _, pen_err, _, tension = self.compatibility_errors(pens, traction_values)
             fric_err, excess, _, _ = self.friction_errors(state, dw)
-            platen_ok = self.platen_met(state)
+            platen_ok = self.group.platen_met(state)
             if (pen_err <= tol and fric_err <= tol and excess <= CONE_TOLERANCE
                     and tension == 0 and platen_ok):
                 log.debug("friction: the sets settled in %d corrections on the pair matrix",
@@ -454,7 +454,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         if not len(q_cols):
             state.shear.update({k: self._zeros(k) for k in range(len(self.contact_pairs))})
             self.assemble_forces(state)
-            if not self.platen_met(state):
+            if not self.group.platen_met(state):
                 self._close_gap(state, pens)
             return None
         cols, rows = np.concatenate([q_cols, s_cols]), np.concatenate(rows)
@@ -483,12 +483,12 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         # the platen's motion solved for where it has a force to meet, or (a zero force: a
         # platen holding the body sideways while it is pressed) where its reaction is off it
         if self.platen_body is not None and (state.platen_force != 0.0
-                                             or not self.platen_met(state)):
+                                             or not self.group.platen_met(state)):
             body = self.surfaces[self.platen_body].body
             row = dR[cols].copy()
             for tq, ts, t in zip(tie_q, tie_s, ties):
                 row[position[tq]] += t * dR[ts]
-            extra = state.platen_force - self.platen_reaction(state) - dR @ jump
+            extra = state.platen_force - self.group.platen_reaction(state) - dR @ jump
             # the rows' change per unit platen motion: penetration reduction (normal rows),
             # relative tangential displacement (tangential rows)
             column = np.where(np.concatenate(normal_rows), -dz_dplaten[rows], dz_dplaten[rows])

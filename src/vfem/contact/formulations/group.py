@@ -57,7 +57,8 @@ def consistent_pressure(s, force: np.ndarray) -> np.ndarray:
 
 class SurfaceGroup:
     """The contact surfaces of all bodies, the pairs of bodies that may touch, the settings, the
-    penetration tolerance and the platen (see the module docstring)."""
+    penetration tolerance and the platen (see the module docstring): a part each virtual-element
+    formulation holds (``formulation.group``), not a class it derives from."""
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]],
                  settings: ContactSettings, backend: str | None = None,
@@ -79,15 +80,21 @@ class SurfaceGroup:
         self.platen_motion = [s.body.u_platen[s.candidate_dofs].reshape(-1, s.dim)
                               for s in surfaces]
 
-    #: the type of the formulation's state (a subclass with its own unknowns, empty at first)
-    state_type: type[ContactState] = ContactState
+    def new_state(self, state_type: type[ContactState] = ContactState,
+                  load_factor: float = 0.0, platen_displacement: float = 0.0) -> ContactState:
+        """No contact force on any body (a ``state_type``: the formulation's, with its own
+        unknowns, empty at first)."""
+        return state_type(load_factor, platen_displacement,
+                          [np.zeros((s.nc, s.dim)) for s in self.surfaces],
+                          [np.zeros(s.nc, dtype=bool) for s in self.surfaces])
 
-    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
-                  ) -> ContactState:
-        """No contact force on any body (a :attr:`state_type`)."""
-        return self.state_type(load_factor, platen_displacement,
-                            [np.zeros((s.nc, s.dim)) for s in self.surfaces],
-                            [np.zeros(s.nc, dtype=bool) for s in self.surfaces])
+    def adopt(self, formulation) -> None:
+        """Give ``formulation`` the group's data by name (the surfaces, pairs of bodies,
+        settings, backend, executor, penetration tolerance and platen), which its stages read
+        throughout."""
+        for name in ("surfaces", "pairs", "settings", "backend", "executor",
+                     "penetration_tolerance", "platen_body", "platen_motion"):
+            setattr(formulation, name, getattr(self, name))
 
     def positions(self, state: ContactState) -> list[np.ndarray]:
         """Current coordinates of every body's condensed nodes (the rows of its flexibility:
@@ -114,6 +121,10 @@ class SurfaceGroup:
         return (b.platen_load_reaction_at(state.load_factor)
                 + state.platen_displacement * b.platen_stiffness
                 + float(s.platen_row @ state.forces[self.platen_body].ravel()))
+
+    def platen_error(self, state: ContactState) -> float:
+        """The platen's reaction less its scheduled force (0 without a platen: both zero)."""
+        return self.platen_reaction(state) - state.platen_force
 
     def platen_met(self, state: ContactState) -> bool:
         """Whether the platen's reaction is on its scheduled force (always, without a platen)."""

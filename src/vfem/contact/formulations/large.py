@@ -243,7 +243,7 @@ class LargeDeformationContact(PairSet):
         """Whether the platen's reaction is on its force: ``need`` (:meth:`_platen_terms`)
         within :meth:`~vfem.contact.formulations.group.SurfaceGroup.platen_allowance` (a zero force:
         of the forces its reaction sums, issue 37)."""
-        return self.platen_body is None or abs(need) <= self.platen_allowance(state)
+        return self.platen_body is None or abs(need) <= self.group.platen_allowance(state)
 
     def _platen_terms(self, state: ContactState, lins: list) -> tuple[float, float, np.ndarray]:
         """The platen's missing force after the bodies' corrections with the contact forces
@@ -253,7 +253,7 @@ class LargeDeformationContact(PairSet):
             return 0.0, 0.0, np.zeros(0)
         s = self.surfaces[i]
         if lins[i] is None:
-            return (state.platen_force - self.platen_reaction(state), s.body.platen_stiffness,
+            return (state.platen_force - self.group.platen_reaction(state), s.body.platen_stiffness,
                     self.platen_motion[i].ravel())
         lin = lins[i]
         return (state.platen_force - lin.platen_reaction, lin.platen_stiffness,

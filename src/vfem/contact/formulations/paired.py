@@ -149,9 +149,9 @@ class PairedContact(PairSet):
             self._check_rind(pens)
             stale_moved = self._update_stale(state, traction_values, pens)
             errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
-            platen_ok = self.platen_met(state)
+            platen_ok = self.group.platen_met(state)
             rec = IterationRecord(it, pen_err, 0.0, contact, tension,
-                                  platen_error=self.platen_reaction(state) - state.platen_force)
+                                  platen_error=self.group.platen_error(state))
             return Check(rec, pen_err <= tol and tension == 0 and platen_ok and not stale_moved,
                          lambda: self.contact_sets(traction_values), pen_err,
                          lambda: self.pairings(state, pens),
@@ -191,7 +191,7 @@ class PairedContact(PairSet):
         self.assemble_forces(state)  # the releases change the forces the platen sees
         m = sum(len(a) for a in active)
         if m == 0:
-            if not self.platen_met(state):
+            if not self.group.platen_met(state):
                 self._close_gap(state, pens)
             return
         dq, dplaten = self._solve_pairs(state, active, np.concatenate(targets))
@@ -259,17 +259,17 @@ class PairedContact(PairSet):
         if platen:
             body = self.surfaces[self.platen_body].body
             touch = (q0 > 0) | (p > -tol)
-            need = state.platen_force - self.platen_reaction(state)
+            need = state.platen_force - self.group.platen_reaction(state)
             # a held node touching counts where the platen's force presses it in (a body
             # landing on its corner), not where it pulls the body away
             presses = np.sign(need) * rate > 1e-9 * float(np.abs(rate).max(initial=0.0))
             if not (touch & (~reserve | presses)).any():
-                if not self.platen_met(state):
+                if not self.group.platen_met(state):
                     self._close_gap(state, pens)
                 return None, 0.0
             return linear_complementarity(
                 W, q0, p, tol, rate, dR, body.platen_stiffness,
-                state.platen_force - self.platen_reaction(state), factor=self._factor,
+                state.platen_force - self.group.platen_reaction(state), factor=self._factor,
                 reserve=reserve, guard=guard, refused=refused)
         return linear_complementarity(W, q0, p, tol, factor=self._factor, reserve=reserve,
                                       guard=guard, refused=refused)
@@ -455,7 +455,7 @@ class PairedContact(PairSet):
             if self.platen_body is not None and state.platen_force != 0.0:
                 border = (-dp_dplaten[index], dR[index],
                           self.surfaces[self.platen_body].body.platen_stiffness,
-                          state.platen_force - self.platen_reaction(state))
+                          state.platen_force - self.group.platen_reaction(state))
             return op.solve(index, rhs, border)
         W, dp_dplaten, dR = self._pair_flexibility(state, active)
         bordered = self.platen_body is not None and state.platen_force != 0.0
@@ -466,7 +466,7 @@ class PairedContact(PairSet):
                 raise np.linalg.LinAlgError("the pair matrix is singular")
             return x, 0.0
         body = self.surfaces[self.platen_body].body
-        extra = state.platen_force - self.platen_reaction(state)
+        extra = state.platen_force - self.group.platen_reaction(state)
         x = self._factor.solve(
             key, lambda: bordered_matrix(W, -dp_dplaten, dR, body.platen_stiffness),
             np.concatenate([rhs, [extra]]))
@@ -519,7 +519,7 @@ class PairedContact(PairSet):
 
     def _close_gap(self, state: ContactState, pens: list[np.ndarray]) -> None:
         """Nothing touches: move the platen just far enough to close the smallest gap."""
-        need = state.platen_force - self.platen_reaction(state)
+        need = state.platen_force - self.group.platen_reaction(state)
         moves = [closing_motion(p, pair.platen_rate, need)
                  for pair, p in zip(self.contact_pairs, pens)]
         moves = [d for d in moves if d != 0.0]

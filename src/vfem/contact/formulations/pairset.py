@@ -29,6 +29,7 @@ from ..geometry import (
 from ..state import (
     ContactState,
     Pairing,
+    SolveResult,
     TractionState,
 )
 from .group import SurfaceGroup
@@ -51,7 +52,7 @@ SIDE_SAMPLE = 4096
 FORCED_COARSER = 1.5
 
 
-class PairSet(SurfaceGroup):
+class PairSet:
     """The paired variant's parts shared by small and large displacements: the contact pairs
     (which side carries compatibility, their nodes, normals, gaps and transfer), the traction
     values that are its unknowns, the forces they make, its errors and its output fields.
@@ -61,7 +62,9 @@ class PairSet(SurfaceGroup):
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
                  backend: str | None = None, sides: dict | None = None, executor=None):
-        super().__init__(surfaces, pairs, settings, backend, executor=executor)
+        #: the bodies' surfaces, the platen and the full-mesh fields (its data by name too)
+        self.group = SurfaceGroup(surfaces, pairs, settings, backend, executor=executor)
+        self.group.adopt(self)
         #: per pair (i, j), i < j, the body that carries its compatibility instead of the one
         #: the rules choose (:meth:`_make_pair`): the solver's switch after a step that the
         #: rules' side could not hold (:meth:`vfem.solver.Analysis._switch_side`)
@@ -96,6 +99,22 @@ class PairSet(SurfaceGroup):
 
     #: the unknowns are the pairs' traction values
     state_type = TractionState
+
+    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
+                  ) -> ContactState:
+        """No contact force on any body (a :attr:`state_type`)."""
+        return self.group.new_state(self.state_type, load_factor, platen_displacement)
+
+    def positions(self, state: ContactState) -> list[np.ndarray]:
+        """Current coordinates of every body's condensed nodes: the bodies' linear response
+        (:meth:`~vfem.contact.formulations.group.SurfaceGroup.positions`; large kinematics
+        reads the bodies' mechanics instead)."""
+        return self.group.positions(state)
+
+    def fields(self, state: ContactState, result: SolveResult) -> dict:
+        """Full-mesh results of a converged state, per body
+        (:meth:`~vfem.contact.formulations.group.SurfaceGroup.fields`)."""
+        return self.group.fields(state, result)
 
     # -- geometry of the pairs (once) -------------------------------------------------------------
 
@@ -362,7 +381,7 @@ class PairSet(SurfaceGroup):
     def _nearest_body(self, i: int, points: np.ndarray) -> np.ndarray:
         best = np.full(len(points), -1)
         dist = np.full(len(points), np.inf)
-        for j in self.opponents(i):
+        for j in self.group.opponents(i):
             _, _, d, _ = self.surfaces[j].project(points)
             closer = d < dist
             best[closer], dist[closer] = j, d[closer]
