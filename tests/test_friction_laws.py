@@ -19,6 +19,7 @@ import pytest
 
 from models import built
 from test_friction import BLOCKS, forces
+from vfem.contact.formulations import friction
 from vfem.contact.formulations.friction import FrictionalPairedContact
 from vfem.contact.laws import (
     FRICTION_LAWS,
@@ -87,8 +88,9 @@ def registered(monkeypatch):
     for law in (CoulombCopy, Weakening):
         monkeypatch.setitem(FRICTION_LAWS, law.name, law)
     caps = FrictionalPairedContact.capabilities
-    monkeypatch.setattr(FrictionalPairedContact, "capabilities", dataclasses.replace(
-        caps, friction_laws=caps.friction_laws + (CoulombCopy.name, Weakening.name)))
+    monkeypatch.setattr(friction, "FrictionalPairedContact", dataclasses.replace(
+        FrictionalPairedContact, capabilities=dataclasses.replace(
+            caps, friction_laws=caps.friction_laws + (CoulombCopy.name, Weakening.name))))
 
 
 def dragged(law: str | None):

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from test_patch3d import stacked
-from vfem.contact.formulations import pairset
+from vfem.contact.formulations import pairmaking
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
 from vfem.solver import Analysis
@@ -87,12 +87,12 @@ def test_3d_patch_test_is_met_to_round_off_matrix_free(lower, upper):
 def test_stacks_agree_with_the_dense_route(dim, parameters, monkeypatch):
     if parameters.get("divisions", 0) == 24:
         # more nodes on each face than the side choice reads: both routes sample alike
-        monkeypatch.setattr(pairset, "SIDE_SAMPLE", 200)
+        monkeypatch.setattr(pairmaking, "SIDE_SAMPLE", 200)
     config = stack.config(stack.Parameters(dim=dim, **parameters))
     dense, free = run_both(config)
     assert_same(dense, free)
     if parameters.get("divisions", 0) == 24:
-        assert max(s.nc for s in free.surfaces) > pairset.SIDE_SAMPLE
+        assert max(s.nc for s in free.surfaces) > pairmaking.SIDE_SAMPLE
 
 
 def test_relaxed_corrections_solve_their_sets_matrix_free():

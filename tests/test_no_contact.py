@@ -88,7 +88,7 @@ def test_a_platen_whose_bodies_meet_edge_or_corner_first_is_held_on_either_side(
         monkeypatch):
     """Random model 3d-17 (a tilted box over a block's corner, pushed by a platen): with the
     box on the compatibility side none of its nodes' facets carry traction over the block, and
-    before the box's corner node was held as a point (``PairSet._make_pair``: a compatibility
+    before the box's corner node was held as a point (``pairmaking.make_pair``: a compatibility
     node over the other patch whose facets carry none of its traction) and the edges of both
     bodies where they cross the other's facets (``held.held_edges``), nothing held the
     platen: the analysis stopped with "no node of either body lies over the other's surface"

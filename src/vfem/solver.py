@@ -745,7 +745,7 @@ class Analysis:
         large-kinematics gasket of docs/examples.md, stopped at step 11, runs through. The
         invariants judge the switched side as they judged the first (their tolerance is the
         surfaces', not the side's: the check stands); a forced coarser side's warning
-        (:data:`~vfem.contact.formulations.pairset.FORCED_COARSER`) is given for it too."""
+        (:data:`~vfem.contact.formulations.pairmaking.FORCED_COARSER`) is given for it too."""
         from .contact.formulations import LargeDeformationContact, PairedContact
 
         if not (isinstance(exc, RindViolation)

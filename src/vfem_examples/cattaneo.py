@@ -196,7 +196,7 @@ def solve(p: Parameters) -> tuple[AnalysisResult, list[Reading]]:
         c, state = analysis.contact, analysis.state
         pair = c.contact_pairs[0]
         force = step.bodies["lower"].contact_force.sum(axis=0)
-        s = c.shear(state, 0)[:, 0].copy()  # (2D: one tangent)
+        s = c.friction.shear(state, 0)[:, 0].copy()  # (2D: one tangent)
         readings.append(Reading(step.load_factor, -float(force[1]), float(force[0]),
                                 c.surfaces[pair.fine].X[pair.nodes, 0].copy(),
                                 c.tractions(state, 0).copy(), s,

@@ -72,6 +72,7 @@ from ..laws import (
 )
 from ..solvers import Check, bordered_matrix, iterate
 from ..state import ContactState, FrictionState, IterationRecord, SolveResult
+from .composed import Composed
 from .friction_history import FrictionHistory
 from .paired import PairedContact
 
@@ -109,30 +110,20 @@ def plane_normals(surface, pair, normal: np.ndarray | None = None,
     return out
 
 
-class FrictionalPairedContact(FrictionHistory, PairedContact):
-    """The paired variant with Coulomb friction, small displacements (module docstring)."""
+class SmallFriction(FrictionHistory):
+    """The friction part of the paired variant under small displacements (module docstring):
+    :class:`~vfem.contact.formulations.paired.PairedContact` holds it as ``friction`` and
+    hands it the solve."""
 
-    capabilities = dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
-                                       friction_laws=("coulomb", "static_dynamic",
-                                                      "elastoplastic"), orders_3d=(1,))
-    state_type = FrictionState
-    #: the equilibrium side's nodes are not held (issue 37): not yet with friction
-    both_surfaces = False
-
-    def __init__(self, surfaces, pairs, settings, backend: str | None = None, executor=None):
-        super().__init__(surfaces, pairs, settings, backend, executor=executor)
-        self._init_friction(settings)
-        self._tangents = [tangents(plane_normals(self.surfaces[pair.fine], pair))
-                          for pair in self.contact_pairs]
+    def __init__(self, form, settings) -> None:
+        super().__init__(form, settings)
+        self._tangents = [tangents(plane_normals(self.form.surfaces[pair.fine], pair))
+                          for pair in self.form.contact_pairs]
         #: tangents per node: 1 in 2D, 2 in 3D
         self._ntan = max((len(t) for t in self._tangents), default=1)
         #: per pair, the nodes released from tension in the current solve
         #: (:meth:`_correct_frictional`)
-        self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.contact_pairs]
-
-    def directions(self, k: int) -> list[np.ndarray]:
-        """The normal, then the tangents: the order of each pair's unknowns."""
-        return [self.contact_pairs[k].normal] + self._tangents[k]
+        self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.form.contact_pairs]
 
     def tangent(self, k: int) -> np.ndarray:
         """Pair k's unit tangent at its nodes (the undeformed one: small kinematics)."""
@@ -145,19 +136,18 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
     def _tangential(self, vector: np.ndarray, k: int) -> np.ndarray:
         """Pair k's tangential rows of a vector over the pair matrix's unknowns, in the shape
         of :meth:`shear`: (n, ntan)."""
-        n, base, ntan = len(self.contact_pairs[k].nodes), self._full[3][k], len(self._tangents[k])
+        n, ntan = len(self.form.contact_pairs[k].nodes), len(self._tangents[k])
+        base = self.form._full[3][k]
         return vector[base + n: base + (1 + ntan) * n].reshape(ntan, n).T
 
     # -- state -----------------------------------------------------------------------------------
 
-    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
-                  ) -> ContactState:
-        """No contact force; the penetrations of the unloaded bodies as the last converged ones
-        (where a node that comes into contact in the first step touched)."""
-        state = super().new_state(load_factor, platen_displacement)
-        for k, p in enumerate(self.penetrations(state)):
+    def start(self, state: FrictionState) -> None:
+        """The state before the first step (no contact force): the penetrations of the
+        unloaded bodies as the last converged ones (where a node that comes into contact in the
+        first step touched)."""
+        for k, p in enumerate(self.form.penetrations(state)):
             state.penetration[k] = p.copy()
-        return state
 
     def free_slips(self, state: FrictionState, relative: list[np.ndarray] | None = None
                    ) -> list[np.ndarray]:
@@ -174,7 +164,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         """Per pair, each node's relative tangential displacement against its virtual node,
         ``w = t.(u_fine - u_virtual)`` (linear kinematics, as the penetrations; from
         ``relative``, :meth:`relative_displacements`, when given)."""
-        relative = self.relative_displacements(state) if relative is None else relative
+        relative = self.form.relative_displacements(state) if relative is None else relative
         return [np.column_stack([np.einsum("ij,ij->i", d, tj) for tj in t])
                 for d, t in zip(relative, self._tangents, strict=True)]
 
@@ -182,8 +172,8 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         """Every body's nodal forces from the pairs' normal and tangential tractions."""
         for F in state.forces:
             F[:] = 0.0
-        for k, pair in enumerate(self.contact_pairs):
-            traction = (self.tractions(state, k)[:, None] * pair.normal
+        for k, pair in enumerate(self.form.contact_pairs):
+            traction = (self.form.tractions(state, k)[:, None] * pair.normal
                         + self.tangential_traction(state, k))
             state.forces[pair.fine] += pair.mass[:, pair.nodes] @ traction
             state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ traction
@@ -194,23 +184,23 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         """Correct the normal and tangential traction values until every pair's normal and
         tangential compatibility and the Coulomb law hold; then move the anchors (the module
         docstring)."""
-        cfg = self.settings
-        tol = self.penetration_tolerance
+        cfg = self.form.settings
+        tol = self.form.penetration_tolerance
         self.assemble_forces(state)
         # the nodes released from tension in this solve (see _correct_frictional)
-        self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.contact_pairs]
+        self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.form.contact_pairs]
 
         def check(it: int) -> Check:
-            relative = self.relative_displacements(state)  # one back-substitution for both
-            pens = self.penetrations(state, relative)
+            relative = self.form.relative_displacements(state)  # one back-substitution for both
+            pens = self.form.penetrations(state, relative)
             dw = self.free_slips(state, relative)
-            traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
-            self._check_rind(pens)
-            errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
+            traction_values = self.form.traction_values(state)
+            self.form._check_rind(pens)
+            errs, pen_err, contact, tension = self.form.compatibility_errors(pens, traction_values)
             fric_err, excess, stick, slip = self.friction_errors(state, dw)
-            platen_ok = self.group.platen_met(state)
+            platen_ok = self.form.group.platen_met(state)
             rec = IterationRecord(it, max(pen_err, fric_err), 0.0, contact, tension,
-                                  platen_error=self.group.platen_error(state))
+                                  platen_error=self.form.group.platen_error(state))
             log.debug("friction: iteration %d, penetration %.3g, tangential %.3g, cone excess "
                       "%.3g, %d sticking, %d slipping", it, pen_err, fric_err, excess, stick,
                       slip)
@@ -218,9 +208,9 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
                          and tension == 0 and platen_ok)
             return Check(rec, converged,
                          lambda: self._sets(state), max(pen_err, fric_err),
-                         lambda: self.pairings(state, pens),
+                         lambda: self.form.pairings(state, pens),
                          lambda: (f"no convergence in {cfg.max_iterations} iterations "
-                                  f"(penetration {pen_err:.3g}{self.worst_node(errs)}, "
+                                  f"(penetration {pen_err:.3g}{self.form.worst_node(errs)}, "
                                   f"tangential slip error {fric_err:.3g}, {tension} nodes in "
                                   f"tension)"),
                          finish=lambda: self._converged(state),
@@ -228,7 +218,7 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
 
         def correct(it: int, c: Check) -> None:
             pens, dw, platen_ok = c.extra
-            if self.complementarity(it):
+            if self.form.complementarity(it):
                 self._settle(state, pens, dw, it, platen_ok)
             else:
                 self._correct_frictional(state, pens, dw, it, platen_ok)
@@ -250,18 +240,18 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         corrections, and no longer once one comes back: the check then measures the last and
         the iteration goes on from there, a correction of the bodies at a time.
         """
-        tol = self.penetration_tolerance
+        tol = self.form.penetration_tolerance
         # each node's relative tangential displacement, from its free slip (free_slips)
         relative = [d + self.anchor(state, k) - self.laws[k].compliance * self.shear(state, k)
                     for k, d in enumerate(dw)]
         seen = set()
-        for inner in range(self.settings.max_iterations):
+        for inner in range(self.form.settings.max_iterations):
             before = self._unknowns(state)
             dplaten = self._correct_frictional(state, pens, dw, it + inner, platen_ok)
             if dplaten is None:  # nothing touches: the platen moved; measure it
                 return
             self.assemble_forces(state)
-            G, rate, _, offsets = self._full
+            G, rate, _, offsets = self.form._full
             # (the change of every unknown: the correction's, and the tension released before)
             motion = G @ (self._unknowns(state) - before)  # penetration decrease (normal
             # rows), slip (tangential rows)
@@ -272,10 +262,10 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
                         for k, w in enumerate(relative)]
             dw = [w - self.anchor(state, k) + self.laws[k].compliance * self.shear(state, k)
                   for k, w in enumerate(relative)]
-            traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
-            _, pen_err, _, tension = self.compatibility_errors(pens, traction_values)
+            traction_values = self.form.traction_values(state)
+            _, pen_err, _, tension = self.form.compatibility_errors(pens, traction_values)
             fric_err, excess, _, _ = self.friction_errors(state, dw)
-            platen_ok = self.group.platen_met(state)
+            platen_ok = self.form.group.platen_met(state)
             if (pen_err <= tol and fric_err <= tol and excess <= CONE_TOLERANCE
                     and tension == 0 and platen_ok):
                 log.debug("friction: the sets settled in %d corrections on the pair matrix",
@@ -304,12 +294,12 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         """A converged step: accumulate each node's slip and anchor it where it now is (the
         step's slip increments are kept for :meth:`fields`)."""
         self._increments = []
-        relative = self.relative_displacements(state)
-        for k, p in enumerate(self.penetrations(state, relative)):
+        relative = self.form.relative_displacements(state)
+        for k, p in enumerate(self.form.penetrations(state, relative)):
             state.penetration[k] = p
         for k, w in enumerate(self.tangential_displacements(state, relative)):
             anchor = self.anchor(state, k)
-            on = self.tractions(state, k) > 0
+            on = self.form.tractions(state, k) > 0
             # where the node is, less its elastic slip (the elastoplastic law's s / k_t)
             new = w + self.laws[k].compliance * self.shear(state, k)
             increment = np.where(on[:, None], new - anchor, 0.0)
@@ -324,14 +314,14 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         the normal and tangential conditions of every pair together (module docstring).
         Returns the platen's motion, or None where nothing touched (the platen then moved to
         close the smallest gap)."""
-        tol = self.penetration_tolerance
-        omega = relaxation(self.settings, it)
-        if self._full is None:
-            self._full = self._full_flexibility()
-            diagonal = np.abs(np.diag(self._full[0]))
+        tol = self.form.penetration_tolerance
+        omega = relaxation(self.form.settings, it)
+        if self.form._full is None:
+            self.form._full = self.form._full_flexibility()
+            diagonal = np.abs(np.diag(self.form._full[0]))
             #: the tangential unknowns whose relative tangential displacement no traction moves
             self._held = diagonal <= HELD * diagonal.max(initial=0.0)
-        G, dz_dplaten, dR, offsets = self._full
+        G, dz_dplaten, dR, offsets = self.form._full
         ntan = self._ntan
         jump = np.zeros(len(G))  # known changes of the unknowns (cone, release)
         # per pair: the unknowns solved for (normal ones, then tangential), the rows (normal
@@ -343,13 +333,13 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         # 3D, per slipping node: its tangential unknowns, the direction across sigma, the
         # compliance of its traction across sigma and its row's target (below)
         perp_s, perp_dir, perp_c, perp_rhs = [], [], [], []
-        for k, pair in enumerate(self.contact_pairs):
+        for k, pair in enumerate(self.form.contact_pairs):
             n, base = len(pair.nodes), offsets[k]
             law = self.laws[k]
             compliance, acts = law.compliance, law.acts
             p, S = pens[k], self.shear(state, k)  # S: (n, ntan)
-            tension, contact = self._release_and_hold(state, k, p, platen_ok)
-            q = self.tractions(state, k)
+            tension, contact = self.form._release_and_hold(state, k, p, platen_ok)
+            q = self.form.tractions(state, k)
             was_sliding = self.sliding(state, k)
             self._torn[k] |= tension
             slip = dw[k].copy()
@@ -452,10 +442,10 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         self.assemble_forces(state)  # the releases change the forces the platen sees
         q_cols, s_cols = np.concatenate(q_cols), np.concatenate(s_cols)
         if not len(q_cols):
-            state.shear.update({k: self._zeros(k) for k in range(len(self.contact_pairs))})
+            state.shear.update({k: self._zeros(k) for k in range(len(self.form.contact_pairs))})
             self.assemble_forces(state)
-            if not self.group.platen_met(state):
-                self._close_gap(state, pens)
+            if not self.form.group.platen_met(state):
+                self.form._close_gap(state, pens)
             return None
         cols, rows = np.concatenate([q_cols, s_cols]), np.concatenate(rows)
         tie_q, tie_s, ties = ([np.concatenate(a) for a in b] for b in (tie_q, tie_s, ties))
@@ -482,13 +472,13 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
             b = np.concatenate([b, np.concatenate(perp_rhs) - Gr[len(rows):] @ jump])
         # the platen's motion solved for where it has a force to meet, or (a zero force: a
         # platen holding the body sideways while it is pressed) where its reaction is off it
-        if self.platen_body is not None and (state.platen_force != 0.0
-                                             or not self.group.platen_met(state)):
-            body = self.surfaces[self.platen_body].body
+        if self.form.platen_body is not None and (state.platen_force != 0.0
+                                             or not self.form.group.platen_met(state)):
+            body = self.form.surfaces[self.form.platen_body].body
             row = dR[cols].copy()
             for tq, ts, t in zip(tie_q, tie_s, ties):
                 row[position[tq]] += t * dR[ts]
-            extra = state.platen_force - self.group.platen_reaction(state) - dR @ jump
+            extra = state.platen_force - self.form.group.platen_reaction(state) - dR @ jump
             # the rows' change per unit platen motion: penetration reduction (normal rows),
             # relative tangential displacement (tangential rows)
             column = np.where(np.concatenate(normal_rows), -dz_dplaten[rows], dz_dplaten[rows])
@@ -508,12 +498,20 @@ class FrictionalPairedContact(FrictionHistory, PairedContact):
         delta[cols] += x
         for tq, ts, t in zip(tie_q, tie_s, ties):
             delta[ts] += t * x[position[tq]]
-        for k, pair in enumerate(self.contact_pairs):
+        for k, pair in enumerate(self.form.contact_pairs):
             n, base = len(pair.nodes), offsets[k]
-            self.tractions(state, k)[:] += delta[base:base + n]
+            self.form.tractions(state, k)[:] += delta[base:base + n]
             self.shear(state, k)[:] += self._tangential(delta, k)
         state.platen_displacement += dplaten
         return dplaten
 
 
-__all__ = ["FrictionalPairedContact"]
+#: the paired variant with friction, small displacements: the frictionless formulation composed
+#: with the friction part (the laws it takes: :class:`~vfem.contact.laws.FrictionLaw`)
+FrictionalPairedContact = Composed(
+    PairedContact, SmallFriction,
+    dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
+                        friction_laws=("coulomb", "static_dynamic", "elastoplastic"),
+                        orders_3d=(1,)))
+
+__all__ = ["FrictionalPairedContact", "SmallFriction"]

@@ -15,43 +15,51 @@ from ..laws import (
     tangent_by_tangent,
     tangents,
 )
-from ..state import ContactState, FrictionState, SolveResult
+from ..state import ContactState, FrictionState
 
 
 class FrictionHistory:
-    """What the frictional formulations (small and large kinematics) share: each pair's law,
-    the history in the state (tangential tractions, anchors, accumulated slip, which nodes
-    slide), the friction's errors and its output fields."""
+    """What the friction parts of the paired formulations (small and large kinematics) share:
+    each pair's law, the history in the state (tangential tractions, anchors, accumulated slip,
+    which nodes slide), the friction's errors and its output fields.
 
-    def _init_friction(self, settings) -> None:
+    A friction part is held by the formulation it serves (``formulation.friction``, built with
+    it: ``form``), which asks it for what friction adds at each of its steps; it reads the
+    formulation's pairs and traction values."""
+
+    #: the state with the friction's history
+    state_type = FrictionState
+
+    def __init__(self, form, settings) -> None:
         """Each pair's friction law (:class:`~vfem.contact.laws.FrictionLaw`: its static and
         dynamic coefficients node by node, its compliance); the last step's slip increments."""
-        self.laws = [friction_law(settings.pair_friction(self.surfaces[p.fine].body.name,
-                                                         self.surfaces[p.coarse].body.name))
-                     for p in self.contact_pairs]
+        self.form = form
+        self.laws = [friction_law(settings.pair_friction(self.form.surfaces[p.fine].body.name,
+                                                         self.form.surfaces[p.coarse].body.name))
+                     for p in self.form.contact_pairs]
         #: per pair, the slip increments of the last converged step (for :meth:`fields`)
-        self._increments = [self._zeros(k) for k in range(len(self.contact_pairs))]
+        self._increments = [self._zeros(k) for k in range(len(self.form.contact_pairs))]
 
     def tangent(self, k: int) -> np.ndarray:
         """Pair k's unit tangent at its nodes (2D: the normal turned by +90 degrees)."""
-        return tangents(self.contact_pairs[k].normal)[0]
+        return tangents(self.form.contact_pairs[k].normal)[0]
 
     def tangent_basis(self, k: int) -> list[np.ndarray]:
         """Pair k's unit tangents at its nodes, dim - 1 of them (:func:`tangents`)."""
-        return tangents(self.contact_pairs[k].normal)
+        return tangents(self.form.contact_pairs[k].normal)
 
     def _zeros(self, k: int) -> np.ndarray:
         """Zeros for pair k's tangential array, (n, ntan): one column per tangent of its
         normals' space (checkpoints written before 2026-11-30 kept 2D's as (n,):
         :func:`vfem.io.checkpoint.read` turns them into columns)."""
-        pair = self.contact_pairs[k]
+        pair = self.form.contact_pairs[k]
         return np.zeros((len(pair.nodes), pair.normal.shape[1] - 1))
 
     def _values(self, state: FrictionState, name: str, k: int, dtype=float) -> np.ndarray:
         """Pair k's array ``name`` of the state's history, zeros until first set."""
         table = getattr(state, name)
         if k not in table:
-            table[k] = np.zeros(len(self.contact_pairs[k].nodes), dtype=dtype)
+            table[k] = np.zeros(len(self.form.contact_pairs[k].nodes), dtype=dtype)
         return table[k]
 
     def shear(self, state: FrictionState, k: int) -> np.ndarray:
@@ -103,7 +111,7 @@ class FrictionHistory:
 
     def status(self, state: FrictionState, k: int) -> np.ndarray:
         """Pair k's nodes: 0 free (no normal traction), 1 sticking, 2 slipping."""
-        on = self.tractions(state, k) > 0
+        on = self.form.tractions(state, k) > 0
         return np.where(on, np.where(self.sliding(state, k), 2, 1), 0)
 
     def friction_errors(self, state: FrictionState, slips: list[np.ndarray]
@@ -113,10 +121,10 @@ class FrictionHistory:
         excess of a tangential traction over its cone (relative to the largest mu q), and the
         nodes sticking and slipping."""
         err, excess, stick, slip = 0.0, 0.0, 0, 0
-        scale = max((float((self.static(state, k) * self.tractions(state, k)).max(initial=0.0))
-                     for k in range(len(self.contact_pairs))), default=0.0)
+        scale = max((float((self.static(state, k) * self.form.tractions(state, k)).max(initial=0.0))
+                     for k in range(len(self.form.contact_pairs))), default=0.0)
         for k, dw in enumerate(slips):
-            q, s = self.tractions(state, k), self.shear(state, k)
+            q, s = self.form.tractions(state, k), self.shear(state, k)
             status = self.status(state, k)
             held = self._held_components(k)
             if held is not None and held.any():  # 3D: a sticking node's slip along a held
@@ -150,43 +158,42 @@ class FrictionHistory:
         round-off) or before the first correction has set up the pair matrix. A sticking node's slip
         along a held tangent is the supports' (a prescribed motion, as the press fit's pushed end
         faces), not an error the iteration could correct."""
-        if getattr(self, "_ntan", 1) == 1 or getattr(self, "_full", None) is None:
+        if getattr(self, "_ntan", 1) == 1 or getattr(self.form, "_full", None) is None:
             return None  # (2D; or the large-kinematics variant, 2D only, without them)
-        n, base = len(self.contact_pairs[k].nodes), self._full[3][k]
+        n, base = len(self.form.contact_pairs[k].nodes), self.form._full[3][k]
         return self._held[base + n: base + (1 + self._ntan) * n].reshape(self._ntan, n).T
 
     def _unknowns(self, state: FrictionState) -> np.ndarray:
         """Every pair's normal then tangential traction values, in the pair matrix's order."""
-        return np.concatenate([np.concatenate([self.tractions(state, k),
+        return np.concatenate([np.concatenate([self.form.tractions(state, k),
                                                tangent_by_tangent(self.shear(state, k))])
-                               for k in range(len(self.contact_pairs))] or [np.zeros(0)])
+                               for k in range(len(self.form.contact_pairs))] or [np.zeros(0)])
 
     def _sets(self, state: FrictionState) -> list[tuple[str, np.ndarray, np.ndarray]]:
         """The contact set, the slipping nodes and their directions, for the cycle watch."""
         out = []
-        for k, pair in enumerate(self.contact_pairs):
-            sf = self.surfaces[pair.fine]
+        for k, pair in enumerate(self.form.contact_pairs):
+            sf = self.form.surfaces[pair.fine]
             status = self.status(state, k)
             nodes = sf.nodes[pair.nodes]
             out += [(sf.body.name, nodes, status > 0), (sf.body.name, nodes, status == 2)]
             out += [(sf.body.name, nodes, c < 0) for c in self.shear(state, k).T]
         return out
 
-    def fields(self, state: ContactState, result: SolveResult) -> dict:
-        """The frictionless fields, and the friction's at each pair's compatibility-side nodes
-        (:class:`~vfem.bodies.results.BodyStepResult`: tangential traction, slip increment,
-        accumulated slip, stick or slip)."""
-        out = super().fields(state, result)
+    def add_fields(self, out: dict, state: ContactState) -> dict:
+        """To the frictionless fields ``out``, the friction's at each pair's compatibility-side
+        nodes (:class:`~vfem.bodies.results.BodyStepResult`: tangential traction, slip
+        increment, accumulated slip, stick or slip)."""
         increments = self._increments
-        for s in self.surfaces:
+        for s in self.form.surfaces:
             r = out[s.body.name]
             n = s.body.npoints
             r.contact_shear, r.slip_increment = np.zeros((n, s.dim)), np.zeros(n)
             r.accumulated_slip = np.zeros(n)
             r.friction_force = np.zeros((n, s.dim))
             r.friction_status = np.full(n, -1)  # not a compatibility-side node of a pair
-        for k, pair in enumerate(self.contact_pairs):
-            sf = self.surfaces[pair.fine]
+        for k, pair in enumerate(self.form.contact_pairs):
+            sf = self.form.surfaces[pair.fine]
             r = out[sf.body.name]
             points = sf.nodes[pair.nodes]
             traction = self.tangential_traction(state, k)
@@ -198,7 +205,7 @@ class FrictionHistory:
             r.friction_status[points] = self.status(state, k)
             # the nodal forces of the tangential traction alone, on both sides (as
             # assemble_forces makes them)
-            sc = self.surfaces[pair.coarse]
+            sc = self.form.surfaces[pair.coarse]
             out[sf.body.name].friction_force[sf.nodes[: sf.nc]] += \
                 pair.mass[:, pair.nodes] @ traction
             out[sc.body.name].friction_force[sc.nodes[: sc.nc]] -= \

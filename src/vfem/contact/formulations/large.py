@@ -105,7 +105,8 @@ class LargeDeformationContact(PairSet):
     keep_all_nodes = True  # which nodes are over the other surface changes as bodies slide
 
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
-                 backend: str | None = None, sides: dict | None = None, executor=None):
+                 backend: str | None = None, sides: dict | None = None, executor=None,
+                 friction: type | None = None):
         for s in surfaces:
             # (the facet kind's order: ``s.order`` counts a 2D facet's nodes; a 3D body that
             # touches nothing has no kind and no candidate)
@@ -114,7 +115,8 @@ class LargeDeformationContact(PairSet):
                                  "linear elements (order 1)")
         # (its own pairs, built on the undeformed geometry, which side carries compatibility
         # and which nodes decided once; :meth:`penetrations` moves them to the current one)
-        super().__init__(surfaces, pairs, settings, backend, sides, executor=executor)
+        super().__init__(surfaces, pairs, settings, backend, sides, executor=executor,
+                         friction=friction)
         self._offsets = np.cumsum([0] + [s.dim * s.nc for s in surfaces])
 
     # -- the bodies' current state ----------------------------------------------------------------
@@ -216,12 +218,17 @@ class LargeDeformationContact(PairSet):
         return iterate(cfg, check, correct, on_iteration)
 
     def _further_errors(self, state: ContactState) -> tuple[float, bool, str]:
-        """The errors of conditions beside the normal ones (friction's): the largest, whether
-        they hold, and what a message says of them. None here."""
+        """The errors of conditions beside the normal ones (the friction part's): the largest,
+        whether they hold, and what a message says of them. None without friction."""
+        if self.friction is not None:
+            return self.friction.further_errors(state)
         return 0.0, True, ""
 
     def _iteration_sets(self, state: ContactState, traction_values: list[np.ndarray]):
-        """The sets the cycle watch compares between iterations: the contact set."""
+        """The sets the cycle watch compares between iterations: the contact set (with
+        friction, the part's: the slip sets and directions too)."""
+        if self.friction is not None:
+            return self.friction.iteration_sets(state, traction_values)
         return self.contact_sets(traction_values)
 
     def _linearize(self, state: ContactState) -> list:
@@ -238,6 +245,8 @@ class LargeDeformationContact(PairSet):
         for i, (s, F) in enumerate(zip(self.surfaces, state.forces)):
             s.body.mechanics.equilibrate(state.load_factor, state.platen_displacement,
                                          self._full_force(i, F))
+        if self.friction is not None:  # the slips accumulated, the anchors moved
+            self.friction.finish(state)
 
     def _platen_on_force(self, state: ContactState, need: float) -> bool:
         """Whether the platen's reaction is on its force: ``need`` (:meth:`_platen_terms`)
@@ -286,7 +295,9 @@ class LargeDeformationContact(PairSet):
                           normal: np.ndarray) -> np.ndarray:
         """Pair k's traction vectors at its nodes ``on`` with ``normal`` there (linear in it:
         given a change of the normals, the change of the vectors): q n (friction adds s t,
-        t the normal turned by +90 degrees)."""
+        t the normal turned by +90 degrees: the friction part's)."""
+        if self.friction is not None:
+            return self.friction.traction_vectors(state, k, on, normal)
         return self.tractions(state, k)[on, None] * normal
 
     def _traction_change(self, state: ContactState, k: int, on: np.ndarray, normal: np.ndarray,
@@ -294,7 +305,10 @@ class LargeDeformationContact(PairSet):
         """The change of pair k's traction vectors at its nodes ``on`` per unit perturbation
         when their normals move from ``normal`` to ``perturbed`` (by ``h``): the traction is
         linear in the normal here (and with 2D friction, the tangent the normal turned), so
-        the traction of the normals' difference quotient."""
+        the traction of the normals' difference quotient (where the friction part's tangents
+        are not linear in the normal, 3D, its own difference)."""
+        if self.friction is not None and self.friction.turns(k):
+            return self.friction.traction_change(state, k, on, normal, perturbed, h)
         return self._traction_vectors(state, k, on, (perturbed - normal) / h)
 
     def _forces_at(self, state: ContactState, x: list[np.ndarray]) -> np.ndarray:
@@ -407,9 +421,9 @@ class LargeDeformationContact(PairSet):
                     q0[rows] = self.tractions(state, k)[s_]
                 else:  # the slip along the tangent per unit traction value
                     W[rows] = self._motion_along(pair, direction, M, s_)
-                    p[rows] = self._slip_now(state, k, s_, direction) + self._motion_along(
-                        pair, direction, a, s_)
-                    q0[rows] = self.shear(state, k)[s_, j - 1]  # (n, ntan): the j-th's
+                    p[rows] = self.friction.slip_now(state, k, s_, direction) \
+                        + self._motion_along(pair, direction, a, s_)
+                    q0[rows] = self.friction.shear(state, k)[s_, j - 1]  # (n, ntan): j-th
                 row += len(s_)
         rate = _concatenate([r[s_] for r, s_ in zip(rates, sets)])
         dR = -motion @ A[off[self.platen_body]:off[self.platen_body + 1]] if platen else None
@@ -436,15 +450,20 @@ class LargeDeformationContact(PairSet):
 
     def directions_now(self, k: int) -> list[np.ndarray]:
         """The directions of pair k's traction unknowns at its nodes, on the current geometry:
-        the normal alone (friction adds the tangent)."""
-        return [self.contact_pairs[k].normal]
+        the normal, then the friction part's tangents (none without friction)."""
+        tangential = self.friction.tangent_basis(k) if self.friction is not None else []
+        return [self.contact_pairs[k].normal, *tangential]
 
     def _solve_linearised(self, state: ContactState, W: np.ndarray, q0: np.ndarray,
                           p: np.ndarray, tol: float, sets: list[np.ndarray], rate, dR,
                           stiffness: float, need: float) -> tuple[np.ndarray, float]:
         """The traction values of the linearised contact problem (and the platen's motion):
         complementarity on the normal ones
-        (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`)."""
+        (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`); with friction,
+        the part's stick and slip sets too."""
+        if self.friction is not None:
+            return self.friction.solve_linearised(state, W, q0, p, tol, sets, rate, dR,
+                                                  stiffness, need)
         return linear_complementarity(W, q0, p, tol, rate, dR, stiffness, need)
 
     def _motion_along(self, pair, direction: np.ndarray, u: np.ndarray, nodes: np.ndarray
@@ -460,7 +479,11 @@ class LargeDeformationContact(PairSet):
 
     def _add_unknowns(self, state: ContactState, sets: list[np.ndarray], dq: np.ndarray
                       ) -> None:
-        """Add a correction of the unknowns (the order of :meth:`_correct_all`'s columns)."""
+        """Add a correction of the unknowns (the order of :meth:`_correct_all`'s columns; with
+        friction, the part's normal and tangential ones)."""
+        if self.friction is not None:
+            self.friction.add_unknowns(state, sets, dq)
+            return
         pos = 0
         for k, s_ in enumerate(sets):
             self.tractions(state, k)[s_] += dq[pos:pos + len(s_)]

@@ -22,7 +22,7 @@ geometry, and:
   normal conditions (complementarity, as without friction) and the tangential ones: a sticking
   node's slip vanishes, a slipping one's traction sits on the Coulomb cone ``s = -mu sigma q``
   opposing its slip. The stick and slip sets are found on the linearised model by an active-set
-  loop of small dense solves (:meth:`FrictionalLargeContact._solve_linearised`), the return map
+  loop of small dense solves (:meth:`FrictionalLargeContact.solve_linearised`), the return map
   onto the cone per node of the small-kinematics variant;
 * **at convergence** each node's slip is accumulated and its anchor moves to its virtual node.
 
@@ -59,6 +59,7 @@ from ..laws import (
     tangents,
 )
 from ..state import ContactState, FrictionState
+from .composed import Composed
 from .friction import HELD, plane_normals
 from .friction_history import FrictionHistory
 from .large import LargeDeformationContact
@@ -71,17 +72,13 @@ log = logging.getLogger(__name__)
 TURNED = 0.95
 
 
-class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
-    """The paired variant with Coulomb friction under large displacements (module docstring)."""
+class LargeFriction(FrictionHistory):
+    """The friction part of the paired variant under large displacements (module docstring):
+    :class:`~vfem.contact.formulations.large.LargeDeformationContact` holds it as ``friction``
+    and asks it for the tangential unknowns, their traction vectors, rows and errors."""
 
-    capabilities = dataclasses.replace(LargeDeformationContact.capabilities,
-                                       name="paired, frictional",
-                                       friction_laws=("coulomb", "static_dynamic"))
-    state_type = FrictionState
-
-    def __init__(self, surfaces, pairs, settings, backend: str | None = None, executor=None):
-        super().__init__(surfaces, pairs, settings, backend, executor=executor)
-        self._init_friction(settings)
+    def __init__(self, form, settings) -> None:
+        super().__init__(form, settings)
         #: 3D: per pair and node, the global axis whose projection on the current tangent plane
         #: is the first tangent (:func:`~vfem.contact.laws.coulomb.tangents`): the one
         #: least aligned with the node's own undeformed outward normal (on a symmetry plane, in the
@@ -92,16 +89,11 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         #: it). None in 2D.
         self._axes = [tangent_axes(plane_normals(sf, p, sf.node_normals()[p.nodes]))
                       if sf.dim == 3 else None
-                      for p, sf in ((p, self.surfaces[p.fine]) for p in self.contact_pairs)]
+                      for p, sf in ((p, form.surfaces[p.fine]) for p in form.contact_pairs)]
         # (the elasto-plastic law and a force-controlled platen are refused before, by
         # vfem.contact.formulations.formulation.check_capabilities)
 
     # -- the traction field ----------------------------------------------------------------------
-
-    def directions_now(self, k: int) -> list[np.ndarray]:
-        """The current normal, then the tangents (one in 2D, two in 3D): the order of each
-        pair's unknowns."""
-        return [self.contact_pairs[k].normal, *self.tangent_basis(k)]
 
     def _basis(self, k: int, on: np.ndarray, normal: np.ndarray) -> list[np.ndarray]:
         """Pair k's tangents at its nodes ``on`` with unit ``normal`` there: 2D the normal
@@ -113,7 +105,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         flat, turned = self._turned(k, on, normal)
         axes = self._axes[k][on]
         # (a node whose normal has turned onto its axis: the least aligned axis now; its
-        # tangents then jump, which :meth:`_further_errors` refuses where it carries traction)
+        # tangents then jump, which :meth:`further_errors` refuses where it carries traction)
         if turned.any():
             axes = axes.copy()
             axes[turned] = tangent_axes(flat[turned])
@@ -121,52 +113,56 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
 
     def tangent_basis(self, k: int) -> list[np.ndarray]:
         """Pair k's unit tangents at its nodes, on the current geometry."""
-        on = np.arange(len(self.contact_pairs[k].nodes))
-        return self._basis(k, on, self.contact_pairs[k].normal)
+        on = np.arange(len(self.form.contact_pairs[k].nodes))
+        return self._basis(k, on, self.form.contact_pairs[k].normal)
 
     def tangent(self, k: int) -> np.ndarray:
         """Pair k's (first) unit tangent at its nodes, on the current geometry."""
         return self.tangent_basis(k)[0]
 
-    def _traction_vectors(self, state, k, on, normal):
+    def traction_vectors(self, state, k, on, normal):
         """``q n + s t`` at the nodes ``on`` (2D: t is ``normal`` turned by +90 degrees; 3D:
         ``q n + s1 t1 + s2 t2``, the tangents of :meth:`_basis`)."""
         s = self.shear(state, k)[on]
-        return self.tractions(state, k)[on, None] * normal + sum(
+        return self.form.tractions(state, k)[on, None] * normal + sum(
             s[:, j, None] * t for j, t in enumerate(self._basis(k, on, normal)))
 
-    def _traction_change(self, state, k, on, normal, perturbed, h):
-        """3D: the tangents are not linear in the normal: the difference of the traction
-        vectors themselves (2D: as without friction)."""
-        if self._axes[k] is None:
-            return super()._traction_change(state, k, on, normal, perturbed, h)
-        return (self._traction_vectors(state, k, on, perturbed)
-                - self._traction_vectors(state, k, on, normal)) / h
+    def turns(self, k: int) -> bool:
+        """Whether pair k's tangents are not linear in its normal (3D: measured from an axis,
+        :meth:`_basis`), so that their change is the traction vectors' own difference
+        (:meth:`traction_change`); in 2D the tangent is the normal turned, linear in it."""
+        return self._axes[k] is not None
+
+    def traction_change(self, state, k, on, normal, perturbed, h):
+        """3D (:meth:`turns`): the tangents are not linear in the normal: the difference of
+        the traction vectors themselves."""
+        return (self.traction_vectors(state, k, on, perturbed)
+                - self.traction_vectors(state, k, on, normal)) / h
 
     def assemble_forces(self, state: ContactState) -> None:
         """Every body's nodal forces from the pairs' normal and tangential tractions, along the
         current normals and tangents."""
         for F in state.forces:
             F[:] = 0.0
-        for k, pair in enumerate(self.contact_pairs):
+        for k, pair in enumerate(self.form.contact_pairs):
             on = np.arange(len(pair.nodes))
-            traction = self._traction_vectors(state, k, on, pair.normal)
+            traction = self.traction_vectors(state, k, on, pair.normal)
             state.forces[pair.fine] += pair.mass[:, pair.nodes] @ traction
             state.forces[pair.coarse] -= pair.transfer[:, pair.nodes] @ traction
 
-    def _add_unknowns(self, state, sets, dq) -> None:
+    def add_unknowns(self, state, sets, dq) -> None:
         """Per pair, the set's normal traction values, then its tangential ones (tangent by
         tangent)."""
         pos = 0
         for k, s_ in enumerate(sets):
             n = len(s_)
-            self.tractions(state, k)[s_] += dq[pos:pos + n]
+            self.form.tractions(state, k)[s_] += dq[pos:pos + n]
             shear = self.shear(state, k)
             for j in range(shear.shape[1]):
                 shear[s_, j] += dq[pos + (1 + j) * n:pos + (2 + j) * n]
             pos += (1 + shear.shape[1]) * n
-        for k in range(len(self.contact_pairs)):  # no shear without a normal traction
-            self.shear(state, k)[self.tractions(state, k) <= 0] = 0.0
+        for k in range(len(self.form.contact_pairs)):  # no shear without a normal traction
+            self.shear(state, k)[self.form.tractions(state, k) <= 0] = 0.0
 
     # -- anchors and slips -----------------------------------------------------------------------
 
@@ -175,8 +171,8 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         opposing surface (what :attr:`FrictionState.anchor` keeps: 2D ``facet + t``, 3D the
         facet and its nodes' shape-function values, :meth:`ContactSurface.material_points`)."""
         out = []
-        for pair in self.contact_pairs:
-            sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
+        for pair in self.form.contact_pairs:
+            sf, sc = self.form.surfaces[pair.fine], self.form.surfaces[pair.coarse]
             if pair.patches is None:  # (nothing over the other surface: no anchor read)
                 out.append(np.zeros(len(pair.nodes)) if sc.dim == 2 else
                            np.zeros((len(pair.nodes), 1 + sc.facets.shape[1])))
@@ -189,11 +185,11 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
     def _anchor_positions(self, k: int, xc: np.ndarray, anchor: np.ndarray) -> np.ndarray:
         """Where the opposing surface's material points ``anchor`` (:meth:`_virtual_points`)
         now are."""
-        return self.surfaces[self.contact_pairs[k].coarse].material_positions(anchor, xc)
+        return self.form.surfaces[self.form.contact_pairs[k].coarse].material_positions(anchor, xc)
 
     def _relative(self, state, k, x) -> np.ndarray:
         """Pair k's nodes' positions less their anchors' (module docstring)."""
-        pair = self.contact_pairs[k]
+        pair = self.form.contact_pairs[k]
         return x[pair.fine][pair.nodes] - self._anchor_positions(k, x[pair.coarse],
                                                                  self.anchor(state, k))
 
@@ -201,30 +197,27 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
               ) -> list[np.ndarray]:
         """Per pair, each node's slip within the step: its distance from its anchor along each
         current tangent, (n, ntan) (module docstring)."""
-        x = self.positions(state) if x is None else x
+        x = self.form.positions(state) if x is None else x
         out = []
-        for k in range(len(self.contact_pairs)):
+        for k in range(len(self.form.contact_pairs)):
             d = self._relative(state, k, x)
             out.append(np.column_stack([np.einsum("ij,ij->i", d, tj)
                                         for tj in self.tangent_basis(k)]))
         return out
 
-    def _slip_now(self, state, k, s_, direction) -> np.ndarray:
+    def slip_now(self, state, k, s_, direction) -> np.ndarray:
         """The slips of pair k's nodes ``s_`` along ``direction`` (a tangent at its nodes; the
         linearised tangential rows' start): :meth:`slips` of this pair and these nodes."""
-        d = self._relative(state, k, self.positions(state))[s_]
+        d = self._relative(state, k, self.form.positions(state))[s_]
         return np.einsum("ij,ij->i", d, direction[s_])
 
-    def new_state(self, load_factor: float = 0.0, platen_displacement: float = 0.0
-                  ) -> ContactState:
-        """No contact force; each node anchored at its virtual node on the undeformed
-        surfaces."""
-        state = super().new_state(load_factor, platen_displacement)
-        x = self.positions(state)
-        self.penetrations(state)  # the pairs on this geometry
+    def start(self, state: FrictionState) -> None:
+        """The state before the first step (no contact force): each node anchored at its
+        virtual node on the undeformed surfaces."""
+        x = self.form.positions(state)
+        self.form.penetrations(state)  # the pairs on this geometry
         for k, v in enumerate(self._virtual_points(x)):
             state.anchor[k] = v
-        return state
 
     # -- the iteration ---------------------------------------------------------------------------
 
@@ -233,43 +226,43 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         """3D: pair k's normals at its nodes ``on`` (all; ``normal`` there, else the pair's)
         less their part across a symmetry plane, and which have turned to within
         ``arccos(TURNED)`` of the axis their tangents are measured from (:meth:`_basis`)."""
-        pair = self.contact_pairs[k]
-        flat = plane_normals(self.surfaces[pair.fine], pair, normal, on)
+        pair = self.form.contact_pairs[k]
+        flat = plane_normals(self.form.surfaces[pair.fine], pair, normal, on)
         axes = self._axes[k] if on is None else self._axes[k][on]
         return flat, np.abs(flat[np.arange(len(flat)), axes]) > TURNED
 
-    def _further_errors(self, state: FrictionState) -> tuple[float, bool, str]:
+    def further_errors(self, state: FrictionState) -> tuple[float, bool, str]:
         """The friction's errors: a sticking node's slip, a slipping node's slip against its
         traction, a tangential traction outside its cone. 3D: a node carrying traction whose
         normal has turned onto the axis of its tangents stops the analysis (:meth:`_basis`)."""
-        for k, pair in enumerate(self.contact_pairs):
+        for k, pair in enumerate(self.form.contact_pairs):
             if self._axes[k] is None:
                 continue
-            bad = np.flatnonzero(self._turned(k)[1] & (self.tractions(state, k) > 0))
+            bad = np.flatnonzero(self._turned(k)[1] & (self.form.tractions(state, k) > 0))
             if len(bad):
-                sf = self.surfaces[pair.fine]
+                sf = self.form.surfaces[pair.fine]
                 raise AnalysisError(
                     f"body {sf.body.name!r}, contact node {sf.nodes[pair.nodes[bad[0]]]}: its "
                     "contact normal has turned onto the axis its friction tangents are measured "
                     "from (within 18 degrees); 3D friction with large kinematics takes contact "
                     "normals turning by up to about 35 degrees from the undeformed ones")
         err, excess, _, _ = self.friction_errors(state, self.slips(state))
-        ok = err <= self.penetration_tolerance and excess <= CONE_TOLERANCE
+        ok = err <= self.form.penetration_tolerance and excess <= CONE_TOLERANCE
         return err, ok, f", tangential slip error {err:.3g}"
 
-    def _iteration_sets(self, state, traction_values):
+    def iteration_sets(self, state, traction_values):
+        """The sets the cycle watch compares: contact, slip and the slip directions."""
         return self._sets(state)
 
-    def _finish(self, state: FrictionState) -> None:
-        """Equilibrate the bodies (as without friction), then accumulate each node's slip and
-        anchor it at its virtual node."""
-        super()._finish(state)
-        x = self.positions(state)
-        self.penetrations(state)  # the pairs on the equilibrated geometry
+    def finish(self, state: FrictionState) -> None:
+        """After the bodies are equilibrated (as without friction), accumulate each node's slip
+        and anchor it at its virtual node."""
+        x = self.form.positions(state)
+        self.form.penetrations(state)  # the pairs on the equilibrated geometry
         slips = self.slips(state, x)
         self._increments = []
         for k, (g, v) in enumerate(zip(slips, self._virtual_points(x))):
-            on = self.tractions(state, k) > 0
+            on = self.form.tractions(state, k) > 0
             increment = np.where(on[:, None], g, 0.0)
             self.accumulated_slip(state, k)[:] += magnitudes(increment)
             self._increments.append(increment)
@@ -287,7 +280,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
                               or [np.zeros(0, bool)])
         return each(self.dynamic), each(self.static), each(self.onset), acts
 
-    def _solve_linearised(self, state, W, q0, p, tol, sets, rate, dR, stiffness, need):
+    def solve_linearised(self, state, W, q0, p, tol, sets, rate, dR, stiffness, need):
         """The normal and tangential traction values of the linearised problem.
 
         Rows and columns per pair: the set's normal unknowns, then its tangential ones. After
@@ -378,7 +371,7 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
         return x, 0.0
 
     def _solve_linearised_3d(self, state, W, q0, p, tol, sets):
-        """:meth:`_solve_linearised` in 3D: per pair, the set's normal unknowns, then those along
+        """:meth:`solve_linearised` in 3D: per pair, the set's normal unknowns, then those along
         the first tangent, then along the second. A sticking node's slip vanishes along both
         tangents; a slipping node's traction is ``-mu q sigma``, sigma the unit direction of its
         slip in the tangent plane. A tangent along which no traction moves the node (a symmetry
@@ -513,4 +506,11 @@ class FrictionalLargeContact(FrictionHistory, LargeDeformationContact):
             self.sliding(state, k)[s_] = (slipping & contact)[pair_of == k]
         return x, 0.0
 
-__all__ = ["FrictionalLargeContact"]
+#: the paired variant with friction under large displacements: the frictionless formulation
+#: composed with the friction part (the laws it takes: :class:`~vfem.contact.laws.FrictionLaw`)
+FrictionalLargeContact = Composed(
+    LargeDeformationContact, LargeFriction,
+    dataclasses.replace(LargeDeformationContact.capabilities, name="paired, frictional",
+                        friction_laws=("coulomb", "static_dynamic")))
+
+__all__ = ["FrictionalLargeContact", "LargeFriction"]

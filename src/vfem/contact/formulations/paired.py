@@ -80,11 +80,13 @@ class PairedContact(PairSet):
     capabilities = Capabilities(
         name="paired", orders=(1, 2), kinematics=("small",), dimensions=(2, 3),
         orders_3d=(1, 2))
-    both_surfaces = True
-
     def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
-                 backend: str | None = None, sides: dict | None = None, executor=None):
-        super().__init__(surfaces, pairs, settings, backend, sides, executor=executor)
+                 backend: str | None = None, sides: dict | None = None, executor=None,
+                 friction: type | None = None):
+        #: whether the equilibrium side's nodes are held too (issue 37): not yet with friction
+        self.both_surfaces = friction is None
+        super().__init__(surfaces, pairs, settings, backend, sides, executor=executor,
+                         friction=friction)
         #: W, the penetration change per unit platen motion, the platen reaction per unit
         #: traction value and the pairs' offsets (:meth:`_full_flexibility`): the pairs'
         #: geometry is fixed under small kinematics, so they are computed once, when first
@@ -136,7 +138,10 @@ class PairedContact(PairSet):
     def solve(self, state: ContactState, on_iteration=None) -> SolveResult:
         """Correct the traction values until every pair's compatibility holds
         (:func:`~vfem.contact.solvers.iteration.iterate`); the forces follow from them, equal and
-        opposite by construction (see the module docstring)."""
+        opposite by construction (see the module docstring). With friction, the friction
+        part's solve (:meth:`~vfem.contact.formulations.friction.SmallFriction.solve`)."""
+        if self.friction is not None:
+            return self.friction.solve(state, on_iteration)
         cfg = self.settings
         tol = self.penetration_tolerance
         self._refused = None
@@ -507,8 +512,9 @@ class PairedContact(PairSet):
 
     def directions(self, k: int) -> list[np.ndarray]:
         """The directions of pair k's traction unknowns at its nodes, each (nodes, dim): the
-        normal alone (frictionless; a frictional formulation adds the tangents)."""
-        return [self.contact_pairs[k].normal]
+        normal, then the friction part's tangents (none without friction)."""
+        tangential = self.friction.tangent_basis(k) if self.friction is not None else []
+        return [self.contact_pairs[k].normal, *tangential]
 
     def _tangent_platen_rate(self, k: int, tangent: np.ndarray) -> np.ndarray:
         """The change of pair k's relative tangential displacement t.(u_f - u_c) per unit

@@ -119,7 +119,7 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     gap, as its nodes are.
 
     Where ``approach`` is given (``approach(read, read_other, normal)``, the loads' relative
-    motion, :meth:`~vfem.contact.formulations.pairset.PairSet._relative_motion`), a point that
+    motion, :meth:`~vfem.contact.formulations.pairmaking.relative_motion`), a point that
     approaches its closest facet clearly (within 60 degrees of its inward normal) is read where the
     ray along that motion enters the other patch (:func:`ray_facet`): the facet under it, and its
     pairing; others at their closest point, and only where they lie over (or under) that
@@ -337,7 +337,7 @@ def _edge_approach(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, ed
     ``t``, at ``points``) approaches the other patch ``opatch``, nan where it does not clearly
     (within 60 degrees of the closest facet's inward normal) or ``approach`` is None.
     ``approach(read, read_other, normal)``: the relative motion under the loads
-    (:meth:`~vfem.contact.formulations.pairset.PairSet._relative_motion`) given how to read a field
+    (:meth:`~vfem.contact.formulations.pairmaking.relative_motion`) given how to read a field
     of each side's candidate nodes at the points and at their closest points."""
     out = np.full(points.shape, np.nan)
     if approach is None:

@@ -188,7 +188,7 @@ def common_normal(sf: ContactSurface, sc: ContactSurface, geo: Overlap, c_fine: 
 
     The normal is the two surfaces' outward normals (the other surface's at the virtual node,
     minus the node's own), each weighted by its body's stiffness per unit length (the inverse
-    of :meth:`~vfem.contact.formulations.pairset.PairSet._compliance_density`): where the bodies are
+    of :meth:`~vfem.contact.formulations.pairmaking.compliance_density`): where the bodies are
     pressed together the stiffer surface keeps its shape and the interface takes its normal, and two
     equally stiff ones meet on the mean plane. Swapping the roles gives the same line.
     **Why**: with the other surface's normal alone, a stiff flat made the compatibility side of
@@ -333,7 +333,7 @@ def approach_gaps(sf: ContactSurface, sc: ContactSurface, geo: Overlap,
     """(m,) the compatibility side's gaps along the pair's normal n (``geo.normal``, the
     common normal, :func:`common_normal`), each scaled so that it closes where the node,
     moving relative to its virtual node along ``approach`` ((m, dim) a: the loads' relative
-    motion, :meth:`~vfem.contact.formulations.pairset.PairSet._approach`), crosses the line (plane)
+    motion, :meth:`~vfem.contact.formulations.pairmaking.approach_motion`), crosses the line (plane)
     of the other surface's facet at its virtual node: g_m (n.a) / (m.a), m that facet's normal and
     g_m the node's distance from its line (small kinematics, undeformed; issue 37). Only where
     the node approaches clearly (a within 60 degrees of -n and of -m) and the ray along a
