@@ -256,3 +256,47 @@ def test_no_module_of_contact_or_bodies_is_longer_than_600_lines_but_the_known_o
             for f in (ROOT / package).rglob("*.py")
             if len(f.read_text(encoding="utf-8").splitlines()) > MODULE_LINES}
     assert long == KNOWN_LONG
+
+
+def inheritance_depths(sources: dict[str, str]) -> dict[str, int]:
+    """Class name -> the levels of classes of ``sources`` (module -> text) above it: 0 for a
+    class that derives from none of them, 1 for one that derives from such a class, and so on.
+    A protocol (a class deriving from ``Protocol``) is not counted as a base, and error classes
+    (those whose bases reach ``Exception``) are left out: a protocol's implementer reuses
+    nothing, an error's kind is its class."""
+    bases: dict[str, list[str]] = {}
+    for text in sources.values():
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ClassDef):
+                bases[node.name] = [ast.unparse(b).split(".")[-1].split("[")[0]
+                                    for b in node.bases]
+
+    def error(name: str, seen: tuple[str, ...] = ()) -> bool:
+        return any(b == "Exception" or (b in bases and b not in seen
+                                        and error(b, seen + (name,)))
+                   for b in bases.get(name, ()))
+
+    def counted(b: str, seen: tuple[str, ...]) -> bool:  # a class of sources, not a protocol
+        return b in bases and b not in seen and "Protocol" not in bases[b]
+
+    def depth(name: str, seen: tuple[str, ...] = ()) -> int:
+        return max((1 + depth(b, seen + (name,)) for b in bases.get(name, ())
+                    if counted(b, seen)), default=0)
+
+    return {name: depth(name) for name in bases if not error(name)}
+
+
+def test_no_class_derives_more_than_one_level_for_reuse():
+    """Issue 38: formulations are composed of parts (the surface group, the friction part, the
+    pairs' making), not one class per combination built on the one before; a class of the
+    library derives at most from one class of it (a protocol's implementer or an error's kind
+    is not reuse)."""
+    sources = {str(f.relative_to(ROOT)): f.read_text(encoding="utf-8")
+               for f in ROOT.rglob("*.py")}
+    deep = {name: d for name, d in inheritance_depths(sources).items() if d > 1}
+    assert not deep, deep
+    # the count sees a chain, not a protocol or an error's kind
+    assert inheritance_depths({"m": "class A: pass\nclass B(A): pass\nclass C(B): pass\n"
+                               "class P(Protocol): pass\nclass Q(P): pass\nclass R(Q): pass\n"
+                               "class E(Exception): pass\nclass F(E): pass\nclass G(F): pass"}
+                              ) == {"A": 0, "B": 1, "C": 2, "P": 0, "Q": 0, "R": 1}

@@ -86,25 +86,37 @@ class TractionState(ContactState):
     tractions: dict[int, np.ndarray] = field(default_factory=dict)
 
     def unknowns(self) -> dict[str, np.ndarray]:
-        return {f"traction_{k}": v for k, v in self.tractions.items()}
+        return _named("traction", self.tractions)
 
     def with_unknowns(self, arrays: dict[str, np.ndarray]) -> TractionState:
-        self.tractions = {int(k.removeprefix("traction_")): v for k, v in arrays.items()
-                          if k.startswith("traction_")}
+        self.tractions = _by_pair("traction", arrays)
         return self
 
 
-@dataclass
-class FrictionState(TractionState):
-    """The frictional paired variant's state (:mod:`vfem.contact.formulations.friction`): besides
-    the normal traction values, per contact pair (its index) at its compatibility-side nodes the
-    tangential traction values (``shear``), the relative tangential displacement against the
-    virtual node at the last converged step (``anchor``: a node that sticks keeps it within the
-    step), the slip accumulated since the start (``slip``) and the penetration at the last
-    converged step (``penetration``: where a node that comes into contact within a step first
-    touched) and which nodes slip (``sliding``). All are path-dependent history: saved in
-    checkpoints and restored exactly when a step is cut."""
+def _named(name: str, table: dict[int, np.ndarray]) -> dict[str, np.ndarray]:
+    """A state's per-pair arrays ``table`` by their names in a checkpoint: ``<name>_<pair>``."""
+    return {f"{name}_{k}": v for k, v in table.items()}
 
+
+def _by_pair(name: str, arrays: dict[str, np.ndarray]) -> dict[int, np.ndarray]:
+    """The per-pair arrays named ``<name>_<pair>`` among ``arrays`` (:func:`_named`), by pair."""
+    return {int(k.removeprefix(f"{name}_")): v for k, v in arrays.items()
+            if k.startswith(f"{name}_")}
+
+
+@dataclass
+class FrictionState(ContactState):
+    """The frictional paired variant's state (:mod:`vfem.contact.formulations.friction`): as
+    :class:`TractionState`, the normal traction values (``tractions``), and per contact pair
+    (its index) at its compatibility-side nodes the tangential traction values (``shear``), the
+    relative tangential displacement against the virtual node at the last converged step
+    (``anchor``: a node that sticks keeps it within the step), the slip accumulated since the
+    start (``slip``) and the penetration at the last converged step (``penetration``: where a
+    node that comes into contact within a step first touched) and which nodes slip
+    (``sliding``). All are path-dependent history: saved in checkpoints and restored exactly
+    when a step is cut."""
+
+    tractions: dict[int, np.ndarray] = field(default_factory=dict)
     shear: dict[int, np.ndarray] = field(default_factory=dict)
     anchor: dict[int, np.ndarray] = field(default_factory=dict)
     slip: dict[int, np.ndarray] = field(default_factory=dict)
@@ -117,15 +129,15 @@ class FrictionState(TractionState):
     HISTORY = ("shear", "anchor", "slip", "penetration", "sliding")
 
     def unknowns(self) -> dict[str, np.ndarray]:
-        return {**super().unknowns(),
-                **{f"{name}_{k}": v for name in self.HISTORY
-                   for k, v in getattr(self, name).items()}}
+        out = _named("traction", self.tractions)
+        for name in self.HISTORY:
+            out.update(_named(name, getattr(self, name)))
+        return out
 
     def with_unknowns(self, arrays: dict[str, np.ndarray]) -> FrictionState:
-        super().with_unknowns(arrays)
+        self.tractions = _by_pair("traction", arrays)
         for name in self.HISTORY:
-            setattr(self, name, {int(k.removeprefix(f"{name}_")): v for k, v in arrays.items()
-                                 if k.startswith(f"{name}_")})
+            setattr(self, name, _by_pair(name, arrays))
         return self
 
 

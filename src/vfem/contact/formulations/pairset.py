@@ -18,6 +18,7 @@ from ..geometry import (
 )
 from ..state import (
     ContactState,
+    FrictionState,
     Pairing,
     SolveResult,
     TractionState,
@@ -132,7 +133,7 @@ class PairSet:
 
     # -- state of the pairs -----------------------------------------------------------------------
 
-    def tractions(self, state: TractionState, k: int) -> np.ndarray:
+    def tractions(self, state: TractionState | FrictionState, k: int) -> np.ndarray:
         """The normal traction values of pair k at its compatibility-side nodes (the unknowns)."""
         pair = self.contact_pairs[k]
         if k not in state.tractions:

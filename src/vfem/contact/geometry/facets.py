@@ -24,6 +24,8 @@ Callers treat ``xi`` and the patch boundary as opaque.
 
 from __future__ import annotations
 
+from typing import Protocol
+
 import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
@@ -40,8 +42,9 @@ from . import closest3d, facets3d
 FACET_READINGS = (0.5, 0.05, 0.95)
 
 
-class FacetKind:
-    """The interface of a kind of facet (:class:`Segment`, :class:`Triangle`, :class:`Quad`).
+class FacetKind(Protocol):
+    """The interface of a kind of facet (:class:`Segment`, :class:`Triangle`, :class:`Quad`):
+    a protocol each kind keeps, not a class they derive from.
 
     Arrays: ``x`` (n, dim) nodal positions of a surface (local node numbers), ``facets`` (nf,
     nodes) its facets' local node numbers (oriented: the outward normal is the kind's),
@@ -69,68 +72,67 @@ class FacetKind:
 
     def shape(self, xi: np.ndarray) -> np.ndarray:
         """(n, nodes) shape functions at ``xi``, in the column order of ``facets``."""
-        raise NotImplementedError
+        ...
 
     def derivatives(self, xi: np.ndarray) -> np.ndarray:
         """Derivatives of :meth:`shape` with respect to ``xi``."""
-        raise NotImplementedError
+        ...
 
     def traction_shape(self, xi: np.ndarray) -> np.ndarray:
         """(n, nodes) the functions that interpolate a contact traction from its nodal values
         (the paired variant's unknowns, thesis §4.4: the traction varies between the contact
         nodes): by default the facet's own shape functions."""
-        return self.shape(xi)
 
     def orient(self, p: np.ndarray, fn: np.ndarray, centroid: np.ndarray) -> None:
         """Reorder, in place, the rows of ``fn`` (point numbers of ``p`` (dim, np)) whose
         normal points into their element (``centroid`` (nf, dim)), so every normal is outward."""
-        raise NotImplementedError
+        ...
 
     def curve(self, x: np.ndarray, facets: np.ndarray, xi: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray]:
         """Position and Jacobian dx/dxi at ``xi`` of the facets (rows) ``facets``."""
-        raise NotImplementedError
+        ...
 
     def surface_map(self, x: np.ndarray, facets: np.ndarray, xi: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
         """(pos, jn): position and the Jacobian times the unit outward normal (its norm the
         measure per unit reference measure) at ``xi`` of the facets (rows) ``facets``."""
-        raise NotImplementedError
+        ...
 
     def facet_normals(self, x: np.ndarray, facets: np.ndarray) -> np.ndarray:
         """(nf, dim) unit outward normals of the facets' chords (rows ``facets``)."""
-        raise NotImplementedError
+        ...
 
     def closest(self, points: np.ndarray, x: np.ndarray, facets: np.ndarray, ids: np.ndarray,
                 point_normals: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Closest point on the facets ``ids`` (rows of ``facets``) for each point: (facet
         number, xi, distance, unit outward normal there, xi_free: unclamped)."""
-        raise NotImplementedError
+        ...
 
     def strictly_inside(self, xi_free: np.ndarray) -> np.ndarray:
         """Whether unclamped local coordinates lie inside the facet, off its boundary."""
-        raise NotImplementedError
+        ...
 
     def patch_boundary(self, facets: np.ndarray, patch: np.ndarray, nc: int):
         """The boundary of the patch ``patch`` (facet numbers) of a surface of ``nc`` candidate
         nodes, in the form :meth:`beyond` and :meth:`on_boundary` read (opaque to callers)."""
-        raise NotImplementedError
+        ...
 
     def boundary_nodes(self, facets: np.ndarray, boundary, nc: int) -> np.ndarray:
         """(nc,) the candidate nodes on a patch boundary (:meth:`patch_boundary`)."""
-        raise NotImplementedError
+        ...
 
     def beyond(self, facets: np.ndarray, seg: np.ndarray, xi_free: np.ndarray, boundary
                ) -> np.ndarray:
         """Points whose closest point on a patch (on facet ``seg`` at unclamped ``xi_free``) is
         on its boundary and that lie outside the facet there: not over the patch."""
-        raise NotImplementedError
+        ...
 
     def on_boundary(self, facets: np.ndarray, seg: np.ndarray, xi_free: np.ndarray, boundary
                     ) -> np.ndarray:
         """Points whose closest point on a patch is (to 1e-9) a vertex on its boundary."""
-        raise NotImplementedError
+        ...
 
     def overlap_quadrature(self, sf, fpatch: np.ndarray, sc, cpatch: np.ndarray,
                            cnormals: np.ndarray, reach: float, xf: np.ndarray, xc: np.ndarray
@@ -139,18 +141,18 @@ class FacetKind:
         over patch ``cpatch`` of ``sc`` (nodal normals ``cnormals``; points farther than
         ``reach`` face something else), positions ``xf``, ``xc``: (facet (q,), xi, weight
         (q,)), the weights times the undeformed measure of ``sf``."""
-        raise NotImplementedError
+        ...
 
     def material_points(self, facets: np.ndarray, seg: np.ndarray, interp: np.ndarray
                         ) -> np.ndarray:
         """Points on facets ``seg`` (their interpolation rows ``interp``) as material points
         of the surface (what a friction anchor keeps)."""
-        raise NotImplementedError
+        ...
 
     def material_positions(self, x: np.ndarray, facets: np.ndarray, points: np.ndarray
                            ) -> np.ndarray:
         """Where :meth:`material_points` ``points`` are at positions ``x``."""
-        raise NotImplementedError
+        ...
 
 
 def facet_shape(t: np.ndarray, order: int) -> np.ndarray:
@@ -171,13 +173,14 @@ def facet_shape_derivative(t: np.ndarray, order: int) -> np.ndarray:
 _SECOND = np.array([[4.0], [4.0], [-8.0]])  # second derivatives of the 3-node shape functions
 
 
-class Segment(FacetKind):
+class Segment:
     """2- or 3-node facets of a 2D surface (``order`` 1 or 2), oriented so that ``(t_y, -t_x)``
     of the tangent is the outward normal. The patch boundary is (nc,) True at the patch's end
     vertices (vertices on one facet of it)."""
 
     dim = 2
     corners = 2
+    weightless_corners: tuple[tuple[int, int, int], ...] = ()
 
     def __init__(self, order: int):
         self.order = order
@@ -336,7 +339,7 @@ class Segment(FacetKind):
         return (1.0 - t) * x[ends[:, 0]] + t * x[ends[:, 1]]
 
 
-class _Facet3D(FacetKind):
+class _Facet3D:
     """Facets of a 3D surface: the kernels of :mod:`vfem.contact.geometry.facets3d` (``geometry``,
     its :class:`~vfem.contact.geometry.facets3d.FacetShape`) behind the :class:`FacetKind`
     interface. A facet is oriented when its corners run counter-clockwise seen from outside:
@@ -345,6 +348,7 @@ class _Facet3D(FacetKind):
     edge of no other facet of the patch (facets off the patch: all False)."""
 
     dim = 3
+    weightless_corners: tuple[tuple[int, int, int], ...] = ()
     #: the name of the kind (``Triangle``, ``Quad``)
     name = ""
     #: nodes per facet by order
@@ -378,6 +382,10 @@ class _Facet3D(FacetKind):
 
     def shape(self, xi: np.ndarray) -> np.ndarray:
         return facets3d.shape_functions(self.geometry, xi)[0]
+
+    def traction_shape(self, xi: np.ndarray) -> np.ndarray:
+        """The facet's own shape functions."""
+        return self.shape(xi)
 
     def derivatives(self, xi: np.ndarray) -> np.ndarray:
         """(n, nodes, 2): d/dξ and d/dη of :meth:`shape`."""
