@@ -205,8 +205,7 @@ def test_each_setting_picks_one_formulation_that_implements_the_contract(method,
     assert caps.orders_3d == ({PairedContact: (1, 2), LargeDeformationContact: (1,)}
                               .get(cls, ()))  # quadratic: tetrahedra, small, frictionless
     # Coulomb friction: the frictional formulations' (vfem), the lagrange baseline's
-    assert caps.friction_laws == (("coulomb", "static_dynamic") if cls is GlobalContact
-                                  else ())
+    assert caps.friction == (("coefficients",) if cls is GlobalContact else ())
     assert ("large" in caps.kinematics) == (cls is LargeDeformationContact)
     assert caps.cuts_steps == (cls is not GlobalContact)
 

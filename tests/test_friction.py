@@ -63,7 +63,7 @@ def test_a_frictional_setting_picks_the_frictional_paired_formulation():
     assert formulation_class(ContactSettings(friction=0.3), False) is FrictionalPairedContact
     assert formulation_class(ContactSettings(friction=0.0), False) is PairedContact
     caps = FrictionalPairedContact.capabilities
-    assert "coulomb" in caps.friction_laws and caps.kinematics == ("small",)
+    assert "coefficients" in caps.friction and caps.kinematics == ("small",)
     with pytest.raises(InputError, match="must be >= 0"):
         ContactSettings(friction=-0.1).validate()
 

@@ -1,16 +1,16 @@
-"""The friction laws behind one protocol (issue 38: a new law is a class in the laws stage, its
-settings and the capabilities that name it, not a change to every frictional formulation).
+"""The friction laws behind one protocol (issue 38: a new law is a class in the laws stage and
+its settings, not a change to every frictional formulation).
 
 A law defined here, outside the library, and registered by name runs in the frictional
-formulations through :class:`vfem.contact.laws.FrictionLaw` alone: a copy of Coulomb's law under
-another name gives Coulomb's answers bit for bit, and a law whose coefficient weakens with the
-slip a node has accumulated makes a block dragged far carry the weakened coefficient times its
-normal force.
+formulations through :class:`vfem.contact.laws.FrictionLaw` alone, taken by those whose
+capabilities read what it asks (``reads``): a copy of Coulomb's law under another name gives
+Coulomb's answers bit for bit, and a law whose coefficient weakens with the slip a node has
+accumulated makes a block dragged far carry the weakened coefficient times its normal force; the
+``lagrange`` baseline, which keeps no slip per node, refuses it.
 """
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -19,8 +19,6 @@ import pytest
 
 from models import built
 from test_friction import BLOCKS, forces
-from vfem.contact.formulations import friction
-from vfem.contact.formulations.friction import FrictionalPairedContact
 from vfem.contact.laws import (
     FRICTION_LAWS,
     beyond_cone,
@@ -45,6 +43,7 @@ class CoulombCopy:
     mu: float
     name: ClassVar[str] = "coulomb_copy"
     parameters: ClassVar[tuple[str, ...]] = ()
+    reads: ClassVar[tuple[str, ...]] = ("coefficients",)
     compliance: ClassVar[float] = 0.0
 
     @classmethod
@@ -71,6 +70,7 @@ class Weakening(CoulombCopy):
     ``WEAK``: a slip-weakening law, static and dynamic alike."""
 
     name: ClassVar[str] = "weakening"
+    reads: ClassVar[tuple[str, ...]] = ("coefficients", "slip")
     CRITICAL: ClassVar[float] = 0.02
     WEAK: ClassVar[float] = 0.2
 
@@ -83,20 +83,18 @@ class Weakening(CoulombCopy):
 
 @pytest.fixture
 def registered(monkeypatch):
-    """The test's laws registered by name, and taken by the small-kinematics frictional
-    formulation (its capabilities name them)."""
+    """The test's laws registered by name (nothing else: the formulations take them by what
+    they read)."""
     for law in (CoulombCopy, Weakening):
         monkeypatch.setitem(FRICTION_LAWS, law.name, law)
-    caps = FrictionalPairedContact.capabilities
-    monkeypatch.setattr(friction, "FrictionalPairedContact", dataclasses.replace(
-        FrictionalPairedContact, capabilities=dataclasses.replace(
-            caps, friction_laws=caps.friction_laws + (CoulombCopy.name, Weakening.name))))
 
 
-def dragged(law: str | None):
+def dragged(law: str | None, method: str = "vfem"):
     """The sliding block of ``test_friction`` (pressed, then dragged 0.1 in four steps of
-    0.025, mu 0.3), with its pair following ``law`` (None: the model's Coulomb law)."""
-    text = BLOCKS.format(mu=0.3, shift=0.1)
+    0.025, mu 0.3), with its pair following ``law`` (None: the model's Coulomb law), by the
+    contact ``method``."""
+    text = BLOCKS.format(mu=0.3, shift=0.1).replace(
+        "[contact]\n", f'[contact]\nmethod = "{method}"\n', 1)
     if law is not None:
         text = text.replace("[[bodies]]", ENTRY.format(law=law) + "[[bodies]]", 1)
     return forces(built(text))
@@ -126,12 +124,14 @@ def test_a_slip_weakening_law_carries_its_weakened_coefficient_once_slipped(regi
     assert np.all(status[status > 0] == 2)
 
 
-def test_a_law_not_among_the_formulations_is_refused_naming_it(monkeypatch):
-    """Registered but not among the laws the formulation takes: one message naming the pair,
-    the law and those it takes."""
-    monkeypatch.setitem(FRICTION_LAWS, Weakening.name, Weakening)
-    with pytest.raises(InputError, match="the weakening friction law is not among those"):
-        dragged(Weakening.name)
+def test_a_law_asking_what_a_formulation_does_not_read_is_refused_naming_it(registered):
+    """The lagrange baseline keeps no accumulated slip: the slip-weakening law is refused, in
+    one message naming the pair, the law, what it reads and the laws the baseline takes."""
+    with pytest.raises(InputError, match="the weakening friction law reads its slip, which the "
+                                         "classical formulation does not: not yet with "
+                                         "contact.method = 'lagrange'; use law = 'coulomb' or "
+                                         "'static_dynamic' or 'coulomb_copy'"):
+        dragged(Weakening.name, "lagrange")
 
 
 def test_the_rule_and_the_records():

@@ -52,7 +52,7 @@ def resultant(result, name: str) -> np.ndarray:
 def test_a_frictional_large_kinematics_model_picks_the_frictional_large_formulation():
     assert formulation_class(ContactSettings(friction=0.3), True) is FrictionalLargeContact
     caps = FrictionalLargeContact.capabilities
-    assert "coulomb" in caps.friction_laws and "large" in caps.kinematics
+    assert "coefficients" in caps.friction and "large" in caps.kinematics
 
 
 def test_a_block_slid_far_carries_mu_times_its_normal_force():

@@ -7,7 +7,7 @@ outside its tolerance is not converged.
   on one block with one held sideways so, stopped in their first step after 100 iterations with
   every error at 1e-17 (``SurfaceGroup.platen_allowance`` measures a zero force against the
   forces its reaction sums); and the frictional correction did not move a platen whose force
-  is zero (``FrictionalPairedContact._correct_frictional``), so where friction makes a sideways
+  is zero (``SmallFriction._correct_frictional``), so where friction makes a sideways
   reaction the iteration could not remove it.
 * In 3D a node of a frictionless pair in a frictional model slips with no traction: its slip
   direction -s / |s| was 0 / 0 (NaN errors, warnings on the screen).

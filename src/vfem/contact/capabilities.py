@@ -21,17 +21,19 @@ class Capabilities:
     nodes, so each body is condensed to its candidate dofs alone (issue 19, item 4: the dense
     block, its inversion and its memory shrink by about 2, 8 and 4 times on a long surface).
     ``orders_3d``: the element orders of ``orders`` it supports on 3D bodies that may touch
-    (the 3D overlap quadrature is for linear facets only: issue 21, C10). ``friction_laws``: the
-    friction laws (:mod:`vfem.contact.laws.friction_laws`) a pair's friction may follow.
+    (the 3D overlap quadrature is for linear facets only: issue 21, C10). ``friction``: what its
+    friction reads of a pair's law (:class:`vfem.contact.laws.FrictionLaw`): ``"coefficients"``
+    (the static and dynamic ones), ``"slip"`` (coefficients that depend on the slip a node has
+    accumulated), ``"compliance"`` (an elastic slip below the cone); it takes every law whose
+    ``reads`` are among them, and none (empty) for frictionless contact only.
     """
 
     name: str
     orders: tuple[int, ...]
     kinematics: tuple[str, ...]
     dimensions: tuple[int, ...]
-    #: the friction laws it takes (:data:`vfem.contact.laws.FRICTION_LAWS`); none: frictionless
-    #: contact only
-    friction_laws: tuple[str, ...] = ()
+    #: what its friction reads of a law (see above); empty: frictionless contact only
+    friction: tuple[str, ...] = ()
     invariants: str = "enforced"
     cuts_steps: bool = True
     reads_rind: bool = False

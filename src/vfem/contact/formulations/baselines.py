@@ -91,7 +91,7 @@ class GlobalContact:
 
     capabilities = Capabilities(
         name="classical", orders=(1,), kinematics=("small",), dimensions=(2,),
-        friction_laws=("coulomb", "static_dynamic"), invariants="compared", cuts_steps=False)
+        friction=("coefficients",), invariants="compared", cuts_steps=False)
 
     #: the methods that solve Coulomb friction (the Lagrange multipliers' saddle point)
     FRICTIONAL_METHODS = ("lagrange",)
@@ -180,8 +180,8 @@ class GlobalContact:
         tangential unknown."""
         names = [b.name for b in self.model.bodies]
         # each row's pair's law (:class:`~vfem.contact.laws.FrictionLaw`), at no accumulated
-        # slip: the baseline keeps none per row, and its capabilities name only the laws whose
-        # coefficients do not depend on it (others are refused before, check_capabilities)
+        # slip: the baseline keeps none per row, and its capabilities read the coefficients
+        # alone (a law that reads the slip is refused before, check_capabilities)
         laws = [friction_law(settings.pair_friction(names[a], names[b]))
                 for a, b in zip(self.c.slave, self.c.master)]
         none = np.zeros(1)

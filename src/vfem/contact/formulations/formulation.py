@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from ...errors import InputError
 from ..capabilities import Capabilities
-from ..laws import friction_law
+from ..laws import FRICTION_LAWS, friction_law
 
 if TYPE_CHECKING:
     from ...bodies.results import BodyStepResult
@@ -100,7 +100,7 @@ def check_capabilities(model) -> None:
                              f"body named {unknown[0]!r} (bodies: {', '.join(sorted(names))})")
     # each pair's law and its parameters (the laws check their own), whether or not it acts
     laws = [(pair, friction_law(pair)) for pair in settings.pairs]
-    if settings.frictional and (not caps.friction_laws or (
+    if settings.frictional and (not caps.friction or (
             settings.method != "vfem"
             and settings.method not in getattr(cls, "FRICTIONAL_METHODS", ()))):
         what = (f"contact.method = {settings.method!r}" if settings.method != "vfem" else
@@ -115,11 +115,14 @@ def check_capabilities(model) -> None:
         what = ("large kinematics" if large else f"contact.method = {settings.method!r}"
                 if settings.method != "vfem" else f"the {caps.name} variant")
         for pair, law in laws:
-            if law.acts and law.name not in caps.friction_laws:
+            missing = [r for r in law.reads if r not in caps.friction]
+            if law.acts and missing:
+                taken = [name for name, other in FRICTION_LAWS.items()
+                         if set(other.reads) <= set(caps.friction)]
                 raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: "
-                                 f"the {law.name} friction law is not among those the "
-                                 f"{caps.name} formulation takes: not yet with {what}; use law = "
-                                 + " or ".join(repr(n) for n in caps.friction_laws))
+                                 f"the {law.name} friction law reads its {' and '.join(missing)}, "
+                                 f"which the {caps.name} formulation does not: not yet with "
+                                 f"{what}; use law = " + " or ".join(repr(n) for n in taken))
         platen = next((b for b in model.bodies if b.platen is not None), None)
         if large and platen is not None:
             raise InputError(f"model {model.name!r}, body {platen.name!r}: a force-controlled "

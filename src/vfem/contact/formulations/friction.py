@@ -35,7 +35,7 @@ more traction field per contact pair:
   penalty and no parameter to tune. The sets are found on the condensed system: after each
   solve the penetrations and slips it makes are predicted from the pair matrix (exact under
   small kinematics), so the bodies see only the settled tractions and a step takes one
-  correction of the bodies (:meth:`FrictionalPairedContact._settle`).
+  correction of the bodies (:meth:`SmallFriction._settle`).
 * **History.** When a step converges, every node's anchor becomes its relative tangential
   displacement and the slip is accumulated (``FrictionState.slip``): friction is path
   dependent, and a step that is cut starts again from the last converged state, anchors
@@ -46,7 +46,7 @@ more traction field per contact pair:
   norm and the cone a disk; a slipping node's direction σ = -s / |s| is a unit vector (±1 in
   2D), and it turns: besides the tie along σ its traction has a part
   across σ, solved for with the row that asks its slip across σ to vanish, linearised (a semismooth
-  Newton step on the disk, in :meth:`FrictionalPairedContact._correct_frictional`); the friction's
+  Newton step on the disk, in :meth:`SmallFriction._correct_frictional`); the friction's
   errors add the slip across σ. A roller plane through the contact holds one tangent of its nodes
   only.
 
@@ -511,7 +511,7 @@ class SmallFriction(FrictionHistory):
 FrictionalPairedContact = Composed(
     PairedContact, SmallFriction,
     dataclasses.replace(PairedContact.capabilities, name="paired, frictional",
-                        friction_laws=("coulomb", "static_dynamic", "elastoplastic"),
+                        friction=("coefficients", "slip", "compliance"),
                         orders_3d=(1,)))
 
 __all__ = ["FrictionalPairedContact", "SmallFriction"]

@@ -74,7 +74,7 @@ class FrictionHistory:
         """Pair k's anchors at the last converged step: under small kinematics its relative
         tangential displacements, (n, ntan) as :meth:`shear`; under large kinematics the
         material points of the other surface its nodes faced
-        (:meth:`~vfem.contact.formulations.large_friction.FrictionalLargeContact._virtual_points`)."""
+        (:meth:`~vfem.contact.formulations.large_friction.LargeFriction._virtual_points`)."""
         table = state.anchor
         if k not in table:
             table[k] = self._zeros(k)

@@ -22,7 +22,7 @@ geometry, and:
   normal conditions (complementarity, as without friction) and the tangential ones: a sticking
   node's slip vanishes, a slipping one's traction sits on the Coulomb cone ``s = -mu sigma q``
   opposing its slip. The stick and slip sets are found on the linearised model by an active-set
-  loop of small dense solves (:meth:`FrictionalLargeContact.solve_linearised`), the return map
+  loop of small dense solves (:meth:`LargeFriction.solve_linearised`), the return map
   onto the cone per node of the small-kinematics variant;
 * **at convergence** each node's slip is accumulated and its anchor moves to its virtual node.
 
@@ -35,9 +35,9 @@ point is not made here). Coulomb with one coefficient and with static and dynami
 elasto-plastic law and a force-controlled platen are small-kinematics only for now.
 
 **In 3D** (issue 21) the same, with two tangents per node measured from a global axis chosen
-once per node (:meth:`FrictionalLargeContact._basis`), anchors kept as a facet and its nodes'
+once per node (:meth:`LargeFriction._basis`), anchors kept as a facet and its nodes'
 shape-function values at the point, and the cone a disk whose slip direction turns in the
-linearised solve (:meth:`FrictionalLargeContact._solve_linearised_3d`); docs/method.md §11,
+linearised solve (:meth:`LargeFriction._solve_linearised_3d`); docs/method.md §11,
 *In 3D*.
 """
 
@@ -67,7 +67,7 @@ from .large import LargeDeformationContact
 log = logging.getLogger(__name__)
 
 #: 3D: the largest |n . axis| of a contact normal and the axis its first tangent is measured
-#: from (:meth:`FrictionalLargeContact._basis`); the axis was the least aligned with the
+#: from (:meth:`LargeFriction._basis`); the axis was the least aligned with the
 #: undeformed normal (|n . axis| <= 0.577), so a normal may turn by at least 36 degrees
 TURNED = 0.95
 
@@ -379,7 +379,7 @@ class LargeFriction(FrictionHistory):
         held along one tangent slides along the other only.
 
         Sigma turns with the solution: as in the small-kinematics variant
-        (:meth:`~vfem.contact.formulations.friction.FrictionalPairedContact._correct_frictional`), a
+        (:meth:`~vfem.contact.formulations.friction.SmallFriction._correct_frictional`), a
         slipping node's traction is ``-mu q sigma + s_perp e``, e across sigma, and its row asks
         its slip across sigma to vanish, linearised in the turn of sigma: ``e . slip +
         (sigma . slip) / |s| s_perp = 0`` (a semismooth Newton step on the disk); sigma is then
@@ -511,6 +511,6 @@ class LargeFriction(FrictionHistory):
 FrictionalLargeContact = Composed(
     LargeDeformationContact, LargeFriction,
     dataclasses.replace(LargeDeformationContact.capabilities, name="paired, frictional",
-                        friction_laws=("coulomb", "static_dynamic")))
+                        friction=("coefficients", "slip")))
 
 __all__ = ["FrictionalLargeContact", "LargeFriction"]

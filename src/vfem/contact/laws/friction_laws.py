@@ -12,10 +12,11 @@ A law answers, per node, from the slip the node has accumulated over the converg
 
 The frictional formulations (small and large kinematics, 2D and 3D, and the ``lagrange``
 baseline) read a pair's law through these alone, so that a new law is one class here, its
-parameters' fields in :class:`~vfem.contact.settings.PairFriction`, and the formulations'
-capabilities that name it (``Capabilities.friction_laws``). :func:`friction_law` builds a
-pair's law from its settings and checks them; :func:`slip_onset` and :func:`reaches_cone` are the
-one rule of when a node at rest or sliding is on the cone. What a law records of itself
+parameters' fields in :class:`~vfem.contact.settings.PairFriction` (if it has parameters of its
+own); which formulations take it follows from what it asks them to read (``reads``, against
+``Capabilities.friction``). :func:`friction_law` builds a pair's law from its settings and checks
+them; :func:`slip_onset` and :func:`reaches_cone` are the one rule of when a node at rest or
+sliding is on the cone. What a law records of itself
 (:func:`law_record`) is what ``summary.json`` keeps, and :func:`law_text` and :func:`law_bounds`
 read that record back, for the screen and the figures, without the model.
 """
@@ -38,6 +39,9 @@ class FrictionLaw(Protocol):
     name: ClassVar[str]
     #: the optional fields of :class:`~vfem.contact.settings.PairFriction` the law reads
     parameters: ClassVar[tuple[str, ...]]
+    #: what a formulation must read of it (``Capabilities.friction``): ``"coefficients"``, and
+    #: ``"slip"`` where they depend on the accumulated slip, ``"compliance"`` where it has one
+    reads: ClassVar[tuple[str, ...]]
     compliance: float
 
     @property
@@ -81,6 +85,7 @@ class Coulomb:
     mu: float
     name: ClassVar[str] = "coulomb"
     parameters: ClassVar[tuple[str, ...]] = ()
+    reads: ClassVar[tuple[str, ...]] = ("coefficients",)
     compliance: ClassVar[float] = 0.0
 
     @classmethod
@@ -118,6 +123,7 @@ class StaticDynamic:
     mu_static: float
     name: ClassVar[str] = "static_dynamic"
     parameters: ClassVar[tuple[str, ...]] = ("static_friction",)
+    reads: ClassVar[tuple[str, ...]] = ("coefficients",)
     compliance: ClassVar[float] = 0.0
 
     @classmethod
@@ -158,6 +164,7 @@ class Elastoplastic:
     slip_stiffness: float
     name: ClassVar[str] = "elastoplastic"
     parameters: ClassVar[tuple[str, ...]] = ("slip_stiffness",)
+    reads: ClassVar[tuple[str, ...]] = ("coefficients", "compliance")
 
     @classmethod
     def of(cls, pair, where: str) -> Elastoplastic:
