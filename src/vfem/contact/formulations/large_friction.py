@@ -37,7 +37,7 @@ elasto-plastic law and a force-controlled platen are small-kinematics only for n
 **In 3D** (issue 21) the same, with two tangents per node measured from a global axis chosen
 once per node (:meth:`LargeFriction._basis`), anchors kept as a facet and its nodes'
 shape-function values at the point, and the cone a disk whose slip direction turns in the
-linearised solve (:meth:`LargeFriction._solve_linearised_3d`); docs/method.md §11,
+linearised solve (:meth:`LargeFriction.solve_linearised`); docs/method.md §11,
 *In 3D*.
 """
 
@@ -281,129 +281,53 @@ class LargeFriction(FrictionHistory):
         return each(self.dynamic), each(self.static), each(self.onset), acts
 
     def solve_linearised(self, state, W, q0, p, tol, sets, rate, dR, stiffness, need):
-        """The normal and tangential traction values of the linearised problem.
+        """The normal and tangential traction values of the linearised problem, in any
+        dimension.
 
-        Rows and columns per pair: the set's normal unknowns, then its tangential ones. After
-        a change dx of the unknowns the penetrations are ``p_n - W_n dx`` and the slips
-        ``p_t + W_t dx``. Find the contact set (q >= 0, penetration <= tol, one of them zero)
-        and, among the nodes in contact, the sticking ones (slip 0, ``|s| <= mu_s q``) and the
-        slipping ones (``s = -mu sigma q``, the slip along sigma): an active-set loop, every
-        violation swapped at once, each set one dense solve, until no set changes (at most
-        ``10 m + 10`` sets; a set that comes back ends it with the last solution, the Newton
-        iteration going on from there). 3D: :meth:`_solve_linearised_3d`.
-        """
-        if any(a is not None for a in self._axes):
-            return self._solve_linearised_3d(state, W, q0, p, tol, sets)
-        m = len(q0)
-        pair_of = np.concatenate([np.full(len(s_), k) for k, s_ in enumerate(sets)]
-                                 or [np.zeros(0, int)])
-        starts = np.cumsum([0] + [2 * len(s_) for s_ in sets])[:-1]
-        nrm = np.concatenate([starts[k] + np.arange(len(s_)) for k, s_ in enumerate(sets)]
-                             or [np.zeros(0, int)]).astype(int)
-        tng = nrm + np.repeat([len(s_) for s_ in sets], [len(s_) for s_ in sets]).astype(int)
-        mu, mu_static, mu_now, acts = self._coefficients(state, sets)
-        q, s = q0[nrm], q0[tng]
-        contact = (q > 0) | (p[nrm] > tol)
-        slipping = contact & (q > 0) & reaches_cone(np.abs(s), q, mu_now) & (s != 0) & acts
-        sigma = np.where(s != 0, -np.sign(s), np.sign(p[tng]))
-        # a node whose relative tangential motion no traction moves (a symmetry plane through
-        # the contact, both bodies held along it) has no tangential unknown, as under small
-        # kinematics (HELD); nor has a frictionless pair's
-        diagonal = np.abs(np.diag(W))
-        held = diagonal[tng] <= HELD * diagonal.max(initial=0.0)
-        frictionless = ~acts | held
-        # a node that comes into contact and has moved along the other surface since the last
-        # converged step slips the way it moved, until its traction says it sticks
-        entering = contact & (q <= 0) & (np.abs(p[tng]) > tol) & ~frictionless
-        slipping |= entering
-        seen: set[bytes] = set()
-        x = q0.copy()
-        for _ in range(10 * m + 10):
-            stick = contact & ~slipping & ~frictionless
-            slide = contact & slipping
-            cols = np.concatenate([nrm[contact], tng[stick]])
-            rows = cols
-            ties = np.where(frictionless, 0.0, -mu * sigma)  # s = tie q on slipping nodes
-            x = np.zeros(m)
-            # known: the nodes off contact carry nothing; solve for the rest
-            A = W[np.ix_(rows, cols)].copy()
-            tied_q = nrm[slide | (contact & frictionless)]
-            tied_s = tng[slide | (contact & frictionless)]
-            tie = ties[slide | (contact & frictionless)]
-            position = np.full(m, -1)
-            position[cols] = np.arange(len(cols))
-            A[:, position[tied_q]] += W[np.ix_(rows, tied_s)] * tie
-            # rows: normal W_n x = p_n + W_n x0 (no penetration left); tangential
-            # W_t x = W_t x0 - p_t (no slip left)
-            normal_row = np.isin(rows, nrm)
-            b = W[rows] @ q0 + np.where(normal_row, p[rows], -p[rows])
-            if len(cols):
-                try:
-                    x[cols] = np.linalg.solve(A, b)
-                except np.linalg.LinAlgError:  # dependent rows: the least-squares solution
-                    x[cols] = np.linalg.lstsq(A, b, rcond=None)[0]
-                x[tied_s] = tie * x[tied_q]
-            dx = x - q0
-            pen = p[nrm] - W[nrm] @ dx
-            slip = p[tng] + W[tng] @ dx
-            qn, sn = x[nrm], x[tng]
-            leave = contact & (qn < 0)
-            join = ~contact & (pen > tol)
-            over = stick & beyond_cone(np.abs(sn), qn, mu_static)
-            back = slide & (sigma * slip < -tol)
-            if not (leave.any() or join.any() or over.any() or back.any()):
-                break
-            key = np.concatenate([contact, slipping, sigma > 0]).tobytes()
-            if key in seen:
-                log.debug("frictional linearised contact: a set came back")
-                break
-            seen.add(key)
-            contact = (contact & ~leave) | join
-            moved = join & (np.abs(slip) > tol) & ~frictionless
-            sigma = np.where(over, -np.sign(sn), np.where(moved, np.sign(slip), sigma))
-            slipping = (slipping | over | moved) & ~back & contact
-        x[nrm] = np.where(x[nrm] > 0, x[nrm], 0.0)
-        x[tng] = np.where(x[nrm] > 0, x[tng], 0.0)
-        # which nodes slide (the static coefficient holds the others)
-        for k, s_ in enumerate(sets):
-            self.sliding(state, k)[:] = False
-            self.sliding(state, k)[s_] = (slipping & contact)[pair_of == k]
-        return x, 0.0
+        Rows and columns per pair: the set's normal unknowns, then those along its first
+        tangent, then (3D) along its second. After a change dx of the unknowns the penetrations
+        are ``p_n - W_n dx`` and the slips ``p_t + W_t dx``. Find the contact set (q >= 0,
+        penetration <= tol, one of them zero) and, among the nodes in contact, the sticking ones
+        (slip 0 along every tangent, ``|s| <= mu_s q``) and the slipping ones (``s = -mu q
+        sigma``, sigma the unit direction of the slip in the tangent space: +-1 with one
+        tangent): an active-set loop, every violation swapped at once, each set one dense solve,
+        until no set changes (at most ``10 m + 10`` sets; a set that comes back ends it with the
+        last solution, the Newton iteration going on from there). A tangent along which no
+        traction moves the node (a symmetry plane through the contact, :data:`HELD`) carries no
+        tangential traction, and a node held along one tangent slides along the other only;
+        nor has a frictionless pair's node a tangential unknown.
 
-    def _solve_linearised_3d(self, state, W, q0, p, tol, sets):
-        """:meth:`solve_linearised` in 3D: per pair, the set's normal unknowns, then those along
-        the first tangent, then along the second. A sticking node's slip vanishes along both
-        tangents; a slipping node's traction is ``-mu q sigma``, sigma the unit direction of its
-        slip in the tangent plane. A tangent along which no traction moves the node (a symmetry
-        plane through the contact, :data:`HELD`) carries no tangential traction, and a node
-        held along one tangent slides along the other only.
-
-        Sigma turns with the solution: as in the small-kinematics variant
-        (:meth:`~vfem.contact.formulations.friction.SmallFriction._correct_frictional`), a
-        slipping node's traction is ``-mu q sigma + s_perp e``, e across sigma, and its row asks
-        its slip across sigma to vanish, linearised in the turn of sigma: ``e . slip +
-        (sigma . slip) / |s| s_perp = 0`` (a semismooth Newton step on the disk); sigma is then
-        read from the new traction and the solve repeated, with the sets swapped as in 2D,
-        until no set changes and no slip crosses its sigma by more than the tolerance. (Taking
-        the predicted slip's direction as the next sigma, a fixed point, diverges at a node
-        that slips little: its own traction turns its slip more than the slip turns it.)
+        Where a slipping node has two free tangents (3D), sigma turns with the solution: as in
+        the small-kinematics variant
+        (:meth:`~vfem.contact.formulations.friction.SmallFriction._correct_frictional`), its
+        traction is ``-mu q sigma + s_perp e``, e across sigma, and its row asks its slip across
+        sigma to vanish, linearised in the turn of sigma: ``e . slip + (sigma . slip) / |s|
+        s_perp = 0`` (a semismooth Newton step on the disk); sigma is then read from the new
+        traction and the solve repeated, with the sets swapped as before, until no set changes
+        and no slip crosses its sigma by more than the tolerance. (Taking the predicted slip's
+        direction as the next sigma, a fixed point, diverges at a node that slips little: its
+        own traction turns its slip more than the slip turns it.) A set that comes back is one
+        of the same contact and slipping nodes, and of the same signs of sigma where it cannot
+        turn (with one tangent: the same slip directions).
         """
         m = len(q0)
         sizes = [len(s_) for s_ in sets]
+        nodes = sum(sizes)
+        ntan = m // nodes - 1 if nodes else 1  # unknowns per node: the normal and the tangents
         pair_of = np.concatenate([np.full(n, k) for k, n in enumerate(sizes)]
                                  or [np.zeros(0, int)])
-        starts = np.cumsum([0] + [3 * n for n in sizes])[:-1]
+        starts = np.cumsum([0] + [(1 + ntan) * n for n in sizes])[:-1]
         nrm = np.concatenate([starts[k] + np.arange(n) for k, n in enumerate(sizes)]
                              or [np.zeros(0, int)]).astype(int)
         offset = np.repeat(sizes, sizes).astype(int)
-        tng = np.column_stack([nrm + offset, nrm + 2 * offset])  # (nodes, 2)
+        tng = nrm[:, None] + offset[:, None] * (1 + np.arange(ntan))  # (nodes, ntan)
         mu, mu_static, mu_now, acts = self._coefficients(state, sets)
         q, S, P = q0[nrm], q0[tng], p[tng]
         diagonal = np.abs(np.diag(W))
         held = diagonal[tng] <= HELD * diagonal.max(initial=0.0)
         free = ~held & acts[:, None]  # the tangents friction acts along
         rough = free.any(axis=1)
-        both = free.all(axis=1)  # a slipping node's sigma may turn
+        both = free.sum(axis=1) > 1  # a slipping node's sigma may turn
 
         def unit(v):
             v = np.where(free, v, 0.0)
@@ -425,17 +349,17 @@ class LargeFriction(FrictionHistory):
         for _ in range(10 * m + 10):
             stick = contact & ~slipping & rough
             slide = contact & slipping
-            # the nodes whose sigma turns: slipping along both tangents, with a traction and a
-            # slip along sigma to turn it by
+            # the nodes whose sigma turns: slipping along two free tangents, with a traction and
+            # a slip along sigma to turn it by (and a dynamic coefficient: with mu = 0 its
+            # traction is zero, and the compliance below would divide by it)
             q_now = x[nrm]
-            # (and a dynamic coefficient: with mu = 0 its traction is zero, and the compliance
-            # below would divide by it)
             turning = (slide & both & (q_now > 0) & (mu > 0)
                        & (np.einsum("ij,ij->i", sigma, slip) > 0))
             turn = np.flatnonzero(turning)
-            across_dir = np.column_stack([-sigma[turn, 1], sigma[turn, 0]])
+            across_dir = (np.column_stack([-sigma[turn, 1], sigma[turn, 0]]) if len(turn)
+                          else np.zeros((0, ntan)))
             cols = np.concatenate([nrm[contact]] + [tng[stick & free[:, j], j]
-                                                    for j in range(2)])
+                                                    for j in range(ntan)])
             n_normal = int(contact.sum())
             # rows: the normal and sticking ones, then each turning node's slip across sigma
             rows_W = np.vstack([W[cols], np.einsum("ij,ijm->im", across_dir, W[tng[turn]])])
@@ -446,7 +370,7 @@ class LargeFriction(FrictionHistory):
             position[cols] = np.arange(len(cols))
             ties = -mu[:, None] * sigma  # s = ties q (+ s_perp e) on a slipping node
             A = rows_W[:, cols]
-            for j in range(2):
+            for j in range(ntan):
                 A[:, position[nrm[slide]]] += rows_W[:, tng[slide, j]] * ties[slide, j]
             if len(turn):
                 A = np.hstack([A, np.einsum("ij,mij->mi", across_dir, rows_W[:, tng[turn]])])
@@ -461,13 +385,13 @@ class LargeFriction(FrictionHistory):
                 except np.linalg.LinAlgError:  # dependent rows: the least-squares solution
                     y = np.linalg.lstsq(A, target, rcond=None)[0]
                 x[cols] = y[:len(cols)]
-                for j in range(2):
+                for j in range(ntan):
                     x[tng[slide, j]] = ties[slide, j] * x[nrm[slide]]
                 if len(turn):
                     x[tng[turn]] += across_dir * y[len(cols):, None]
             dx = x - q0
             pen = p[nrm] - W[nrm] @ dx
-            slip = np.where(free, P + (W[tng.ravel()] @ dx).reshape(-1, 2), 0.0)
+            slip = np.where(free, P + (W[tng.ravel()] @ dx).reshape(-1, ntan), 0.0)
             qn, sn = x[nrm], x[tng]
             # sigma from the new traction (where it turned), and the slip's parts along it and
             # across it
@@ -488,9 +412,9 @@ class LargeFriction(FrictionHistory):
                 late = crossing & ~turning
                 sigma[late] = unit(slip)[late]
                 continue
-            key = np.concatenate([contact, slipping]).tobytes()
+            key = np.concatenate([contact, slipping, (sigma > 0)[~both].ravel()]).tobytes()
             if key in seen and not crossing.any():
-                log.debug("frictional linearised contact (3D): a set came back")
+                log.debug("frictional linearised contact: a set came back")
                 break
             seen.add(key)
             contact = (contact & ~leave) | join
@@ -499,8 +423,9 @@ class LargeFriction(FrictionHistory):
             sigma[moved] = unit(slip)[moved]
             slipping = (slipping | over | moved) & ~back & contact
         x[nrm] = np.where(x[nrm] > 0, x[nrm], 0.0)
-        for j in range(2):
+        for j in range(ntan):
             x[tng[:, j]] = np.where((x[nrm] > 0) & free[:, j], x[tng[:, j]], 0.0)
+        # which nodes slide (the static coefficient holds the others)
         for k, s_ in enumerate(sets):
             self.sliding(state, k)[:] = False
             self.sliding(state, k)[s_] = (slipping & contact)[pair_of == k]
