@@ -214,7 +214,7 @@ def test_a_normal_turned_onto_its_tangent_axis_stops_the_step_with_a_message():
     pair = contact.contact_pairs[k]
     contact.tractions(state, k)[:] = 1.0
     contact._further_errors(state)  # as pressed: no normal near its axis
-    pair.normal[:] = np.eye(3)[contact._axes[k]]
+    pair.normal[:] = np.eye(3)[contact.friction._axes[k]]  # (the friction part's axes)
     with pytest.raises(AnalysisError, match=r"body '(base|block)', contact node \d+: its "
                                             "contact normal has turned onto the axis"):
         contact._further_errors(state)
