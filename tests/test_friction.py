@@ -31,7 +31,8 @@ from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
 from vfem.contact.formulations.formulation import formulation_class
 from vfem.contact.formulations.friction import FrictionalPairedContact
 from vfem.contact.formulations.paired import PairedContact
-from vfem.contact.laws import coulomb_status, tangents
+from vfem.contact.geometry import tangents
+from vfem.contact.laws import coulomb_status
 from vfem.contact.settings import ContactSettings
 from vfem.contact.state import FrictionState
 from vfem.errors import InputError

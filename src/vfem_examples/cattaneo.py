@@ -30,7 +30,8 @@ import numpy as np
 
 from vfem.bodies import Platen, PrescribedDisplacement, Support
 from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from vfem.contact.laws import coulomb_status, tangents
+from vfem.contact.geometry import tangents
+from vfem.contact.laws import coulomb_status
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
 from vfem.io.runner import friction_line, run_headline

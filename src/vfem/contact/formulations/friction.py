@@ -41,7 +41,7 @@ more traction field per contact pair:
   dependent, and a step that is cut starts again from the last converged state, anchors
   included (they are part of the state the checkpoints save).
 
-* **3D** (issue 21, C13): two tangents per node (:func:`~vfem.contact.laws.coulomb.tangents`),
+* **3D** (issue 21, C13): two tangents per node (:func:`~vfem.contact.geometry.tangents`),
   the tangential arrays (n, 2) where 2D has (n, 1) (one column per tangent); |s| is the row
   norm and the cone a disk; a slipping node's direction σ = -s / |s| is a unit vector (±1 in
   2D), and it turns: besides the tie along σ its traction has a part
@@ -62,13 +62,12 @@ import logging
 
 import numpy as np
 
-from ..geometry import symmetry_planes
+from ..geometry import symmetry_planes, tangents
 from ..laws import (
     CONE_TOLERANCE,
     magnitudes,
     reaches_cone,
     relaxation,
-    tangents,
 )
 from ..solvers import Check, bordered_matrix, iterate
 from ..state import ContactState, FrictionState, IterationRecord, SolveResult

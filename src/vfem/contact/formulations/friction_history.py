@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry import tangents
 from ..laws import (
     friction_law,
     magnitudes,
     slip_onset,
     tangent_by_tangent,
-    tangents,
 )
 from ..state import ContactState, FrictionState
 

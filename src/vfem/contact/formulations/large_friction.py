@@ -49,14 +49,12 @@ import logging
 import numpy as np
 
 from ...errors import AnalysisError
-from ..geometry import virtual_nodes
+from ..geometry import tangent_axes, tangents, virtual_nodes
 from ..laws import (
     CONE_TOLERANCE,
     beyond_cone,
     magnitudes,
     reaches_cone,
-    tangent_axes,
-    tangents,
 )
 from ..state import ContactState, FrictionState
 from .composed import Composed
@@ -80,7 +78,7 @@ class LargeFriction(FrictionHistory):
     def __init__(self, form, settings) -> None:
         super().__init__(form, settings)
         #: 3D: per pair and node, the global axis whose projection on the current tangent plane
-        #: is the first tangent (:func:`~vfem.contact.laws.coulomb.tangents`): the one
+        #: is the first tangent (:func:`~vfem.contact.geometry.tangent_basis.tangents`): the one
         #: least aligned with the node's own undeformed outward normal (on a symmetry plane, in the
         #: plane), so the tangents follow the turning normal smoothly and the choice depends on
         #: nothing but the mesh (not on where the pairing first put the node: a node beyond the
@@ -174,8 +172,7 @@ class LargeFriction(FrictionHistory):
         for pair in self.form.contact_pairs:
             sf, sc = self.form.surfaces[pair.fine], self.form.surfaces[pair.coarse]
             if pair.patches is None:  # (nothing over the other surface: no anchor read)
-                out.append(np.zeros(len(pair.nodes)) if sc.dim == 2 else
-                           np.zeros((len(pair.nodes), 1 + sc.facets.shape[1])))
+                out.append(sc.unset_material_points(len(pair.nodes)))
                 continue
             _, _, interp, seg, _ = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse],
                                                  pair.nodes, *pair.patches)

@@ -25,6 +25,7 @@ from .pairing import (
 )
 from .placement import check_initial_overlap, select_candidate_facets
 from .surface import ContactSurface, beyond, patch_ends
+from .tangent_basis import tangent_axes, tangents
 from .transfer import traction_from_forces
 
 __all__ = [
@@ -50,6 +51,8 @@ __all__ = [
     "read_facets",
     "select_candidate_facets",
     "symmetry_planes",
+    "tangent_axes",
+    "tangents",
     "traction_from_forces",
     "virtual_nodes",
 ]

@@ -516,6 +516,10 @@ class ContactSurface:
         surface (a friction anchor; 2D: ``facet + t``)."""
         return self.kind.material_points(self.facets, seg, interp)
 
+    def unset_material_points(self, n: int) -> np.ndarray:
+        """``n`` material points read nowhere yet: zeros, as :meth:`material_points` has them."""
+        return self.kind.material_points(self.facets, np.zeros(n, int), np.zeros((n, self.nc)))
+
     def material_positions(self, points: np.ndarray, x: np.ndarray) -> np.ndarray:
         """Where the material points ``points`` (:meth:`material_points`) are at positions
         ``x``."""

@@ -11,9 +11,7 @@ from .coulomb import (
     CONE_TOLERANCE,
     coulomb_status,
     magnitudes,
-    tangent_axes,
     tangent_by_tangent,
-    tangents,
 )
 from .friction_laws import (
     FRICTION_LAWS,
@@ -44,7 +42,5 @@ __all__ = [
     "magnitudes",
     "relaxation",
     "release_tension",
-    "tangent_axes",
     "tangent_by_tangent",
-    "tangents",
 ]
