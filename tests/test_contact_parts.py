@@ -219,7 +219,7 @@ def fake_model(order=1, dim=2, large=False, corners=4, **settings):
                                                    t=np.zeros((corners, 1), dtype=int)))
               for name in "ab"]
     return SimpleNamespace(name="m", bodies=bodies, contact=ContactSettings(**settings),
-                           contact_pairs=None)
+                           contact_pairs=None, iterates=large)
 
 
 def test_the_model_checks_read_the_declared_capabilities():

@@ -18,7 +18,7 @@ import pytest
 
 from models import box_mesh, input_file, rollers, support, toml_body, traction
 from vfem.bodies import Body, Support, Traction
-from vfem.contact.invariants.polygon import _symmetry_facets
+from vfem.contact.invariants.polygon import symmetry_facets
 from vfem.errors import InputError
 from vfem.io.input import dumps, loads
 from vfem.io.replot import Folder, read_contact_csv
@@ -289,16 +289,16 @@ def test_symmetry_facets_of_a_z_roller():
     x on the bottom (not normal to x) is none."""
     mesh = box(0.0, 0.0, 0.0, *SIZE, nx=2, ny=3, nz=2)
     body = Body("box", mesh, LinearElastic(E, NU), supports=ROLLERS)
-    found = np.sort(_symmetry_facets(body))
+    found = np.sort(symmetry_facets(body))
     expected = np.sort(np.concatenate([mesh.boundaries[n] for n in ("left", "front",
                                                                     "bottom")]))
     np.testing.assert_array_equal(found, expected)
     only_z = Body("box", mesh, LinearElastic(E, NU), supports=(Support("bottom", ("z",)),))
-    np.testing.assert_array_equal(np.sort(_symmetry_facets(only_z)),
+    np.testing.assert_array_equal(np.sort(symmetry_facets(only_z)),
                                   np.sort(mesh.boundaries["bottom"]))
     across = Body("box", mesh, LinearElastic(E, NU), supports=(Support("bottom", ("x",)),
                                                                Support("top")))
-    assert len(_symmetry_facets(across)) == 0
+    assert len(symmetry_facets(across)) == 0
 
 
 def test_a_model_of_2d_and_3d_bodies_is_refused():

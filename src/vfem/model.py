@@ -35,6 +35,12 @@ class Model:
     #: seconds spent building it (meshes, bodies, checks: ModelConfig.build), for the phases
     build_s: float = field(default=0.0, compare=False)
 
+    @property
+    def iterates(self) -> bool:
+        """Whether a body's response is corrected by Newton's method (:attr:`Body.iterates`):
+        the contact then takes the large-kinematics formulation."""
+        return any(b.iterates for b in self.bodies)
+
     def validate(self) -> None:
         names = [b.name for b in self.bodies]
         if not self.bodies:

@@ -386,7 +386,7 @@ class Analysis:
 
     def _formulation(self) -> type:
         """The formulation class of the model's contact settings and kinematics."""
-        return formulation_class(self.model.contact, any(b.iterates for b in self.model.bodies))
+        return formulation_class(self.model.contact, self.model.iterates)
 
     def _invariant_check(self) -> InvariantCheck:
         """The invariants every converged step must satisfy (:mod:`vfem.contact.invariants.check`),

@@ -275,7 +275,7 @@ def symmetry_planes(body) -> list[tuple[np.ndarray, int]]:
     along one axis only, :meth:`Body.support_components`) whose facets are all flat, normal to
     that axis and on one plane (x, y, or z in 3D). The model continues across them as
     their mirror image: no surface that contact sees (the invariants,
-    :func:`vfem.contact.invariants.polygon._symmetry_facets`), no edge of a contact patch
+    :func:`vfem.contact.invariants.polygon.symmetry_facets`), no edge of a contact patch
     (:meth:`vfem.contact.geometry.surface.ContactSurface.patch_boundary`), a tangent plane for
     friction (:func:`vfem.contact.formulations.friction.plane_normals`)."""
     mesh = body.mesh

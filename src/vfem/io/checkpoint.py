@@ -258,7 +258,7 @@ def _tangential_columns(unknowns: dict[str, np.ndarray], model: Model) -> dict[s
     under small kinematics, its anchors (``anchor_k``: relative tangential displacements) as
     (n,); they become one column. The large-kinematics anchors are material points of the other
     surface, not tangential arrays, and stay as they are."""
-    small = not any(b.iterates for b in model.bodies)
+    small = not model.iterates
     out = dict(unknowns)
     for key, value in unknowns.items():
         if value.ndim == 1 and (key.startswith("shear_") or small and key.startswith("anchor_")):

@@ -78,7 +78,7 @@ def check_capabilities(model) -> None:
     """Raise :class:`InputError` for a body the model's formulation cannot analyse (its element
     order, kinematics or dimension), naming the body and what to choose instead."""
     settings = model.contact
-    large = any(b.iterates for b in model.bodies)  # corrected by Newton's method
+    large = model.iterates  # a body corrected by Newton's method
     cls = formulation_class(settings, large)
     caps = cls.capabilities
     if settings.method != "vfem":

@@ -9,7 +9,7 @@ along its first diagonal) in place of its boundary polygon:
   faces' normals at a vertex: exact for a closed surface, Bærentzen & Aanæs 2005); the whole
   closed boundary is used, symmetry planes included.
 * **depth**: the distance to the boundary without its symmetry planes (roller supports held
-  normal to a flat boundary, any axis, :func:`~vfem.contact.invariants.polygon._symmetry_facets`);
+  normal to a flat boundary, any axis, :func:`~vfem.contact.invariants.polygon.symmetry_facets`);
   the facet's size L is its longest side.
 * **allowance** (L/2)·tan(α/2), α twice the largest angle between the node's normal and the
   normal of a boundary node within L of it on the convex side (the 2D "convex turning within
@@ -46,7 +46,7 @@ from ..geometry import closest_on_facets, kind_of
 from .cached_boundary import CachedBoundary
 from .kind import SurfaceKind
 from .measures import nodal_tension
-from .polygon import _symmetry_facets
+from .polygon import symmetry_facets
 
 if TYPE_CHECKING:
     from ...bodies import Body
@@ -83,7 +83,7 @@ class Boundary3:
     @classmethod
     def of(cls, body: Body, symmetry: np.ndarray) -> Boundary3:
         """``symmetry``: the body's facets on a symmetry plane
-        (:func:`vfem.contact.invariants.polygon._symmetry_facets`)."""
+        (:func:`vfem.contact.invariants.polygon.symmetry_facets`)."""
         mesh = body.mesh
         bf = mesh.boundary_facets()
         fp = body.facet_points(bf).copy()
@@ -431,7 +431,7 @@ def _nodal_measure(g: Surface3, f: np.ndarray) -> np.ndarray:
 
 def _boundary(body: Body) -> Boundary3:
     """A 3D body's boundary, its symmetry planes left out of what contact may touch."""
-    return Boundary3.of(body, _symmetry_facets(body))
+    return Boundary3.of(body, symmetry_facets(body))
 
 
 #: 3D bodies: boundaries of triangles and quadrilaterals, the nodal tension measure, a model in

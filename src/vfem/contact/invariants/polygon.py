@@ -46,7 +46,7 @@ class _Boundary:
             normal = np.column_stack([t[:, 1], -t[:, 0]])
             flip = np.einsum("ij,ij->i", normal, 0.5 * (a + b) - centroid) < 0
             fp[flip, :2] = fp[flip][:, 1::-1]
-        mirror = np.isin(bf, _symmetry_facets(body))
+        mirror = np.isin(bf, symmetry_facets(body))
         if fp.shape[1] == 3:  # quadratic: a facet is two chords through its midpoint
             segments = np.vstack([fp[:, [0, 2]], fp[:, [2, 1]]])
             mirror = np.concatenate([mirror, mirror])
@@ -59,7 +59,7 @@ class _Boundary:
                    mirror=mirror, large=body.large)
 
 
-def _symmetry_facets(body: Body) -> np.ndarray:
+def symmetry_facets(body: Body) -> np.ndarray:
     """Facets on a symmetry plane (:meth:`~vfem.bodies.Body.symmetry_planes`): the model
     continues across them as their mirror image, so they are no surface that contact sees."""
     return np.concatenate([np.zeros(0, dtype=np.int64)]
