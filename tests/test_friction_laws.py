@@ -122,6 +122,9 @@ def test_a_slip_weakening_law_carries_its_weakened_coefficient_once_slipped(regi
     assert abs(first_slide[0]) / abs(first_slide[1]) > Weakening.WEAK + 0.05
     status = result.steps[-1].bodies["upper"].friction_status
     assert np.all(status[status > 0] == 2)
+    # the closing screen and the figures word a law that brings no text or bounds of its own
+    assert law_text(law_record(Weakening(0.3))) == "weakening, mu = 0.3"
+    assert law_bounds(law_record(Weakening(0.3))) == []
 
 
 def test_a_law_asking_what_a_formulation_does_not_read_is_refused_naming_it(registered):

@@ -57,6 +57,20 @@ class FrictionLaw(Protocol):
     def record(self) -> dict:
         """The law and its coefficients by name (``summary.json``)."""
 
+    @classmethod
+    def of(cls, pair, where: str) -> FrictionLaw:
+        """The law of one pair's settings, its own parameters checked (:func:`friction_law`)."""
+
+    @staticmethod
+    def text(record: dict) -> str:
+        """A record of the law (:meth:`record`) in words, for the screen and the figures
+        (optional: :func:`law_text` words any record)."""
+
+    @staticmethod
+    def bounds(record: dict) -> list[tuple[str, float]]:
+        """The bounds of the tangential traction over the normal one its record puts on a
+        node, each (what it is, its coefficient), for the friction figure (optional: none)."""
+
 
 def _check_static_dynamic(pair, where: str) -> None:
     static = pair.static_friction
@@ -225,18 +239,26 @@ def law_record(law: FrictionLaw) -> dict:
 
 
 def law_text(record: dict) -> str:
-    """A recorded law (:func:`law_record`) in words: "Coulomb, mu = 0.3", "frictionless"."""
-    law = FRICTION_LAWS.get(record.get("law"))
-    if record.get("law") == "frictionless":
+    """A recorded law (:func:`law_record`) in words: "Coulomb, mu = 0.3", "frictionless"; a
+    law without its own ``text``, by its name and coefficients ("weakening, mu = 0.3"); a
+    record of no law known (a folder written before the law was recorded), as Coulomb's."""
+    name = record.get("law")
+    if name == "frictionless":
         return "frictionless"
-    return (law or Coulomb).text(record)
+    law = FRICTION_LAWS.get(name)
+    if law is None:
+        return Coulomb.text(record)
+    if hasattr(law, "text"):
+        return law.text(record)
+    return ", ".join([str(name)] + [f"{k} = {v:g}" for k, v in record.items()
+                                    if k != "law" and isinstance(v, (int, float))])
 
 
 def law_bounds(record: dict) -> list[tuple[str, float]]:
     """The bounds of the tangential traction over the normal one a recorded law puts on a node,
-    each (what it is, its coefficient): [] for none known."""
+    each (what it is, its coefficient): [] for none known (nor for a law that gives none)."""
     law = FRICTION_LAWS.get(record.get("law"))
-    return law.bounds(record) if law is not None else []
+    return law.bounds(record) if hasattr(law, "bounds") else []
 
 
 def slip_onset(law: FrictionLaw, was_sliding: np.ndarray, slip: np.ndarray) -> np.ndarray:
