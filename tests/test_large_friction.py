@@ -195,3 +195,38 @@ def test_the_sliding_reactions_tend_to_mu_as_the_indentation_shrinks():
         assert ratio == pytest.approx(math.tan(math.atan(0.3) - tilts[depth]), rel=1e-6)
     assert 0 < tilts[0.0125] < tilts[0.05] / 4
     assert abs(ratio / 0.3 - 1) < 0.01
+
+
+def test_a_frictionless_pair_in_a_frictional_model_slides_freely():
+    """Two blocks pressed on one base and pushed along it, under large kinematics: the left
+    pair with Coulomb's mu = 0.3, the right one frictionless (``[[contact.pairs]]`` friction
+    0). The frictionless pair's nodes are free, as under small kinematics (counted as sticking,
+    their slip along the base was an error no traction could correct, and the step stopped
+    short of convergence): every step converges, the right block's contact forces have no
+    tangential part (its friction forces, the nodal forces of the tangential traction, are
+    zero), and the left block's have one."""
+    from vfem.bodies import Body, PrescribedDisplacement, Support
+    from vfem.materials import LinearElastic
+    from vfem.mesh.shapes import rectangle
+
+    press, shove = ((0.0, 0.0), (0.5, 1.0), (2.0, 1.0)), ((0.0, 0.0), (0.5, 0.0), (2.0, 1.0))
+    material = LinearElastic(1000.0, 0.3)
+    base = Body("base", rectangle(-1.0, -0.5, 2.0, 0.5, 16, 4), material,
+                supports=(Support("bottom"),), contact_boundaries=("top",), kinematics="total")
+
+    def block(name, x0):
+        moved = (PrescribedDisplacement("top", "y", -0.01, amplitude=press),
+                 PrescribedDisplacement("top", "x", 0.1, amplitude=shove))
+        return Body(name, rectangle(x0, 0.0, 0.4, 0.25, 5, 3), material, prescribed=moved,
+                    contact_boundaries=("bottom",), kinematics="total")
+
+    pairs = (PairFriction(("base", "left"), 0.3), PairFriction(("base", "right"), 0.0))
+    model = Model("two blocks", [base, block("left", -0.8), block("right", 0.2)],
+                  ContactSettings(friction=0.0, pairs=pairs), [0.25, 0.5, 0.8, 1.2],
+                  contact_pairs=(("base", "left"), ("base", "right")))
+    result = run(model)
+    for step in result.steps:
+        right = step.bodies["right"]
+        assert np.abs(right.contact_force).max() > 0  # pressed
+        assert not np.any(right.friction_force)
+    assert np.abs(result.steps[-1].bodies["left"].friction_force).max() > 0

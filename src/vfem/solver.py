@@ -384,8 +384,9 @@ class Analysis:
         return self._formulation()(self.surfaces, pairs, self.model.contact,
                                    backend=self.backend, executor=current_ranks(), **extra)
 
-    def _formulation(self) -> type:
-        """The formulation class of the model's contact settings and kinematics."""
+    def _formulation(self):
+        """The formulation class (or composition) of the model's contact settings and
+        kinematics."""
         return formulation_class(self.model.contact, self.model.iterates)
 
     def _invariant_check(self) -> InvariantCheck:
@@ -755,6 +756,7 @@ class Analysis:
         if (key is None or key in self.sides or key in self.side_notes
                 or self.model.contact.compatibility_side is not None
                 or type(self.contact) not in (PairedContact, LargeDeformationContact)
+                or self.contact.friction is not None  # (friction: its slip history)
                 or key not in self.contact.carriers):
             return None
         carrier, _ = self.contact.carriers[key]

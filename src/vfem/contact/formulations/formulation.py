@@ -47,8 +47,10 @@ class ContactFormulation(Protocol):
         """The full-mesh results of a converged state, per body name."""
 
 
-def formulation_class(settings, large: bool) -> type:
-    """The formulation of the contact settings (``method``, ``variant``) and kinematics."""
+def formulation_class(settings, large: bool):
+    """The formulation of the contact settings (``method``, ``variant``) and kinematics: a
+    class, or a :class:`~vfem.contact.formulations.composed.Composed` (with friction); either
+    declares its ``capabilities`` and builds the formulation when called."""
     if settings.method != "vfem":
         from .baselines import GlobalContact
 

@@ -162,7 +162,9 @@ class SmallFriction(FrictionHistory):
                                  relative: list[np.ndarray] | None = None) -> list[np.ndarray]:
         """Per pair, each node's relative tangential displacement against its virtual node,
         ``w = t.(u_fine - u_virtual)`` (linear kinematics, as the penetrations; from
-        ``relative``, :meth:`relative_displacements`, when given)."""
+        ``relative``, the formulation's
+        :meth:`~vfem.contact.formulations.paired.PairedContact.relative_displacements`, when
+        given)."""
         relative = self.form.relative_displacements(state) if relative is None else relative
         return [np.column_stack([np.einsum("ij,ij->i", d, tj) for tj in t])
                 for d, t in zip(relative, self._tangents, strict=True)]
@@ -291,7 +293,7 @@ class SmallFriction(FrictionHistory):
 
     def _converged(self, state: FrictionState) -> None:
         """A converged step: accumulate each node's slip and anchor it where it now is (the
-        step's slip increments are kept for :meth:`fields`)."""
+        step's slip increments are kept for :meth:`add_fields`)."""
         self._increments = []
         relative = self.form.relative_displacements(state)
         for k, p in enumerate(self.form.penetrations(state, relative)):

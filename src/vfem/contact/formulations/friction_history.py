@@ -37,7 +37,7 @@ class FrictionHistory:
         self.laws = [friction_law(settings.pair_friction(self.form.surfaces[p.fine].body.name,
                                                          self.form.surfaces[p.coarse].body.name))
                      for p in self.form.contact_pairs]
-        #: per pair, the slip increments of the last converged step (for :meth:`fields`)
+        #: per pair, the slip increments of the last converged step (for :meth:`add_fields`)
         self._increments = [self._zeros(k) for k in range(len(self.form.contact_pairs))]
 
     def tangent(self, k: int) -> np.ndarray:

@@ -304,8 +304,8 @@ class LargeFriction(FrictionHistory):
         and no slip crosses its sigma by more than the tolerance. (Taking the predicted slip's
         direction as the next sigma, a fixed point, diverges at a node that slips little: its
         own traction turns its slip more than the slip turns it.) A set that comes back is one
-        of the same contact and slipping nodes, and of the same signs of sigma where it cannot
-        turn (with one tangent: the same slip directions).
+        of the same contact and slipping nodes, and with one tangent of the same slip directions
+        (one of two; with two, sigma turns continuously).
         """
         m = len(q0)
         sizes = [len(s_) for s_ in sets]
@@ -409,7 +409,10 @@ class LargeFriction(FrictionHistory):
                 late = crossing & ~turning
                 sigma[late] = unit(slip)[late]
                 continue
-            key = np.concatenate([contact, slipping, (sigma > 0)[~both].ravel()]).tobytes()
+            # (with one tangent a node's slip direction is one of two, part of the set; with
+            # two it turns continuously, and the set is the contact and slipping nodes alone)
+            key = np.concatenate([contact, slipping]
+                                 + ([sigma[:, 0] > 0] if ntan == 1 else [])).tobytes()
             if key in seen and not crossing.any():
                 log.debug("frictional linearised contact: a set came back")
                 break
@@ -422,10 +425,13 @@ class LargeFriction(FrictionHistory):
         x[nrm] = np.where(x[nrm] > 0, x[nrm], 0.0)
         for j in range(ntan):
             x[tng[:, j]] = np.where((x[nrm] > 0) & free[:, j], x[tng[:, j]], 0.0)
-        # which nodes slide (the static coefficient holds the others)
+        # which nodes slide (the static coefficient holds the others); a frictionless pair's
+        # nodes in contact are free, as under small kinematics: counted as sticking, their
+        # slip was an error no traction could correct, and a frictionless pair in a frictional
+        # model never converged once its nodes moved along the other surface
         for k, s_ in enumerate(sets):
             self.sliding(state, k)[:] = False
-            self.sliding(state, k)[s_] = (slipping & contact)[pair_of == k]
+            self.sliding(state, k)[s_] = ((slipping | ~acts) & contact)[pair_of == k]
         return x, 0.0
 
 #: the paired variant with friction under large displacements: the frictionless formulation

@@ -50,9 +50,9 @@ def make_pair(form, i: int, j: int, density_i: tuple[float, bool],
                ) -> tuple[ContactPair | None, list[ContactPair]]:
     """The pair of bodies i < j (both with candidate facets), from their compliance
     densities against each other (:func:`compliance_density`), or None where they do not
-    face each other; and with :attr:`both_surfaces` the nodes held by point forces (pairs
-    with ``point`` set, :func:`~vfem.contact.geometry.held.held_nodes`): the equilibrium
-    side's, and the compatibility side's beyond the other patch's ends.
+    face each other; and with the formulation's ``both_surfaces`` the nodes held by point
+    forces (pairs with ``point`` set, :func:`~vfem.contact.geometry.held.held_nodes`): the
+    equilibrium side's, and the compatibility side's beyond the other patch's ends.
 
     Where the side the rules choose leaves no node paired at all (neither its own nodes
     over the other surface nor the other's held against it: a tilted box's corner over a
@@ -62,8 +62,8 @@ def make_pair(form, i: int, j: int, density_i: tuple[float, bool],
     block on the compatibility side the box's corner nodes are held against it and the
     model solves.
 
-    A pair in :attr:`given_sides` is carried by the body given there. Returns (pair, held,
-    the body carrying compatibility, -1 where neither faces the other)."""
+    A pair in the formulation's ``given_sides`` is carried by the body given there. Returns
+    (pair, held, the body carrying compatibility, -1 where neither faces the other)."""
     given = form.given_sides.get((i, j))
     if given is not None:
         return make_pair_sided(form, i, j, density_i, density_j, carrier=given)

@@ -220,16 +220,18 @@ def friction_law(pair, where: str = "contact.pairs") -> FrictionLaw:
     """The law of one pair's friction settings (a :class:`~vfem.contact.settings.PairFriction`),
     its parameters checked: an unknown law, a parameter it needs missing or out of range, or one
     it does not read, raise :class:`InputError` naming the pair (``where``)."""
+    pair.validate(where)  # the entry's own checks first (its bodies, friction >= 0)
     law = FRICTION_LAWS.get(pair.law)
     if law is None:
         raise InputError(f"{where} {list(pair.bodies)!r}: law must be one of "
                          f"{tuple(FRICTION_LAWS)}, got {pair.law!r}")
+    out = law.of(pair, where)  # its own parameters, then those it does not read
     for other in FRICTION_LAWS.values():
         for field in other.parameters:
             if field not in law.parameters and getattr(pair, field) is not None:
                 raise InputError(f"{where} {list(pair.bodies)!r}: {field} is for the "
                                  f"{other.name} law, not {pair.law!r}")
-    return law.of(pair, where)
+    return out
 
 
 def law_record(law: FrictionLaw) -> dict:
