@@ -55,13 +55,13 @@ def guard_as_before(monkeypatch):
     surface does, as when this mechanism came (a stiff surface's own features, the punch's
     fillet vertices, are held now whatever their guard, and paired where the loads' approach
     meets the other surface: ``held.held_nodes``)."""
-    import vfem.contact.formulations.pairset as pairset
-    made_by = pairset.held_nodes
+    import vfem.contact.formulations.pairmaking as pairmaking  # (where the pairs are made)
+    made_by = pairmaking.held_nodes
 
     def as_before(*args, **kwargs):
         return made_by(*args, **{**kwargs, "features": False, "approach": None})
 
-    monkeypatch.setattr(pairset, "held_nodes", as_before)
+    monkeypatch.setattr(pairmaking, "held_nodes", as_before)
 
 
 def test_alone_it_holds_the_node_and_solves_the_step(monkeypatch):
