@@ -169,12 +169,11 @@ class StaticDynamic:
 
 
 @dataclass(frozen=True)
-class Elastoplastic:
+class Elastoplastic(Coulomb):
     """The thesis's friction-slippage law (§1.10), a regularised Coulomb law: below the cone the
     tangential traction is ``slip_stiffness`` times an elastic slip, on it the node slips at
-    ``mu q``."""
+    ``mu q`` (Coulomb's coefficients, with a compliance)."""
 
-    mu: float
     slip_stiffness: float
     name: ClassVar[str] = "elastoplastic"
     parameters: ClassVar[tuple[str, ...]] = ("slip_stiffness",)
@@ -189,16 +188,6 @@ class Elastoplastic:
     def compliance(self) -> float:
         return 1.0 / self.slip_stiffness
 
-    @property
-    def acts(self) -> bool:
-        return self.mu > 0
-
-    def static(self, slip: np.ndarray) -> np.ndarray:
-        return np.full(len(slip), self.mu)
-
-    def dynamic(self, slip: np.ndarray) -> np.ndarray:
-        return np.full(len(slip), self.mu)
-
     def record(self) -> dict:
         return {"law": self.name, "mu": self.mu, "slip_stiffness": self.slip_stiffness}
 
@@ -206,10 +195,6 @@ class Elastoplastic:
     def text(record: dict) -> str:
         return (f"elasto-plastic, mu = {record['mu']:g}, slip stiffness "
                 f"{record['slip_stiffness']:g}")
-
-    @staticmethod
-    def bounds(record: dict) -> list[tuple[str, float]]:
-        return [("mu q, Coulomb limit", float(record["mu"]))] if record.get("mu") else []
 
 
 #: the friction laws by the name ``[[contact.pairs]] law`` gives
