@@ -124,10 +124,6 @@ class SmallFriction(FrictionHistory):
         #: (:meth:`_correct_frictional`)
         self._torn = [np.zeros(len(p.nodes), dtype=bool) for p in self.form.contact_pairs]
 
-    def tangent(self, k: int) -> np.ndarray:
-        """Pair k's unit tangent at its nodes (the undeformed one: small kinematics)."""
-        return self._tangents[k][0]
-
     def tangent_basis(self, k: int) -> list[np.ndarray]:
         """Pair k's unit tangents at its nodes (the undeformed ones: small kinematics)."""
         return self._tangents[k]

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import tangents
 from ..laws import (
     friction_law,
     magnitudes,
@@ -39,14 +38,6 @@ class FrictionHistory:
                      for p in self.form.contact_pairs]
         #: per pair, the slip increments of the last converged step (for :meth:`add_fields`)
         self._increments = [self._zeros(k) for k in range(len(self.form.contact_pairs))]
-
-    def tangent(self, k: int) -> np.ndarray:
-        """Pair k's unit tangent at its nodes (2D: the normal turned by +90 degrees)."""
-        return tangents(self.form.contact_pairs[k].normal)[0]
-
-    def tangent_basis(self, k: int) -> list[np.ndarray]:
-        """Pair k's unit tangents at its nodes, dim - 1 of them (:func:`tangents`)."""
-        return tangents(self.form.contact_pairs[k].normal)
 
     def _zeros(self, k: int) -> np.ndarray:
         """Zeros for pair k's tangential array, (n, ntan): one column per tangent of its
@@ -121,10 +112,12 @@ class FrictionHistory:
         excess of a tangential traction over its cone (relative to the largest mu q), and the
         nodes sticking and slipping."""
         err, excess, stick, slip = 0.0, 0.0, 0, 0
-        scale = max((float((self.static(state, k) * self.form.tractions(state, k)).max(initial=0.0))
-                     for k in range(len(self.form.contact_pairs))), default=0.0)
+        # per pair, each node's cone mu_s q (no cone where the node pulls)
+        cones = [self.static(state, k) * np.maximum(self.form.tractions(state, k), 0.0)
+                 for k in range(len(self.form.contact_pairs))]
+        scale = max((float(c.max(initial=0.0)) for c in cones), default=0.0)
         for k, dw in enumerate(slips):
-            q, s = self.form.tractions(state, k), self.shear(state, k)
+            s = self.shear(state, k)
             status = self.status(state, k)
             held = self._held_components(k)
             if held is not None and held.any():  # 3D: a sticking node's slip along a held
@@ -144,7 +137,7 @@ class FrictionHistory:
                 along = np.einsum("ij,ij->i", sigma, dw[on])
                 across = magnitudes(dw[on] - along[:, None] * sigma)
                 err = max(err, float(np.maximum(-along, 0.0).max()), float(across.max()))
-            outside = magnitudes(s) - self.static(state, k) * np.maximum(q, 0.0)
+            outside = magnitudes(s) - cones[k]
             if len(outside) and scale > 0:
                 excess = max(excess, float(outside.max()) / scale)
             elif np.any(s != 0):
@@ -159,7 +152,7 @@ class FrictionHistory:
         along a held tangent is the supports' (a prescribed motion, as the press fit's pushed end
         faces), not an error the iteration could correct."""
         if getattr(self, "_ntan", 1) == 1 or getattr(self.form, "_full", None) is None:
-            return None  # (2D; or the large-kinematics variant, 2D only, without them)
+            return None  # (2D; or the large-kinematics part, which reads none)
         n, base = len(self.form.contact_pairs[k].nodes), self.form._full[3][k]
         return self._held[base + n: base + (1 + self._ntan) * n].reshape(self._ntan, n).T
 

@@ -186,7 +186,7 @@ class LargeDeformationContact(PairSet):
             pens = self.penetrations(state)
             self.assemble_forces(state)  # the tractions along the current normals
             lins = self._linearize(state)
-            traction_values = [self.tractions(state, k) for k in range(len(pens))]
+            traction_values = self.traction_values(state)
             errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
             body_err = max((lin.residual / lin.reference for lin in lins if lin is not None),
                            default=0.0)

@@ -114,10 +114,6 @@ class LargeFriction(FrictionHistory):
         on = np.arange(len(self.form.contact_pairs[k].nodes))
         return self._basis(k, on, self.form.contact_pairs[k].normal)
 
-    def tangent(self, k: int) -> np.ndarray:
-        """Pair k's (first) unit tangent at its nodes, on the current geometry."""
-        return self.tangent_basis(k)[0]
-
     def traction_vectors(self, state, k, on, normal):
         """``q n + s t`` at the nodes ``on`` (2D: t is ``normal`` turned by +90 degrees; 3D:
         ``q n + s1 t1 + s2 t2``, the tangents of :meth:`_basis`)."""

@@ -150,7 +150,7 @@ class PairedContact(PairSet):
 
         def check(it: int) -> Check:
             pens = self.penetrations(state)
-            traction_values = [self.tractions(state, k) for k in range(len(self.contact_pairs))]
+            traction_values = self.traction_values(state)
             self._check_rind(pens)
             stale_moved = self._update_stale(state, traction_values, pens)
             errs, pen_err, contact, tension = self.compatibility_errors(pens, traction_values)
@@ -220,8 +220,7 @@ class PairedContact(PairSet):
         if self._full is None:
             self._full = self._full_flexibility()
         W, rate, dR, _ = self._full
-        q0 = np.concatenate([self.tractions(state, k) for k in range(len(self.contact_pairs))]
-                            or [np.zeros(0)])
+        q0 = np.concatenate(self.traction_values(state) or [np.zeros(0)])
         p = np.concatenate(pens or [np.zeros(0)])
         reserve, guard = self._reserve()
         # held nodes whose conditions and the compatibility side's cross (two of nearly one,
