@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .bodies import Body
+from .bodies.section import SPACES
 from .contact.formulations import check_capabilities
 from .contact.geometry import ContactSurface, check_initial_overlap, select_candidate_facets
 from .contact.settings import ContactSettings
@@ -63,10 +64,11 @@ class Model:
                     raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
         for b in self.bodies:
             b.validate()
-        dims = {b.name: b.dim for b in self.bodies}
-        if len(set(dims.values())) > 1:
-            raise InputError(f"model {self.name!r}: its bodies must all be 2D or all 3D, got "
-                             + ", ".join(f"{n!r} {d}D" for n, d in dims.items()))
+        spaces = {b.name: b.section.space for b in self.bodies}  # bodies.section
+        if len(set(spaces.values())) > 1:
+            raise InputError(f"model {self.name!r}: its bodies must all be "
+                             + " or all ".join(SPACES) + ", got "
+                             + ", ".join(f"{n!r} {d}" for n, d in spaces.items()))
         check_capabilities(self)  # what the formulation supports, as it declares it
         if sum(b.platen is not None for b in self.bodies) > 1:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")

@@ -20,6 +20,7 @@ from . import condensation, discretisation, loads, reactions, validation
 from .discretisation import AXES
 from .loads import AllComponents, Platen, PrescribedDisplacement, Support, Traction
 from .mechanics import BodyMechanics, Linearization, LinearMechanics
+from .section import Section, section_of
 
 
 @dataclass
@@ -71,6 +72,12 @@ class Body:
     def dim(self) -> int:
         """The body's dimension, 2 or 3: its mesh's number of coordinates."""
         return int(self.mesh.p.shape[0])
+
+    @property
+    def section(self) -> Section:
+        """The body's section: what its out-of-plane assumption decides (plane strain, plane
+        stress, 3D; :mod:`.section`), from its mesh and its material's ``plane``."""
+        return section_of(self)
 
     @property
     def components(self) -> tuple[str, ...]:

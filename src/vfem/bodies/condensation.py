@@ -19,11 +19,8 @@ import logging
 import time
 
 import numpy as np
-from skfem import Basis, ElementVector, asm
-from skfem.models.elasticity import linear_elasticity
 
 from ..linalg import factorize
-from .assembly import elasticity_stiffness
 from .loads import constraints, load_cases
 from .mechanics import _platen_stiffness, mechanics_for
 from .validation import check_supported, validate
@@ -47,13 +44,11 @@ def assemble(body) -> dict[int, float]:
     validate(body)
     t0 = time.perf_counter()
     lam, mu = body.material.lame()
-    if body.dim == 3:  # scikit-fem's per-pair loop takes minutes at 3D sizes (assembly.py),
-        # and its basis, 147 KB a hexahedron, is not kept (:attr:`basis`)
-        body.K = elasticity_stiffness(body.mesh, body.element(), lam, mu,
-                                      body.dof_map.element_dofs)
-    else:
-        body.basis = Basis(body.mesh, ElementVector(body.element()))
-        body.K = asm(linear_elasticity(lam, mu), body.basis).tocsr()
+    section = body.section  # its measure, strains and basis (:mod:`.section`)
+    basis = section.basis(body)
+    if basis is not None:
+        body.basis = basis
+    body.K = section.stiffness(body, lam, mu)
     body.ndofs = body.K.shape[0]
     t1 = time.perf_counter()
     fixed = constraints(body)

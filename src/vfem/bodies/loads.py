@@ -247,16 +247,19 @@ def load_cases(body, fixed: dict[int, float]) -> list[LoadCase]:
 
 
 def traction_vector(body, tr: Traction) -> np.ndarray:
+    """The nodal forces (ndofs) of a uniform traction on a named boundary: ∫ t·v times the
+    section's measure (:meth:`~vfem.bodies.section.Section.weight`) over its facets."""
     fb = FacetBasis(body.mesh, ElementVector(body.element()),
                     facets=body.mesh.boundaries[tr.boundary])
     t = np.asarray(tr.value, dtype=float)
+    section = body.section  # the measure of the body's boundary (:mod:`.section`)
 
     @LinearForm
     def load(v, w):
         out = t[0] * v[0] + t[1] * v[1]
         for d in range(2, len(t)):  # 3D: + t[2] * v[2]
             out = out + t[d] * v[d]
-        return out
+        return out * section.weight(w.x)
 
     return asm(load, fb)
 

@@ -34,25 +34,36 @@ def cauchy_stress(nonlinear, u: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def small_strain_stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
-    """Element-average linear-elastic stresses of ``body`` (assembled) at ``u``: the stress of
-    the element-average strain (the stress is linear in the strain), the average strain by one
-    sparse product with :func:`average_strain_operator`."""
+    """Element-average linear-elastic stresses of ``body`` (assembled) at ``u``: its section's
+    (:meth:`vfem.bodies.section.Section.stress`: plane strain, plane stress or 3D)."""
+    return body.section.stress(body, u)
+
+
+def plane_small_strain_stress(body, u: np.ndarray, out_of_plane) -> dict[str, np.ndarray]:
+    """Element-average linear-elastic stresses of a 2D ``body`` (assembled) at ``u``: the
+    stress of the element-average strain (the stress is linear in the strain), the average
+    strain by one sparse product with :func:`plane_average_strain_operator`. ``out_of_plane``
+    gives szz from the in-plane stresses and Poisson's ratio (the section's assumption)."""
     lam, mu = body.material.lame()
     nel = body.mesh.nelements
-    e = average_strain_operator(body) @ np.asarray(u, dtype=float)
-    if body.mesh.p.shape[0] == 3:
-        exx, eyy, ezz, eyz, exz, exy = e.reshape(6, nel)
-        tr = exx + eyy + ezz
-        avg = {"sxx": 2 * mu * exx + lam * tr, "syy": 2 * mu * eyy + lam * tr,
-               "szz": 2 * mu * ezz + lam * tr, "syz": 2 * mu * eyz, "sxz": 2 * mu * exz,
-               "sxy": 2 * mu * exy}
-        return _with_von_mises(avg)
+    e = plane_average_strain_operator(body) @ np.asarray(u, dtype=float)
     exx, eyy, exy = e[:nel], e[nel:2 * nel], e[2 * nel:]
     tr = exx + eyy
     avg = {"sxx": 2 * mu * exx + lam * tr, "syy": 2 * mu * eyy + lam * tr, "sxy": 2 * mu * exy}
-    nu = body.material.poissons_ratio
-    avg["szz"] = (nu * (avg["sxx"] + avg["syy"]) if body.material.plane == "strain"
-                  else np.zeros_like(avg["sxx"]))
+    avg["szz"] = out_of_plane(avg, body.material.poissons_ratio)
+    return _with_von_mises(avg)
+
+
+def solid_small_strain_stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`plane_small_strain_stress` of a 3D body: sxx, syy, szz, syz, sxz, sxy."""
+    lam, mu = body.material.lame()
+    nel = body.mesh.nelements
+    e = solid_average_strain_operator(body) @ np.asarray(u, dtype=float)
+    exx, eyy, ezz, eyz, exz, exy = e.reshape(6, nel)
+    tr = exx + eyy + ezz
+    avg = {"sxx": 2 * mu * exx + lam * tr, "syy": 2 * mu * eyy + lam * tr,
+           "szz": 2 * mu * ezz + lam * tr, "syz": 2 * mu * eyz, "sxz": 2 * mu * exz,
+           "sxy": 2 * mu * exy}
     return _with_von_mises(avg)
 
 
@@ -63,8 +74,11 @@ def average_strain_operator(body):
     Stresses of every step and body are then one sparse product (issue 19: recomputing them
     by interpolation took 0.6 s per step of a 462k-dof body). A 3D body's is 6 nelems x ndofs:
     exx, eyy, ezz, eyz, exz, exy (tensor shear strains, half the engineering ones)."""
-    if body.mesh.p.shape[0] == 3:
-        return _average_strain_operator_3d(body)
+    return body.section.average_strain_operator(body)
+
+
+def plane_average_strain_operator(body):
+    """:func:`average_strain_operator` of a 2D body (3 nelems x ndofs)."""
     cached = body.__dict__.get("_average_strain")
     if cached is not None and cached[0] is body.basis:
         return cached[1]
@@ -91,7 +105,7 @@ def average_strain_operator(body):
     return op
 
 
-def _average_strain_operator_3d(body):
+def solid_average_strain_operator(body):
     """:func:`average_strain_operator` of a 3D body, from the gradients of a chunk of elements
     at a time (:func:`~vfem.bodies.assembly.cell_gradients`: a 3D body keeps no basis)."""
     cached = body.__dict__.get("_average_strain")
@@ -137,23 +151,18 @@ def max_strain(body, u: np.ndarray) -> tuple[float, int]:
     0.05 s for 160k dofs; after :meth:`~vfem.bodies.Body.assemble`); for linear triangles,
     whose strain is constant in each element, from :func:`average_strain_operator`. In 3D the
     largest absolute eigenvalue of the 3 x 3 strain tensor (:func:`_largest_eigenvalue`)."""
-    if body.mesh.p.shape[0] == 3:
-        if body.order == 1 and body.mesh.t.shape[0] == 4:  # linear tetrahedra: constant
-            nel = body.mesh.nelements
-            e = (average_strain_operator(body) @ np.asarray(u, dtype=float)).reshape(6, nel)
-            per_element = _largest_eigenvalue(*e)
-            if not per_element.size:
-                return 0.0, 0
-            element = int(np.argmax(per_element))
-            return float(per_element[element]), element
-        return _max_strain_at_quadrature_3d(body, u)
+    return body.section.max_strain(body, u)
+
+
+def plane_max_strain(body, u: np.ndarray) -> tuple[float, int]:
+    """:func:`max_strain` of a 2D body."""
     basis = body.basis
     if body.order == 1 and body.mesh.t.shape[0] == 3:
         # linear triangles: the strain is constant in each element, its average (one sparse
         # product, :func:`average_strain_operator`) is its value at every quadrature point
         # (issue 19: 0.15 s per step and body at 1M dofs otherwise, 5 % of the run)
         nel = basis.nelems
-        e = average_strain_operator(body) @ np.asarray(u, dtype=float)
+        e = plane_average_strain_operator(body) @ np.asarray(u, dtype=float)
         exx, eyy, exy = e[:nel], e[nel:2 * nel], e[2 * nel:]
         per_element = np.abs(0.5 * (exx + eyy)) + np.sqrt((0.5 * (exx - eyy)) ** 2 + exy**2)
         if not per_element.size:
@@ -161,6 +170,19 @@ def max_strain(body, u: np.ndarray) -> tuple[float, int]:
         element = int(np.argmax(per_element))
         return float(per_element[element]), element
     return _max_strain_at_quadrature(body, u)
+
+
+def solid_max_strain(body, u: np.ndarray) -> tuple[float, int]:
+    """:func:`max_strain` of a 3D body."""
+    if body.order == 1 and body.mesh.t.shape[0] == 4:  # linear tetrahedra: constant
+        nel = body.mesh.nelements
+        e = (solid_average_strain_operator(body) @ np.asarray(u, dtype=float)).reshape(6, nel)
+        per_element = _largest_eigenvalue(*e)
+        if not per_element.size:
+            return 0.0, 0
+        element = int(np.argmax(per_element))
+        return float(per_element[element]), element
+    return _max_strain_at_quadrature_3d(body, u)
 
 
 def _max_strain_at_quadrature(body, u: np.ndarray) -> tuple[float, int]:
@@ -239,4 +261,6 @@ def _with_von_mises(avg: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return avg
 
 
-__all__ = ["cauchy_stress", "max_strain", "small_strain_stress", "stress"]
+__all__ = ["cauchy_stress", "max_strain", "plane_average_strain_operator", "plane_max_strain",
+           "plane_small_strain_stress", "small_strain_stress", "solid_average_strain_operator",
+           "solid_max_strain", "solid_small_strain_stress", "stress"]

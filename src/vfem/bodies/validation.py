@@ -14,6 +14,7 @@ from ..materials import LAWS
 from ..mesh.checks import check_mesh
 from .discretisation import COMPONENTS, MESHES
 from .loads import _shown, check_amplitude, constraints
+from .section import SECTIONS, check_plane, section_of
 
 
 def _named_first(null: np.ndarray) -> np.ndarray:
@@ -46,22 +47,19 @@ def validate(body) -> None:
         raise InputError(f"{where}: order must be 1 (linear) or 2 (quadratic elements), "
                          f"got {body.order!r}")
     body.material.validate(f"{where}, material")
+    check_plane(body.material.plane, f"{where}, material")
     if body.kinematics not in ("small", "total", "updated"):
         raise InputError(f"{where}: kinematics must be 'small', 'total' or 'updated', "
                          f"got {body.kinematics!r}")
     if body.law not in LAWS:
         names = " or ".join(repr(name) for name in LAWS)
         raise InputError(f"{where}: law must be {names}, got {body.law!r}")
-    if body.dim == 3 and body.material.plane != "strain":
-        raise InputError(f"{where}: plane = {body.material.plane!r} is an assumption of 2D "
-                         "bodies; a 3D body (tetrahedra or hexahedra) has none: leave "
-                         "the material's plane out")
-    if body.dim == 3 and body.large and body.order != 1:
+    section = section_of(body)  # refuses a plane given to a 3D body
+    if body.large and (body.order != 1 or not section.takes_large):
+        taken = [s.name for s in SECTIONS.values() if s.takes_large]
         raise InputError(f"{where}: large kinematics ({body.kinematics!r}) needs linear "
-                         "elements (order 1)")
-    if body.large and (body.order != 1 or body.material.plane != "strain"):
-        raise InputError(f"{where}: large kinematics ({body.kinematics!r}) needs linear "
-                         "elements (order 1) and plane strain")
+                         "elements (order 1)"
+                         + ("" if section.space != "2D" else f" and {' or '.join(taken)}"))
     names = set((body.mesh.boundaries or {}).keys())
     for bc in (*body.supports, *body.prescribed, *body.tractions,
                *((body.platen,) if body.platen else ()), *(body.contact_boundaries or ())):
@@ -113,23 +111,11 @@ def check_supports(body) -> None:
 
 
 def rigid_modes(body) -> dict[str, np.ndarray]:
-    """The body's rigid-body motions by name, each (npoints, dim): in 2D the translations
-    in x and y and the rotation; in 3D the translations in x, y and z and the rotations
-    about the axes x, y and z through the points' centroid."""
-    if body.dim == 2:
-        x, y = body.points
-        return {"translation in x": np.column_stack([np.ones_like(x), 0 * y]),
-                "translation in y": np.column_stack([0 * x, np.ones_like(y)]),
-                "rotation": np.column_stack([-(y - y.mean()), x - x.mean()])}
-    X = body.points - body.points.mean(axis=1, keepdims=True)
-    zero, one = np.zeros(X.shape[1]), np.ones(X.shape[1])
-    x, y, z = X
-    return {"translation in x": np.column_stack([one, zero, zero]),
-            "translation in y": np.column_stack([zero, one, zero]),
-            "translation in z": np.column_stack([zero, zero, one]),
-            "rotation about x": np.column_stack([zero, -z, y]),
-            "rotation about y": np.column_stack([z, zero, -x]),
-            "rotation about z": np.column_stack([-y, x, zero])}
+    """The body's rigid-body motions by name, each (npoints, dim): its section's
+    (:meth:`~vfem.bodies.section.Section.rigid_modes`): in 2D the translations in x and y
+    and the rotation; in 3D the translations in x, y and z and the rotations about the axes
+    x, y and z through the points' centroid."""
+    return body.section.rigid_modes(body.points)
 
 
 def check_supported(body) -> None:

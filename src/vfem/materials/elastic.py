@@ -30,7 +30,8 @@ class LinearElastic:
     Attributes:
         youngs_modulus: E, > 0.
         poissons_ratio: nu, in (-1, 0.5).
-        plane: ``"strain"`` (default) or ``"stress"``; the out-of-plane assumption of a 2D body.
+        plane: ``"strain"`` (default) or ``"stress"``; the out-of-plane assumption of a 2D body
+            (its section, :mod:`vfem.bodies.section`).
     """
 
     youngs_modulus: float
@@ -38,10 +39,10 @@ class LinearElastic:
     plane: str = PLANE_STRAIN
 
     def validate(self, where: str = "material") -> None:
-        """Raise :class:`InputError` naming ``where`` if the constants are not admissible."""
+        """Raise :class:`InputError` naming ``where`` if the constants are not admissible.
+        ``plane`` is the body's section's name, checked with it
+        (:func:`vfem.bodies.section.section_of`)."""
         check_elastic_constants(self.youngs_modulus, self.poissons_ratio, where)
-        if self.plane not in (PLANE_STRAIN, PLANE_STRESS):
-            raise InputError(f"{where}: plane must be 'strain' or 'stress', got {self.plane!r}")
 
     def lame(self) -> tuple[float, float]:
         """Lamé constants (lambda, mu) of the 2D model (lambda modified for plane stress)."""

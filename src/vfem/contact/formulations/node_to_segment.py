@@ -38,8 +38,9 @@ log = logging.getLogger(__name__)
 
 
 def modulus(surface: ContactSurface) -> float:
-    """The plane-strain modulus E / (1 - nu^2) of the surface's body (E in plane stress)."""
-    return surface.body.material.plane_strain_modulus()
+    """The modulus of Hertz's E* of the surface's body: E / (1 - nu^2), E in plane stress
+    (its section's, :meth:`~vfem.bodies.section.Section.contact_modulus`)."""
+    return surface.body.section.contact_modulus(surface.body.material)
 
 
 def node_density(surface: ContactSurface) -> float:

@@ -290,7 +290,7 @@ class Segment:
         integrand (degree 4 at most, with quadratic elements) on straight facets. On curved
         (quadratic) facets the points and weights follow the curve; the splits are found on
         the chords. The weights are times the fine side's undeformed length (the traction is
-        nominal)."""
+        nominal) and its body's section's weight there (:meth:`ContactSurface.weight`)."""
         fa, fb = xf[sf.facets[:, 0]], xf[sf.facets[:, 1]]
         fa, fb = fa[fpatch], fb[fpatch]
         d = fb - fa
@@ -323,8 +323,10 @@ class Segment:
         sloc = (lo[:, None] + (hi - lo)[:, None] * xi[None, :]).ravel()
         wts = ((hi - lo)[:, None] * w[None, :]).ravel()
         fac = np.repeat(np.asarray(fpatch)[row], len(xi))
-        _, tangent = self.curve(sf.X, sf.facets[fac], sloc)
-        wts = wts * np.linalg.norm(tangent, axis=1)
+        pos, tangent = self.curve(sf.X, sf.facets[fac], sloc)
+        # the fine side's undeformed measure: its length times its body's section's weight
+        # there (1, or 2πr on a body of revolution: :meth:`ContactSurface.weight`)
+        wts = wts * np.linalg.norm(tangent, axis=1) * sf.weight(pos)
         return fac, sloc, wts
 
     def material_points(self, facets, seg, interp):

@@ -21,14 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import BilinearForm, ElementLineP1, FacetBasis
-from skfem.quadrature import get_quadrature
-from skfem.refdom import RefLine
 
 from ...bodies import Body
-from ...errors import InputError
 from .bodymesh import (
-    _most_distorted,
     element_volumes,
     locate_in_simplices,
     simplices,
@@ -40,6 +35,7 @@ from .facets import (
     Segment,
     kind_of,
 )
+from .measure import facet_mass_entries, virtual_quadrature
 
 log = logging.getLogger(__name__)
 
@@ -437,6 +433,13 @@ class ContactSurface:
         x = self.X if x is None else x
         return self.kind.facet_normals(x, self.facets)
 
+    def weight(self, points: np.ndarray) -> np.ndarray | float:
+        """The measure of the body's boundary per unit of its mesh's length at undeformed
+        ``points`` (..., dim): its section's (:meth:`vfem.bodies.section.Section.weight`; 1 in
+        plane strain, plane stress and 3D). N*, the quadratures and the overlap quadrature
+        of the transfer multiply by it."""
+        return self.body.section.weight(np.moveaxis(points, -1, 0))
+
     @property
     def sizes(self) -> np.ndarray:
         """(nf,) undeformed facet sizes: their lengths in 2D, the square roots of their areas
@@ -531,15 +534,10 @@ class ContactSurface:
         return locate_in_simplices(x_tracked, self.rind, points)
 
     def quadrature(self, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Gauss points of the virtual elements on each candidate facet.
-
-        Returns (xi, phi, w): local coordinates (nq,), shape function values (2, nq) of the
-        facet's own 2-node element, and weights per facet (nf, nq) times the undeformed length.
-        """
-        X, W = get_quadrature(RefLine, order)
-        e = ElementLineP1()
-        phi = np.vstack([e.lbasis(X, i)[0] for i in range(2)])
-        return X[0], phi, self.lengths[:, None] * W[None, :]
+        """Gauss points of the virtual elements on each candidate facet: (xi, phi, w), the
+        weights times the undeformed length and the section's weight
+        (:func:`.measure.virtual_quadrature`)."""
+        return virtual_quadrature(self, order)
 
     def mass_matrix(self, facet_weight: np.ndarray) -> sp.csr_matrix:
         """Redistribution matrix N* over the facets with nonzero weight (eq. 4.4.10), (nc, nc).
@@ -553,35 +551,9 @@ class ContactSurface:
         return sp.csr_matrix((vals * facet_weight[facet], (rows, cols)), shape=(self.nc, self.nc))
 
     def _facet_mass_entries(self):
-        """(facet, row, col, value) of every nonzero of every facet's mass matrix."""
-        try:
-            fb = FacetBasis(self.body.mesh, self.body.element(), facets=self.facet_ids)
-        except Exception as exc:  # noqa: BLE001 - scikit-fem raises a bare Exception here
-            # its map of the facets' quadrature points into their quadrilaterals (Newton's
-            # iteration on the isoparametric map) failed: an element along the surface so
-            # distorted that the map barely turns (a thin row on a steep part of a curve)
-            raise InputError(
-                f"body {self.body.name!r}: the quadrature points of its contact facets could "
-                f"not be mapped into their elements ({exc}); "
-                f"{_most_distorted(self.body.mesh, self.facet_ids)} is too distorted: refine "
-                "or regrade the mesh along the contact surface") from exc
-
-        @BilinearForm
-        def mass(u, v, w):
-            return w["tag"] * u * v
-
-        nq = fb.X.shape[1]
-        # scikit-fem's unsummed (per facet) entries; the tag tells which facet each came from
-        ones = mass.coo_data(fb, tag=np.ones((len(self.facet_ids), nq)))
-        tagged = mass.coo_data(fb, tag=np.repeat(
-            np.arange(1.0, len(self.facet_ids) + 1)[:, None], nq, axis=1))
-        # entries of the element's nodes off the facet vanish (to round-off) on the facet
-        keep = np.abs(ones.data) > 1e-12 * np.abs(ones.data).max()
-        facet = np.rint(tagged.data[keep] / ones.data[keep]).astype(int) - 1
-        local = np.full(self.body.npoints, -1)
-        local[self.nodes[: self.nc]] = np.arange(self.nc)
-        rows, cols = local[ones.indices[0][keep]], local[ones.indices[1][keep]]
-        return facet, rows, cols, ones.data[keep]
+        """(facet, row, col, value) of every nonzero of every facet's mass matrix
+        (:func:`.measure.facet_mass_entries`)."""
+        return facet_mass_entries(self)
 
 
 def patch_ends(s: ContactSurface, patch: np.ndarray) -> np.ndarray:

@@ -158,7 +158,7 @@ def _tension_consistent(bodies: list[Body], least: float, F: list[np.ndarray],
         used = np.unique(fac)
         local = np.full(len(f), -1)
         local[used] = np.arange(len(used))
-        M = _boundary_mass(g.x, fac, local, len(used))
+        M = _boundary_mass(b.section, g.x, fac, local, len(used))
         p = spla.spsolve(M.tocsc(), -fn[used])
         recovered.append((b, g.b.nodes[used], np.atleast_1d(p)))
     scale = max((float(np.abs(p).max(initial=0.0)) for _, _, p in recovered), default=0.0)
@@ -174,18 +174,14 @@ def _tension_consistent(bodies: list[Body], least: float, F: list[np.ndarray],
     return worst[0] / scale, least, {"body": worst[1], "node": worst[2], "value": worst[3]}
 
 
-def _boundary_mass(x: np.ndarray, facets: np.ndarray, local: np.ndarray, n: int
+def _boundary_mass(section, x: np.ndarray, facets: np.ndarray, local: np.ndarray, n: int
                    ) -> sp.csr_matrix:
-    """The mass matrix ∫φφᵀ over straight boundary facets (2 or 3 nodes: ends, midpoint)."""
-    L = np.linalg.norm(x[facets[:, 1]] - x[facets[:, 0]], axis=1)
-    if facets.shape[1] == 2:
-        ref = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
-    else:
-        ref = np.array([[4.0, -1.0, 2.0], [-1.0, 4.0, 2.0], [2.0, 2.0, 16.0]]) / 30.0
+    """The mass matrix ∫φφᵀ over straight boundary facets (2 or 3 nodes: ends, midpoint),
+    in the measure of the body's section (:meth:`~vfem.bodies.section.Section.facet_mass`)."""
     k = facets.shape[1]
     rows = np.repeat(local[facets], k, axis=1).ravel()
     cols = np.tile(local[facets], (1, k)).ravel()
-    vals = (L[:, None, None] * ref[None]).ravel()
+    vals = section.facet_mass(x, facets).ravel()
     return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
 
 
