@@ -17,11 +17,13 @@ The laws here are test laws, not physical ones, chosen for closed forms:
 """
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 import pytest
 
 from vfem.bodies import Body, PrescribedDisplacement, Support
+from vfem.bodies.stresses import stress
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
 from vfem.materials import LAWS, LinearElastic, Material, Response, SaintVenantKirchhoff
@@ -199,3 +201,63 @@ def test_a_contact_analysis_carries_the_law_unchanged(monkeypatch):
     assert kappa.max() > 0.01
     assert np.allclose(block.saved_state()["material_kappa"], kappa, rtol=1e-9,
                        atol=1e-12 * kappa.max())
+
+
+@dataclass(frozen=True)
+class Shown(Recording):
+    """:class:`Recording` whose results show its state."""
+
+    def fields(self, state):
+        return {"kappa": state["kappa"]}
+
+
+@dataclass(frozen=True)
+class RecordingTable(LinearElastic):
+    """A material table (``[bodies.material]``, :data:`vfem.materials.MATERIALS`) whose bodies
+    carry :class:`Shown`'s state, as a plastic material's will: they iterate whatever their
+    kinematics, and evaluate its law, not the body's hyperelastic ``law``."""
+
+    carries_state: ClassVar[bool] = True
+
+    def law(self, name):
+        return Shown(self.youngs_modulus, self.poissons_ratio)
+
+
+def test_the_fields_a_law_shows_of_its_state_are_element_averages_beside_the_stresses():
+    """Under the homogeneous stretch the state is uniform: its element averages are its value,
+    to round-off."""
+    body = stretched(Shown(E_MOD, NU), "total")
+    body.solve([1.0])
+    *_, fields = body.cauchy_stress_at(body.displacement)
+    kappa = strain_norm(body.green_lagrange_strain())
+    assert np.allclose(fields["kappa"], kappa.mean(), rtol=1e-12, atol=0.0)
+    assert np.ptp(kappa) <= 1e-12 * kappa.mean()
+    *_, none = stretched(SaintVenantKirchhoff(E_MOD, NU), "total").cauchy_stress_at(
+        np.zeros(2 * 16))
+    assert none == {}
+
+
+def test_a_material_table_that_carries_state_makes_its_body_iterate_with_its_own_law():
+    """What a body reads of its material: ``carries_state`` (Newton's method, whatever the
+    kinematics) and ``law`` (what it evaluates); a contact analysis then shows the state beside
+    the stresses, each element's value between its quadrature points' committed ones."""
+    mesh = rectangle(-1.0, -1.0, 2.0, 1.0, nx=10, ny=5)
+    small = Body("block", mesh, RecordingTable(E_MOD, NU), supports=(Support("bottom"),))
+    assert small.iterates and not small.large
+    assert not Body("block", mesh, LinearElastic(E_MOD, NU)).iterates
+    block = Body("block", mesh, RecordingTable(E_MOD, NU), supports=(Support("bottom"),),
+                 contact_boundaries=("top",), kinematics="total")
+    punch = Body("punch", rectangle(-0.35, 0.0, 0.7, 0.3, nx=5, ny=2),
+                 LinearElastic(20 * E_MOD, NU),
+                 prescribed=(PrescribedDisplacement("top", "y", -0.02),),
+                 supports=(Support("top", ("x",)),), contact_boundaries=("bottom",))
+    model = Model("recorded", [block, punch], load_factors=[1.0])
+    model.contact = ContactSettings()
+    result = Analysis(model).run()
+    assert result.converged, result.message
+    assert isinstance(block.nonlinear.material, Shown)
+    shown = stress(block, np.ravel(result.steps[-1].bodies["block"].displacement))["kappa"]
+    kappa = block.saved_state()["material_kappa"]
+    assert shown.max() > 0.005
+    assert (shown >= kappa.min(axis=1) * (1 - 1e-12)).all()
+    assert (shown <= kappa.max(axis=1) * (1 + 1e-12)).all()

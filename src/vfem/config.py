@@ -7,7 +7,8 @@ names, types, defaults and help text of every key: the loader (:mod:`vfem.io.inp
 against them and the key reference in ``docs/input.md`` is generated from them (a test keeps the
 two equal).
 
-Classes that describe a body's physics are the solver's own: :class:`~vfem.materials.LinearElastic`,
+Classes that describe a body's physics are the solver's own: the material tables
+(:data:`~vfem.materials.MATERIALS`: :class:`~vfem.materials.LinearElastic`),
 :class:`~vfem.bodies.Support`, :class:`~vfem.bodies.PrescribedDisplacement`,
 :class:`~vfem.bodies.Traction`, :class:`~vfem.bodies.Platen` and
 :class:`~vfem.contact.settings.ContactSettings`. What only a description needs (how to make the
@@ -29,7 +30,7 @@ import numpy as np
 from .bodies import Body, Platen, PrescribedDisplacement, Support, Traction
 from .contact.settings import ContactSettings
 from .errors import InputError
-from .materials import LinearElastic
+from .materials import MaterialTable
 from .mesh import parametric, shapes, solids
 from .schema import check_parameters
 from .solver import Model
@@ -189,7 +190,7 @@ class BodyConfig:
 
     name: str
     mesh: MeshSpec
-    material: LinearElastic
+    material: MaterialTable
     order: int = 1
     supports: tuple[Support, ...] = ()
     prescribed: tuple[PrescribedDisplacement, ...] = ()

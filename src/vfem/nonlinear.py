@@ -793,20 +793,25 @@ class NonlinearBody:
         """Internal nodal forces (ndofs) at the total displacement ``u``."""
         return self._internal(self._state(np.asarray(u, dtype=float) - self._u_at_current))
 
-    def cauchy_stress_at(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def cauchy_stress_at(self, u: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
         """Element averages over the current volume at the total displacement ``u``: the
         in-plane Cauchy stress (nelems, 2, 2) and ``sigma_zz`` (nelems,); in 3D the Cauchy
-        stress (nelems, 3, 3) and its zz component."""
+        stress (nelems, 3, 3) and its zz component; and the fields the material shows of the
+        state it would commit there (:meth:`~vfem.materials.protocol.Material.fields`, by
+        name, (nelems,) each)."""
         state = self._state(np.asarray(u, dtype=float) - self._u_at_current)
         J = determinant(state.F)
         w = state.basis.dx * J
+        fields = {name: (v * w).sum(axis=-1) / w.sum(axis=-1)
+                  for name, v in self.material.fields(state.material_state).items()}
         sig = push_forward_stress(state.S, state.F)
         avg = (sig * w).sum(axis=-1) / w.sum(axis=-1)
         if state.S33 is None:
             avg = np.moveaxis(avg, -1, 0)
-            return avg, avg[:, 2, 2].copy()
+            return avg, avg[:, 2, 2].copy(), fields
         szz = (state.S33 / J * w).sum(axis=-1) / w.sum(axis=-1)
-        return np.moveaxis(avg, -1, 0), szz
+        return np.moveaxis(avg, -1, 0), szz, fields
 
     def _accept(self, delta: np.ndarray) -> None:
         """Make the converged iterate the new state.

@@ -105,10 +105,11 @@ class Body:
     def iterates(self) -> bool:
         """Whether the body's response to its contact forces is nonlinear, so that contact
         corrects it by Newton's method (:meth:`.mechanics.BodyMechanics.linearize`) instead of
-        through its constant flexibility: under large kinematics today; a material with
-        history (issue 41) makes a small-kinematics body iterate too. Where the code asks how
-        a body responds it reads this; where it asks which geometry, :attr:`large`."""
-        return self.large
+        through its constant flexibility: under large kinematics, or where its material carries
+        a state from step to step (``carries_state``: a plastic one, issue 41), under small
+        kinematics too. Where the code asks how a body responds it reads this; where it asks
+        which geometry, :attr:`large`."""
+        return self.large or self.material.carries_state
 
     # -- set-up (vfem.bodies.condensation) --------------------------------------------------------
 

@@ -31,7 +31,6 @@ import scipy.sparse as sp
 
 from ..errors import AnalysisError
 from ..linalg import factorize
-from ..materials import LAWS
 from ..nonlinear import NonlinearBody
 from .loads import boundary_dofs
 from .stresses import cauchy_stress, small_strain_stress
@@ -165,7 +164,7 @@ class LargeMechanics:
         starts from.
         """
         self.body = body
-        material = LAWS[body.law](body.material.youngs_modulus, body.material.poissons_ratio)
+        material = body.material.law(body.law)  # the law its material evaluates
         nl = NonlinearBody(body.mesh, material, formulation=body.kinematics,
                            name=f"body {body.name!r}")
         dofs = np.array(sorted(fixed), dtype=int)

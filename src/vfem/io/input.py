@@ -35,6 +35,7 @@ from ..config import (
     Steps,
 )
 from ..errors import InputError
+from ..materials import MATERIALS
 from ..schema import (
     _join,
     _kind,
@@ -56,7 +57,7 @@ SECTIONS = {
     "BodyConfig": "[[bodies]]",
     "MeshSpec": "[bodies.mesh]",
     "Curve": "[bodies.mesh.curve]",
-    "LinearElastic": "[bodies.material]",
+    **{table.__name__: "[bodies.material]" for table in MATERIALS},
     "Support": "[[bodies.supports]]",
     "PrescribedDisplacement": "[[bodies.prescribed]]",
     "Traction": "[[bodies.tractions]]",
@@ -390,10 +391,9 @@ def reference() -> str:
     """The key reference of ``docs/input.md`` (generated; a test compares the two)."""
     from ..bodies import Platen, PrescribedDisplacement, Support, Traction
     from ..contact.settings import ContactSettings, PairFriction
-    from ..materials import LinearElastic
 
     classes = [ModelConfig, ContactSettings, PairFriction, Steps, Output, BodyConfig, MeshSpec,
-               Curve, LinearElastic, Support, PrescribedDisplacement, Traction, Platen]
+               Curve, *MATERIALS, Support, PrescribedDisplacement, Traction, Platen]
     out = []
     for cls in classes:
         doc = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0].replace("\n", " ")

@@ -2,25 +2,17 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar
 
-from ..errors import InputError
+from .constants import check_elastic_constants
+from .hyperelastic import LAWS
+
+if TYPE_CHECKING:
+    from .protocol import Material
 
 PLANE_STRAIN = "strain"
 PLANE_STRESS = "stress"
-
-
-def check_elastic_constants(E: float, nu: float, where: str) -> None:
-    """Raise :class:`InputError` naming ``where`` unless E > 0 and -1 < nu < 0.5 (finite)."""
-    if not (isinstance(E, (int, float)) and math.isfinite(E)) or E <= 0:
-        raise InputError(f"{where}: youngs_modulus must be a finite number > 0, got {E!r}")
-    if not (isinstance(nu, (int, float)) and math.isfinite(nu)) or not -1.0 < nu < 0.5:
-        raise InputError(
-            f"{where}: poissons_ratio must lie in (-1, 0.5), got {nu!r}"
-            + (" (0.5 is incompressible, which displacement elements cannot represent)"
-               if isinstance(nu, (int, float)) and nu >= 0.5 else "")
-        )
 
 
 @dataclass(frozen=True)
@@ -31,18 +23,31 @@ class LinearElastic:
         youngs_modulus: E, > 0.
         poissons_ratio: nu, in (-1, 0.5).
         plane: ``"strain"`` (default) or ``"stress"``; the out-of-plane assumption of a 2D body
-            (its section, :mod:`vfem.bodies.section`).
+            (its section).
     """
 
     youngs_modulus: float
     poissons_ratio: float
     plane: str = PLANE_STRAIN
 
+    #: Whether a body of this material carries a state from step to step (a plastic one,
+    #: issue 41), and so answers its contact forces by Newton's method under small kinematics
+    #: too (:attr:`vfem.bodies.Body.iterates`): not an elastic one.
+    carries_state: ClassVar[bool] = False
+
     def validate(self, where: str = "material") -> None:
         """Raise :class:`InputError` naming ``where`` if the constants are not admissible.
         ``plane`` is the body's section's name, checked with it
         (:func:`vfem.bodies.section.section_of`)."""
         check_elastic_constants(self.youngs_modulus, self.poissons_ratio, where)
+
+    def law(self, name: str) -> Material:
+        """The constitutive law (:class:`~vfem.materials.protocol.Material`) a body of this
+        material evaluates where it iterates (:mod:`vfem.nonlinear`): the hyperelastic law
+        ``name`` (the body's ``law``, :data:`~vfem.materials.hyperelastic.LAWS`) whose
+        small-strain constants are the material's. A material with its own law (and state)
+        answers with it."""
+        return LAWS[name](self.youngs_modulus, self.poissons_ratio)
 
     def lame(self) -> tuple[float, float]:
         """Lamé constants (lambda, mu) of the 2D model (lambda modified for plane stress)."""

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..kinematics import determinant as _det
 from ..kinematics import inverse as _inv
-from .elastic import check_elastic_constants
+from .constants import check_elastic_constants
 from .protocol import Response, State
 
 
@@ -89,6 +89,10 @@ class _Isotropic:
         """``S(E)``, ``dS/dE`` when asked, ``S_33`` in plane strain; ``state`` unchanged."""
         return Response(self.second_piola(E), lambda: self.tangent(E),
                         self.out_of_plane_stress(E), state)
+
+    def fields(self, state: State) -> dict[str, np.ndarray]:
+        """No state to show."""
+        return {}
 
 
 @dataclass(frozen=True)

@@ -69,5 +69,11 @@ class Material(Protocol):
         """The stress, its tangent and the state to commit for the Green-Lagrange strain ``E``
         (dim, dim, nelements, nq), from the converged ``state``."""
 
+    def fields(self, state: State) -> dict[str, np.ndarray]:
+        """What of ``state`` the results show, by name: arrays (nelements, nq) over the
+        quadrature points, written as element averages beside the stresses (the VTU's cell
+        fields; an equivalent plastic strain, a yielded flag): nothing for a law without
+        history."""
+
 
 __all__ = ["Material", "Response", "State"]
