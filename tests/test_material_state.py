@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, PrescribedDisplacement, Support
-from vfem.bodies.stresses import stress
+from vfem.bodies.stresses import cauchy_stress, stress
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
 from vfem.materials import LAWS, LinearElastic, Material, Response, SaintVenantKirchhoff
@@ -261,3 +261,44 @@ def test_a_material_table_that_carries_state_makes_its_body_iterate_with_its_own
     assert shown.max() > 0.005
     assert (shown >= kappa.min(axis=1) * (1 - 1e-12)).all()
     assert (shown <= kappa.max(axis=1) * (1 + 1e-12)).all()
+
+
+def test_a_body_of_a_material_with_state_is_refused_where_newtons_method_cannot_take_it():
+    """Linear elements only (the Newton mechanics' element), not by the classical contact
+    methods (one linear solve), and, until the small-strain mode (issue 41), not under small
+    kinematics: each with a message that says so."""
+    from vfem.contact.formulations import check_capabilities
+
+    mesh = rectangle(-1.0, -1.0, 2.0, 1.0, nx=4, ny=2)
+    quadratic = Body("block", mesh, RecordingTable(E_MOD, NU), supports=(Support("bottom"),),
+                     order=2)
+    with pytest.raises(InputError, match=r"body 'block': a material that carries state "
+                                         r"needs linear elements \(order 1\)"):
+        quadratic.validate()
+    small = Body("block", mesh, RecordingTable(E_MOD, NU), supports=(Support("bottom"),))
+    with pytest.raises(InputError, match="a material that carries state under small "
+                                         "kinematics needs a small-strain mode"):
+        small.setup()
+    punch = Body("punch", rectangle(-0.35, 0.0, 0.7, 0.3, nx=2, ny=1), LinearElastic(E_MOD, NU),
+                 supports=(Support("top"),))
+    model = Model("recorded", [small, punch])
+    model.contact = ContactSettings(method="penalty")
+    with pytest.raises(InputError, match="small kinematics with a material that carries no "
+                                         "state; use contact.method = 'vfem'"):
+        check_capabilities(model)
+    model.contact = ContactSettings(variant="thesis")
+    with pytest.raises(InputError, match="a material that carries state \\(Newton's method\\) "
+                                         "needs the paired contact variant"):
+        check_capabilities(model)
+
+
+def test_a_law_whose_fields_would_replace_a_stress_is_refused():
+    @dataclass(frozen=True)
+    class Clashing(Recording):
+        def fields(self, state):
+            return {"sxx": state["kappa"]}
+
+    body = stretched(Clashing(E_MOD, NU), "total")
+    body.solve([1.0])
+    with pytest.raises(ValueError, match=r"fields \['sxx'\] have the names of stresses"):
+        cauchy_stress(body, body.displacement)

@@ -6,9 +6,11 @@ runs through :class:`vfem.bodies.section.Section` alone: a slab of plane strain 
 (its measure ``DEPTH`` everywhere) must give the displacements, stresses and contact pressures of
 the slab one deep, and ``DEPTH`` times its forces. A place that integrated over the mesh without
 the section's measure — the stiffness, a traction, the contact surface's N* and tributary
-lengths, the transfer's overlap quadrature, the thesis variant's virtual elements, the
-invariants' consistent tension measure — would break the equality: the loads, the contact forces
-or the pressures would be off by the factor ``DEPTH`` somewhere and not elsewhere.
+lengths — would break the equality: the loads, the contact forces or the pressures would be off
+by the factor ``DEPTH`` somewhere and not elsewhere. A constant measure cancels out of what is a
+ratio of two integrals on one side (the transfer's N and T against the traction values, the
+thesis variant's opposing traction, the invariants' recovered pressure against its largest), so
+those are tried with a measure that varies along the surface (:class:`Graded`), or directly.
 
 DEPTH is a power of two, so the deep model's arrays are the shallow one's times DEPTH up to the
 order of the floating-point operations; the displacements are compared to 1e-9 of their
@@ -38,6 +40,7 @@ from vfem.bodies.stresses import stress
 from vfem.contact.formulations.algorithm import VirtualElementContact
 from vfem.contact.geometry.pairing import overlap
 from vfem.contact.geometry.surface import ContactSurface
+from vfem.contact.invariants.plane import _boundary_mass
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
 from vfem.materials import LinearElastic
@@ -200,3 +203,16 @@ def test_the_thesis_variants_virtual_elements_read_each_side_in_its_own_measure(
     total = contact._virtual_forces(0, x, tractions).sum(axis=0)
     expected = (1 - shift) + (1 - shift) ** 2 / 2
     assert np.abs(total - expected * q).max() <= 1e-13 * expected
+
+
+def test_the_invariants_consistent_measure_is_taken_in_the_sections_measure(monkeypatch):
+    """The boundary mass matrix of the consistent tension measure is the section's facet mass:
+    ``DEPTH`` times plane strain's for the deep slab, whose row sums are then ``DEPTH`` times
+    the facets' lengths around each node (exact: the same products)."""
+    lower, _ = graded_strips(monkeypatch)
+    x, facets = lower.X, lower.facets
+    local = np.arange(lower.nc)
+    plain = _boundary_mass(PlaneStrain(), x, facets, local, lower.nc).toarray()
+    deep = _boundary_mass(Deep(), x, facets, local, lower.nc).toarray()
+    assert np.array_equal(deep, DEPTH * plain)
+    assert abs(plain.sum() - 1.0) <= 1e-15  # the unit strip's length

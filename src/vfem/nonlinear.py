@@ -306,7 +306,11 @@ class NonlinearBody:
         material.validate(f"{name}: material")
         if formulation not in (TOTAL, UPDATED):
             raise InputError(f"{name}: formulation must be 'total' or 'updated', "
-                             f"got {formulation!r}")
+                             f"got {formulation!r}" + (
+                                 " (a material that carries state under small kinematics "
+                                 "needs a small-strain mode, which is not implemented yet: "
+                                 "give the body kinematics = 'total')"
+                                 if formulation == "small" else ""))
         if order not in (1, 2):
             raise InputError(f"{name}: order must be 1 or 2, got {order!r}")
         self.material = material
@@ -798,13 +802,15 @@ class NonlinearBody:
         """Element averages over the current volume at the total displacement ``u``: the
         in-plane Cauchy stress (nelems, 2, 2) and ``sigma_zz`` (nelems,); in 3D the Cauchy
         stress (nelems, 3, 3) and its zz component; and the fields the material shows of the
-        state it would commit there (:meth:`~vfem.materials.protocol.Material.fields`, by
-        name, (nelems,) each)."""
+        state it would commit there (its optional ``fields``, :mod:`vfem.materials.protocol`;
+        by name, (nelems,) each)."""
         state = self._state(np.asarray(u, dtype=float) - self._u_at_current)
         J = determinant(state.F)
         w = state.basis.dx * J
-        fields = {name: (v * w).sum(axis=-1) / w.sum(axis=-1)
-                  for name, v in self.material.fields(state.material_state).items()}
+        shown = getattr(self.material, "fields", None)  # optional (materials.protocol)
+        fields = {} if shown is None else {
+            name: (v * w).sum(axis=-1) / w.sum(axis=-1)
+            for name, v in shown(state.material_state).items()}
         sig = push_forward_stress(state.S, state.F)
         avg = (sig * w).sum(axis=-1) / w.sum(axis=-1)
         if state.S33 is None:

@@ -321,9 +321,12 @@ class Analysis:
             shared = self.model.contact.variant != "paired"
             if ranks.parallel:  # each body on its own rank (vfem.parallel, issue 22)
                 if any(b.iterates for b in bodies):
+                    b = next(b for b in bodies if b.iterates)
                     raise InputError("a run over MPI ranks serves small kinematics; body "
-                                     f"{next(b.name for b in bodies if b.iterates)!r} has large "
-                                     "kinematics: run it in one process")
+                                     f"{b.name!r} "
+                                     + ("has large kinematics" if b.large else
+                                        "carries a material state (Newton's method)")
+                                     + ": run it in one process")
                 set_up_bodies(ranks, bodies, lambda i: bodies[i].setup(
                     self.backend, condensed_dofs=None if self.matrix_free
                     else self.surfaces[i].condensed_dofs), shared)

@@ -3,15 +3,19 @@
 A 2D body stands for a 3D one by an assumption about the third direction: a slice of a long
 body (plane strain: no strain across it), a thin plate (plane stress: no stress across it), or
 — the next one (issue 42) — a body of revolution (axisymmetric: the hoop strain u_r / r, and a
-measure 2πr). A 3D body has none. Every integral of a body reads its section rather than the
-material's ``plane`` or the mesh's dimension:
+measure 2πr). A 3D body has none. Every integral of a small-kinematics body reads its section
+rather than the material's ``plane`` or the mesh's dimension (the plane-stress λ is the
+material's :meth:`~vfem.materials.LinearElastic.lame`; the large-kinematics integrals of
+:mod:`vfem.nonlinear`, plane strain or 3D, do not read it yet):
 
 * :meth:`Section.weight` — the measure per unit of the mesh's own length, area or volume at given
   points: 1 here (2πr, or r per radian, for a body of revolution). The body's tractions
-  (:func:`vfem.bodies.loads.traction_vector`), the contact surface's mass matrix N* and its
-  quadratures (:mod:`vfem.contact.geometry.surface`, :meth:`Segment.overlap_quadrature
-  <vfem.contact.geometry.facets.Segment.overlap_quadrature>`) and the invariants' consistent
-  tension measure (:meth:`Section.facet_mass`) multiply by it;
+  (:func:`vfem.bodies.loads.traction_vector`), the contact surface's mass matrix N*
+  (:mod:`vfem.contact.geometry.measure`), the transfer's overlap quadrature
+  (:meth:`Segment.overlap_quadrature
+  <vfem.contact.geometry.facets.Segment.overlap_quadrature>`), the thesis variant's opposing
+  traction (:mod:`vfem.contact.formulations.algorithm`) and the invariants' consistent tension
+  measure (:meth:`Section.facet_mass`) multiply by it;
 * the stiffness (:meth:`Section.stiffness`), the element-average strains and stresses
   (:meth:`Section.average_strain_operator`, :meth:`Section.stress`: the out-of-plane stress)
   and the strain the solver's warning reads (:meth:`Section.max_strain`);

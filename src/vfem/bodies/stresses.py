@@ -31,7 +31,11 @@ def cauchy_stress(nonlinear, u: np.ndarray) -> dict[str, np.ndarray]:
                "syz": sig[:, 1, 2], "sxz": sig[:, 0, 2], "sxy": sig[:, 0, 1]}
     else:
         avg = {"sxx": sig[:, 0, 0], "syy": sig[:, 1, 1], "sxy": sig[:, 0, 1], "szz": szz}
-    return {**_with_von_mises(avg), **fields}
+    avg = _with_von_mises(avg)
+    clash = sorted(set(fields) & set(avg))
+    if clash:
+        raise ValueError(f"the material's fields {clash} have the names of stresses")
+    return {**avg, **fields}
 
 
 def small_strain_stress(body, u: np.ndarray) -> dict[str, np.ndarray]:

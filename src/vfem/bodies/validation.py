@@ -55,6 +55,9 @@ def validate(body) -> None:
         names = " or ".join(repr(name) for name in LAWS)
         raise InputError(f"{where}: law must be {names}, got {body.law!r}")
     section = section_of(body)  # refuses a plane given to a 3D body
+    if body.iterates and not body.large and body.order != 1:  # Newton's mechanics: order 1
+        raise InputError(f"{where}: a material that carries state needs linear elements "
+                         "(order 1)")
     if body.large and (body.order != 1 or not section.takes_large):
         taken = [s.name for s in SECTIONS.values() if s.takes_large]
         raise InputError(f"{where}: large kinematics ({body.kinematics!r}) needs linear "

@@ -90,10 +90,6 @@ class _Isotropic:
         return Response(self.second_piola(E), lambda: self.tangent(E),
                         self.out_of_plane_stress(E), state)
 
-    def fields(self, state: State) -> dict[str, np.ndarray]:
-        """No state to show."""
-        return {}
-
 
 @dataclass(frozen=True)
 class SaintVenantKirchhoff(_Isotropic):

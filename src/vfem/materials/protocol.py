@@ -14,6 +14,16 @@ keeps the converged one; an iterate's :class:`Response` says which state it *wou
 the body commits it only when its step converges (:meth:`NonlinearBody.accept`), drops it when a
 step is cut (:meth:`NonlinearBody.discard`) and saves it with the body's state (checkpoints,
 ``--resume``, :meth:`NonlinearBody.saved_state`), so a path-dependent law is restored bit for bit.
+
+A law may also show what it will of its state: a method ``fields(state)`` giving named arrays
+(nelements, nq) over the quadrature points (an equivalent plastic strain, a yielded flag), which
+the body writes as element averages beside its stresses
+(:meth:`NonlinearBody.cauchy_stress_at`, the VTU's cell fields). It is optional, outside the
+protocol's runtime check: a law without it shows nothing.
+
+The body that evaluates a law is one that iterates (:attr:`vfem.bodies.Body.iterates`): under
+large kinematics, or of a material that carries state (its material table's ``law(name)``,
+:mod:`vfem.materials`).
 """
 
 from __future__ import annotations
@@ -68,12 +78,6 @@ class Material(Protocol):
     def response(self, E: np.ndarray, state: State) -> Response:
         """The stress, its tangent and the state to commit for the Green-Lagrange strain ``E``
         (dim, dim, nelements, nq), from the converged ``state``."""
-
-    def fields(self, state: State) -> dict[str, np.ndarray]:
-        """What of ``state`` the results show, by name: arrays (nelements, nq) over the
-        quadrature points, written as element averages beside the stresses (the VTU's cell
-        fields; an equivalent plastic strain, a yielded flag): nothing for a law without
-        history."""
 
 
 __all__ = ["Material", "Response", "State"]

@@ -206,11 +206,6 @@ class VirtualElementContact:
         # ds/stretch_opp of the opposing one, so the opposing traction is weighted by
         # stretch_own/stretch_opp: the virtual forces then add up to the opposing total.
         stretch_own = np.repeat(np.linalg.norm(xb - xa, axis=1) / s.lengths, nq)
-        # and per undeformed measure: the sections' weights at the undeformed points (1, or
-        # 2πr on a body of revolution), the own one's in w (ContactSurface.quadrature)
-        own0 = (s.X[s.facets[:, 0]][:, None, :] * (1 - xi)[None, :, None]
-                + s.X[s.facets[:, 1]][:, None, :] * xi[None, :, None]).reshape(-1, 2)
-        weight_own = s.weight(own0)
         trac = np.zeros((len(pts), 2))
         for j in np.unique(owners[seg]):
             sel = np.flatnonzero((owners[seg] == j) & near)
@@ -219,8 +214,10 @@ class VirtualElementContact:
             ends = sj.facets[g]
             qj = tractions[j]
             jac = stretch_own[sel] * sj.lengths[g] / opp_len[seg[sel]]
+            # and the opposing body's section's measure at its undeformed point (1, or 2πr on
+            # a body of revolution): the opposing force per own undeformed length
             opp0 = (1 - t[sel, None]) * sj.X[ends[:, 0]] + t[sel, None] * sj.X[ends[:, 1]]
-            jac = jac * (sj.weight(opp0) / _at(weight_own, sel))
+            jac = jac * sj.weight(opp0)
             trac[sel] = jac[:, None] * ((1 - t[sel, None]) * qj[ends[:, 0]]
                                         + t[sel, None] * qj[ends[:, 1]])
         trac = trac.reshape(len(s.facets), nq, 2)
@@ -410,8 +407,3 @@ class VirtualElementContact:
             return None
 
         return iterate(cfg, check, correct, on_iteration)
-
-
-def _at(weight, sel: np.ndarray):
-    """A section's weight at the points ``sel``: a number (measure 1) as it is."""
-    return weight[sel] if np.ndim(weight) else weight

@@ -85,15 +85,21 @@ def check_capabilities(model) -> None:
     caps = cls.capabilities
     if settings.method != "vfem":
         for b in model.bodies:
-            if ("large" if b.large else "small") not in caps.kinematics \
+            # (a body corrected by Newton's method under small kinematics, of a material that
+            # carries state, is not linear either: the classical methods solve K u = f once)
+            if ("large" if b.iterates else "small") not in caps.kinematics \
                     or b.order not in caps.orders:
                 raise InputError(f"model {model.name!r}, body {b.name!r}: the classical "
                                  f"contact methods (contact.method = {settings.method!r}) need "
-                                 f"{_orders(caps)} and small kinematics; use contact.method = "
-                                 "'vfem'")
+                                 f"{_orders(caps)} and small kinematics"
+                                 + ("" if b.large or not b.iterates else
+                                    " with a material that carries no state")
+                                 + "; use contact.method = 'vfem'")
     elif large and settings.variant != "paired":
-        raise InputError(f"model {model.name!r}: large kinematics needs the paired contact "
-                         "variant")
+        raise InputError(f"model {model.name!r}: "
+                         + ("large kinematics" if any(b.large for b in model.bodies) else
+                            "a material that carries state (Newton's method)")
+                         + " needs the paired contact variant")
     names = {b.name for b in model.bodies}
     for pair in settings.pairs:
         unknown = [n for n in pair.bodies if n not in names]

@@ -1,8 +1,10 @@
-"""The measure of a 2D contact surface: what N* (eq. 4.4.10) and the virtual elements'
-quadrature integrate, in its body's section's measure (:meth:`ContactSurface.weight
+"""The measure of a 2D contact surface: what N* (eq. 4.4.10) integrates, in its body's section's
+measure (:meth:`ContactSurface.weight
 <vfem.contact.geometry.surface.ContactSurface.weight>`: the mesh's length, times 2πr on a
-body of revolution). :class:`~vfem.contact.geometry.surface.ContactSurface` asks here
-(``mass_matrix``, ``quadrature``); the transfer's overlap quadrature weights the same way
+body of revolution), and the virtual elements' Gauss points (in the mesh's length: the thesis
+variant weighs the opposing traction by the opposing body's measure).
+:class:`~vfem.contact.geometry.surface.ContactSurface` asks here (``mass_matrix``,
+``quadrature``); the transfer's overlap quadrature weights as N* does
 (:meth:`Segment.overlap_quadrature <vfem.contact.geometry.facets.Segment.overlap_quadrature>`),
 and the invariants' consistent tension measure by the section's
 :meth:`~vfem.bodies.section.Section.facet_mass`."""
@@ -22,15 +24,16 @@ def virtual_quadrature(surface, order: int) -> tuple[np.ndarray, np.ndarray, np.
     """Gauss points of the virtual elements on each candidate facet of ``surface``.
 
     Returns (xi, phi, w): local coordinates (nq,), shape function values (2, nq) of the
-    facet's own 2-node element, and weights per facet (nf, nq) times the undeformed length
-    and the section's weight at the points.
+    facet's own 2-node element, and weights per facet (nf, nq) times the undeformed length.
+    The thesis variant integrates the opposing traction over them in the opposing body's
+    measure (its section's weight at the opposing point,
+    :meth:`~vfem.contact.formulations.algorithm.VirtualElementContact._virtual_forces`): the
+    own side's weight cancels out of the nominal traction carried across.
     """
     X, W = get_quadrature(RefLine, order)
     e = ElementLineP1()
     phi = np.vstack([e.lbasis(X, i)[0] for i in range(2)])
-    a, b = surface.X[surface.facets[:, 0]], surface.X[surface.facets[:, 1]]
-    points = a[:, None, :] * phi[0][None, :, None] + b[:, None, :] * phi[1][None, :, None]
-    return X[0], phi, surface.lengths[:, None] * W[None, :] * surface.weight(points)
+    return X[0], phi, surface.lengths[:, None] * W[None, :]
 
 
 def facet_mass_entries(surface):

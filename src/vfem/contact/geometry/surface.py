@@ -535,8 +535,7 @@ class ContactSurface:
 
     def quadrature(self, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Gauss points of the virtual elements on each candidate facet: (xi, phi, w), the
-        weights times the undeformed length and the section's weight
-        (:func:`.measure.virtual_quadrature`)."""
+        weights times the undeformed length (:func:`.measure.virtual_quadrature`)."""
         return virtual_quadrature(self, order)
 
     def mass_matrix(self, facet_weight: np.ndarray) -> sp.csr_matrix:
