@@ -166,18 +166,20 @@ def rect(cls, x0, x1, y0, y1, nx, ny, boundaries=("bottom", "top")):
     return m.with_boundaries({name: marks[name] for name in boundaries})
 
 
-def strip(cls, y0, y1, nx, name, E=1e9) -> Body:
+def strip(cls, y0, y1, nx, name, E=1e9, plane="strain") -> Body:
     """A body: a unit-wide strip of two element rows over [y0, y1], held at its far face."""
     mesh = rect(cls, 0, 1, y0, y1, nx, 2, boundaries=("top", "bottom"))
-    return Body(name, mesh, LinearElastic(E, 0.3),
+    return Body(name, mesh, LinearElastic(E, 0.3, plane),
                 supports=(Support("bottom" if y0 < 0 else "top"),))
 
 
-def strip_surfaces(n_lower, n_upper, E=1e9, names=("lower", "upper")) -> list[ContactSurface]:
-    """Set-up surfaces of two facing strips: quadrilaterals below y = 0, triangles above."""
+def strip_surfaces(n_lower, n_upper, E=1e9, names=("lower", "upper"), plane="strain"
+                   ) -> list[ContactSurface]:
+    """Set-up surfaces of two facing strips: quadrilaterals below y = 0, triangles above (of
+    the section ``plane`` names)."""
     out = []
-    for b, side in ((strip(MeshQuad, -0.5, 0.0, n_lower, names[0], E), "top"),
-                    (strip(MeshTri, 0.0, 0.5, n_upper, names[1], E), "bottom")):
+    for b, side in ((strip(MeshQuad, -0.5, 0.0, n_lower, names[0], E, plane), "top"),
+                    (strip(MeshTri, 0.0, 0.5, n_upper, names[1], E, plane), "bottom")):
         b.setup()
         s = ContactSurface.build(b, b.mesh.boundaries[side])
         s.compute_flexibility()

@@ -159,6 +159,24 @@ def test_unloading_remembers_the_largest_strain():
     assert np.abs(body.reactions() - (1.0 - d2) * r0).max() <= 1e3 * eps * np.abs(r0).max()
 
 
+def pressed_block(material, law: str, load_factors: list[float]):
+    """A block of ``material`` under large kinematics (hyperelastic ``law``), held at its
+    bottom and pressed by a stiffer punch 0.02 down per unit load factor: the converged run
+    and the block."""
+    block = Body("block", rectangle(-1.0, -1.0, 2.0, 1.0, nx=10, ny=5), material,
+                 supports=(Support("bottom"),), contact_boundaries=("top",),
+                 kinematics="total", law=law)
+    punch = Body("punch", rectangle(-0.35, 0.0, 0.7, 0.3, nx=5, ny=2),
+                 LinearElastic(20 * E_MOD, NU),
+                 prescribed=(PrescribedDisplacement("top", "y", -0.02),),
+                 supports=(Support("top", ("x",)),), contact_boundaries=("bottom",))
+    model = Model("pressed", [block, punch], load_factors=load_factors)
+    model.contact = ContactSettings()
+    result = Analysis(model).run()
+    assert result.converged, result.message
+    return result, block
+
+
 def test_a_contact_analysis_carries_the_law_unchanged(monkeypatch):
     """A block of a law with state under large kinematics, pressed by a stiffer punch in
     three steps (down, further, back up): contact sees only the body's mechanics, so the
@@ -166,23 +184,9 @@ def test_a_contact_analysis_carries_the_law_unchanged(monkeypatch):
     body's saved state holds the largest strain norm of the steps' converged fields, computed
     here from the steps' displacements."""
     monkeypatch.setitem(LAWS, "recording", Recording)
-
-    def run(law):
-        block = Body("block", rectangle(-1.0, -1.0, 2.0, 1.0, nx=10, ny=5),
-                     LinearElastic(E_MOD, NU), supports=(Support("bottom"),),
-                     contact_boundaries=("top",), kinematics="total", law=law)
-        punch = Body("punch", rectangle(-0.35, 0.0, 0.7, 0.3, nx=5, ny=2),
-                     LinearElastic(20 * E_MOD, NU),
-                     prescribed=(PrescribedDisplacement("top", "y", -0.02),),
-                     supports=(Support("top", ("x",)),), contact_boundaries=("bottom",))
-        model = Model("damage", [block, punch], load_factors=[1.0, 2.0, 1.0])
-        model.contact = ContactSettings()
-        result = Analysis(model).run()
-        assert result.converged, result.message
-        return result, block
-
-    recorded, block = run("recording")
-    plain, _ = run("saint-venant-kirchhoff")
+    recorded, block = pressed_block(LinearElastic(E_MOD, NU), "recording", [1.0, 2.0, 1.0])
+    plain, _ = pressed_block(LinearElastic(E_MOD, NU), "saint-venant-kirchhoff",
+                             [1.0, 2.0, 1.0])
     # the same arithmetic in both runs; a threaded factorization may round differently from
     # run to run, and each converged state is exact only to the bodies' Newton tolerance (1e-8
     # of the reference force, large.BODY_TOLERANCE): the answers agree within it
@@ -245,16 +249,7 @@ def test_a_material_table_that_carries_state_makes_its_body_iterate_with_its_own
     small = Body("block", mesh, RecordingTable(E_MOD, NU), supports=(Support("bottom"),))
     assert small.iterates and not small.large
     assert not Body("block", mesh, LinearElastic(E_MOD, NU)).iterates
-    block = Body("block", mesh, RecordingTable(E_MOD, NU), supports=(Support("bottom"),),
-                 contact_boundaries=("top",), kinematics="total")
-    punch = Body("punch", rectangle(-0.35, 0.0, 0.7, 0.3, nx=5, ny=2),
-                 LinearElastic(20 * E_MOD, NU),
-                 prescribed=(PrescribedDisplacement("top", "y", -0.02),),
-                 supports=(Support("top", ("x",)),), contact_boundaries=("bottom",))
-    model = Model("recorded", [block, punch], load_factors=[1.0])
-    model.contact = ContactSettings()
-    result = Analysis(model).run()
-    assert result.converged, result.message
+    result, block = pressed_block(RecordingTable(E_MOD, NU), "saint-venant-kirchhoff", [1.0])
     assert isinstance(block.nonlinear.material, Shown)
     shown = stress(block, np.ravel(result.steps[-1].bodies["block"].displacement))["kappa"]
     kappa = block.saved_state()["material_kappa"]

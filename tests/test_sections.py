@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from skfem import MeshQuad, MeshTri
 
 from models import (
     built,
@@ -30,7 +29,7 @@ from models import (
     pressed,
     rectangle_mesh,
     slid,
-    strip,
+    strip_surfaces,
     support,
     toml_body,
     traction,
@@ -39,11 +38,9 @@ from vfem.bodies.section import SECTIONS, PlaneStrain, section_of
 from vfem.bodies.stresses import stress
 from vfem.contact.formulations.algorithm import VirtualElementContact
 from vfem.contact.geometry.pairing import overlap
-from vfem.contact.geometry.surface import ContactSurface
 from vfem.contact.invariants.plane import _boundary_mass
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
-from vfem.materials import LinearElastic
 from vfem.solver import Analysis
 
 DEPTH = 2.0
@@ -158,18 +155,10 @@ class Graded(PlaneStrain):
 
 
 def graded_strips(monkeypatch, n_lower=4, n_upper=7):
-    """The two facing unit strips of ``models.strip`` (quadrilaterals below y = 0, triangles
-    above), both of the graded section, set up: their contact surfaces."""
+    """The two facing unit strips of ``models.strip_surfaces`` (quadrilaterals below y = 0,
+    triangles above), both of the graded section, set up: their contact surfaces."""
     monkeypatch.setitem(SECTIONS, Graded.plane, Graded())
-    out = []
-    for b, side in ((strip(MeshQuad, -0.5, 0.0, n_lower, "lower"), "top"),
-                    (strip(MeshTri, 0.0, 0.5, n_upper, "upper"), "bottom")):
-        b.material = LinearElastic(1e9, 0.3, Graded.plane)
-        b.setup()
-        s = ContactSurface.build(b, b.mesh.boundaries[side])
-        s.compute_flexibility()
-        out.append(s)
-    return out
+    return strip_surfaces(n_lower, n_upper, plane=Graded.plane)
 
 
 def test_the_transfer_of_a_uniform_traction_carries_the_sections_measure(monkeypatch):

@@ -320,8 +320,8 @@ class Analysis:
             # variant on its owner only (vfem.parallel)
             shared = self.model.contact.variant != "paired"
             if ranks.parallel:  # each body on its own rank (vfem.parallel, issue 22)
-                if any(b.iterates for b in bodies):
-                    b = next(b for b in bodies if b.iterates)
+                b = next((b for b in bodies if b.iterates), None)
+                if b is not None:
                     raise InputError("a run over MPI ranks serves small kinematics; body "
                                      f"{b.name!r} "
                                      + ("has large kinematics" if b.large else
