@@ -53,6 +53,7 @@ def model(kind: str, order: int, n: int):
 
 def measure(kind: str, order: int, n: int, backend: str) -> dict:
     import vfem.solver
+    from vfem.contact.geometry import ContactPairs
     from vfem.memory import estimate, factor_entries
     from vfem.solver import Analysis
 
@@ -73,7 +74,7 @@ def measure(kind: str, order: int, n: int, backend: str) -> dict:
         rows.append({"dofs": s.body.ndofs, "tracked": condensed, "nnz_LU": entries,
                      "model": round(factor_entries(s.body.ndofs, condensed, backend,
                                                    s.body.dim))})
-    total = estimate(analysis.surfaces, [frozenset((0, 1))], backend)["total"]
+    total = estimate(analysis.surfaces, ContactPairs.every(2), backend)["total"]
     return {"case": f"{kind} P{order} n={n}", "bodies": rows, "peak_MiB": peak / 2**20,
             "estimate_MiB": total / 2**20}
 

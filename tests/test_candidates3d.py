@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from vfem.bodies import Body, Platen, PrescribedDisplacement, Support
+from vfem.contact.geometry import ContactPairs
 from vfem.contact.geometry.bodymesh import exterior_facets, locate_in_simplices, simplices
 from vfem.contact.geometry.placement import (
     check_initial_overlap,
@@ -24,7 +25,7 @@ from vfem.materials import LinearElastic
 from vfem.mesh.solids import box
 
 MAT = LinearElastic(200.0, 0.3)
-PAIR = {frozenset((0, 1))}
+PAIR = ContactPairs.every(2)
 DISTANCE = 0.1
 
 

@@ -7,6 +7,7 @@ import numpy as np
 from models import strip_surfaces
 from vfem import parallel
 from vfem.contact.formulations.paired import PairedContact
+from vfem.contact.geometry import ContactPairs
 from vfem.contact.settings import ContactSettings
 from vfem.executor import SERIAL
 
@@ -16,7 +17,7 @@ def surfaces():
 
 
 def test_a_formulation_built_without_an_executor_runs_serially_and_alike():
-    pairs = {frozenset((0, 1))}
+    pairs = ContactPairs.every(2)
     alone = PairedContact(surfaces(), pairs, ContactSettings())
     ranks = PairedContact(surfaces(), pairs, ContactSettings(), executor=parallel.Ranks())
     assert alone.executor is SERIAL and alone.executor.size == 1

@@ -37,6 +37,7 @@ from models import (
 from vfem.bodies.section import SECTIONS, PlaneStrain, section_of
 from vfem.bodies.stresses import stress
 from vfem.contact.formulations.algorithm import VirtualElementContact
+from vfem.contact.geometry import ContactPairs
 from vfem.contact.geometry.pairing import overlap
 from vfem.contact.invariants.plane import _boundary_mass
 from vfem.contact.settings import ContactSettings
@@ -183,7 +184,7 @@ def test_the_thesis_variants_virtual_elements_read_each_side_in_its_own_measure(
     1.21875 q, the lower's measure. The lower's facets end at x = s, so the Gauss rule (order
     7) is exact on each: to round-off."""
     lower, upper = graded_strips(monkeypatch)
-    contact = VirtualElementContact([lower, upper], {frozenset((0, 1))},
+    contact = VirtualElementContact([lower, upper], ContactPairs.every(2),
                                     ContactSettings(variant="thesis"))
     shift = 0.25
     x = [lower.X.copy(), upper.X + np.array([shift, 0.0])]

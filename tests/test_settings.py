@@ -7,6 +7,7 @@ import pytest
 
 from models import strip_surfaces
 from vfem.contact.formulations.algorithm import VirtualElementContact
+from vfem.contact.geometry import ContactPairs
 from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
 from vfem.solver import Analysis, Model
@@ -30,7 +31,7 @@ def test_other_settings_reach_the_same_hertz_answer(hertz_level0, changes):
 
 
 def two_blocks():
-    return VirtualElementContact(strip_surfaces(4, 5, E=1e3), {frozenset((0, 1))},
+    return VirtualElementContact(strip_surfaces(4, 5, E=1e3), ContactPairs.every(2),
                                  ContactSettings(variant="thesis"))
 
 

@@ -5,6 +5,7 @@ import pytest
 
 from models import strip_surfaces
 from vfem.contact.formulations.algorithm import VirtualElementContact
+from vfem.contact.geometry import ContactPairs
 from vfem.contact.geometry.transfer import traction_from_forces
 from vfem.contact.settings import ContactSettings
 
@@ -13,7 +14,7 @@ from vfem.contact.settings import ContactSettings
 def test_uniform_traction_crosses_non_matching_meshes_exactly(n_lower, n_upper):
     # stiff (E = 1e9) enough that the test forces leave the surfaces unstretched (to ~1e-9)
     surfaces = strip_surfaces(n_lower, n_upper)
-    contact = VirtualElementContact(surfaces, {frozenset((0, 1))}, ContactSettings())
+    contact = VirtualElementContact(surfaces, ContactPairs.every(2), ContactSettings())
     state = contact.new_state()
     # the upper body carries a uniform pressure 1 from the lower one: consistent nodal loads
     su = surfaces[1]

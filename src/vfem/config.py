@@ -296,8 +296,11 @@ class ModelConfig:
         bodies: the bodies, two or more for contact (each one ``[[bodies]]`` table).
         contact: settings of the contact algorithm.
         steps: the load history.
-        contact_pairs: which pairs of bodies may touch, by name, e.g.
-            ``[["cylinder", "flat"]]``. Default: every pair.
+        contact_pairs: which surfaces may touch, in pairs, e.g. ``[["cylinder", "flat"]]``.
+            A surface is a body's name (its whole contact surface), or its name, a colon and
+            boundaries of its mesh separated by commas (``"block:top"``, ``"block:top,left"``):
+            that pair reads those facets alone. Two bodies are paired once. Default: every
+            two bodies.
         output: what a run writes.
     """
 

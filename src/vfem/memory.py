@@ -179,8 +179,7 @@ def estimate(surfaces, pairs=(), backend: str | None = None, matrix_free: bool =
                                and body.dim == 3 else STIFFNESS_BYTES) * stiffness_entries(body)
         if body.iterates:  # its tangent's factor and flexibility, each iteration
             parts["large"] += LARGE_BYTES * ndofs * 2.0 * s.nc
-    for pair in pairs:
-        i, j = sorted(pair)
+    for i, j in pairs.keys():
         parts["pairs"] += PAIR_BYTES * float(surfaces[i].nc) * surfaces[j].nc
     parts["total"] = BASE_BYTES + sum(parts.values())
     return parts

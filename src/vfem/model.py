@@ -14,7 +14,12 @@ import numpy as np
 from .bodies import Body
 from .bodies.section import SPACES
 from .contact.formulations import check_capabilities
-from .contact.geometry import ContactSurface, check_initial_overlap, select_candidate_facets
+from .contact.geometry import (
+    ContactPairs,
+    ContactSurface,
+    check_initial_overlap,
+    select_candidate_facets,
+)
 from .contact.settings import ContactSettings
 from .errors import InputError
 
@@ -55,13 +60,7 @@ class Model:
             raise InputError(f"model {self.name!r}: load_factors must be finite numbers, each "
                              f"different from the one before (and the first not 0), got "
                              f"{list(self.load_factors)}")
-        for a, b in self.contact_pairs or ():
-            if a == b:
-                raise InputError(f"model {self.name!r}: contact pair [{a!r}, {b!r}] names one "
-                                 "body twice: contact of a body with itself is not supported")
-            for n in (a, b):
-                if n not in names:
-                    raise InputError(f"model {self.name!r}: contact pair names unknown body {n!r}")
+        self.pairs()  # its bodies and boundaries exist, one pair per two bodies
         for b in self.bodies:
             b.validate()
         spaces = {b.name: b.section.space for b in self.bodies}  # bodies.section
@@ -74,22 +73,24 @@ class Model:
             raise InputError(f"model {self.name!r}: at most one force-controlled platen")
         self.contact.validate()
 
-    def contact_surfaces(self) -> tuple[set[frozenset[int]], list[ContactSurface]]:
-        """The pairs of bodies (by index) that may touch (``contact_pairs``, or every pair) and
-        each body's contact surface: candidate facets within ``contact.search_distance`` of a
-        body it may touch (by default every facet that may touch under large kinematics, where
-        bodies may slide far; a distance given is honoured there, along the whole path of the
-        prescribed motions).
+    def pairs(self) -> ContactPairs:
+        """The pairs of surface sides that may touch (``contact_pairs``, or every two bodies on
+        their whole contact surfaces; :class:`~vfem.contact.geometry.sides.ContactPairs`)."""
+        return ContactPairs.parse(self.contact_pairs, self.bodies,
+                                  f"model {self.name!r}: contact pair")
+
+    def contact_surfaces(self) -> tuple[ContactPairs, list[ContactSurface]]:
+        """The pairs of surface sides that may touch (:meth:`pairs`, their zones read on the
+        surfaces) and each body's contact surface: candidate facets within
+        ``contact.search_distance`` of a side it may touch (by default every facet that may
+        touch under large kinematics, where bodies may slide far; a distance given is honoured
+        there, along the whole path of the prescribed motions).
 
         Depends on the meshes only, so it is also part of ``vfem check``: bodies that start
         deeper into each other than the outer layer of elements are refused here
         (:func:`~vfem.contact.geometry.placement.check_initial_overlap`).
         """
-        index = {b.name: i for i, b in enumerate(self.bodies)}
-        if self.contact_pairs is None:
-            pairs = {frozenset((i, j)) for i in range(len(self.bodies)) for j in range(i)}
-        else:
-            pairs = {frozenset((index[a], index[b])) for a, b in self.contact_pairs}
+        pairs = self.pairs()
         distance = self.contact.search_distance
         large = any(b.large for b in self.bodies)
         if distance is None and large:  # bodies may slide anywhere: every facet (issue 19:
@@ -100,5 +101,6 @@ class Model:
         facets = select_candidate_facets(self.bodies, pairs, distance, self.load_factors,
                                          follow_path=large)
         surfaces = [ContactSurface.build(b, f) for b, f in zip(self.bodies, facets)]
+        pairs = pairs.on(surfaces)
         check_initial_overlap(surfaces, pairs)
         return pairs, surfaces

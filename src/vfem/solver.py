@@ -39,7 +39,7 @@ import numpy as np
 from .bodies import multiplier
 from .bodies.stresses import max_strain
 from .contact.formulations import formulation_class
-from .contact.geometry import exterior_facets
+from .contact.geometry import ContactPairs, exterior_facets
 from .contact.invariants import InvariantCheck, Invariants
 from .contact.search import project_points
 from .contact.settings import ContactSettings
@@ -97,15 +97,13 @@ def easy_iterations(settings: ContactSettings) -> int:
     return max(3, settings.max_iterations // 10)
 
 
-def unreachable_pairs(model: Model, pairs: set[frozenset[int]],
-                      surfaces: list) -> list[str]:
+def unreachable_pairs(model: Model, pairs: ContactPairs, surfaces: list) -> list[str]:
     """A note for every pair of bodies that may touch but has no contact candidate on either
     body: how far apart they are, against the search distance (``contact.search_distance``).
     Such bodies cannot touch in the analysis; a body that only contact would hold (pushed by
     a platen) then has nothing to push against, and the stop diagnosis says so."""
     notes = []
-    for pair in sorted(tuple(sorted(p)) for p in pairs):
-        i, j = pair
+    for i, j in pairs.keys():
         if surfaces[i].nc or surfaces[j].nc:
             continue
         ends = []
@@ -350,7 +348,7 @@ class Analysis:
         for key in ("assemble_s", "factorize_s"):
             self.timings[key] = sum(b.timings[key] for b in bodies)
 
-    def _matrix_free(self, pairs: set[frozenset[int]]) -> bool:
+    def _matrix_free(self, pairs: ContactPairs) -> bool:
         """Whether the contact correction applies the bodies' flexibility instead of forming
         it (``contact.flexibility``, issue 22): asked for, or ``"auto"`` and the dense blocks
         would exceed ``contact.dense_limit_mib`` (default half the memory available). The
@@ -380,7 +378,7 @@ class Analysis:
                  "none" if limit is None else f"{limit / 2**20:.0f} MiB")
         return chosen
 
-    def _contact(self, pairs: set[frozenset[int]]):
+    def _contact(self, pairs: ContactPairs):
         """The contact formulation of the model's settings and kinematics
         (:func:`~vfem.contact.formulations.formulation.formulation_class`)."""
         extra = {"sides": dict(self.sides)} if self.sides else {}

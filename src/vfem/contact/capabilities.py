@@ -25,7 +25,10 @@ class Capabilities:
     friction reads of a pair's law (:class:`vfem.contact.laws.FrictionLaw`): ``"coefficients"``
     (the static and dynamic ones), ``"slip"`` (coefficients that depend on the slip a node has
     accumulated), ``"compliance"`` (an elastic slip below the cone); it takes every law whose
-    ``reads`` are among them, and none (empty) for frictionless contact only.
+    ``reads`` are among them, and none (empty) for frictionless contact only. ``sides``:
+    whether it reads a pair's sides (:class:`vfem.contact.geometry.sides.ContactPairs`: a side
+    that names boundaries, ``["punch", "block:top"]``); one that reads whole surfaces refuses
+    such a pair.
     """
 
     name: str
@@ -38,3 +41,4 @@ class Capabilities:
     cuts_steps: bool = True
     reads_rind: bool = False
     orders_3d: tuple[int, ...] = ()
+    sides: bool = False

@@ -368,10 +368,8 @@ def contact_settings(model) -> dict:
     pair"``; then ``pairs``, each pair of bodies that may touch with its own law."""
     out = {"variant": model.contact.variant, "method": model.contact.method}
     if model.contact.frictional:
-        names = [b.name for b in model.bodies]
-        pairs = [friction_law(model.contact.pair_friction(a, b)) for a, b in (
-            model.contact_pairs if model.contact_pairs is not None
-            else [(a, b) for i, a in enumerate(names) for b in names[i + 1:]])]
+        pairs = [friction_law(model.contact.pair_friction(a, b))
+                 for a, b in model.pairs().names(model.bodies)]
         laws = [{k: v for k, v in p.items() if k != "bodies"} for p in pairs]
         common = laws[0] if laws and all(law == laws[0] for law in laws) else {"law": "per pair"}
         out["friction"] = {**common, "pairs": pairs}

@@ -30,7 +30,7 @@ import numpy as np
 
 from ...errors import RindViolation
 from ..capabilities import Capabilities
-from ..geometry import traction_from_forces
+from ..geometry import ContactPairs, traction_from_forces
 from ..laws import (
     compatibility_displacement,
     equilibrium_force,
@@ -59,7 +59,7 @@ class VirtualElementContact:
         name="thesis", orders=(1,), kinematics=("small",), dimensions=(2,),
         invariants="recorded", reads_rind=True)
 
-    def __init__(self, surfaces, pairs: set[frozenset[int]], settings, backend: str | None = None,
+    def __init__(self, surfaces, pairs: ContactPairs, settings, backend: str | None = None,
                  executor=None):
         #: the bodies' surfaces, the platen and the full-mesh fields (its data by name too)
         self.group = SurfaceGroup(surfaces, pairs, settings, backend, executor=executor)

@@ -100,6 +100,12 @@ def check_capabilities(model) -> None:
                          + ("large kinematics" if any(b.large for b in model.bodies) else
                             "a material that carries state (Newton's method)")
                          + " needs the paired contact variant")
+    if not caps.sides and model.pairs().named:
+        what = (f"contact.method = {settings.method!r}" if settings.method != "vfem" else
+                f"contact.variant = {settings.variant!r}")
+        raise InputError(f"model {model.name!r}: contact_pairs names boundaries of a body "
+                         f"(a pair's side), which the paired variant reads and {what} does "
+                         "not: name whole bodies, or use the paired variant (the default)")
     names = {b.name for b in model.bodies}
     for pair in settings.pairs:
         unknown = [n for n in pair.bodies if n not in names]
@@ -174,10 +180,7 @@ def bodies_that_may_touch(model) -> set[str]:
     pair of the model's bodies). A body in none (a model of one body, or one its
     ``contact_pairs`` leave out) is analysed without contact: its dimension is not the contact
     formulation's to refuse (a 3D body alone runs before 3D contact does, issue 21)."""
-    names = [b.name for b in model.bodies]
-    if model.contact_pairs is None:
-        return set(names) if len(names) > 1 else set()
-    return {n for pair in model.contact_pairs for n in pair}
+    return {n for pair in model.pairs().names(model.bodies) for n in pair}
 
 
 def _orders(caps: Capabilities) -> str:

@@ -15,7 +15,7 @@ import numpy as np
 
 from ...bodies.results import BodyStepResult, add_reactions
 from ...executor import SERIAL, Executor
-from ..geometry import ContactSurface
+from ..geometry import ContactPairs, ContactSurface
 from ..settings import ContactSettings
 from ..state import ContactState, SolveResult
 
@@ -60,7 +60,7 @@ class SurfaceGroup:
     penetration tolerance and the platen (see the module docstring): a part each virtual-element
     formulation holds (``formulation.group``), not a class it derives from."""
 
-    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]],
+    def __init__(self, surfaces: list[ContactSurface], pairs: ContactPairs,
                  settings: ContactSettings, backend: str | None = None,
                  executor: Executor | None = None):
         self.surfaces = surfaces
@@ -201,5 +201,4 @@ class SurfaceGroup:
 
     def opponents(self, i: int) -> list[int]:
         """The bodies body ``i`` may touch that have candidate facets."""
-        return [j for j in range(len(self.surfaces))
-                if j != i and frozenset((i, j)) in self.pairs and len(self.surfaces[j].facets)]
+        return [j for j in self.pairs.opponents(i) if len(self.surfaces[j].facets)]

@@ -73,7 +73,7 @@ import numpy as np
 
 from ...errors import AnalysisError, InputError
 from ..capabilities import Capabilities
-from ..geometry import ContactSurface, overlap, virtual_nodes
+from ..geometry import ContactPairs, ContactSurface, overlap, virtual_nodes
 from ..solvers import Check, iterate, linear_complementarity
 from ..state import ContactState, IterationRecord, SolveResult, closing_motion
 from .follower import follower_stiffness
@@ -100,11 +100,11 @@ class LargeDeformationContact(PairSet):
 
     capabilities = Capabilities(
         name="paired", orders=(1,), kinematics=("small", "large"), dimensions=(2, 3),
-        orders_3d=(1,))
+        orders_3d=(1,), sides=True)
 
     keep_all_nodes = True  # which nodes are over the other surface changes as bodies slide
 
-    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
+    def __init__(self, surfaces: list[ContactSurface], pairs: ContactPairs, settings,
                  backend: str | None = None, sides: dict | None = None, executor=None,
                  friction: type | None = None):
         for s in surfaces:
@@ -151,7 +151,9 @@ class LargeDeformationContact(PairSet):
         out = []
         for k, pair in enumerate(self.contact_pairs):
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            geo = overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes)
+            geo = overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes,
+                          (self.pairs.zone(pair.fine, pair.coarse),
+                           self.pairs.zone(pair.coarse, pair.fine)))
             if geo is None:  # the surfaces no longer face each other anywhere
                 pair.carries = np.zeros(len(pair.nodes), dtype=bool)
                 pair.mass = np.zeros_like(pair.mass)

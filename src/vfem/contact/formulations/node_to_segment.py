@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..geometry import ContactSurface, beyond
+from ..geometry import ContactPairs, ContactSurface, beyond
 
 log = logging.getLogger(__name__)
 
@@ -115,14 +115,14 @@ class NodeToSegment:
                              None if self.T_master is None else self.T_master[keep])
 
 
-def node_to_segment(surfaces: list[ContactSurface], pairs: set[frozenset[int]],
+def node_to_segment(surfaces: list[ContactSurface], pairs: ContactPairs,
                     offsets: np.ndarray, ndofs: int, penalty: float | None,
                     penalty_factor: float) -> NodeToSegment:
     """Project every slave node of every pair on its closest master segment (undeformed
     configuration, vectorised) and assemble the rows of the gaps (COO)."""
     index = {id(s): i for i, s in enumerate(surfaces)}
     parts = []
-    for pair in sorted(tuple(sorted(p)) for p in pairs):
+    for pair in pairs.keys():
         slave, master = choose_slave(surfaces[pair[0]], surfaces[pair[1]])
         if slave.nc == 0 or len(master.facets) == 0:
             continue

@@ -43,6 +43,7 @@ import numpy as np
 from ...errors import PlatenUnheld, PlatenUnpaired
 from ..capabilities import Capabilities
 from ..geometry import (
+    ContactPairs,
     ContactSurface,
 )
 from ..laws import relaxation, release_tension
@@ -79,8 +80,8 @@ class PairedContact(PairSet):
 
     capabilities = Capabilities(
         name="paired", orders=(1, 2), kinematics=("small",), dimensions=(2, 3),
-        orders_3d=(1, 2))
-    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
+        orders_3d=(1, 2), sides=True)
+    def __init__(self, surfaces: list[ContactSurface], pairs: ContactPairs, settings,
                  backend: str | None = None, sides: dict | None = None, executor=None,
                  friction: type | None = None):
         #: whether the equilibrium side's nodes are held too (issue 37): not yet with friction

@@ -111,7 +111,7 @@ def make_pair_sided(form, i: int, j: int, density_i: tuple[float, bool],
         fine, coarse = (i, j) if carrier == i else (j, i)
     sf, sc = form.surfaces[fine], form.surfaces[coarse]
     nodes = (facing_nodes(form, fine, coarse) if form.keep_all_nodes else None)
-    geo = overlap(sf, sc, nodes=nodes)
+    geo = overlap(sf, sc, nodes=nodes, zones=zones(form, fine, coarse))
     if geo is None:
         return None, [], fine
     c_fine, c_coarse = (ci, cj) if fine == i else (cj, ci)
@@ -253,7 +253,8 @@ def compliance_density(form, i: int, j: int) -> tuple[float, bool]:
     node read costs a back-substitution, and both routes must choose alike.
     """
     s, so = form.surfaces[i], form.surfaces[j]
-    patch, opatch = facing(s, s.X, so, so.X), facing(so, so.X, s, s.X)
+    zone, ozone = zones(form, i, j)
+    patch, opatch = facing(s, s.X, so, so.X, zone, ozone), facing(so, so.X, s, s.X, ozone, zone)
     if not len(patch) or not len(opatch):
         return 0.0, False
     oends = so.patch_boundary(opatch)
@@ -284,16 +285,25 @@ def compliance_density(form, i: int, j: int) -> tuple[float, bool]:
             if len(flexibility) else 0.0), edge
 
 
+def zones(form, i: int, j: int) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The facets of body i's and body j's surfaces on the sides of their pair (None: all;
+    :meth:`~vfem.contact.geometry.sides.ContactPairs.zone`)."""
+    return form.pairs.zone(i, j), form.pairs.zone(j, i)
+
+
 def facing_nodes(form, i: int, j: int) -> np.ndarray:
+    """Body i's candidate nodes (on its side of the pair) nearer j's side than any other's."""
     s = form.surfaces[i]
-    return np.flatnonzero(nearest_body(form, i, s.X[: s.nc]) == j)
+    nodes = np.flatnonzero(nearest_body(form, i, s.X[: s.nc]) == j)
+    zone = form.pairs.zone(i, j)
+    return nodes if zone is None else np.intersect1d(nodes, s.facets[zone])
 
 
 def nearest_body(form, i: int, points: np.ndarray) -> np.ndarray:
     best = np.full(len(points), -1)
     dist = np.full(len(points), np.inf)
-    for j in form.group.opponents(i):
-        _, _, d, _ = form.surfaces[j].project(points)
+    for j in form.group.opponents(i):  # (the closest point on j's side of the pair)
+        _, _, d, _ = form.surfaces[j].closest(points, None, form.pairs.zone(j, i))[:4]
         closer = d < dist
         best[closer], dist[closer] = j, d[closer]
     return best

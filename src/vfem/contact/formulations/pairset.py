@@ -14,6 +14,7 @@ import numpy as np
 from ...errors import RindViolation
 from ..geometry import (
     ContactPair,
+    ContactPairs,
     ContactSurface,
 )
 from ..state import (
@@ -37,7 +38,7 @@ class PairSet:
     :class:`~vfem.contact.formulations.paired.PairedContact` (small displacements) and
     :class:`~vfem.contact.formulations.large.LargeDeformationContact` are built on it."""
 
-    def __init__(self, surfaces: list[ContactSurface], pairs: set[frozenset[int]], settings,
+    def __init__(self, surfaces: list[ContactSurface], pairs: ContactPairs, settings,
                  backend: str | None = None, sides: dict | None = None, executor=None,
                  friction: type | None = None):
         #: the bodies' surfaces, the platen and the full-mesh fields (its data by name too)
@@ -48,8 +49,8 @@ class PairSet:
         #: solver's switch after a step that the rules' side could not hold
         #: (:meth:`vfem.solver.Analysis._switch_side`)
         self.given_sides = dict(sides or {})
-        keys = [tuple(sorted(pp)) for pp in sorted(pairs, key=sorted)]
-        keys = [(i, j) for i, j in keys if len(surfaces[i].facets) and len(surfaces[j].facets)]
+        keys = [(i, j) for i, j in pairs.keys()
+                if len(surfaces[i].facets) and len(surfaces[j].facets)]
         # each body's compliance densities against the bodies it may touch on the rank that
         # owns it (its flexibility), then each pair's geometry on a rank of its own, all at
         # once (vfem.parallel; in serial in order, as before)

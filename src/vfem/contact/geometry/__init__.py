@@ -24,6 +24,7 @@ from .pairing import (
     virtual_nodes,
 )
 from .placement import check_initial_overlap, select_candidate_facets
+from .sides import ContactPairs, Side, SurfacePair
 from .surface import ContactSurface, beyond, patch_ends
 from .tangent_basis import tangent_axes, tangents
 from .transfer import traction_from_forces
@@ -35,6 +36,7 @@ __all__ = [
     "closest_on_facets",
     "common_normal",
     "ContactPair",
+    "ContactPairs",
     "ContactSurface",
     "EDGE_RATIO",
     "exterior_facets",
@@ -50,6 +52,8 @@ __all__ = [
     "patch_ends",
     "read_facets",
     "select_candidate_facets",
+    "Side",
+    "SurfacePair",
     "symmetry_planes",
     "tangent_axes",
     "tangents",

@@ -103,21 +103,25 @@ FACING = 0.5
 EDGE_RATIO = 4.0
 
 
-def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray) -> np.ndarray:
+def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray,
+           zone: np.ndarray | None = None, ozone: np.ndarray | None = None) -> np.ndarray:
     """The candidate facets of ``s`` (at tracked positions ``x``) that face the body of ``so``
-    (at ``xo``): its patch in their pair (:data:`FACING`)."""
-    if len(s.facets) == 0 or len(so.facets) == 0:
+    (at ``xo``): its patch in their pair (:data:`FACING`). ``zone``, ``ozone``: the pair's
+    sides, the facets of each surface that take part (:class:`~.sides.ContactPairs`; None:
+    all)."""
+    facets = np.arange(len(s.facets)) if zone is None else np.asarray(zone, dtype=int)
+    if len(facets) == 0 or len(so.facets) == 0 or (ozone is not None and not len(ozone)):
         return np.zeros(0, dtype=int)
     n = s.facet_normals(x)
     faces = np.zeros(len(s.facets), dtype=bool)
-    for _, m, _ in read_facets(s, np.arange(len(s.facets)), x, so, xo, None, n):
-        faces |= np.einsum("ij,ij->i", n, m) <= -FACING
+    for _, m, _ in read_facets(s, facets, x, so, xo, ozone, n[facets]):
+        faces[facets] |= np.einsum("ij,ij->i", n[facets], m) <= -FACING
     # and a facet over which a vertex of the other surface lies, facing it: a punch's corner
     # that has slid past the end of the face it pressed presses the block's facet beyond (left
     # out, the corner went into the block unheld: large kinematics, equal stiffness, 3e-3 deep)
-    verts = so.vertices
+    verts = so.vertices if ozone is None else np.intersect1d(so.vertices, so.facets[ozone])
     vn = so.node_normals(xo)[verts]
-    seg, _, dist, _, tf = s.closest(xo[verts], x, None, vn)
+    seg, _, dist, _, tf = s.closest(xo[verts], x, zone, vn)
     reach = 2.0 * (s.sizes.max() + so.sizes.max())
     over = (s.kind.strictly_inside(tf) & (dist < reach)
             & (np.einsum("ij,ij->i", vn, n[seg]) <= -FACING))
@@ -390,7 +394,8 @@ class Overlap:
 
 
 def overlap(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray | None = None,
-             xc: np.ndarray | None = None, nodes: np.ndarray | None = None
+             xc: np.ndarray | None = None, nodes: np.ndarray | None = None,
+             zones: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
              ) -> Overlap | None:
     """Where the compatibility surface ``sf`` meets ``sc`` (undeformed, or at tracked
     positions ``xf`` and ``xc``): each node's virtual node, normal and gap, and the
@@ -404,11 +409,13 @@ def overlap(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray | None = None
     Elsewhere the normal is the patch's, interpolated between its nodal normals
     (continuous along a faceted curve; the facet normal on a flat) at the virtual node.
 
-    ``nodes``: the ``sf`` nodes to pair (default: the nodes of its patch).
+    ``nodes``: the ``sf`` nodes to pair (default: the nodes of its patch). ``zones``: the
+    facets of ``sf`` and ``sc`` on the pair's sides (:class:`~.sides.ContactPairs`; None: all),
+    within which each patch lies.
     """
     xf = sf.X if xf is None else xf
     xc = sc.X if xc is None else xc
-    fpatch, cpatch = facing(sf, xf, sc, xc), facing(sc, xc, sf, xf)
+    fpatch, cpatch = facing(sf, xf, sc, xc, *zones), facing(sc, xc, sf, xf, *zones[::-1])
     if not len(fpatch) or not len(cpatch):
         return None
     if nodes is None:

@@ -17,10 +17,11 @@ from .bodymesh import (
     mesh_simplices,
 )
 from .closest3d import closest_on_facets
+from .sides import ContactPairs
 from .surface import ContactSurface
 
 
-def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[int]]) -> None:
+def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs) -> None:
     """Refuse bodies that start deeper into each other than the outer layer of elements.
 
     The contact iteration finds a node's partner on the other surface only while the node is
@@ -28,10 +29,11 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
     stops a step whose penetration passes the depth of the element behind the facet it is measured
     against (``rind_depth``), and cuts it; an overlap that deep at the start cannot be cut away,
     so every step would fail. The same rule is applied here to the undeformed bodies: for each
-    pair of bodies that may touch, each candidate node of one is projected onto the other's
-    candidate surface; a node behind it by more than the ``rind_depth`` of the facet there, and
-    inside that body's elements (not behind a thin body, beyond its far side), is refused. An
-    overlap within the rind is allowed: the first step resolves it.
+    pair of sides that may touch (:class:`~.sides.ContactPairs`, their zones read on these
+    surfaces), each candidate node of one side is projected onto the other side's facets; a
+    node behind it by more than the ``rind_depth`` of the facet there, and inside that body's
+    elements (not behind a thin body, beyond its far side), is refused. An overlap within the
+    rind is allowed: the first step resolves it.
 
     Raises:
         InputError: naming both bodies, the node, its position and depth, and the rind there.
@@ -40,11 +42,15 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
     for i, si in enumerate(surfaces):
         if si.nc == 0:
             continue
-        x = si.X[: si.nc]
-        for j, sj in enumerate(surfaces):
-            if j == i or frozenset((i, j)) not in pairs or len(sj.facets) == 0:
+        for j in pairs.opponents(i):
+            sj = surfaces[j]
+            own, other = pairs.zone(i, j), pairs.zone(j, i)
+            if len(sj.facets) == 0 or (other is not None and not len(other)):
                 continue
-            seg, t, _, n = sj.project(x)
+            # the nodes of i's side, against j's side (the pair's zones: :mod:`.sides`)
+            local = np.arange(si.nc) if own is None else np.unique(si.facets[own])
+            x, node = si.X[local], si.nodes[local]
+            seg, t, _, n = sj.closest(x, None, other)[:4]
             pos, _ = sj.curve(seg, t)
             depth = -np.einsum("ij,ij->i", x - pos, n)
             rind = sj.rind_depth[seg]
@@ -58,13 +64,13 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: set[frozenset[i
             count += deep.size
             k = int(deep[np.argmax(depth[deep])])
             if worst is None or depth[k] > worst[0]:
-                worst = (float(depth[k]), float(rind[k]), si, sj, k)
+                worst = (float(depth[k]), float(rind[k]), si, sj, x[k], int(node[k]))
     if worst is not None:
-        depth, rind, si, sj, k = worst
+        depth, rind, si, sj, x_k, k = worst
         a, b = si.body.name, sj.body.name
-        where = ", ".join(f"{v:.6g}" for v in si.X[k])  # (x, y) or (x, y, z)
+        where = ", ".join(f"{v:.6g}" for v in x_k)  # (x, y) or (x, y, z)
         raise InputError(
-            f"bodies {a!r} and {b!r} start deeply interpenetrated: node {int(si.nodes[k])} of "
+            f"bodies {a!r} and {b!r} start deeply interpenetrated: node {k} of "
             f"{a!r}, at ({where}), lies {depth:.3g} inside {b!r}, deeper than "
             f"its outer layer of elements there ({rind:.3g}; {count} such node(s) in all); "
             "contact cannot resolve an overlap that deep. Move the bodies apart (an input file's "
@@ -158,6 +164,15 @@ def _facet_geometry(body: Body, f: np.ndarray):
     return tri, mids, half
 
 
+def _some(facets: tuple[np.ndarray, ...], which: np.ndarray, nf: int
+          ) -> tuple[np.ndarray, ...]:
+    """The facets ``which`` (of ``nf``) of :func:`_facet_geometry`'s ``facets``: in 3D each
+    facet's triangles (a quadrilateral's two, the second ``nf`` later)."""
+    per = len(facets[0]) // nf if nf else 1
+    rows = np.concatenate([which + k * nf for k in range(per)]) if per > 1 else which
+    return tuple(f[rows] for f in facets)
+
+
 def _distance_to_facets(points: np.ndarray, facets: tuple[np.ndarray, ...]) -> np.ndarray:
     """(m,) each point's distance to the nearest of the facets (:func:`_facet_geometry`)."""
     if len(facets) == 2:
@@ -190,12 +205,13 @@ def _path_samples(bodies: list[Body], samples: np.ndarray, search_distance: floa
     return np.unique(np.concatenate([samples, np.linspace(samples.min(), samples.max(), n)]))
 
 
-def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
+def select_candidate_facets(bodies: list[Body], pairs: ContactPairs,
                             search_distance: float,
                             load_factors: tuple[float, ...] = (),
                             follow_path: bool = False) -> list[np.ndarray]:
     """Per body, the exterior facets within ``search_distance`` of a body it may touch, at any
-    load factor of the schedule.
+    load factor of the schedule: of each pair's sides (:class:`~.sides.ContactPairs`), the
+    facets of one side near the other side's.
 
     Bodies that start apart and are driven together must find each other: each body's facets
     are moved by the body's :func:`predicted_translation` at load factors sampled over the
@@ -225,13 +241,19 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
     out = []
     for i in range(len(bodies)):
         keep = np.zeros(len(ext[i]), dtype=bool)
-        for j in range(len(bodies)):
-            if i == j or frozenset((i, j)) not in pairs or len(ext[j]) == 0 or len(ext[i]) == 0:
+        for j in pairs.opponents(i):
+            # each side's facets (all of the body's, or its zone's)
+            own, oth = (np.arange(len(ext[a])) if z is None else
+                        np.flatnonzero(np.isin(ext[a], z))
+                        for a, z in ((i, pairs.mesh_zone(bodies, i, j)),
+                                     (j, pairs.mesh_zone(bodies, j, i))))
+            if len(oth) == 0 or len(own) == 0:
                 continue
+            side = {i: own, j: oth}
             relative = moves[i] - moves[j]
             for mover, other, sign in ((i, j, 1.0), (j, i, -1.0)):
                 platen = bodies[mover].platen
-                if platen is None or len(ext[other]) == 0:
+                if platen is None:
                     continue
                 # the directions the platen pushes in over the schedule (its load curve may
                 # change sign)
@@ -240,25 +262,27 @@ def select_candidate_facets(bodies: list[Body], pairs: set[frozenset[int]],
                         continue
                     e = np.zeros(bodies[mover].dim)
                     e[COMPONENTS[platen.component]] = direction
-                    t = platen_approach(ends[mover], ends[other], e)
+                    t = platen_approach(_some(ends[mover], side[mover], len(ext[mover])),
+                                        _some(ends[other], side[other], len(ext[other])),
+                                        e)
                     if np.isfinite(t) and t > search_distance:  # else the schedule's reach
                         relative = np.vstack([relative, relative[:1] + sign * t * e])
             mesh = bodies[j].mesh
             lo, hi = mesh.p.min(axis=1), mesh.p.max(axis=1)
             tri = None  # body j's triangles, made only if a facet may start inside it
-            scale = float(np.ptp(np.vstack([mids[i], mids[j]]), axis=0).max())
+            scale = float(np.ptp(np.vstack([mids[i][own], mids[j][oth]]), axis=0).max())
             for r in np.unique(relative, axis=0):
                 if not np.all(np.abs(r) <= 1e6 * max(scale, 1e-300)):
                     continue  # a motion no step of a contact analysis can follow
-                x = mids[i] + r
-                d = _distance_to_facets(x, ends[j])
-                keep |= d <= search_distance + half[i]
+                x = mids[i][own] + r
+                d = _distance_to_facets(x, _some(ends[j], oth, len(ext[j])))
+                keep[own] |= d <= search_distance + half[i][own]
                 # facets that start inside the other body (an initial overlap)
-                box = np.flatnonzero(~keep & np.all((x >= lo) & (x <= hi), axis=1))
+                box = np.flatnonzero(~keep[own] & np.all((x >= lo) & (x <= hi), axis=1))
                 if len(box):
                     tri = mesh_simplices(mesh) if tri is None else tri
                     inside = locate_in_simplices(mesh.p[:, : mesh.nvertices].T, tri,
                                                  x[box]) >= 0
-                    keep[box[inside]] = True
+                    keep[own[box[inside]]] = True
         out.append(ext[i][keep])
     return out

@@ -102,8 +102,8 @@ class InvariantCheck:
                  quadratic_tension_tolerance: float = QUADRATIC_TENSION_TOLERANCE,
                  tension_measure: str = "nodal"):
         if hasattr(bodies, "bodies"):  # a model
-            if pairs is None:
-                pairs = bodies.contact_pairs
+            if pairs is None:  # its pairs' bodies (a side's boundaries do not matter here)
+                pairs = bodies.pairs().keys()
             bodies = bodies.bodies
         self.bodies = list(bodies)
         names = [b.name for b in self.bodies]

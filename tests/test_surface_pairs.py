@@ -1,0 +1,201 @@
+"""Contact pairs of surface sides (``contact_pairs = [["punch", "block:top"]]``;
+:mod:`vfem.contact.geometry.sides`): a side that names boundaries of its body takes part with
+those facets only, in the candidates, the facing patches, the pairing and the placement checks.
+
+The references are models whose answer a side's zone must not change and the same model with
+the zone made by other means: a side named by its boundary is the body with that boundary as
+its contact surface (``contact_boundaries``), to round-off, in 2D and 3D, with small and large
+kinematics and with friction; a stack whose middle plates name their top and bottom is the
+stack whose pairs name bodies. And a zone that leaves out the facets that would touch leaves
+the pair without them: the candidates lie on the named boundary alone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from models import (
+    box_mesh,
+    built,
+    input_file,
+    rectangle_mesh,
+    support,
+    toml_body,
+)
+from vfem.cli import main
+from vfem.contact.geometry import ContactPairs, facing, overlap
+from vfem.errors import InputError
+from vfem.solver import Analysis
+
+#: the displacements and contact forces of two runs of one model that differ in how a side's
+#: facets were chosen: the same facets in the same order, so the same arithmetic; a tolerance
+#: of round-off on the condensed flexibility's inverse (a few thousand contact dofs' dense
+#: solve, condition ~1e6 at these stiffness ratios, times 1e-16)
+ROUND_OFF = 1e-9
+
+
+def punch_on_block(dim: int, pairs: str | None = None, block_boundaries=None, friction=None,
+                   kinematics=None, contact: dict | None = None) -> str:
+    """A stiff coarse punch pressed (and, with friction, pushed sideways) onto a softer, finer
+    block held at its bottom."""
+    if dim == 2:
+        block = rectangle_mesh(-1.0, -1.0, 2.0, 1.0, 16, 8)
+        punch = rectangle_mesh(-0.4, 0.0, 0.8, 0.4, 5, 3)
+        down, across = "y", "x"
+    else:
+        block = box_mesh(-1.0, -1.0, -1.0, 2.0, 2.0, 1.0, 6, 6, 3)
+        punch = box_mesh(-0.4, -0.4, 0.0, 0.8, 0.8, 0.4, 3, 3, 2)
+        down, across = "z", "x"
+    loads = [f'[[bodies.prescribed]]\nboundary = "top"\ncomponent = "{down}"\nvalue = -0.01']
+    if friction is not None:
+        loads.append(f'[[bodies.prescribed]]\nboundary = "top"\ncomponent = "{across}"\n'
+                     "value = 0.002")
+    others = [c for c in ("x", "y", "z")[:dim] if c != down and (friction is None or c != across)]
+    if others:
+        loads.insert(0, support("top", others))
+    text = input_file(
+        "named sides",
+        toml_body("block", block, support("bottom"), contact_boundaries=block_boundaries,
+                  kinematics=kinematics),
+        toml_body("punch", punch, *loads, E=2e5, kinematics=kinematics),
+        contact={**({} if friction is None else {"friction": friction}), **(contact or {})}
+        or None,
+        load_factors=[0.5, 1.0])
+    if pairs is not None:
+        text = text.replace('name = "named sides"',
+                            f'name = "named sides"\ncontact_pairs = {pairs}', 1)
+    return text
+
+
+def solved(text: str):
+    result = Analysis(built(text)).run()
+    assert result.converged, result.message
+    return result
+
+
+def assert_same(a, b) -> None:
+    for sa, sb in zip(a.steps, b.steps, strict=True):
+        for name, ra in sa.bodies.items():
+            rb = sb.bodies[name]
+            for field in ("displacement", "contact_force"):
+                x, y = getattr(ra, field), getattr(rb, field)
+                assert np.abs(x - y).max() <= ROUND_OFF * np.abs(x).max(), (name, field)
+
+
+@pytest.mark.parametrize("dim, friction, kinematics", [
+    (2, None, None), (2, 0.3, None), (2, None, "total"), (3, None, None)])
+def test_a_side_named_by_its_boundary_is_the_body_with_that_boundary_as_its_contact_surface(
+        dim, friction, kinematics):
+    named = solved(punch_on_block(dim, '[["punch", "block:top"]]', friction=friction,
+                                  kinematics=kinematics))
+    bounded = solved(punch_on_block(dim, block_boundaries=["top"], friction=friction,
+                                    kinematics=kinematics))
+    everywhere = solved(punch_on_block(dim, friction=friction, kinematics=kinematics))
+    assert_same(named, bounded)
+    # the whole surface gives the same contact too (the block's sides face nothing): the zone
+    # changed which facets were candidates, not the answer
+    assert_same(named, everywhere)
+    force = named.steps[-1].bodies["punch"].contact_force.sum(axis=0)
+    assert abs(force[dim - 1]) > 0  # the punch pressed the block
+
+
+def test_a_zone_that_leaves_out_the_touching_facets_leaves_the_pair_without_them():
+    """The punch's side named by its top, which faces away from the block: the punch's
+    candidates are on its top alone, and none of them faces the block, so no node is paired
+    (the invariants, which read the bodies and not the sides, then stop the run: the punch
+    goes into the block)."""
+    model = built(punch_on_block(2, '[["punch:top", "block"]]'))
+    pairs, surfaces = model.contact_surfaces()
+    punch = surfaces[1]
+    on_top = model.bodies[1].mesh.boundaries["top"]
+    assert len(punch.facet_ids) == 0 or np.isin(punch.facet_ids, on_top).all()
+    whole = built(punch_on_block(2))
+    _, everywhere = whole.contact_surfaces()
+    assert not np.isin(everywhere[1].facet_ids, on_top).all()  # bottom facets were candidates
+    result = Analysis(model).run()
+    assert not result.converged
+
+
+def stack(pairs: str) -> str:
+    """Three plates pressed together, the middle one touching the others on its top and
+    bottom (each plate's whole exterior a candidate otherwise)."""
+    plates = []
+    for k, (y0, nx) in enumerate(((0.0, 12), (0.25, 9), (0.5, 7))):
+        loads = ([support("bottom", ["y"]), support("left", ["x"])] if k == 0 else
+                 [support("left", ["x"]), support("right", ["y"])])  # (as the stack example)
+        if k == 2:
+            loads = [support("left", ["x"]), '[[bodies.prescribed]]\nboundary = "top"\n'
+                     'component = "y"\nvalue = -0.004']
+        plates.append(toml_body(f"plate{k}", rectangle_mesh(0.0, y0, 1.0 - 0.1 * k, 0.25, nx, 3),
+                                *loads, E=7e4))
+    text = input_file("stack of three", *plates, load_factors=[1.0])
+    return text.replace('name = "stack of three"',
+                        f'name = "stack of three"\ncontact_pairs = {pairs}', 1)
+
+
+def test_a_stack_whose_middle_plate_names_its_top_and_bottom_is_the_stack_of_bodies():
+    sides = solved(stack('[["plate0:top", "plate1:bottom"], ["plate1:top", "plate2:bottom"]]'))
+    bodies = solved(stack('[["plate0", "plate1"], ["plate1", "plate2"]]'))
+    assert_same(sides, bodies)
+    model = built(stack('[["plate0", "plate1:bottom"], ["plate1:top", "plate2"]]'))
+    pairs, surfaces = model.contact_surfaces()
+    middle, mesh = surfaces[1], model.bodies[1].mesh
+    # each pair's zone on the middle plate is its named boundary's candidates
+    assert np.isin(middle.facet_ids[pairs.zone(1, 0)], mesh.boundaries["bottom"]).all()
+    assert np.isin(middle.facet_ids[pairs.zone(1, 2)], mesh.boundaries["top"]).all()
+    assert pairs.zone(0, 1) is None and pairs.zone(2, 1) is None
+    named = np.union1d(mesh.boundaries["top"], mesh.boundaries["bottom"])
+    assert np.isin(middle.facet_ids, named).all()
+
+
+@pytest.mark.parametrize("pairs, message", [
+    ('[["punch", "block:tpo"]]', "body 'block' has no boundary 'tpo'; its mesh's boundaries: "),
+    ('[["punch", "blok:top"]]', "names unknown body 'blok:top'"),
+    ('[["punch", "block:top"], ["block:bottom", "punch"]]', "are already paired"),
+    ('[["punch:bottom", "punch:top"]]', "names one body twice"),
+])
+def test_a_side_that_names_what_is_not_there_is_one_message(pairs, message):
+    with pytest.raises(InputError, match=message.replace("(", r"\(").replace("[", r"\[")):
+        built(punch_on_block(2, pairs))
+
+
+def test_a_side_must_name_a_contact_boundary_where_the_body_lists_them():
+    with pytest.raises(InputError, match="boundary 'left' of body 'block' is not one of its "
+                                         "contact_boundaries"):
+        built(punch_on_block(2, '[["punch", "block:left"]]', block_boundaries=["top"]))
+
+
+def test_a_formulation_that_reads_whole_surfaces_refuses_named_sides(tmp_path, capsys):
+    path = tmp_path / "thesis.toml"
+    path.write_text(punch_on_block(2, '[["punch", "block:top"]]', contact={"variant": "thesis"}))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "names boundaries of a body" in err and "contact.variant = 'thesis'" in err
+    assert "Traceback" not in err
+
+
+def test_the_pairs_read_bodies_alike_whatever_order_the_input_names_them():
+    model = built(punch_on_block(2, '[["block:top", "punch"]]'))
+    pairs = model.pairs()
+    assert pairs.keys() == [(0, 1)] and pairs.opponents(0) == [1] and frozenset((0, 1)) in pairs
+    assert pairs.names(model.bodies) == [("block", "punch")]
+    assert ContactPairs.every(3).keys() == [(0, 1), (0, 2), (1, 2)]
+
+
+def test_a_zone_splits_a_surface_the_pairing_reads_its_part_alone():
+    """What self-contact's two sides of one boundary need (issue 42): of the block's top, the
+    facets left of x = 0 as one side against the punch: the facing patch is the whole top's
+    within the zone, and every node paired lies on it."""
+    model = built(punch_on_block(2))
+    _, (block, punch) = model.contact_surfaces()
+    left = np.flatnonzero(block.X[block.facets].mean(axis=1)[:, 0] < 0.0)
+    whole = facing(block, block.X, punch, punch.X)
+    part = facing(block, block.X, punch, punch.X, left)
+    assert len(part) and np.array_equal(part, np.intersect1d(whole, left))
+    geo = overlap(block, punch, zones=(left, None))
+    assert len(geo.nodes) and np.isin(geo.nodes, block.facets[left]).all()
+    assert (block.X[geo.nodes, 0] <= 1e-12).all()
+    assert np.array_equal(geo.fpatch, part)
+    everywhere = overlap(block, punch)
+    assert len(everywhere.nodes) > len(geo.nodes)  # the zone left the right half out
