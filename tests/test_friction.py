@@ -560,7 +560,8 @@ def test_a_pair_entry_overrides_the_models_friction():
      "needs slip_stiffness > 0, got -1.0"),
     ('bodies = ["lower", "upper"]\nfriction = 0.3\nslip_stiffness = 10.0',
      "slip_stiffness is for the elastoplastic law"),
-    ('bodies = ["lower", "lower"]\nfriction = 0.3', "two different bodies"),
+    ('bodies = ["lower", "lower"]\nfriction = 0.3', "names one body twice, and contact_pairs "
+                                                     "pairs no sides of it"),
     ('bodies = ["lower", "top"]\nfriction = 0.3', "no body named 'top'"),
 ])
 def test_a_wrong_pair_entry_is_refused_naming_it(entry, words):

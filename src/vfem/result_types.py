@@ -18,7 +18,7 @@ from .bodies.results import BodyStepResult, add_reactions  # noqa: F401 - here t
 from .contact.state import ContactState, IterationRecord
 
 if TYPE_CHECKING:
-    from .contact.geometry import ContactSurface
+    from .contact.geometry import ContactPairs, ContactSurface
     from .model import Model
 
 
@@ -57,6 +57,9 @@ class AnalysisResult:
     #: thesis variant ran every step but stopped some at its fixed point outside its tolerance
     #: (``StepResult.fixed_point``; not converged, its answers there for comparison)
     complete: bool = False
+    #: the pairs of surface sides that might touch, their zones read on ``surfaces``
+    #: (:meth:`Model.contact_surfaces`); None: every two bodies on their whole surfaces
+    pairs: ContactPairs | None = None
 
 
 @dataclass
@@ -114,54 +117,53 @@ def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
 
     The paired variant enforces compatibility at one surface of each pair (docs/method.md §6);
     the other surface's nodes are free to indent it where its facets are longer or its geometry
-    sharper. This measures that, for every candidate node of every body against every other
-    body's candidate surface, with the same linear kinematics as the analysis: the node's
-    closest point on the other undeformed surface, the outward normal there, and the gap
-    ``g0 + n . (u_node - u_other(closest point))``; where the closest point is a vertex (a
-    corner), n is the direction from it to the node. Nodes whose closest point is an end of the
-    other surface (beyond its edge) are left out. When any body is analysed under large
-    displacements the same measure is taken on the deformed surfaces: each node's current
-    position against the other surface as it now lies.
+    sharper. This measures that, for every candidate node of every side of a pair that may
+    touch (``result.pairs``) against the other side's candidate surface, with the same linear
+    kinematics as the analysis: the node's closest point on the other undeformed surface, the
+    outward normal there, and the gap ``g0 + n . (u_node - u_other(closest point))``; where the
+    closest point is a vertex (a corner), n is the direction from it to the node. Nodes whose
+    closest point is an end of the other surface (beyond its edge) are left out. When any body
+    is analysed under large displacements the same measure is taken on the deformed surfaces:
+    each node's current position against the other surface as it now lies.
 
     Returns ``{body: {"penetration": value (> 0 overlap, <= 0 none), "node": point number,
     "into": other body}}`` for the given step (default: the last).
     """
+    from .contact.geometry import ContactPairs
+
     step = step or result.steps[-1]
     surfaces = result.surfaces
-    out = {}
-    for s in surfaces:
-        best = {"penetration": -np.inf, "node": -1, "into": ""}
-        if s.nc == 0:
-            out[s.body.name] = best
+    pairs = result.pairs if result.pairs is not None else ContactPairs.every(len(surfaces))
+    large = any(b.large for b in result.model.bodies)
+    out = {s.body.name: {"penetration": -np.inf, "node": -1, "into": ""} for s in surfaces}
+    for side, other in pairs.oriented():  # each side's nodes against the other side's facets
+        s, so = surfaces[side.body], surfaces[other.body]
+        if s.nc == 0 or so.nc == 0:
             continue
-        large = any(b.large for b in result.model.bodies)
-        u = step.bodies[s.body.name].displacement[s.nodes[: s.nc]]
-        x = s.X[: s.nc] + u if large else s.X[: s.nc]
-        for so in surfaces:
-            if so is s or so.nc == 0:
-                continue
-            xo = so.X + step.bodies[so.body.name].displacement[so.nodes] if large else so.X
-            seg, t, dist, n = so.project(x, xo)
-            pos, _ = so.curve(seg, t, xo)
-            # closest to a vertex (a corner of the other surface): measure along the line from
-            # that vertex to the node, not along a facet normal that does not reach it
-            at_vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * max(so.lengths.max(), 1e-300))
-            n = np.where(at_vertex[:, None],
-                         (x - pos) / np.maximum(dist, 1e-300)[:, None], n)
-            if large:
-                pen = -np.einsum("ij,ij->i", x - pos, n)
-            else:
-                uo = step.bodies[so.body.name].displacement[so.nodes[: so.nc]]
-                uv = np.einsum("nk,nkd->nd", so.shape(t), uo[so.facets[seg]])
-                pen = -(np.einsum("ij,ij->i", x - pos, n)
-                        + np.einsum("ij,ij->i", u - uv, n))
-            ends = so.facets[seg]
-            off = (((t <= 0) & so.surface_ends[ends[:, 0]])
-                   | ((t >= 1) & so.surface_ends[ends[:, 1]]))
-            pen = np.where(off, -np.inf, pen)
-            k = int(np.argmax(pen))
-            if pen[k] > best["penetration"]:
-                best = {"penetration": float(pen[k]), "node": int(s.nodes[k]),
-                        "into": so.body.name}
-        out[s.body.name] = best
+        local = np.arange(s.nc) if side.facets is None else np.unique(s.facets[side.facets])
+        u = step.bodies[s.body.name].displacement[s.nodes[local]]
+        x = s.X[local] + u if large else s.X[local]
+        xo = so.X + step.bodies[so.body.name].displacement[so.nodes] if large else so.X
+        seg, t, dist, n = so.closest(x, xo, other.facets)[:4]
+        pos, _ = so.curve(seg, t, xo)
+        # closest to a vertex (a corner of the other surface): measure along the line from
+        # that vertex to the node, not along a facet normal that does not reach it
+        at_vertex = ((t <= 0) | (t >= 1)) & (dist > 1e-12 * max(so.lengths.max(), 1e-300))
+        n = np.where(at_vertex[:, None],
+                     (x - pos) / np.maximum(dist, 1e-300)[:, None], n)
+        if large:
+            pen = -np.einsum("ij,ij->i", x - pos, n)
+        else:
+            uo = step.bodies[so.body.name].displacement[so.nodes[: so.nc]]
+            uv = np.einsum("nk,nkd->nd", so.shape(t), uo[so.facets[seg]])
+            pen = -(np.einsum("ij,ij->i", x - pos, n)
+                    + np.einsum("ij,ij->i", u - uv, n))
+        ends = so.facets[seg]
+        off = (((t <= 0) & so.surface_ends[ends[:, 0]])
+               | ((t >= 1) & so.surface_ends[ends[:, 1]]))
+        pen = np.where(off, -np.inf, pen)
+        k = int(np.argmax(pen))
+        if pen[k] > out[s.body.name]["penetration"]:
+            out[s.body.name] = {"penetration": float(pen[k]), "node": int(s.nodes[local[k]]),
+                                "into": so.body.name}
     return out

@@ -689,7 +689,7 @@ class Analysis:
         return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
                               self.surfaces, self.contact.penetration_tolerance, self.backend,
                               "matrix_free" if getattr(self, "matrix_free", False) else "dense",
-                              complete)
+                              complete, getattr(self, "pairs", None))
 
     def _enforce(self, exc: AnalysisError) -> bool:
         """A step stopped at invariant (b) at a node the formulation left out on purpose (a

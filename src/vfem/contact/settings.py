@@ -41,9 +41,10 @@ class PairFriction:
     slip_stiffness: float | None = None
 
     def validate(self, where: str = "contact.pairs") -> None:
-        if len(self.bodies) != 2 or self.bodies[0] == self.bodies[1]:
-            raise InputError(f"{where}: bodies must name two different bodies, got "
-                             f"{list(self.bodies)!r}")
+        if len(self.bodies) != 2:
+            raise InputError(f"{where}: bodies must name two bodies, got {list(self.bodies)!r}")
+        # (one body twice: its friction with itself, which needs a pair of its own sides in
+        # contact_pairs: checked with the model's pairs, vfem.contact.formulations.formulation)
         if not (math.isfinite(self.friction) and self.friction >= 0):
             raise InputError(f"{where} {list(self.bodies)!r}: friction must be a number >= 0, "
                              f"got {self.friction!r}")

@@ -107,11 +107,17 @@ def check_capabilities(model) -> None:
                          f"(a pair's side), which the paired variant reads and {what} does "
                          "not: name whole bodies, or use the paired variant (the default)")
     names = {b.name for b in model.bodies}
+    index = {b.name: i for i, b in enumerate(model.bodies)}
     for pair in settings.pairs:
         unknown = [n for n in pair.bodies if n not in names]
         if unknown:
             raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: no "
                              f"body named {unknown[0]!r} (bodies: {', '.join(sorted(names))})")
+        one = {index[n] for n in pair.bodies}
+        if len(one) == 1 and frozenset(one) not in model.pairs():  # a body's own sides
+            raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r} names "
+                             "one body twice, and contact_pairs pairs no sides of it with "
+                             "each other (a body's contact with itself is not supported)")
     # each pair's law and its parameters (the laws check their own), whether or not it acts
     laws = [(pair, friction_law(pair)) for pair in settings.pairs]
     if settings.frictional and (not caps.friction or (

@@ -151,9 +151,7 @@ class LargeDeformationContact(PairSet):
         out = []
         for k, pair in enumerate(self.contact_pairs):
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
-            geo = overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes,
-                          (self.pairs.zone(pair.fine, pair.coarse),
-                           self.pairs.zone(pair.coarse, pair.fine)))
+            geo = overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes, pair.zones)
             if geo is None:  # the surfaces no longer face each other anywhere
                 pair.carries = np.zeros(len(pair.nodes), dtype=bool)
                 pair.mass = np.zeros_like(pair.mass)

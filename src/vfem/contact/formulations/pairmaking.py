@@ -17,6 +17,8 @@ from ..geometry import (
     ContactPair,
     ContactSurface,
     Overlap,
+    Side,
+    SurfacePair,
     approach_gaps,
     common_normal,
     facing,
@@ -45,10 +47,11 @@ SIDE_SAMPLE = 4096
 FORCED_COARSER = 1.5
 
 
-def make_pair(form, i: int, j: int, density_i: tuple[float, bool],
+def make_pair(form, sides: SurfacePair, density_i: tuple[float, bool],
                density_j: tuple[float, bool]
                ) -> tuple[ContactPair | None, list[ContactPair]]:
-    """The pair of bodies i < j (both with candidate facets), from their compliance
+    """The pair of the two ``sides`` (:class:`~vfem.contact.geometry.sides.SurfacePair`, the
+    lower body's first: bodies i <= j, both with candidate facets), from their compliance
     densities against each other (:func:`compliance_density`), or None where they do not
     face each other; and with the formulation's ``both_surfaces`` the nodes held by point
     forces (pairs with ``point`` set, :func:`~vfem.contact.geometry.held.held_nodes`): the
@@ -64,12 +67,12 @@ def make_pair(form, i: int, j: int, density_i: tuple[float, bool],
 
     A pair in the formulation's ``given_sides`` is carried by the body given there. Returns
     (pair, held, the body carrying compatibility, -1 where neither faces the other)."""
-    given = form.given_sides.get((i, j))
+    given = form.given_sides.get(sides.bodies)
     if given is not None:
-        return make_pair_sided(form, i, j, density_i, density_j, carrier=given)
-    pair, held, fine = make_pair_sided(form, i, j, density_i, density_j)
+        return make_pair_sided(form, sides, density_i, density_j, carrier=given)
+    pair, held, fine = make_pair_sided(form, sides, density_i, density_j)
     if form.settings.compatibility_side is None and not count_nodes(pair, held):
-        other = make_pair_sided(form, i, j, density_i, density_j, flip=True)
+        other = make_pair_sided(form, sides, density_i, density_j, flip=True)
         if count_nodes(*other[:2]):
             log.info("contact pair: no node paired with the first side on the "
                      "compatibility side; the other side carries it")
@@ -81,40 +84,46 @@ def count_nodes(pair: ContactPair | None, held: list[ContactPair]) -> int:
     return (len(pair.nodes) if pair is not None else 0) + sum(len(h.nodes) for h in held)
 
 
-def make_pair_sided(form, i: int, j: int, density_i: tuple[float, bool],
+def make_pair_sided(form, sides: SurfacePair, density_i: tuple[float, bool],
                      density_j: tuple[float, bool], flip: bool = False,
                      carrier: int | None = None
                      ) -> tuple[ContactPair | None, list[ContactPair], int]:
     """:func:`make_pair` with the compatibility side the rules choose, or (``flip``) the other,
     or (``carrier``) the one given."""
-    si, sj = form.surfaces[i], form.surfaces[j]
+    a, b = sides.a, sides.b
+    si, sj = form.surfaces[a.body], form.surfaces[b.body]
     (ci, ei), (cj, ej) = density_i, density_j
     if ci == 0.0 and cj == 0.0:
         return None, [], -1  # no facet of either faces the other
     if ei != ej and (ci if ei else cj) * EDGE_RATIO >= max(ci, cj):
         # the contact zone ends at an edge of one surface (a corner over the other): that
         # surface carries compatibility, unless it is much stiffer
-        fine, coarse = (i, j) if ei else (j, i)
+        fine, coarse = (a, b) if ei else (b, a)
     elif abs(ci - cj) > 1e-9 * max(ci, cj):
-        fine, coarse = (i, j) if ci > cj else (j, i)
-    else:  # equal: a rule that does not depend on the order of the bodies
-        fine, coarse = (i, j) if si.body.name < sj.body.name else (j, i)
+        fine, coarse = (a, b) if ci > cj else (b, a)
+    else:  # equal: a rule that does not depend on the order of the bodies (or the sides)
+        fine, coarse = (a, b) if ((si.body.name, a.boundaries or ())
+                                  < (sj.body.name, b.boundaries or ())) else (b, a)
     chosen = fine
     if form.settings.compatibility_side is not None:  # forced (for testing)
         names = (si.body.name, sj.body.name)
         if form.settings.compatibility_side in names:
-            fine, coarse = (i, j) if si.body.name == form.settings.compatibility_side \
-                else (j, i)
+            fine, coarse = (a, b) if si.body.name == form.settings.compatibility_side \
+                else (b, a)
     if flip:
         fine, coarse = coarse, fine
     if carrier is not None:  # given (the solver's switch)
-        fine, coarse = (i, j) if carrier == i else (j, i)
+        fine, coarse = (a, b) if carrier == a.body else (b, a)
+    c_fine, c_coarse = (ci, cj) if fine is a else (cj, ci)
+    zones = (fine.facets, coarse.facets)
+    fine_side, chosen = fine, chosen.body
+    fine, coarse = fine.body, coarse.body
     sf, sc = form.surfaces[fine], form.surfaces[coarse]
-    nodes = (facing_nodes(form, fine, coarse) if form.keep_all_nodes else None)
-    geo = overlap(sf, sc, nodes=nodes, zones=zones(form, fine, coarse))
+    nodes = (facing_nodes(form, fine_side, sides.b if fine_side is sides.a else sides.a)
+             if form.keep_all_nodes else None)
+    geo = overlap(sf, sc, nodes=nodes, zones=zones)
     if geo is None:
         return None, [], fine
-    c_fine, c_coarse = (ci, cj) if fine == i else (cj, ci)
     if fine != chosen and (carrier is not None or not flip):
         ratio = float(np.median(sf.sizes[geo.fpatch]) / np.median(sc.sizes[geo.cpatch]))
         if ratio >= FORCED_COARSER:
@@ -154,19 +163,21 @@ def make_pair_sided(form, i: int, j: int, density_i: tuple[float, bool],
         gap = approach_gaps(sf, sc, geo, approach_motion(form, fine, coarse, geo))
     pair = ContactPair(fine, coarse, geo.nodes, geo.normal, gap, geo.interp,
                        geo.transfer, geo.mass, geo.rind_depth, geo.carries,
-                       (geo.fpatch, geo.cpatch)) if len(geo.nodes) else None
+                       (geo.fpatch, geo.cpatch), zones=zones) if len(geo.nodes) else None
     if not both:
         # (the thesis's relaxed corrections, §5.6, act one correction of the bodies at a
         # time on the compatibility side's nodes alone)
         return pair, [], fine
     held = []
-    for own, other, which in (
-            (coarse, fine, None),  # the equilibrium side's nodes
-            (fine, coarse, past)):  # the compatibility side's beyond the other patch
+    for own, other, which, equilibrium in (
+            (coarse, fine, None, True),  # the equilibrium side's nodes
+            (fine, coarse, past, False)):  # the compatibility side's beyond the other patch
         if which is not None and not len(which):
             continue
-        patches = (geo.cpatch, geo.fpatch) if own == coarse else (geo.fpatch, geo.cpatch)
-        c_own, c_other = (c_coarse, c_fine) if own == coarse else (c_fine, c_coarse)
+        # (which side is which by its role: the two sides of one body are one body)
+        patches = (geo.cpatch, geo.fpatch) if equilibrium else (geo.fpatch, geo.cpatch)
+        c_own, c_other = (c_coarse, c_fine) if equilibrium else (c_fine, c_coarse)
+        own_zones = zones[::-1] if equilibrium else zones
         # a stiffer surface's own features (its vertices, not the other side's faceting)
         # are held even between compatibility nodes in contact: the softer side must
         # take their shape (:func:`held_nodes`)
@@ -176,7 +187,7 @@ def make_pair_sided(form, i: int, j: int, density_i: tuple[float, bool],
         if made is None:
             continue
         h, guard, reach = made
-        if own == fine:  # beyond the other patch: nothing of the compatibility side's
+        if not equilibrium:  # beyond the other patch: nothing of the compatibility side's
             guard = np.full_like(guard, -1)
         log.info("contact pair: %d nodes of %s held against %s", len(h.nodes),
                  form.surfaces[own].body.name, form.surfaces[other].body.name)
@@ -184,12 +195,12 @@ def make_pair_sided(form, i: int, j: int, density_i: tuple[float, bool],
         held.append(ContactPair(own, other, h.nodes, force, h.gap, h.interp,
                                 h.transfer, h.mass, h.rind_depth, h.carries,
                                 (h.fpatch, h.cpatch), point=True, guard=guard,
-                                gap_normal=h.normal, reach=reach))
+                                gap_normal=h.normal, reach=reach, zones=own_zones))
     # and each side's edges where they cross the other side's facets (3D): a stiff box's
     # edge between its vertices, a soft block's rim under an overhanging punch
-    for own, other, patches, feature in (
-            (coarse, fine, (geo.cpatch, geo.fpatch), c_coarse < c_fine),
-            (fine, coarse, (geo.fpatch, geo.cpatch), True)):
+    for own, other, patches, feature, own_zones in (
+            (coarse, fine, (geo.cpatch, geo.fpatch), c_coarse < c_fine, zones[::-1]),
+            (fine, coarse, (geo.fpatch, geo.cpatch), True, zones)):
         edges = held_edges(
             form.surfaces[own], form.surfaces[other], *patches, feature=feature,
             approach=lambda *a, o=own, t=other: relative_motion(form, o, t, *a))
@@ -201,7 +212,7 @@ def make_pair_sided(form, i: int, j: int, density_i: tuple[float, bool],
         held.append(ContactPair(own, other, nodes, normal, gap, interp, None, None, rind,
                                 np.ones(len(nodes), dtype=bool), patches,
                                 point=True, guard=guard, gap_normal=normal, reach=reach,
-                                at=at))
+                                at=at, zones=own_zones))
     return pair, held, fine
 
 
@@ -236,8 +247,9 @@ def relative_motion(form, own: int, other: int, read, read_other,
     return np.where(none[:, None], sense * platen, out)
 
 
-def compliance_density(form, i: int, j: int) -> tuple[float, bool]:
-    """How much body i's surface facing j gives way, per unit length, where the two meet:
+def compliance_density(form, side: Side, other: Side) -> tuple[float, bool]:
+    """How much a side (body i's surface, or its zone) facing the ``other`` (body j's) gives
+    way, per unit length, where the two meet:
     the median nodal flexibility along the normal (1 / Castigliano stiffness) over the median
     facet length, over i's facets that face j and lie over j's surface facing i; and whether
     an end of i's surface facing j lies over j's (an edge of i inside the contact zone).
@@ -252,8 +264,8 @@ def compliance_density(form, i: int, j: int) -> tuple[float, bool]:
     them give the median: where the flexibility is applied, not formed (issue 22), each
     node read costs a back-substitution, and both routes must choose alike.
     """
-    s, so = form.surfaces[i], form.surfaces[j]
-    zone, ozone = zones(form, i, j)
+    s, so = form.surfaces[side.body], form.surfaces[other.body]
+    zone, ozone = side.facets, other.facets
     patch, opatch = facing(s, s.X, so, so.X, zone, ozone), facing(so, so.X, s, s.X, ozone, zone)
     if not len(patch) or not len(opatch):
         return 0.0, False
@@ -285,25 +297,21 @@ def compliance_density(form, i: int, j: int) -> tuple[float, bool]:
             if len(flexibility) else 0.0), edge
 
 
-def zones(form, i: int, j: int) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """The facets of body i's and body j's surfaces on the sides of their pair (None: all;
-    :meth:`~vfem.contact.geometry.sides.ContactPairs.zone`)."""
-    return form.pairs.zone(i, j), form.pairs.zone(j, i)
+def facing_nodes(form, side: Side, other: Side) -> np.ndarray:
+    """The candidate nodes of ``side`` (its zone's) nearer the ``other`` side than any other
+    side they may meet (:meth:`~vfem.contact.geometry.sides.ContactPairs.facing`)."""
+    s = form.surfaces[side.body]
+    sides = [o for o in form.pairs.facing(side) if len(form.surfaces[o.body].facets)]
+    nodes = np.flatnonzero(nearest_side(form, sides, s.X[: s.nc]) == sides.index(other))
+    return nodes if side.facets is None else np.intersect1d(nodes, s.facets[side.facets])
 
 
-def facing_nodes(form, i: int, j: int) -> np.ndarray:
-    """Body i's candidate nodes (on its side of the pair) nearer j's side than any other's."""
-    s = form.surfaces[i]
-    nodes = np.flatnonzero(nearest_body(form, i, s.X[: s.nc]) == j)
-    zone = form.pairs.zone(i, j)
-    return nodes if zone is None else np.intersect1d(nodes, s.facets[zone])
-
-
-def nearest_body(form, i: int, points: np.ndarray) -> np.ndarray:
+def nearest_side(form, sides: list[Side], points: np.ndarray) -> np.ndarray:
+    """(n,) for each point the index in ``sides`` of the side closest to it (-1: none)."""
     best = np.full(len(points), -1)
     dist = np.full(len(points), np.inf)
-    for j in form.group.opponents(i):  # (the closest point on j's side of the pair)
-        _, _, d, _ = form.surfaces[j].closest(points, None, form.pairs.zone(j, i))[:4]
+    for k, side in enumerate(sides):
+        _, _, d, _ = form.surfaces[side.body].closest(points, None, side.facets)[:4]
         closer = d < dist
-        best[closer], dist[closer] = j, d[closer]
+        best[closer], dist[closer] = k, d[closer]
     return best

@@ -49,18 +49,20 @@ class PairSet:
         #: solver's switch after a step that the rules' side could not hold
         #: (:meth:`vfem.solver.Analysis._switch_side`)
         self.given_sides = dict(sides or {})
-        keys = [(i, j) for i, j in pairs.keys()
-                if len(surfaces[i].facets) and len(surfaces[j].facets)]
-        # each body's compliance densities against the bodies it may touch on the rank that
-        # owns it (its flexibility), then each pair's geometry on a rank of its own, all at
-        # once (vfem.parallel; in serial in order, as before)
+        sided = [p for p in pairs.sorted()
+                 if len(surfaces[p.a.body].facets) and len(surfaces[p.b.body].facets)]
+        keys = [p.bodies for p in sided]
+        # each body's compliance densities, of each of its sides against the other side, on
+        # the rank that owns it (its flexibility), then each pair's geometry on a rank of its
+        # own, all at once (vfem.parallel; in serial in order, as before)
         ranks = self.executor
-        partners = {b: [j if i == b else i for i, j in keys if b in (i, j)]
-                    for b in range(len(surfaces))}
         density = ranks.map(range(len(surfaces)), lambda b: {
-            j: compliance_density(self, b, j) for j in partners[b]})
+            (k, n): compliance_density(self, own, other)
+            for k, p in enumerate(sided) for n, (own, other) in enumerate(((p.a, p.b),
+                                                                           (p.b, p.a)))
+            if own.body == b})
         made = ranks.map(range(len(keys)), lambda k: make_pair(
-            self, *keys[k], density[keys[k][0]][keys[k][1]], density[keys[k][1]][keys[k][0]]),
+            self, sided[k], density[keys[k][0]][k, 0], density[keys[k][1]][k, 1]),
             owners=[k % ranks.size for k in range(len(keys))])
         # the compatibility sides' pairs first, then the held nodes (so a pair's index does
         # not depend on whether the other surface is enforced too)

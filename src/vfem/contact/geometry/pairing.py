@@ -62,6 +62,9 @@ class ContactPair:
     #: position, and its force's share, over the body's candidate nodes (``nodes`` is then
     #: the nearer corner, for messages and output); None: the points are ``nodes``
     at: np.ndarray | None = None
+    #: the facets of the ``fine`` and ``coarse`` surfaces on the pair's sides, within which
+    #: it is paired again as the bodies move (:class:`~.sides.Side`; None: all)
+    zones: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
 
     def fine_columns(self) -> np.ndarray:
         """(nc_fine, m) the fine body's nodal force per unit traction value of each unknown."""

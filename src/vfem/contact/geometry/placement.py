@@ -39,32 +39,29 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs) -
         InputError: naming both bodies, the node, its position and depth, and the rind there.
     """
     worst, count = None, 0
-    for i, si in enumerate(surfaces):
-        if si.nc == 0:
+    for side, facing in pairs.oriented():
+        si, sj = surfaces[side.body], surfaces[facing.body]
+        own, other = side.facets, facing.facets
+        if si.nc == 0 or len(sj.facets) == 0 or (other is not None and not len(other)):
             continue
-        for j in pairs.opponents(i):
-            sj = surfaces[j]
-            own, other = pairs.zone(i, j), pairs.zone(j, i)
-            if len(sj.facets) == 0 or (other is not None and not len(other)):
-                continue
-            # the nodes of i's side, against j's side (the pair's zones: :mod:`.sides`)
-            local = np.arange(si.nc) if own is None else np.unique(si.facets[own])
-            x, node = si.X[local], si.nodes[local]
-            seg, t, _, n = sj.closest(x, None, other)[:4]
-            pos, _ = sj.curve(seg, t)
-            depth = -np.einsum("ij,ij->i", x - pos, n)
-            rind = sj.rind_depth[seg]
-            deep = np.flatnonzero(depth > rind)
-            if deep.size:
-                mesh = sj.body.mesh
-                deep = deep[locate_in_simplices(mesh.p[:, : mesh.nvertices].T,
-                                                mesh_simplices(mesh), x[deep]) >= 0]
-            if not deep.size:
-                continue
-            count += deep.size
-            k = int(deep[np.argmax(depth[deep])])
-            if worst is None or depth[k] > worst[0]:
-                worst = (float(depth[k]), float(rind[k]), si, sj, x[k], int(node[k]))
+        # the nodes of one side, against the other's facets (their zones: :mod:`.sides`)
+        local = np.arange(si.nc) if own is None else np.unique(si.facets[own])
+        x, node = si.X[local], si.nodes[local]
+        seg, t, _, n = sj.closest(x, None, other)[:4]
+        pos, _ = sj.curve(seg, t)
+        depth = -np.einsum("ij,ij->i", x - pos, n)
+        rind = sj.rind_depth[seg]
+        deep = np.flatnonzero(depth > rind)
+        if deep.size:
+            mesh = sj.body.mesh
+            deep = deep[locate_in_simplices(mesh.p[:, : mesh.nvertices].T,
+                                            mesh_simplices(mesh), x[deep]) >= 0]
+        if not deep.size:
+            continue
+        count += deep.size
+        k = int(deep[np.argmax(depth[deep])])
+        if worst is None or depth[k] > worst[0]:
+            worst = (float(depth[k]), float(rind[k]), si, sj, x[k], int(node[k]))
     if worst is not None:
         depth, rind, si, sj, x_k, k = worst
         a, b = si.body.name, sj.body.name
@@ -238,51 +235,48 @@ def select_candidate_facets(bodies: list[Body], pairs: ContactPairs,
         ends.append(facets)
         mids.append(mid)
         half.append(h)
-    out = []
-    for i in range(len(bodies)):
-        keep = np.zeros(len(ext[i]), dtype=bool)
-        for j in pairs.opponents(i):
-            # each side's facets (all of the body's, or its zone's)
-            own, oth = (np.arange(len(ext[a])) if z is None else
-                        np.flatnonzero(np.isin(ext[a], z))
-                        for a, z in ((i, pairs.mesh_zone(bodies, i, j)),
-                                     (j, pairs.mesh_zone(bodies, j, i))))
-            if len(oth) == 0 or len(own) == 0:
+    keeps = [np.zeros(len(f), dtype=bool) for f in ext]
+    for side, facing in pairs.oriented():
+        i, j = side.body, facing.body
+        keep = keeps[i]
+        # each side's facets (all of the body's, or its zone's)
+        own, oth = (np.arange(len(ext[s.body])) if z is None else
+                    np.flatnonzero(np.isin(ext[s.body], z))
+                    for s, z in ((side, side.mesh_facets(bodies[i])),
+                                 (facing, facing.mesh_facets(bodies[j]))))
+        if len(oth) == 0 or len(own) == 0:
+            continue
+        relative = moves[i] - moves[j]
+        for mover, other, sign, moving, fixed in ((i, j, 1.0, own, oth), (j, i, -1.0, oth, own)):
+            platen = bodies[mover].platen
+            if platen is None:
                 continue
-            side = {i: own, j: oth}
-            relative = moves[i] - moves[j]
-            for mover, other, sign in ((i, j, 1.0), (j, i, -1.0)):
-                platen = bodies[mover].platen
-                if platen is None:
+            # the directions the platen pushes in over the schedule (its load curve may
+            # change sign)
+            for direction in np.unique(np.sign([platen.force_at(x) for x in samples])):
+                if direction == 0.0:
                     continue
-                # the directions the platen pushes in over the schedule (its load curve may
-                # change sign)
-                for direction in np.unique(np.sign([platen.force_at(x) for x in samples])):
-                    if direction == 0.0:
-                        continue
-                    e = np.zeros(bodies[mover].dim)
-                    e[COMPONENTS[platen.component]] = direction
-                    t = platen_approach(_some(ends[mover], side[mover], len(ext[mover])),
-                                        _some(ends[other], side[other], len(ext[other])),
-                                        e)
-                    if np.isfinite(t) and t > search_distance:  # else the schedule's reach
-                        relative = np.vstack([relative, relative[:1] + sign * t * e])
-            mesh = bodies[j].mesh
-            lo, hi = mesh.p.min(axis=1), mesh.p.max(axis=1)
-            tri = None  # body j's triangles, made only if a facet may start inside it
-            scale = float(np.ptp(np.vstack([mids[i][own], mids[j][oth]]), axis=0).max())
-            for r in np.unique(relative, axis=0):
-                if not np.all(np.abs(r) <= 1e6 * max(scale, 1e-300)):
-                    continue  # a motion no step of a contact analysis can follow
-                x = mids[i][own] + r
-                d = _distance_to_facets(x, _some(ends[j], oth, len(ext[j])))
-                keep[own] |= d <= search_distance + half[i][own]
-                # facets that start inside the other body (an initial overlap)
-                box = np.flatnonzero(~keep[own] & np.all((x >= lo) & (x <= hi), axis=1))
-                if len(box):
-                    tri = mesh_simplices(mesh) if tri is None else tri
-                    inside = locate_in_simplices(mesh.p[:, : mesh.nvertices].T, tri,
-                                                 x[box]) >= 0
-                    keep[own[box[inside]]] = True
-        out.append(ext[i][keep])
-    return out
+                e = np.zeros(bodies[mover].dim)
+                e[COMPONENTS[platen.component]] = direction
+                t = platen_approach(_some(ends[mover], moving, len(ext[mover])),
+                                    _some(ends[other], fixed, len(ext[other])), e)
+                if np.isfinite(t) and t > search_distance:  # else the schedule's reach
+                    relative = np.vstack([relative, relative[:1] + sign * t * e])
+        mesh = bodies[j].mesh
+        lo, hi = mesh.p.min(axis=1), mesh.p.max(axis=1)
+        tri = None  # body j's triangles, made only if a facet may start inside it
+        scale = float(np.ptp(np.vstack([mids[i][own], mids[j][oth]]), axis=0).max())
+        for r in np.unique(relative, axis=0):
+            if not np.all(np.abs(r) <= 1e6 * max(scale, 1e-300)):
+                continue  # a motion no step of a contact analysis can follow
+            x = mids[i][own] + r
+            d = _distance_to_facets(x, _some(ends[j], oth, len(ext[j])))
+            keep[own] |= d <= search_distance + half[i][own]
+            # facets that start inside the other body (an initial overlap)
+            box = np.flatnonzero(~keep[own] & np.all((x >= lo) & (x <= hi), axis=1))
+            if len(box):
+                tri = mesh_simplices(mesh) if tri is None else tri
+                inside = locate_in_simplices(mesh.p[:, : mesh.nvertices].T, tri,
+                                             x[box]) >= 0
+                keep[own[box[inside]]] = True
+    return [f[keep] for f, keep in zip(ext, keeps)]

@@ -7,19 +7,23 @@ contact surface. This is how CalculiX's ``*CONTACT PAIR`` and Abaqus pair *surfa
 touching two others on two faces says which face meets which, and a side's facets (its
 **zone**) are all that the pair's search, pairing, transfer and placement read.
 
-Every stage that reads "which facets of body i may meet body j" takes it from here
-(:meth:`ContactPairs.zones`): the candidates (:mod:`.placement`), the facing patches
-(:func:`~.pairing.facing`, :func:`~.pairing.overlap`), the compliance densities and the side
-choice (:mod:`vfem.contact.formulations.pairmaking`), and the pairs the formulations and the
-solver iterate (:meth:`ContactPairs.keys`, :meth:`ContactPairs.opponents`). A pair of two
-sides of one body (self-contact, issue 42) is a pair like any other here; what it adds is the
-split of one boundary into two sides (each node's own neighbourhood left out), which is not
-built yet (:meth:`ContactPairs.parse` refuses a body named twice).
+Every stage that reads "which facets of one side may meet the other" reads the pair's sides,
+not two body indices: the candidates and the placement check (:mod:`.placement`, through
+:meth:`ContactPairs.oriented`), the facing patches (:func:`~.pairing.facing`,
+:func:`~.pairing.overlap`, a side's ``facets``), the compliance densities, the side choice and
+the nodes a side keeps (:mod:`vfem.contact.formulations.pairmaking`: :meth:`ContactPairs.sorted`,
+:meth:`ContactPairs.facing`), and the large-kinematics re-pairing (each pair keeps its zones).
+What reads bodies only (the memory estimate, the unreachable pairs' note, the thesis variant
+and the baselines, which refuse named sides) reads :meth:`ContactPairs.keys` and
+:meth:`ContactPairs.opponents`. A pair of two sides of one body (self-contact, issue 42) is a
+pair like any other to those that read sides; what it adds is the split of one boundary into
+two sides (each node's own neighbourhood left out), which is not built yet
+(:meth:`ContactPairs.parse` refuses a body named twice).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -30,19 +34,24 @@ from ...errors import InputError
 SEPARATOR = ":"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Side:
     """One side of a contact pair: body ``body`` (its index), on its named ``boundaries`` only,
-    or (None) on its whole contact surface."""
+    or (None) on its whole contact surface. ``facets``: its **zone**, the facets of the body's
+    contact surface it holds (indices into ``surface.facets``; :meth:`ContactPairs.on`), None
+    for all of them. A side is itself and no other (compared by identity): the two sides of
+    one body in a self-contact pair are two sides."""
 
     body: int
     boundaries: tuple[str, ...] | None = None
+    facets: np.ndarray | None = None
 
-    def mesh_facets(self, bodies) -> np.ndarray | None:
-        """(k,) the side's facets as indices into its mesh's facets, or None for all."""
+    def mesh_facets(self, body) -> np.ndarray | None:
+        """(k,) the side's facets as indices into its ``body``'s mesh's facets, or None for
+        all."""
         if self.boundaries is None:
             return None
-        mesh = bodies[self.body].mesh
+        mesh = body.mesh
         return np.unique(np.concatenate([np.zeros(0, dtype=np.int64)] + [
             np.asarray(mesh.boundaries[b], dtype=np.int64) for b in self.boundaries]))
 
@@ -50,6 +59,12 @@ class Side:
         name = bodies[self.body].name
         return name if self.boundaries is None else (
             f"{name}{SEPARATOR}{','.join(self.boundaries)}")
+
+    def on(self, surface) -> Side:
+        """This side with its zone read on its body's contact ``surface``."""
+        facets = self.mesh_facets(surface.body)
+        return Side(self.body, self.boundaries, None if facets is None else
+                    np.flatnonzero(np.isin(surface.facet_ids, facets)))
 
 
 @dataclass(frozen=True)
@@ -63,21 +78,20 @@ class SurfacePair:
     def bodies(self) -> tuple[int, int]:
         return self.a.body, self.b.body
 
-    def side(self, body: int) -> Side:
-        return self.a if body == self.a.body else self.b
+    def ordered(self) -> SurfacePair:
+        """The pair with the lower body's side first (a pair's key order, :meth:`keys`)."""
+        return self if self.a.body <= self.b.body else SurfacePair(self.b, self.a)
 
 
 @dataclass(frozen=True)
 class ContactPairs:
-    """The pairs of surface sides that may touch, one pair at most per two bodies.
-
-    ``zones``: per pair (i, j) and body, its side's facets as indices into that body's
-    contact surface (:meth:`on`), or None where the side is the whole surface. Membership
-    (``frozenset((i, j)) in pairs``) and iteration (:meth:`keys`) read the bodies only.
+    """The pairs of surface sides that may touch, one pair at most per two bodies, in the order
+    the input names them. What reads a pair's geometry reads its sides (:meth:`sorted`,
+    :meth:`oriented`, a side's ``facets``, after :meth:`on`); membership
+    (``frozenset((i, j)) in pairs``), :meth:`keys` and :meth:`opponents` read the bodies only.
     """
 
     pairs: tuple[SurfacePair, ...]
-    zones: dict = field(default_factory=dict, compare=False)
 
     @classmethod
     def every(cls, n: int) -> ContactPairs:
@@ -119,7 +133,17 @@ class ContactPairs:
 
     def keys(self) -> list[tuple[int, int]]:
         """(i, j), i < j, of every pair, in order."""
-        return sorted(tuple(sorted(p.bodies)) for p in self.pairs)
+        return [p.bodies for p in self.sorted()]
+
+    def sorted(self) -> list[SurfacePair]:
+        """The pairs in the order of their bodies, the lower body's side first."""
+        return sorted((p.ordered() for p in self.pairs), key=lambda p: p.bodies)
+
+    def oriented(self) -> list[tuple[Side, Side]]:
+        """Every pair both ways, (own side, other side), in the order of (own body, other
+        body): what the placement and the side choice read of each side against the other."""
+        both = [(s, o) for p in self.pairs for s, o in ((p.a, p.b), (p.b, p.a))]
+        return sorted(both, key=lambda so: (so[0].body, so[1].body))
 
     def names(self, bodies) -> list[tuple[str, str]]:
         """Each pair's two bodies' names, in the order the input gives them."""
@@ -132,7 +156,10 @@ class ContactPairs:
         return len(self.pairs)
 
     def __contains__(self, bodies) -> bool:
-        return self.between(*sorted(bodies)) is not None if len(bodies) == 2 else False
+        """Whether a pair joins the bodies of the set ``bodies`` (two, or one: a pair of one
+        body's sides)."""
+        b = sorted(bodies)
+        return len(b) in (1, 2) and self.between(b[0], b[-1]) is not None
 
     def between(self, i: int, j: int) -> SurfacePair | None:
         for p in self.pairs:
@@ -144,36 +171,21 @@ class ContactPairs:
         """The bodies body ``i`` may touch, in order."""
         return sorted(j for p in self.pairs for j in p.bodies if i in p.bodies and j != i)
 
+    def facing(self, side: Side) -> list[Side]:
+        """The sides that ``side``'s nodes may meet: the other side of every pair with a side
+        on its body, but itself (in the order of :meth:`oriented`)."""
+        return [o for s, o in self.oriented() if s.body == side.body and o is not side]
+
     @property
     def named(self) -> bool:
         """Whether a side names boundaries (a formulation that reads whole surfaces refuses
         it: :attr:`~vfem.contact.capabilities.Capabilities.surface_pairs`)."""
         return any(s.boundaries is not None for p in self.pairs for s in (p.a, p.b))
 
-    def mesh_zone(self, bodies, i: int, j: int) -> np.ndarray | None:
-        """Body i's side of its pair with j as mesh facet indices (None: all)."""
-        return self.between(i, j).side(i).mesh_facets(bodies)
-
     def on(self, surfaces) -> ContactPairs:
-        """These pairs with their zones read on the bodies' contact ``surfaces``."""
-        bodies = [s.body for s in surfaces]
-        zones = {}
-        for p in self.pairs:
-            for own, other in (p.bodies, p.bodies[::-1]):
-                facets = self.mesh_zone(bodies, own, other)
-                zones[own, other] = None if facets is None else np.flatnonzero(
-                    np.isin(surfaces[own].facet_ids, facets))
-        return ContactPairs(self.pairs, zones)
-
-    def zone(self, i: int, j: int) -> np.ndarray | None:
-        """Body i's facets (indices into its contact surface) on its side of the pair with
-        body j, or None for its whole surface."""
-        if (i, j) in self.zones:
-            return self.zones[i, j]
-        if self.between(i, j).side(i).boundaries is not None:
-            raise ValueError("a side's zone is read on the contact surfaces (ContactPairs.on) "
-                             "before it is used")
-        return None
+        """These pairs with their sides' zones read on the bodies' contact ``surfaces``."""
+        return ContactPairs(tuple(SurfacePair(p.a.on(surfaces[p.a.body]),
+                                              p.b.on(surfaces[p.b.body])) for p in self.pairs))
 
 
 def _side(text, names: dict, bodies, entry, where: str) -> Side:
