@@ -14,6 +14,7 @@ from vfem.contact.formulations.baselines import GlobalContact
 from vfem.contact.formulations.formulation import check_capabilities, formulation_class
 from vfem.contact.formulations.large import LargeDeformationContact
 from vfem.contact.formulations.paired import PairedContact
+from vfem.contact.geometry import ContactPairs
 from vfem.contact.geometry.pairing import overlap
 from vfem.contact.geometry.surface import beyond, patch_ends
 from vfem.contact.settings import ContactSettings
@@ -219,7 +220,8 @@ def fake_model(order=1, dim=2, large=False, corners=4, **settings):
                                                    t=np.zeros((corners, 1), dtype=int)))
               for name in "ab"]
     return SimpleNamespace(name="m", bodies=bodies, contact=ContactSettings(**settings),
-                           contact_pairs=None, iterates=large)
+                           contact_pairs=None, iterates=large,
+                           pairs=lambda: ContactPairs.every(len(bodies)))
 
 
 def test_the_model_checks_read_the_declared_capabilities():

@@ -200,3 +200,69 @@ def test_a_zone_splits_a_surface_the_pairing_reads_its_part_alone():
     assert np.array_equal(geo.fpatch, part)
     everywhere = overlap(block, punch)
     assert len(everywhere.nodes) > len(geo.nodes)  # the zone left the right half out
+
+
+def two_parts(gap: float = 1e-3):
+    """A block (quadrilaterals, y in [-1, 0]) and a narrower pad over it (y in [gap, 0.4 + gap]),
+    their boundaries named (``base`` and ``base_top`` below, ``pad_bottom`` and ``pad_top``
+    above): the two meshes, and the one mesh of both (the block's nodes first)."""
+    from skfem import MeshQuad
+
+    eps = 1e-9
+    marks = {"base": lambda x: x[1] < -1 + eps, "base_top": lambda x: np.abs(x[1]) < eps,
+             "pad_bottom": lambda x: np.abs(x[1] - gap) < eps,
+             "pad_top": lambda x: x[1] > 0.4 + gap - eps}
+    lower = MeshQuad.init_tensor(np.linspace(-1, 1, 17), np.linspace(-1, 0, 9))
+    upper = MeshQuad.init_tensor(np.linspace(-0.4, 0.4, 6), np.linspace(gap, 0.4 + gap, 4))
+    both = MeshQuad(np.hstack([lower.p, upper.p]),
+                    np.hstack([lower.t, upper.t + lower.p.shape[1]]))
+    return (lower.with_boundaries({k: marks[k] for k in ("base", "base_top")}),
+            upper.with_boundaries({k: marks[k] for k in ("pad_bottom", "pad_top")}),
+            both.with_boundaries(marks))
+
+
+def test_two_sides_of_one_body_are_paired_as_two_bodies_are(monkeypatch):
+    """What the pairs of sides carry for self-contact (issue 42; its split of one boundary and
+    its invariants are not built): one body whose mesh is two parts, a block and a pad pressed
+    onto it, its two sides paired (the block's top, the pad's bottom), gives the contact of the
+    two parts as two bodies: one body's pair of its own sides goes through the candidates, the
+    side choice, the pairing, the held nodes and the transfer, and its flexibility (both
+    parts' in one factorization) carries both sides' forces. (A body of two pieces is refused
+    by the mesh checks, which this test leaves out: each piece here is held.)"""
+    from vfem.bodies import Body, PrescribedDisplacement, Support
+    from vfem.contact.geometry import Side, SurfacePair
+    from vfem.materials import LinearElastic
+    from vfem.mesh import checks
+    from vfem.model import Model
+
+    monkeypatch.setattr(checks, "_check_pieces", lambda p, t, where: None)
+
+    lower, upper, both = two_parts()
+    press = (PrescribedDisplacement("pad_top", "y", -0.01),
+             PrescribedDisplacement("pad_top", "x", 0.0))
+    material = LinearElastic(1000.0, 0.3)
+    one = Body("parts", both, material, supports=(Support("base"),), prescribed=press,
+               contact_boundaries=("base_top", "pad_bottom"))
+    own = ContactPairs((SurfacePair(Side(0, ("base_top",)), Side(0, ("pad_bottom",))),))
+    monkeypatch.setattr(Model, "pairs", lambda self: own if self.name == "one" else
+                        ContactPairs.every(len(self.bodies)))
+    got = Analysis(Model("one", [one], load_factors=(0.5, 1.0))).run()
+    assert got.converged, got.message
+    two = Model("two", [Body("block", lower, material, supports=(Support("base"),),
+                             contact_boundaries=("base_top",)),
+                        Body("pad", upper, material, prescribed=press,
+                             contact_boundaries=("pad_bottom",))], load_factors=(0.5, 1.0))
+    two.validate()
+    want = Analysis(two).run()
+    assert want.converged, want.message
+    n = lower.p.shape[1]
+    for a, b in zip(got.steps, want.steps, strict=True):
+        mine = a.bodies["parts"]
+        for name, part in (("block", slice(0, n)), ("pad", slice(n, None))):
+            theirs = b.bodies[name]
+            for field in ("displacement", "contact_force"):
+                x, y = getattr(mine, field)[part], getattr(theirs, field)
+                assert np.abs(x - y).max() <= ROUND_OFF * np.abs(y).max(), (name, field)
+    force = got.steps[-1].bodies["parts"].contact_force
+    assert force[n:, 1].sum() > 0
+    assert np.isclose(force[n:, 1].sum(), -force[:n, 1].sum(), rtol=1e-12)

@@ -100,7 +100,7 @@ def check_capabilities(model) -> None:
                          + ("large kinematics" if any(b.large for b in model.bodies) else
                             "a material that carries state (Newton's method)")
                          + " needs the paired contact variant")
-    if not caps.sides and model.pairs().named:
+    if not caps.sides and model.pairs().sided:
         what = (f"contact.method = {settings.method!r}" if settings.method != "vfem" else
                 f"contact.variant = {settings.variant!r}")
         raise InputError(f"model {model.name!r}: contact_pairs names boundaries of a body "

@@ -177,10 +177,12 @@ class ContactPairs:
         return [o for s, o in self.oriented() if s.body == side.body and o is not side]
 
     @property
-    def named(self) -> bool:
-        """Whether a side names boundaries (a formulation that reads whole surfaces refuses
-        it: :attr:`~vfem.contact.capabilities.Capabilities.surface_pairs`)."""
-        return any(s.boundaries is not None for p in self.pairs for s in (p.a, p.b))
+    def sided(self) -> bool:
+        """Whether a pair is not two whole bodies: a side names boundaries, or both sides are
+        one body's. A formulation that reads whole surfaces refuses it
+        (:attr:`~vfem.contact.capabilities.Capabilities.sides`)."""
+        return any(s.boundaries is not None for p in self.pairs for s in (p.a, p.b)) or any(
+            p.a.body == p.b.body for p in self.pairs)
 
     def on(self, surfaces) -> ContactPairs:
         """These pairs with their sides' zones read on the bodies' contact ``surfaces``."""
