@@ -141,6 +141,8 @@ def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
         if s.nc == 0 or so.nc == 0:
             continue
         local = np.arange(s.nc) if side.facets is None else np.unique(s.facets[side.facets])
+        if not len(local) or (other.facets is not None and not len(other.facets)):
+            continue  # (a side with no candidate facet)
         u = step.bodies[s.body.name].displacement[s.nodes[local]]
         x = s.X[local] + u if large else s.X[local]
         xo = so.X + step.bodies[so.body.name].displacement[so.nodes] if large else so.X

@@ -270,6 +270,7 @@ class Analysis:
         self.timings: dict[str, float] = {}
         self.strain_warned: set[str] = set()  # bodies already warned about (warn_large_strain)
         self.unreachable: list[str] = []  # pairs that cannot touch (unreachable_pairs)
+        self.pairs: ContactPairs | None = None  # the pairs of sides that may touch (setup)
         #: per pair (i, j), i < j, whose compatibility side was switched (:meth:`_switch_side`),
         #: the body that carries it; and per pair whose other side was tried and not kept,
         #: what the stop message says of it
@@ -291,7 +292,7 @@ class Analysis:
             from .contact.formulations import GlobalContact
 
             self.contact = GlobalContact(self.model, self.backend)
-            self.surfaces = self.contact.surfaces
+            self.surfaces, self.pairs = self.contact.surfaces, self.contact.pairs
             self.timings.update(self.contact.timings, flexibility_s=0.0,
                                 assemble_factorize_s=self.contact.timings["assemble_s"])
             # recorded per step, not enforced (its capabilities)
@@ -689,7 +690,7 @@ class Analysis:
         return AnalysisResult(self.model, converged, steps, dict(self.timings), message,
                               self.surfaces, self.contact.penetration_tolerance, self.backend,
                               "matrix_free" if getattr(self, "matrix_free", False) else "dense",
-                              complete, getattr(self, "pairs", None))
+                              complete, self.pairs)
 
     def _enforce(self, exc: AnalysisError) -> bool:
         """A step stopped at invariant (b) at a node the formulation left out on purpose (a

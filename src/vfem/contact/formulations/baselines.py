@@ -103,6 +103,7 @@ class GlobalContact:
         settings = model.contact
         t0 = time.perf_counter()
         pairs, self.surfaces = model.contact_surfaces()
+        self.pairs = pairs  # (the result's, as the paired variant's)
         t1 = time.perf_counter()
         bodies = model.bodies
         for b in bodies:

@@ -101,11 +101,12 @@ def check_capabilities(model) -> None:
                             "a material that carries state (Newton's method)")
                          + " needs the paired contact variant")
     if not caps.sides and model.pairs().sided:
-        what = (f"contact.method = {settings.method!r}" if settings.method != "vfem" else
-                f"contact.variant = {settings.variant!r}")
+        what, use = ((f"contact.method = {settings.method!r}", "contact.method = 'vfem'")
+                     if settings.method != "vfem" else
+                     (f"contact.variant = {settings.variant!r}", "the paired variant"))
         raise InputError(f"model {model.name!r}: contact_pairs names boundaries of a body "
                          f"(a pair's side), which the paired variant reads and {what} does "
-                         "not: name whole bodies, or use the paired variant (the default)")
+                         f"not: name whole bodies, or use {use} (the default)")
     names = {b.name for b in model.bodies}
     index = {b.name: i for i, b in enumerate(model.bodies)}
     for pair in settings.pairs:

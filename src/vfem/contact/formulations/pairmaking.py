@@ -101,7 +101,8 @@ def make_pair_sided(form, sides: SurfacePair, density_i: tuple[float, bool],
         fine, coarse = (a, b) if ei else (b, a)
     elif abs(ci - cj) > 1e-9 * max(ci, cj):
         fine, coarse = (a, b) if ci > cj else (b, a)
-    else:  # equal: a rule that does not depend on the order of the bodies (or the sides)
+    else:  # equal: a rule that does not depend on the order of the bodies (by name, then by
+        # the sides' boundaries; two sides alike of one body: the second)
         fine, coarse = (a, b) if ((si.body.name, a.boundaries or ())
                                   < (sj.body.name, b.boundaries or ())) else (b, a)
     chosen = fine
@@ -249,7 +250,7 @@ def relative_motion(form, own: int, other: int, read, read_other,
 
 def compliance_density(form, side: Side, other: Side) -> tuple[float, bool]:
     """How much a side (body i's surface, or its zone) facing the ``other`` (body j's) gives
-    way, per unit length, where the two meet:
+    way, per unit length, where the two meet (below, "i" and "j" are the sides):
     the median nodal flexibility along the normal (1 / Castigliano stiffness) over the median
     facet length, over i's facets that face j and lie over j's surface facing i; and whether
     an end of i's surface facing j lies over j's (an edge of i inside the contact zone).
@@ -277,10 +278,11 @@ def compliance_density(form, side: Side, other: Side) -> tuple[float, bool]:
     over = patch[inside]
     if not len(over):
         return 0.0, False
-    # ends of the patch at a corner of the body (another candidate facet, not facing j,
-    # meets it there), not where the candidates or the boundary stop
-    ends = np.flatnonzero(s.boundary_nodes(s.patch_boundary(patch))
-                          & (s.vertex_valence >= 2))
+    # ends of the patch at a corner of the body (another facet of the side, not facing j,
+    # meets it there), not where the candidates, the side or the boundary stop
+    valence = s.vertex_valence if zone is None else np.bincount(
+        s.facets[zone][:, : s.kind.corners].ravel(), minlength=s.nc)[: s.nc]
+    ends = np.flatnonzero(s.boundary_nodes(s.patch_boundary(patch)) & (valence >= 2))
     normals = s.node_normals(None, patch)
     seg, _, _, _, tf = so.closest(s.X[ends], None, opatch, normals[ends])
     shared = so.on_boundary(seg, tf, oends)
@@ -299,19 +301,25 @@ def compliance_density(form, side: Side, other: Side) -> tuple[float, bool]:
 
 def facing_nodes(form, side: Side, other: Side) -> np.ndarray:
     """The candidate nodes of ``side`` (its zone's) nearer the ``other`` side than any other
-    side they may meet (:meth:`~vfem.contact.geometry.sides.ContactPairs.facing`)."""
+    side they may meet: the other side of each pair of which a side of this body holds them
+    (:meth:`~vfem.contact.geometry.sides.ContactPairs.facing`)."""
     s = form.surfaces[side.body]
-    sides = [o for o in form.pairs.facing(side) if len(form.surfaces[o.body].facets)]
-    nodes = np.flatnonzero(nearest_side(form, sides, s.X[: s.nc]) == sides.index(other))
-    return nodes if side.facets is None else np.intersect1d(nodes, s.facets[side.facets])
+    meets = [(own, o) for own, o in form.pairs.facing(side) if len(form.surfaces[o.body].facets)]
+    k = next(k for k, (own, o) in enumerate(meets) if own is side and o is other)
+    return np.flatnonzero(nearest_side(form, s, meets) == k)
 
 
-def nearest_side(form, sides: list[Side], points: np.ndarray) -> np.ndarray:
-    """(n,) for each point the index in ``sides`` of the side closest to it (-1: none)."""
+def nearest_side(form, s: ContactSurface, meets: list[tuple[Side, Side]]) -> np.ndarray:
+    """(nc,) for each candidate node of surface ``s`` the index in ``meets`` ((own side,
+    other side) pairs) of the other side closest to it among the pairs whose own side holds
+    it (-1: none)."""
+    points = s.X[: s.nc]
     best = np.full(len(points), -1)
     dist = np.full(len(points), np.inf)
-    for k, side in enumerate(sides):
-        _, _, d, _ = form.surfaces[side.body].closest(points, None, side.facets)[:4]
+    for k, (own, other) in enumerate(meets):
+        _, _, d, _ = form.surfaces[other.body].closest(points, None, other.facets)[:4]
+        if own.facets is not None:  # only the nodes of the own side's zone meet it
+            d = np.where(np.isin(np.arange(len(points)), s.facets[own.facets]), d, np.inf)
         closer = d < dist
         best[closer], dist[closer] = k, d[closer]
     return best

@@ -291,10 +291,12 @@ class PairSet:
                     pen[pair.nodes] = pens[k]
                     other[pair.nodes[on]] = pair.coarse
                     normal[pair.nodes] = pair.normal
-                elif pair.coarse == i:
+                if pair.coarse == i:  # (and both, for a pair of two sides of one body)
                     nn = s.node_normals()
                     f = -np.einsum("ij,ij->i", state.forces[i], nn)
                     on = np.abs(state.forces[i]).sum(axis=1) > 0
+                    if pair.zones[1] is not None:  # the equilibrium side's nodes alone
+                        on &= np.isin(np.arange(nc), s.facets[pair.zones[1]])
                     force[on] = f[on]
                     other[on] = pair.fine
                     normal[on] = -nn[on]

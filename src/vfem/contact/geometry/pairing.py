@@ -125,7 +125,8 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray,
     verts = so.vertices if ozone is None else np.intersect1d(so.vertices, so.facets[ozone])
     vn = so.node_normals(xo)[verts]
     seg, _, dist, _, tf = s.closest(xo[verts], x, zone, vn)
-    reach = 2.0 * (s.sizes.max() + so.sizes.max())
+    reach = 2.0 * (s.sizes[facets].max()
+                   + (so.sizes.max() if ozone is None else so.sizes[ozone].max()))
     over = (s.kind.strictly_inside(tf) & (dist < reach)
             & (np.einsum("ij,ij->i", vn, n[seg]) <= -FACING))
     faces[seg[over]] = True

@@ -47,12 +47,17 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs) -
         # the nodes of one side, against the other's facets (their zones: :mod:`.sides`)
         local = np.arange(si.nc) if own is None else np.unique(si.facets[own])
         x, node = si.X[local], si.nodes[local]
-        seg, t, _, n = sj.closest(x, None, other)[:4]
+        seg, t, _, n, tf = sj.closest(x, None, other)
         pos, _ = sj.curve(seg, t)
         depth = -np.einsum("ij,ij->i", x - pos, n)
         rind = sj.rind_depth[seg]
         deep = np.flatnonzero(depth > rind)
-        if deep.size:
+        if deep.size and si is sj:
+            # two sides of one body: its own nodes lie in its elements, so that test says
+            # nothing; a node counts where it lies over the other side, not past its end
+            ends = sj.patch_boundary(np.arange(len(sj.facets)) if other is None else other)
+            deep = deep[~sj.beyond(seg[deep], tf[deep], ends)]
+        elif deep.size:
             mesh = sj.body.mesh
             deep = deep[locate_in_simplices(mesh.p[:, : mesh.nvertices].T,
                                             mesh_simplices(mesh), x[deep]) >= 0]
@@ -67,7 +72,8 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs) -
         a, b = si.body.name, sj.body.name
         where = ", ".join(f"{v:.6g}" for v in x_k)  # (x, y) or (x, y, z)
         raise InputError(
-            f"bodies {a!r} and {b!r} start deeply interpenetrated: node {k} of "
+            (f"bodies {a!r} and {b!r}" if si is not sj else f"two sides of body {a!r}")
+            + f" start deeply interpenetrated: node {k} of "
             f"{a!r}, at ({where}), lies {depth:.3g} inside {b!r}, deeper than "
             f"its outer layer of elements there ({rind:.3g}; {count} such node(s) in all); "
             "contact cannot resolve an overlap that deep. Move the bodies apart (an input file's "
@@ -272,9 +278,10 @@ def select_candidate_facets(bodies: list[Body], pairs: ContactPairs,
             x = mids[i][own] + r
             d = _distance_to_facets(x, _some(ends[j], oth, len(ext[j])))
             keep[own] |= d <= search_distance + half[i][own]
-            # facets that start inside the other body (an initial overlap)
+            # facets that start inside the other body (an initial overlap; not for two sides of
+            # one body, whose own facets lie on it)
             box = np.flatnonzero(~keep[own] & np.all((x >= lo) & (x <= hi), axis=1))
-            if len(box):
+            if len(box) and i != j:
                 tri = mesh_simplices(mesh) if tri is None else tri
                 inside = locate_in_simplices(mesh.p[:, : mesh.nvertices].T, tri,
                                              x[box]) >= 0

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
+from .bodymesh import exterior_facets
 
 #: what separates a body's name from its boundaries' in a ``contact_pairs`` entry
 #: (``"block:top"``, ``"block:top,left"``)
@@ -126,13 +127,13 @@ class ContactPairs:
                     f"{where} {list(entry)!r}: bodies {bodies[key[0]].name!r} and "
                     f"{bodies[key[1]].name!r} are already paired "
                     f"({[first.a.text(bodies), first.b.text(bodies)]!r}); name all the "
-                    "boundaries of a side in one entry, separated by commas "
-                    f"('{bodies[key[1]].name}{SEPARATOR}top,left')")
+                    "boundaries of a side in one entry, separated by commas (e.g. "
+                    f"'{bodies[key[1]].name}{SEPARATOR}top,left')")
             made[key] = SurfacePair(*sides)
         return cls(tuple(made.values()))
 
     def keys(self) -> list[tuple[int, int]]:
-        """(i, j), i < j, of every pair, in order."""
+        """(i, j), i <= j (equal: two sides of one body), of every pair, in order."""
         return [p.bodies for p in self.sorted()]
 
     def sorted(self) -> list[SurfacePair]:
@@ -171,10 +172,11 @@ class ContactPairs:
         """The bodies body ``i`` may touch, in order."""
         return sorted(j for p in self.pairs for j in p.bodies if i in p.bodies and j != i)
 
-    def facing(self, side: Side) -> list[Side]:
-        """The sides that ``side``'s nodes may meet: the other side of every pair with a side
-        on its body, but itself (in the order of :meth:`oriented`)."""
-        return [o for s, o in self.oriented() if s.body == side.body and o is not side]
+    def facing(self, side: Side) -> list[tuple[Side, Side]]:
+        """What the nodes of ``side``'s body may meet: (own side, other side) of every pair
+        with a side on its body, but ``side`` itself as the other (in the order of
+        :meth:`oriented`). A node meets the other side of a pair whose own side holds it."""
+        return [(s, o) for s, o in self.oriented() if s.body == side.body and o is not side]
 
     @property
     def sided(self) -> bool:
@@ -201,8 +203,12 @@ def _side(text, names: dict, bodies, entry, where: str) -> Side:
                          f"{', '.join(names)} (a side may name boundaries as "
                          f"'body{SEPARATOR}boundary')")
     body = bodies[names[name]]
-    wanted = tuple(dict.fromkeys(b.strip() for b in rest.split(",")))
+    wanted = tuple(dict.fromkeys(b.strip() for b in rest.split(",")))  # (spaces ignored)
+    if "" in wanted:
+        raise InputError(f"{where} {list(entry)!r}: {text!r} names an empty boundary; give "
+                         f"'{name}{SEPARATOR}boundary' or boundaries separated by commas")
     known = sorted(body.mesh.boundaries or {})
+    exterior = exterior_facets(body)
     for b in wanted:
         if b not in known:
             raise InputError(f"{where} {list(entry)!r}: body {name!r} has no boundary {b!r}; "
@@ -211,4 +217,9 @@ def _side(text, names: dict, bodies, entry, where: str) -> Side:
             raise InputError(f"{where} {list(entry)!r}: boundary {b!r} of body {name!r} is not "
                              f"one of its contact_boundaries ({', '.join(body.contact_boundaries)})"
                              "; add it there, or leave contact_boundaries out")
+        if not np.isin(body.mesh.boundaries[b], exterior).any():
+            raise InputError(f"{where} {list(entry)!r}: boundary {b!r} of body {name!r} cannot "
+                             "touch: a displacement is prescribed on it (a support, a prescribed "
+                             "displacement or the platen); name it in contact_boundaries if it "
+                             "is meant to")
     return Side(names[name], wanted)
