@@ -12,7 +12,10 @@ invariants), the model being built before it starts. The sizes are those of ``vf
 --dofs`` (the Hertz example with its contact facets and largest element scaled together; the
 sphere with more facets across the contact radius). Printed: each run's seconds, then per case
 the two trees' medians, their ratio (second over first) and whether the two trees' answers (the
-sum of every body's nodal contact forces, a checksum) are the same to 1e-10. A tree from before
+sum of every body's nodal contact forces, a checksum) are the same to 1e-10; then each phase's
+median on each tree (search, assembly, factorization, flexibility, contact iterations, fields,
+invariants, steps: the timings every run records), which says where a difference lies when the
+machine's noise on the whole run is larger than it. A tree from before
 the examples moved beside the library (``vfem.examples`` rather than ``vfem_examples``) is run
 as it is.
 """
@@ -38,6 +41,8 @@ beside = os.path.isdir(os.path.join(tree, "vfem_examples"))
 bench = importlib.import_module("vfem_tools.bench" if beside else "vfem.tools.bench")
 examples = importlib.import_module("vfem_examples" if beside else "vfem.examples")
 case, dofs = sys.argv[1], int(sys.argv[2])
+PHASES = ("search_s", "assemble_s", "factorize_s", "flexibility_s", "contact_s", "fields_s",
+          "invariants_s", "steps_s")
 parameters = bench.hertz_parameters(dofs) if case == "hertz" else bench.sphere_parameters(dofs)
 model = importlib.import_module(examples.__name__ + "." + case).build(parameters)
 t0 = time.perf_counter()
@@ -47,7 +52,8 @@ assert result.converged, result.message
 checksum = float(sum(np.abs(np.asarray(b.contact_force)).sum()
                      for b in result.steps[-1].bodies.values()))
 print(json.dumps({"seconds": seconds, "checksum": checksum,
-                  "dofs": sum(b.ndofs for b in model.bodies)}))
+                  "dofs": sum(b.ndofs for b in model.bodies),
+                  "phases": {k: v for k, v in result.timings.items() if k in PHASES}}))
 """
 
 def run(tree: str, case: str, dofs: int) -> dict:
@@ -74,12 +80,14 @@ def main(argv: list[str] | None = None) -> int:
     dofs = parse_size(args.dofs)
     trees = [os.path.abspath(args.first), os.path.abspath(args.second)]
     times = {(c, t): [] for c in args.cases for t in trees}
+    phases = {(c, t): [] for c in args.cases for t in trees}
     sums = {}
     for k in range(args.repeat):
         for case in args.cases:
             for tree in trees:
                 row = run(tree, case, dofs)
                 times[case, tree].append(row["seconds"])
+                phases[case, tree].append(row["phases"])
                 sums.setdefault((case, tree), row["checksum"])
                 print(f"{k + 1} {case:6s} {row['dofs']:8d} dofs  {row['seconds']:8.3f} s  {tree}",
                       flush=True)
@@ -89,6 +97,11 @@ def main(argv: list[str] | None = None) -> int:
             sums[case, trees[0]])
         print(f"{case}: median {a:.3f} s then {b:.3f} s, ratio {b / a:.3f} "
               f"(answers {'the same' if same else 'DIFFERENT'})")
+        # each phase's median (the timings a run records): where a difference lies, apart
+        # from the machine's noise on the whole
+        for key in phases[case, trees[0]][0]:
+            a, b = (statistics.median(p.get(key, 0.0) for p in phases[case, t]) for t in trees)
+            print(f"  {key.removesuffix('_s'):12s} {a:8.3f} s then {b:8.3f} s  ({b - a:+.3f} s)")
     return 0
 
 
