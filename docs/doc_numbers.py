@@ -574,10 +574,15 @@ _ROUND_OFF = re.compile(r"[-+]?\d(\.\d+)?e-(1[3-9]|[2-9]\d|\d{3})\b|[-+]?0(\.0+)
 #: Where a round-off figure was largest (which body and step is round-off's choice too).
 _WORST = re.compile(r"\(worst: '[^']*', step \d+\)")
 
+#: The linear solver a closing line names: the fastest installed on the machine that ran it
+#: (``vfem.io.runner.solver_words``), with its hint where it is SuperLU.
+_SOLVER = re.compile(r", linear solver \w+( \(the slowest: [^)]*\))?")
+
 
 def normalised(text: str) -> str:
-    """``text`` with wall-clock times, round-off numbers (below 1e-12) and where the largest
-    round-off was masked."""
+    """``text`` with wall-clock times, round-off numbers (below 1e-12), where the largest
+    round-off was and the linear solver's name masked."""
+    text = _SOLVER.sub(", linear solver <installed>", text)
     return _WORST.sub("(worst: <where>)", _ROUND_OFF.sub("<round-off>", _TIME.sub("<time> s",
                                                                                text)))
 

@@ -217,3 +217,35 @@ def test_a_taken_over_analysis_factorizes_again_after_solves_at_its_size():
         threads.apply(before or "off")
     assert np.array_equal(x, fresh)
     assert np.abs(K2 @ x - b).max() <= 1e-13 * np.abs(K2).max() * np.abs(x).max()
+
+
+def test_the_default_install_brings_pardiso_where_its_wheel_exists():
+    """Issue 39: `pip install -e .` installs PARDISO on x86-64 Linux and Windows (a platform
+    marker on pypardiso, whose MKL has wheels there), nowhere else; `auto` then picks it."""
+    import tomllib
+    from pathlib import Path
+
+    from packaging.markers import default_environment
+    from packaging.requirements import Requirement
+
+    project = tomllib.loads((Path(__file__).parent.parent / "pyproject.toml").read_text())
+    (pardiso,) = [Requirement(r) for r in project["project"]["dependencies"]
+                  if Requirement(r).name == "pypardiso"]
+    env = default_environment()
+    for machine, platform, wanted in (("x86_64", "linux", True), ("AMD64", "win32", True),
+                                      ("aarch64", "linux", False), ("arm64", "darwin", False),
+                                      ("x86_64", "darwin", False)):
+        assert pardiso.marker.evaluate({**env, "platform_machine": machine,
+                                        "sys_platform": platform}) is wanted, (machine, platform)
+    assert linalg.PREFERENCE[0] == "pardiso"
+    if linalg.is_available("pardiso"):
+        assert linalg.resolve() == "pardiso"
+
+
+def test_the_closing_line_names_the_linear_solver():
+    from vfem.io.runner import solver_words
+
+    assert solver_words({"linear_solver": "pardiso"}) == ", linear solver pardiso"
+    assert solver_words({"linear_solver": "superlu"}).startswith(
+        ", linear solver superlu (the slowest: ")
+    assert solver_words({}) == ""  # (a summary written before the key existed)

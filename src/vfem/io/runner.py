@@ -225,7 +225,24 @@ def run_headline(s: dict, unit: str = "steps", contact_dofs: bool = False) -> st
     dofs = f"{s['dofs']} dofs" + (f" ({s['contact_dofs']} contact dofs)" if contact_dofs else "")
     return (f"vfem: {run_status(s)} in {len(steps)} {unit}, "
             f"{sum(x['iterations'] for x in steps)} contact iterations, {dofs}, "
-            f"{s['timings']['total_s']:.1f} s")
+            f"{s['timings']['total_s']:.1f} s" + solver_words(s))
+
+
+def solver_words(s: dict) -> str:
+    """", linear solver <name>" for a summary that records its backend (``linear_solver``),
+    with the way to a faster one where it is SciPy's SuperLU and a faster one is not installed
+    (:data:`vfem.linalg.PREFERENCE`)."""
+    name = s.get("linear_solver")
+    if not name:
+        return ""
+    words = f", linear solver {name}"
+    if name == "superlu":
+        import platform
+
+        words += (" (the slowest: pip install pypardiso gives PARDISO)"
+                  if platform.machine() in ("x86_64", "AMD64") else
+                  " (the slowest: docs/benchmarks.md lists the faster backends)")
+    return words
 
 
 def report(s: dict, out: Path) -> list[str]:
@@ -234,7 +251,7 @@ def report(s: dict, out: Path) -> list[str]:
     lines = [f"vfem: {s['model']}: {run_status(s)} — "
              f"{len(s['steps'])} step{'' if len(s['steps']) == 1 else 's'}, {n_iter} contact "
              f"iteration{'' if n_iter == 1 else 's'}, {s['dofs']} dofs, "
-             f"{s['timings'].get('total_s', 0.0):.1f} s"]
+             f"{s['timings'].get('total_s', 0.0):.1f} s{solver_words(s)}"]
     for name, b in s["bodies"].items():
         reactions = f", reactions {_xy(b['reactions'])}" if "reactions" in b else ""
         if any(b.get("applied_load") or ()):
