@@ -3,6 +3,7 @@
 import copy
 import csv
 import dataclasses
+import json
 import re
 import shutil
 import xml.etree.ElementTree as ET
@@ -172,6 +173,13 @@ def test_plot_results_errors_name_the_path(tmp_path):
     missing = tmp_path / "nowhere"
     with pytest.raises(InputError, match=re.escape(str(missing))):
         plot_results(missing)
+    # the folder of a run that converged no step: its summary alone, and what the run said
+    (tmp_path / "summary.json").write_text(json.dumps(
+        {"converged": False, "message": "step 1 (load factor 0 -> 0.1) failed: no convergence"}))
+    with pytest.raises(InputError, match=re.escape(
+            f"{tmp_path}: its run wrote no step to draw (no results.pvd: it stopped before its "
+            "first step converged); the run said: step 1 (load factor 0 -> 0.1) failed")):
+        plot_results(tmp_path)
     (tmp_path / "results.pvd").write_text(
         '<?xml version="1.0"?>\n<VTKFile type="Collection"><Collection>\n'
         '<DataSet timestep="1" group="" part="0" file="gone_step0001.vtu"/>\n'

@@ -183,7 +183,7 @@ class BodyConfig:
             exterior facet on which no displacement is prescribed.
         kinematics: ``"small"`` (small displacements, linear elasticity), or large
             displacements and strains by the ``"total"`` or ``"updated"`` Lagrangian
-            formulation (plane strain, linear elements).
+            formulation (plane strain or 3D, linear elements).
         law: under large kinematics, the hyperelastic law whose small-strain constants are the
             material's: ``"saint-venant-kirchhoff"`` or ``"neo-hookean"``.
     """

@@ -80,9 +80,13 @@ def validate(p: HertzParameters) -> None:
         if not (isinstance(value, (int, float)) and 0 < value < math.inf):
             raise InputError(f"{name} must be a finite number > 0 (the cylinder is pressed onto "
                              f"the flat), got {value!r}")
-    if p.facets_per_half_width < 1 or p.refinement < 0:
-        raise InputError("facets_per_half_width must be at least 1 and refinement not negative, "
-                         f"got {p.facets_per_half_width} and {p.refinement}")
+    # (each named alone: the one given wrong, not its companion the user did not set)
+    if p.facets_per_half_width < 1:
+        raise InputError("facets_per_half_width must be at least 1 (facets over the contact "
+                         f"half-width), got {p.facets_per_half_width}")
+    if p.refinement < 0:
+        raise InputError("refinement must be 0 or more (each level halves the elements), got "
+                         f"{p.refinement}")
     build(p).validate()
 
 

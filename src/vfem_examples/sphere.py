@@ -85,9 +85,13 @@ def validate(p: SphereParameters) -> None:
         if not (isinstance(value, (int, float)) and 0 < value < math.inf):
             raise InputError(f"{name} must be a finite number > 0 (the sphere is pressed onto "
                              f"the flat), got {value!r}")
-    if p.facets_per_radius < 1 or p.refinement < 0:
-        raise InputError("facets_per_radius must be at least 1 and refinement not negative, "
-                         f"got {p.facets_per_radius} and {p.refinement}")
+    # (each named alone: the one given wrong, not its companion the user did not set)
+    if p.facets_per_radius < 1:
+        raise InputError("facets_per_radius must be at least 1 (facets over the contact "
+                         f"radius), got {p.facets_per_radius}")
+    if p.refinement < 0:
+        raise InputError("refinement must be 0 or more (each level halves the elements), got "
+                         f"{p.refinement}")
     for name in ("sphere_cells", "flat_cells"):
         if getattr(p, name) not in ("hex", "tet"):
             raise InputError(f"{name} must be 'hex' or 'tet', got {getattr(p, name)!r}")

@@ -137,7 +137,7 @@ class PrescribedDisplacement:
 
     Attributes:
         boundary: the boundary's name.
-        component: ``"x"`` or ``"y"``.
+        component: ``"x"``, ``"y"`` or (3D) ``"z"``.
         value: the displacement at load factor 1.
         amplitude: a load curve, ``[[load_factor, multiplier], ...]`` points (load factors
             strictly increasing): the displacement is ``value`` times the multiplier
@@ -187,7 +187,7 @@ class Platen:
 
     Attributes:
         boundary: the boundary the platen holds.
-        component: the direction it moves in, ``"x"`` or ``"y"``.
+        component: the direction it moves in, ``"x"``, ``"y"`` or (3D) ``"z"``.
         force: its total force at load factor 1 (negative: towards -x or -y).
         amplitude: a load curve, ``[[load_factor, multiplier], ...]`` points (load factors
             strictly increasing): the force is ``force`` times the multiplier interpolated

@@ -123,6 +123,15 @@ def read_pvd(directory: Path) -> list[tuple[int, float, int, str, Path]]:
     """
     pvd = Path(directory) / "results.pvd"
     if not pvd.is_file():
+        summary = Path(directory) / "summary.json"
+        if summary.is_file():  # a run that converged no step writes its summary alone
+            try:
+                said = str(json.loads(summary.read_text(encoding="utf-8")).get("message", ""))
+            except (OSError, ValueError, AttributeError):
+                said = ""
+            raise InputError(f"{directory}: its run wrote no step to draw (no results.pvd: it "
+                             "stopped before its first step converged)"
+                             + (f"; the run said: {said}" if said else ""))
         raise InputError(f"no results.pvd in {directory} (not a vfem results directory?)")
     try:
         root = ET.parse(pvd).getroot()
