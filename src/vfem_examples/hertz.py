@@ -80,14 +80,20 @@ def validate(p: HertzParameters) -> None:
         if not (isinstance(value, (int, float)) and 0 < value < math.inf):
             raise InputError(f"{name} must be a finite number > 0 (the cylinder is pressed onto "
                              f"the flat), got {value!r}")
-    # (each named alone: the one given wrong, not its companion the user did not set)
-    if p.facets_per_half_width < 1:
-        raise InputError("facets_per_half_width must be at least 1 (facets over the contact "
-                         f"half-width), got {p.facets_per_half_width}")
-    if p.refinement < 0:
-        raise InputError("refinement must be 0 or more (each level halves the elements), got "
-                         f"{p.refinement}")
+    check_resolution("facets_per_half_width", p.facets_per_half_width, "half-width",
+                     p.refinement)
     build(p).validate()
+
+
+def check_resolution(name: str, count: int, over: str, refinement: int) -> None:
+    """Refuse a facet count ``name`` below 1 or a negative ``refinement``, each by its own name
+    (not the companion the user did not set); hertz's and sphere's."""
+    if count < 1:
+        raise InputError(f"{name} must be at least 1 (facets over the contact {over}), got "
+                         f"{count}")
+    if refinement < 0:
+        raise InputError("refinement must be 0 or more (each level halves the elements), got "
+                         f"{refinement}")
 
 
 def config(p: HertzParameters | None = None) -> ModelConfig:

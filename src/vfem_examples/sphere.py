@@ -33,6 +33,8 @@ from vfem.io.runner import run_headline
 from vfem.materials import LinearElastic
 from vfem.solver import AnalysisResult, Model
 
+from .hertz import check_resolution
+
 #: The contact region's proportions, over the sphere's radius.
 CYLINDER_RADIUS, CYLINDER_HEIGHT = 0.6, 0.5
 FLAT_HALF_WIDTH, FLAT_DEPTH = 1.0, 1.0
@@ -85,13 +87,7 @@ def validate(p: SphereParameters) -> None:
         if not (isinstance(value, (int, float)) and 0 < value < math.inf):
             raise InputError(f"{name} must be a finite number > 0 (the sphere is pressed onto "
                              f"the flat), got {value!r}")
-    # (each named alone: the one given wrong, not its companion the user did not set)
-    if p.facets_per_radius < 1:
-        raise InputError("facets_per_radius must be at least 1 (facets over the contact "
-                         f"radius), got {p.facets_per_radius}")
-    if p.refinement < 0:
-        raise InputError("refinement must be 0 or more (each level halves the elements), got "
-                         f"{p.refinement}")
+    check_resolution("facets_per_radius", p.facets_per_radius, "radius", p.refinement)
     for name in ("sphere_cells", "flat_cells"):
         if getattr(p, name) not in ("hex", "tet"):
             raise InputError(f"{name} must be 'hex' or 'tet', got {getattr(p, name)!r}")
