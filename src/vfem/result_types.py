@@ -129,7 +129,7 @@ def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
     Returns ``{body: {"penetration": value (> 0 overlap, <= 0 none), "node": point number,
     "into": other body}}`` for the given step (default: the last).
     """
-    from .contact.geometry import ContactPairs
+    from .contact.geometry import ContactPairs, zone_nodes
 
     step = step or result.steps[-1]
     surfaces = result.surfaces
@@ -140,7 +140,7 @@ def largest_penetrations(result: AnalysisResult, step: StepResult | None = None
         s, so = surfaces[side.body], surfaces[other.body]
         if s.nc == 0 or so.nc == 0:
             continue
-        local = np.arange(s.nc) if side.facets is None else np.unique(s.facets[side.facets])
+        local = zone_nodes(s, side.facets)
         if not len(local) or (other.facets is not None and not len(other.facets)):
             continue  # (a side with no candidate facet)
         u = step.bodies[s.body.name].displacement[s.nodes[local]]

@@ -100,7 +100,8 @@ def check_capabilities(model) -> None:
                          + ("large kinematics" if any(b.large for b in model.bodies) else
                             "a material that carries state (Newton's method)")
                          + " needs the paired contact variant")
-    if not caps.sides and model.pairs().sided:
+    pairs = model.pairs()  # (parsed once here)
+    if not caps.sides and pairs.sided:
         what, use = ((f"contact.method = {settings.method!r}", "contact.method = 'vfem'")
                      if settings.method != "vfem" else
                      (f"contact.variant = {settings.variant!r}", "the paired variant"))
@@ -115,7 +116,7 @@ def check_capabilities(model) -> None:
             raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r}: no "
                              f"body named {unknown[0]!r} (bodies: {', '.join(sorted(names))})")
         one = {index[n] for n in pair.bodies}
-        if len(one) == 1 and frozenset(one) not in model.pairs():  # a body's own sides
+        if len(one) == 1 and frozenset(one) not in pairs:  # a body's own sides
             raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r} names "
                              "one body twice, and contact_pairs pairs no sides of it with "
                              "each other (a body's contact with itself is not supported)")

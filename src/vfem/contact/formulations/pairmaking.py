@@ -27,6 +27,7 @@ from ..geometry import (
     held_nodes,
     overlap,
     read_facets,
+    zone_mask,
 )
 
 log = logging.getLogger(__name__)
@@ -319,7 +320,7 @@ def nearest_side(form, s: ContactSurface, meets: list[tuple[Side, Side]]) -> np.
     for k, (own, other) in enumerate(meets):
         _, _, d, _ = form.surfaces[other.body].closest(points, None, other.facets)[:4]
         if own.facets is not None:  # only the nodes of the own side's zone meet it
-            d = np.where(np.isin(np.arange(len(points)), s.facets[own.facets]), d, np.inf)
+            d = np.where(zone_mask(s, own.facets), d, np.inf)
         closer = d < dist
         best[closer], dist[closer] = k, d[closer]
     return best

@@ -16,6 +16,7 @@ from ..geometry import (
     ContactPair,
     ContactPairs,
     ContactSurface,
+    zone_mask,
 )
 from ..state import (
     ContactState,
@@ -296,7 +297,7 @@ class PairSet:
                     f = -np.einsum("ij,ij->i", state.forces[i], nn)
                     on = np.abs(state.forces[i]).sum(axis=1) > 0
                     if pair.zones[1] is not None:  # the equilibrium side's nodes alone
-                        on &= np.isin(np.arange(nc), s.facets[pair.zones[1]])
+                        on &= zone_mask(s, pair.zones[1])
                     force[on] = f[on]
                     other[on] = pair.fine
                     normal[on] = -nn[on]

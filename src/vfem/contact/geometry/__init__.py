@@ -24,7 +24,7 @@ from .pairing import (
     virtual_nodes,
 )
 from .placement import check_initial_overlap, select_candidate_facets
-from .sides import ContactPairs, Side, SurfacePair
+from .sides import ContactPairs, Side, SurfacePair, zone_mask, zone_nodes
 from .surface import ContactSurface, beyond, patch_ends
 from .tangent_basis import tangent_axes, tangents
 from .transfer import traction_from_forces
@@ -59,4 +59,6 @@ __all__ = [
     "tangents",
     "traction_from_forces",
     "virtual_nodes",
+    "zone_mask",
+    "zone_nodes",
 ]

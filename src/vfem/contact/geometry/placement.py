@@ -17,7 +17,7 @@ from .bodymesh import (
     mesh_simplices,
 )
 from .closest3d import closest_on_facets
-from .sides import ContactPairs
+from .sides import ContactPairs, zone_nodes
 from .surface import ContactSurface
 
 
@@ -45,7 +45,7 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs) -
         if si.nc == 0 or len(sj.facets) == 0 or (other is not None and not len(other)):
             continue
         # the nodes of one side, against the other's facets (their zones: :mod:`.sides`)
-        local = np.arange(si.nc) if own is None else np.unique(si.facets[own])
+        local = zone_nodes(si, own)
         x, node = si.X[local], si.nodes[local]
         seg, t, _, n, tf = sj.closest(x, None, other)
         pos, _ = sj.curve(seg, t)

@@ -192,6 +192,20 @@ class ContactPairs:
                                               p.b.on(surfaces[p.b.body])) for p in self.pairs))
 
 
+def zone_nodes(surface, facets: np.ndarray | None) -> np.ndarray:
+    """(k,) the candidate nodes of ``surface`` (its local numbers) on a zone's ``facets``, all of
+    them for None (a whole surface)."""
+    return np.arange(surface.nc) if facets is None else np.unique(surface.facets[facets])
+
+
+def zone_mask(surface, facets: np.ndarray | None) -> np.ndarray:
+    """(nc,) True at the candidate nodes of ``surface`` on a zone's ``facets``
+    (:func:`zone_nodes`)."""
+    mask = np.zeros(surface.nc, dtype=bool)
+    mask[zone_nodes(surface, facets)] = True
+    return mask
+
+
 def _side(text, names: dict, bodies, entry, where: str) -> Side:
     if not isinstance(text, str):
         raise InputError(f"{where} {list(entry)!r}: {text!r} is not a name")
