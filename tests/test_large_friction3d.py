@@ -146,12 +146,22 @@ def test_the_3d_slide_turned_about_the_vertical_gives_the_turned_forces():
 def test_a_small_push_in_3d_is_the_small_kinematics_one_to_the_strain():
     """Pressed and then pushed sideways by a tenth of the press (far less than the slide the
     friction allows), the block's middle sticks (its rim slips, where the pressure is singular)
-    and its forces are the small-kinematics ones but for the geometric nonlinearity, in
-    proportion to the strain: pressed by 0.05 % of its height they differ by 3.4e-4 of the
-    largest force, pressed ten times more by ten times that (measured 3.4e-3)."""
-    differences = []
+    and its normal force is the small-kinematics one but for the geometric nonlinearity, in
+    proportion to the strain: pressed by 0.05 % of its height they differ by less than that
+    strain (measured 3.6e-4 of the largest force), pressed ten times more by ten times as much
+    (measured 3.45e-3, with PARDISO and with SuperLU).
+
+    The tangential force (about 1 % of the normal one here) is not held to the strain: the
+    contact iteration leaves each node's friction error within the equilibrium tolerance of the
+    largest nodal force (``ContactSettings.equilibrium_tolerance``), and a node at the cone's
+    edge sticks or slips by round-off (one node did between PARDISO and SuperLU, moving the
+    difference from 2.3e-4 to 8.8e-4 of the largest force: issue 39). The two answers' tangential
+    resultants agree to the sum of those tolerances over the nodes that carry force."""
+    tolerance = ContactSettings().equilibrium_tolerance
+    height = 0.25  # the block's
+    normal, tangential, allowed = [], [], []
     for press in (0.000125, 0.00125):
-        forces = {}
+        forces, bound = {}, 0.0
         for kinematics in ("total", "small"):
             result = run(slide(shift=0.1 * press, press=press, kinematics=kinematics,
                                factors=(0.25, 0.5, 0.75, 1.0)))
@@ -159,11 +169,17 @@ def test_a_small_push_in_3d_is_the_small_kinematics_one_to_the_strain():
             block = result.steps[-1].bodies["block"]
             middle = np.flatnonzero(block.friction_status >= 0)[12]  # the contact's centre
             assert block.friction_status[middle] == 1
+            nodal = np.linalg.norm(block.contact_force, axis=1)
+            bound += tolerance * nodal.max() * np.count_nonzero(nodal)
         large, small = forces["total"], forces["small"]
         assert np.linalg.norm(large[-1, :2]) < MU * large[-1, 2]  # inside the cone
-        differences.append(np.abs(large - small).max() / np.abs(small).max())
-    assert differences[0] < 5e-4
-    assert 5 < differences[1] / differences[0] < 20
+        scale = np.abs(small).max()
+        normal.append(np.abs(large[:, 2] - small[:, 2]).max() / scale)
+        tangential.append(np.abs(large[:, :2] - small[:, :2]).max())
+        allowed.append(bound)
+    assert normal[0] < 0.000125 / height  # the strain, 5e-4
+    assert 5 < normal[1] / normal[0] < 20
+    assert all(t <= a for t, a in zip(tangential, allowed)), (tangential, allowed)
 
 
 def test_a_resumed_3d_slide_equals_an_uninterrupted_one(tmp_path):
