@@ -250,7 +250,45 @@ def summarize(result: AnalysisResult, p: HertzParameters) -> dict:
     }
     if result.steps and result.steps[-1].load_factor == 1.0:
         summary["hertz"] = evaluate(result, p)
+        summary["verification"] = verification(summary["hertz"], p)
     return summary
+
+
+#: Hertz's closed form for two elastic half-spaces in plane strain (the source of a and p0)
+HERTZ = "Hertz, with the flat's compliance"
+
+
+def verification(h: dict, p: HertzParameters) -> list[dict]:
+    """The Hertz run's checks against Hertz's theory (two elastic half-spaces in plane strain,
+    Johnson, *Contact Mechanics*, §4.2) and its own load (``summary.json``'s
+    ``verification``; :mod:`vfem.io.verification`). The tolerances: this finite model (a
+    half-cylinder on a 0.1-thick layer) differs from Hertz's half-spaces by +0.074 % in p0, its
+    converged limit (``docs/accuracy.md``), and the discretisation adds under 0.03 % from 12
+    facets across a; the profile's RMS error against Hertz averaged as the nodes read it is
+    0.73 % at 12 facets and falls with refinement; the contact edge lies between the last node in
+    contact and the next, within one facet; the platen's force is met to its tolerance."""
+    from vfem.io.verification import check
+
+    settings = ContactSettings()
+    return [
+        check("peak pressure p_max", h["p_max"], h["p0_theory"], HERTZ, 0.005,
+              "the finite model's limit +0.074 % and the discretisation, under 0.03 % from 12 "
+              "facets across a (docs/accuracy.md), with margin"),
+        check("half-width a", h["a_estimate"], h["a_theory"], HERTZ, h["contact_facet_length"],
+              "the edge is read between the last node in contact and the next: one facet",
+              measure="absolute"),
+        check("pressure profile, RMS error / p0", h["rms_error_averaged"], 0.0,
+              "Hertz, averaged as the nodes read it", 0.02,
+              "discretisation: 0.73 % at 12 facets across a, falling with refinement "
+              "(docs/accuracy.md)", measure="absolute"),
+        check("contact force on the cylinder", h["total_contact_force"], h["applied_force"],
+              "the platen's force", settings.platen_tolerance,
+              "the platen's force is met to contact.platen_tolerance"),
+        check("contact force on the flat", h["total_contact_force_flat"],
+              h["total_contact_force"], "the cylinder's, equal and opposite",
+              settings.equilibrium_tolerance,
+              "the contact iteration's equilibrium tolerance (contact.equilibrium_tolerance)"),
+    ]
 
 
 def run(p: HertzParameters, out, on_step=None, figures: bool = True,

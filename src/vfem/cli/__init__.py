@@ -29,6 +29,7 @@ from .commands import cmd_export, cmd_plot, cmd_reference
 from .launch import join_ranks, launch_ranks, tell_rank_failure
 from .progress import Progress
 from .run import SOLVER_HELP, cmd_check, cmd_run
+from .verify import cmd_verify
 
 __all__ = ["main", "build_parameters", "Progress"]
 
@@ -114,6 +115,14 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--json", help="also write the table to this JSON file")
     bench.add_argument("--variant", default="paired", choices=("paired", "thesis"),
                        help="contact variant (default paired)")
+    verify = sub.add_parser("verify", help="run every built-in example and print how right "
+                                           "each is (a check of the install)")
+    verify.add_argument("examples", nargs="*", metavar="EXAMPLE",
+                        help="only these examples (default: all)")
+    verify.add_argument("--slow", action="store_true",
+                        help="the refined models the examples name, instead of the defaults")
+    verify.add_argument("--out", help="keep the results and verify.json in this folder "
+                                      "(default: a temporary one, removed)")
     study = sub.add_parser("study", help="an example under refinement, both variants, plotted")
     study.add_argument("example", help="hertz")
     study.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3, 4],
@@ -156,7 +165,7 @@ def _main(args) -> int:
         threads.apply(args.threads)  # one thread policy for every command (vfem.threads)
         command = {"run": cmd_run, "check": cmd_check, "export": cmd_export, "plot": cmd_plot,
                    "reference": cmd_reference,
-                   "bench": cmd_bench, "study": cmd_study}[args.command]
+                   "bench": cmd_bench, "study": cmd_study, "verify": cmd_verify}[args.command]
         return command(args)
     except InputError as exc:
         print(f"vfem: error: {exc}", file=sys.stderr)

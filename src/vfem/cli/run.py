@@ -65,10 +65,12 @@ def _with_invariants(lines: list[str], summary: dict) -> list[str]:
     reactions and how they balance (:func:`vfem.io.runner.reaction_lines`) and the invariants
     line of its steps (:func:`vfem.io.runner.invariants_line`); the results line, made from the
     folder's record, comes after them (:func:`results_line`)."""
+    from ..io import verification
     from ..io.runner import invariants_line, reaction_lines
 
     steps = summary.get("steps") or []
-    return [*lines, *("  " + x for x in (*reaction_lines(steps), invariants_line(steps)) if x)]
+    return [*lines, *("  " + x for x in (*reaction_lines(steps), invariants_line(steps)) if x),
+            *verification.lines(summary.get("verification") or [])]
 
 
 def _writable_folder(out: Path, what: str) -> None:
