@@ -222,3 +222,22 @@ def test_a_folder_friction_and_one_body_are_told_plainly(tmp_path, capsys):
     one.write_text(text[: text.index('[[bodies]]\nname = "punch"')])
     assert main(["check", str(one)]) == 0
     assert "1 body (" in capsys.readouterr().out
+
+
+def test_the_progress_reads_a_terminal_as_the_ranks_launcher_said(monkeypatch):
+    """Under ``vfem run --ranks`` a rank's stdout is mpiexec's pseudo-terminal whatever the
+    user's screen is: the launcher's word (VFEM_TTY) decides, else the stream's isatty."""
+    import io
+
+    from vfem.cli.progress import TTY_ENV, Progress, is_terminal
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    monkeypatch.delenv(TTY_ENV, raising=False)
+    assert is_terminal(Terminal()) and not is_terminal(io.StringIO())
+    monkeypatch.setenv(TTY_ENV, "0")
+    assert not is_terminal(Terminal()) and not Progress(stream=Terminal()).tty
+    monkeypatch.setenv(TTY_ENV, "1")
+    assert is_terminal(io.StringIO())

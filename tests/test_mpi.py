@@ -91,6 +91,11 @@ def test_the_ranks_launcher_runs_the_same_command(tmp_path):
                  "--no-figures"])
     assert done.returncode == 0, done.stderr
     assert done.stdout.count("vfem: stack, results in") == 1  # one rank prints
+    # into a pipe, a line per step: mpiexec gives the ranks a pseudo-terminal, and they wrote
+    # carriage returns, ESC[K and a line per contact iteration before the launcher told them
+    # the screen was no terminal (issue 39)
+    assert "\r" not in done.stdout and "\x1b" not in done.stdout
+    assert " iteration " not in done.stdout and done.stdout.count("  step ") >= 1
     serial = tmp_path / "serial"
     assert vfem(["run", "stack", "--set", "dim=2", "--out", str(serial),
                  "--no-figures"]).returncode == 0

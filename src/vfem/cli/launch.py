@@ -7,6 +7,7 @@ import os
 import sys
 
 from .. import parallel
+from .progress import TTY_ENV
 
 
 def tell_rank_failure(ranks) -> None:
@@ -41,6 +42,9 @@ def launch_ranks(args, argv: list[str], main) -> int:
               file=sys.stderr)
         return 2
     command, env = parallel.launch_command(launcher, n, [sys.executable, "-m", "vfem", *rest])
+    # whether the user's screen is a terminal: mpiexec hands the ranks a pseudo-terminal of its
+    # own, so a rank cannot tell that its output goes to a file (progress.TTY_ENV)
+    env[TTY_ENV] = "1" if getattr(sys.stdout, "isatty", lambda: False)() else "0"
     import subprocess
 
     try:

@@ -2,7 +2,23 @@
 
 from __future__ import annotations
 
+import os
 import sys
+
+#: set by ``vfem run --ranks`` for the ranks it launches: "1" when the user's screen is a
+#: terminal, "0" when the output goes to a file or a pipe (mpiexec gives the ranks a
+#: pseudo-terminal either way, so without it a run piped to a file wrote carriage returns,
+#: ESC[K and a line per contact iteration into it)
+TTY_ENV = "VFEM_TTY"
+
+
+def is_terminal(stream) -> bool:
+    """Whether ``stream`` shows on a terminal: what ``vfem run --ranks`` said (:data:`TTY_ENV`)
+    where it launched this process, else the stream's own ``isatty``."""
+    said = os.environ.get(TTY_ENV)
+    if said in ("0", "1"):
+        return said == "1"
+    return bool(getattr(stream, "isatty", lambda: False)())
 
 
 class Progress:
@@ -14,7 +30,7 @@ class Progress:
         self.total = len(self.factors)
         self.enabled = enabled
         self.stream = stream or sys.stdout
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.tty = is_terminal(self.stream)
         self.done = 0  # scheduled steps completed (a cut step completes only at its target)
         self.steps_seen = 0  # converged steps, cut ones included
         self.label = ""  # the case under way, in a run of several (wedge): "case 3: "
