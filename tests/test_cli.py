@@ -241,3 +241,24 @@ def test_the_progress_reads_a_terminal_as_the_ranks_launcher_said(monkeypatch):
     assert not is_terminal(Terminal()) and not Progress(stream=Terminal()).tty
     monkeypatch.setenv(TTY_ENV, "1")
     assert is_terminal(io.StringIO())
+
+
+def test_the_invariants_line_reads_as_passed_when_every_node_is_within_its_allowance():
+    """A corner's faceting allows its node more than the tolerance: the deepest node may be
+    deeper than the allowance of the node nearest its own, and the line says so instead of
+    printing a depth above an allowance as if it were a violation (issue 39)."""
+    from vfem.io.runner import invariants_line
+
+    def step(deepest, near, allowed):
+        return {"invariants": {"force_balance": 1e-16, "max_penetration_any_body": deepest,
+                               "penetration": near, "allowed": allowed,
+                               "where": {"node": 3, "body": "a", "into": "b"},
+                               "tension": 0.0, "tension_tolerance": 1e-8, "passed": True}}
+
+    corner = invariants_line([step(1.4e-5, 2.0e-7, 1.6e-6)])
+    assert "no node beyond its allowance (deepest 1.4e-05 inside, within its own; nearest its " \
+           "allowance 2.0e-07 inside, allowed 1.6e-06)" in corner and "VIOLATED" not in corner
+    plain = invariants_line([step(1.1e-18, -3.4e-18, 5.6e-8)])
+    assert "no node beyond its allowance (deepest 1.1e-18 inside, allowed 5.6e-08)" in plain
+    outside = invariants_line([step(1.4e-5, -1e-9, 1.6e-6)])
+    assert "(deepest 1.4e-05 inside, within its own)" in outside

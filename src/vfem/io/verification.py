@@ -67,17 +67,17 @@ def lines(records: list[dict]) -> list[str]:
     error and tolerance, and the reference's source), then how many passed."""
     if not records:
         return []
-    out = ["verification (against references the run did not compute; summary.json's "
+    out = ["  verification, against references the run did not compute (summary.json's "
            "verification says where each tolerance comes from):"]
     width = max(len(r["quantity"]) for r in records)
     for r in records:
         rel = r["measure"] == "relative"
         mark = "passed" if r["passed"] else "FAILED"
-        out.append(f"  {mark}  {r['quantity']:<{width}}  {r['value']:.6g} against "
+        out.append(f"    {mark}  {r['quantity']:<{width}}  {r['value']:.6g} against "
                    f"{r['reference']:.6g} ({r['source']}): error {_amount(r['error'], rel)}, "
                    f"allowed {_amount(r['tolerance'], rel)}")
     failed = sum(not r["passed"] for r in records)
-    out.append(f"  {len(records) - failed} of {len(records)} passed"
+    out.append(f"    {len(records) - failed} of {len(records)} passed"
                + (f"; {failed} FAILED" if failed else ""))
     return out
 
