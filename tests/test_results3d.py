@@ -246,7 +246,8 @@ BOX_TOML = input_file("box3d", toml_body(
 def test_a_3d_input_file_runs_and_writes_its_summary(tmp_path):
     """``shape = "box"`` in an input file: the model runs as ``vfem run`` runs it
     (:func:`vfem.io.runner.run`), its summary's forces with three components, no contact
-    dofs; the history is its only figure (3D figures are to come)."""
+    dofs; its figures are the 3D ones without a pressure map (no node in contact, which a note
+    says) and the history."""
     from vfem.io.runner import run as run_input
 
     config = loads(BOX_TOML)
@@ -263,7 +264,10 @@ def test_a_3d_input_file_runs_and_writes_its_summary(tmp_path):
     pytest.importorskip("matplotlib")
     from vfem.io.replot import plot_results
 
-    assert [p.name for p in plot_results(tmp_path)] == ["history.png"]
+    notes: list[str] = []
+    assert sorted(p.name for p in plot_results(tmp_path, notes)) == [
+        "deformed.png", "history.png", "von_mises.png"]
+    assert any(n.startswith("pressure_box.png: no node of 'box' in contact") for n in notes)
 
 
 def test_export_writes_a_3d_support_exactly():

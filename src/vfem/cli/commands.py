@@ -51,8 +51,11 @@ def cmd_plot(args) -> int:
     why = unfinished_example(Path(args.results))  # an example's own figures cannot be drawn
     if why and not args.quiet:
         print(f"vfem: {why}", file=sys.stderr)
-    written = plot_results(Path(args.results))
+    notes: list[str] = []  # what was not drawn, and why (a 3D body with no node in contact)
+    written = plot_results(Path(args.results), notes)
     if not args.quiet:
         print(f"vfem: wrote {', '.join(str(p) for p in written)}" if written else
               f"vfem: {args.results}: no figures to draw (its run drew none)")
+        for note in notes:
+            print(f"vfem: not drawn: {note}", file=sys.stderr)
     return 0

@@ -149,6 +149,8 @@ def _solve_and_report(solve, progress: Progress, report, quiet: bool, args, out:
         print("\n".join(results_line(report(summary), out)))
         if summary.get("figures_not_drawn"):  # no matplotlib, or --no-figures (draw_run)
             print(f"vfem: figures not drawn: {summary['figures_not_drawn']}", file=sys.stderr)
+        for note in summary.get("figures_notes") or ():  # a figure left out, and why
+            print(f"vfem: not drawn: {note}", file=sys.stderr)
     if not summary["converged"]:
         print(f"vfem: the analysis did not converge: "
               f"{summary.get('message') or 'see summary.json for each case'}",

@@ -24,6 +24,10 @@ records no figure set, e.g. one written before figure sets were recorded):
   the Coulomb limit ±mu q (q the normal traction there; both of the static/dynamic law's
   coefficients): a slipping node lies on it, a sticking one within.
 
+A 3D model's are :mod:`vfem.io.figures3d`'s: ``pressure_<body>.png`` (and with friction
+``stick_slip_<body>.png``) per body in contact, ``deformed.png``, ``von_mises.png``, with
+``history.png``; what they leave undrawn is said in ``summary.json``'s ``figures_notes``.
+
 Without ``contact.csv`` (results written by an older version), the nodes in contact and their
 pressure are taken from the VTU's ``contact_status`` and ``contact_pressure`` point fields.
 """
@@ -46,7 +50,7 @@ import numpy as np
 from ..contact.laws import friction_law as contact_friction_law
 from ..contact.laws import law_bounds, law_record, law_text
 from ..errors import InputError
-from . import plots
+from . import figures3d, plots
 from .files import _safe, forget_vtus, write_summary, written_vtu
 
 log = logging.getLogger(__name__)
@@ -261,6 +265,8 @@ class Folder:
         self.summary = read_summary(self.directory) if summary is None else summary
         self._steps: list[Step] | None = None
         self._table: dict | None = None
+        #: what the figures left undrawn, and why: "<figure>: <why>" each
+        self.notes: list[str] = []
 
     @property
     def has_steps(self) -> bool:
@@ -433,6 +439,7 @@ def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> lis
     if model is not None:
         summary["contact_settings"] = contact_settings(model)
     summary.pop("figures_not_drawn", None)
+    summary.pop("figures_notes", None)
     missing = (f"--no-figures (vfem plot {out} draws them)" if _deferred
                else plots.matplotlib_missing())
     if missing is not None:
@@ -442,10 +449,13 @@ def draw_run(out: Path | str, summary: dict, figure_set: str, model=None) -> lis
         write_summary(out, summary)
         return []
     write_summary(out, summary)
+    notes: list[str] = []
     try:
-        summary["figures"] = [p.relative_to(out).as_posix() for p in plot_results(out)]
+        summary["figures"] = [p.relative_to(out).as_posix() for p in plot_results(out, notes)]
     finally:
         forget_vtus()  # the run's last step was drawn from memory; a redraw reads the files
+    if notes:  # what was not drawn, and why ("<figure>: <why>"; vfem run prints them)
+        summary["figures_notes"] = notes
     write_summary(out, summary)
     return summary["figures"]
 
@@ -465,7 +475,7 @@ def register_examples(names: Iterable[str], load: Callable[[str], object]) -> No
     _examples = (tuple(names), load)
 
 
-def plot_results(directory: Path | str) -> list[Path]:
+def plot_results(directory: Path | str, notes: list[str] | None = None) -> list[Path]:
     """Draw a results folder's figures from its files; return the paths written.
 
     Which figures: ``summary.json``'s ``figure_set``, the built-in example whose run wrote the
@@ -477,6 +487,9 @@ def plot_results(directory: Path | str) -> list[Path]:
     whose own figures need its finished run's evaluation (:func:`unfinished_example` says
     so). A run draws its figures by calling this after writing its files, so ``vfem plot``
     redraws the same figures from the same data.
+
+    ``notes``, when given, gets what was not drawn and why, "<figure>: <why>" each (a 3D
+    model's body with no node in contact has no pressure map, :mod:`vfem.io.figures3d`).
 
     Raises :class:`~vfem.errors.InputError` naming the path when the directory, its
     ``results.pvd`` or a VTU file it lists is missing or unreadable, and naming the fix when
@@ -503,6 +516,8 @@ def plot_results(directory: Path | str) -> list[Path]:
         written = generic(folder)
     for p in written:
         log.info("wrote %s", p)
+    if notes is not None:
+        notes.extend(folder.notes)
     return written
 
 
@@ -540,15 +555,19 @@ def unfinished_example(directory: Path | str) -> str | None:
 
 
 def generic(folder: Folder) -> list[Path]:
-    """The figures of an input file's run (see :func:`plot_results`). Of a 3D model's, only
-    ``history.png`` for now: its deformed shape, pressure map and sections are issue 21's
-    figures to come."""
+    """The figures of an input file's run (see :func:`plot_results`). A 3D model's are
+    :mod:`vfem.io.figures3d`'s (pressure and stick/slip maps per contact surface, the deformed
+    outlines, von Mises on the surfaces), with ``history.png``; what they leave undrawn, and
+    why, goes to ``folder.notes``."""
     steps = folder.steps
     label = contact_label(folder.summary)
     if any(b.dim == 3 for b in steps[-1].bodies):
-        log.info("%s: a 3D model: only history.png is drawn (3D figures are not implemented "
-                 "yet)", folder.directory)
-        return [_history(folder.directory, steps, folder.summary or None)]
+        written = figures3d.figures(folder, steps, label, magnification_for(steps),
+                                    folder.notes)
+        written.append(_history(folder.directory, steps, folder.summary or None))
+        for note in folder.notes:
+            log.info("not drawn: %s", note)
+        return written
     written = _deformed(folder.directory, steps, folder.contact, label)
     written.append(_pressure(folder.directory, steps, folder.contact, folder.contact_source,
                              label))
@@ -587,9 +606,7 @@ def _cell_field(frame: BodyFrame, name: str) -> np.ndarray:
 
 #: The faces of VTK's 3D cells, by the cells' node positions (hexahedron: bottom 0-3, top
 #: 4-7; tetrahedron: any three of four).
-_VTK_FACES = {8: ((0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6),
-                  (3, 0, 4, 7)),
-              4: ((0, 1, 2), (0, 1, 3), (1, 2, 3), (0, 2, 3))}
+_VTK_FACES = figures3d.CELL_FACES
 
 
 def plane_section(frame: BodyFrame, axis: int, at: float
