@@ -38,6 +38,10 @@ from vfem.materials import LinearElastic
 from vfem.result_types import largest_penetrations
 from vfem.solver import AnalysisResult, Model
 
+#: ``vfem verify --slow``: every element size halved (33 columns in the large block, odd so no
+#: node of its face sits on the corner), 2 840 dofs, about 2 s
+VERIFY_SLOW = ("h=0.05", "h_corner=0.01", "large_columns=33")
+
 
 @dataclass(frozen=True)
 class Parameters:
@@ -137,7 +141,45 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
     summary = example_summary("block", result, p)
     if result.complete:  # (also the thesis variant's run, not converged: issue 37)
         summary["block"] = evaluate(result, p)
+        if result.converged:
+            summary["verification"] = verification(summary["block"], p, result)
     return summary
+
+
+def verification(b: dict, p: Parameters, result: AnalysisResult) -> list[dict]:
+    """The block's checks (``summary.json``'s ``verification``; :mod:`vfem.io.verification`).
+    Its exact answer is not known in closed form (the corner is a stress singularity, thesis
+    §5.4), so it is checked against what any contact solution must meet exactly: each block in
+    equilibrium (the fixed block's support reaction and the press's reaction equal the contact
+    force: round-off of the linear solves, :data:`vfem.io.runner.ROUND_OFF`), the forces on the
+    two blocks equal and opposite (in the paired variant both follow from one traction,
+    docs/method.md §6: round-off; the thesis variant's to its equilibrium tolerance), and no
+    node of either block inside the other (checked both ways, independently of the solver:
+    within the contact iteration's penetration tolerance)."""
+    from vfem.io.runner import ROUND_OFF
+    from vfem.io.verification import check
+
+    force = b["contact_force"]
+    solve = ("round-off of the linear solves: machine epsilon times their condition, with "
+             "margin (vfem.io.runner.ROUND_OFF)")
+    if p.variant == "paired":
+        opposite, why = ROUND_OFF, ("the paired variant's forces on both blocks come from one "
+                                    "traction (docs/method.md §6): round-off (ROUND_OFF)")
+    else:
+        opposite = result.model.contact.equilibrium_tolerance
+        why = "the contact iteration's equilibrium tolerance (contact.equilibrium_tolerance)"
+    return [
+        check("fixed block's support reaction", b["small_reaction_y"], force,
+              "the contact force, by the block's equilibrium", ROUND_OFF, solve),
+        check("press's reaction", -b["large_reaction_y"], force,
+              "the contact force, by the block's equilibrium", ROUND_OFF, solve),
+        check("contact force on the fixed block", -b["small_contact_force_y"], force,
+              "the large block's, equal and opposite", opposite, why),
+        check("penetration, any node, both ways", b["largest_penetration_any_node"], 0.0,
+              "none: the bodies do not overlap", b["penetration_tolerance"],
+              "the contact iteration's penetration tolerance (contact.penetration_tolerance: "
+              "1e-5 of the shortest contact facet)", measure="absolute"),
+    ]
 
 
 def run(p: Parameters, out, on_step=None, figures: bool = True,

@@ -80,6 +80,23 @@ Parameters = GasketParameters
 #: The steps the thesis draws (prediction and resolved position, Figs. 5.19 to 5.22).
 SHOWN_STEPS = (5, 10)
 
+#: The reference of the verification (:func:`verification`): the contact force at the full
+#: motion (load factor 1, step 10) of the model refined around and through the thickness,
+#: ``vfem run gasket --set n_around=480 --set n_through=2`` (about 17 s; docs/examples.md,
+#: Gasket, *Why this mesh*), with E_soft = 1e6 (forces scale with the moduli)
+REFINED_FORCE = 2456.69
+#: Its refinement: elements around each gasket and through its thickness
+REFINED_MESH = (480, 2)
+#: The discretisation error of the force against the reference (docs/examples.md): one
+#: quadratic element through the thickness reads it 0.76 % above two (at 480 around), and the
+#: mesh around adds 0.99 %, 0.14 % and -0.01 % at 60, 120 and 240 elements (one element
+#: through, against 480): second order, within THROUGH_ONE + AROUND_60 (60 / n_around)^2
+THROUGH_ONE = 0.01
+AROUND_60 = 0.015
+#: ``vfem verify --slow``: twice as many elements around and two through the thickness (the
+#: loading steps are then cut by the rind rule; 9 620 dofs, a few seconds)
+VERIFY_SLOW = ("n_around=240", "n_through=2")
+
 
 def load_factors(p: GasketParameters) -> tuple[float, ...]:
     """1/n, 2/n, ..., 1, then (n - 1)/n, ..., 0: n loading and n unloading steps."""
@@ -382,7 +399,92 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
     summary["dofs"] = int(sum(s.body.ndofs for s in result.surfaces))
     summary["parameters"] = asdict(p)
     summary["timings"] = result.timings
+    summary["penetration_tolerance"] = result.penetration_tolerance
+    if summary["converged"]:
+        summary["verification"] = verification(summary, p, result.model.contact)
     return summary
+
+
+def force_tolerance(p: GasketParameters) -> float | None:
+    """The relative discretisation error allowed to the force at the full motion against
+    :data:`REFINED_FORCE`, or None where the reference is not this model: another geometry,
+    motion, stiffness ratio, Poisson's ratio or plane, linear elements, large kinematics, or
+    candidate surfaces that do not reach past the contact (search distance under 0.3;
+    docs/examples.md, *Why a search distance of 0.4*)."""
+    d = GasketParameters()
+    same = ("radius", "thickness", "offset", "separation", "back_motion", "stiffness_ratio",
+            "poissons_ratio", "plane", "order", "kinematics")
+    if any(getattr(p, k) != getattr(d, k) for k in same) or p.search_distance < 0.3:
+        return None
+    if p.n_through >= REFINED_MESH[1] and p.n_around >= REFINED_MESH[0]:
+        return AROUND_60 * (60 / REFINED_MESH[0]) ** 2  # finer than the reference: its error
+    through = THROUGH_ONE if p.n_through < REFINED_MESH[1] else 0.0
+    return through + AROUND_60 * (60 / min(p.n_around, REFINED_MESH[0])) ** 2
+
+
+def verification(s: dict, p: GasketParameters, contact: ContactSettings) -> list[dict]:
+    """The gasket's checks (``summary.json``'s ``verification``; :mod:`vfem.io.verification`).
+    The thesis shows this example for reversibility (§5.5, Fig. 5.23): unloading retraces
+    loading, and after the last step every node is back where it started. With them, the forces
+    on the two gaskets equal and opposite at every step and, where the model is the thesis's,
+    the force at the full motion against the refined model (:data:`REFINED_FORCE`, within
+    :func:`force_tolerance`).
+
+    Under small kinematics with the paired variant the first three hold to round-off
+    (:data:`vfem.io.runner.ROUND_OFF`): the contact state at a load factor is unique and each
+    step reaches it exactly (one correction closes every gap, docs/method.md §5); once every
+    force is released the displacements are u = 0 u_load + K^-1 0 = 0; both gaskets' forces come
+    from one traction (§6). Otherwise (the thesis variant, large kinematics) each state is the
+    exact one only to the contact iteration's tolerances: its equilibrium tolerance for the
+    forces and its penetration tolerance for the positions."""
+    from vfem.io.runner import ROUND_OFF
+    from vfem.io.verification import check
+
+    rows = s["steps"]
+    n = p.steps
+    F = force_history(s)
+    largest = float(F.max())
+    motion = abs(p.back_motion) or p.thickness  # the scale of the positions
+    exact = p.variant == "paired" and p.kinematics == "small"
+    if exact:
+        forces = positions = ROUND_OFF
+        basis = ("round-off: the paired variant reaches the exact discrete state under small "
+                 "kinematics (machine epsilon times the solves' condition, with margin: "
+                 "vfem.io.runner.ROUND_OFF)")
+        where = basis
+    else:
+        forces = contact.equilibrium_tolerance
+        positions = s["penetration_tolerance"] / motion
+        basis = "the contact iteration's equilibrium tolerance (contact.equilibrium_tolerance)"
+        where = ("the contact iteration's penetration tolerance (contact.penetration_tolerance) "
+                 "over the backs' motion")
+    records = []
+    if largest > 0:
+        # the loading step whose force unloading misses most (of equals, the larger force)
+        miss = np.abs(F[:n] - F[::-1][:n])
+        k = max(range(n), key=lambda j: (miss[j], F[j]))
+        records.append(check(f"unloading: force after step {2 * n - k}", F[2 * n - k], F[k],
+                             f"loading's after step {k}, the same load factor", forces, basis,
+                             measure="scaled", scale=largest))
+    records.append(check(f"after step {2 * n}: largest |u|", s["reversibility"], 0.0,
+                         "the initial state: nothing loads the gaskets", positions, where,
+                         measure="scaled", scale=motion))
+    imbalance = [float(np.linalg.norm(np.add(r["contact_force_soft"], r["contact_force_stiff"])))
+                 for r in rows]
+    if largest > 0:
+        records.append(check("|F_soft + F_stiff|, largest over the steps", max(imbalance), 0.0,
+                             "equal and opposite", forces, basis, measure="scaled",
+                             scale=largest))
+    tol = force_tolerance(p)
+    if tol is not None:
+        ref = REFINED_FORCE * p.soft_youngs_modulus / GasketParameters.soft_youngs_modulus
+        records.append(check(
+            f"step {n}: contact force", F[n], ref,
+            f"the model refined to {REFINED_MESH[0]} x {REFINED_MESH[1]} elements", tol,
+            f"discretisation: {THROUGH_ONE:.0%} for one element through the thickness, "
+            f"{AROUND_60:.1%} (60 / n_around)^2 around (the refinement study, "
+            "docs/examples.md)"))
+    return records
 
 
 # -- running ------------------------------------------------------------------------------------

@@ -73,6 +73,24 @@ class Parameters:
     friction: float = 0.0  # Coulomb's mu between punch and block (0: frictionless)
 
 
+#: ``vfem verify --slow``: every mesh twice as fine (240 x 32 block, 96 x 16 punch)
+VERIFY_SLOW = ("block_columns=240", "block_rows=32", "punch_columns=96", "punch_rows=16")
+
+#: the block's ends: the normal reaction varies smoothly over the steady slide by 0.028 % on the
+#: 6-long block frictionless and by 0.12 % with mu = 0.3 (the friction pushes the block's top
+#: towards its far end), by 2e-6 and 6e-6 on a block 12 long (``--set block_length=12 --set
+#: block_columns=240``; docs/examples.md, Sliding): a long block's constant reaction is the
+#: reference, and :func:`ends` is how far the default's ends move it, linear in mu between those
+ENDS = 3e-4
+ENDS_PER_MU = 3e-3
+
+
+def ends(p: Parameters) -> float:
+    """How far the block's ends move the normal reaction over the steady slide (a fraction of
+    it): :data:`ENDS` plus :data:`ENDS_PER_MU` times mu."""
+    return ENDS + ENDS_PER_MU * p.friction
+
+
 def load_factors(p: Parameters) -> tuple[float, ...]:
     """0 to 1: pressing in; 1 to 2: sliding."""
     press = tuple((k + 1) / p.press_steps for k in range(p.press_steps))
@@ -160,6 +178,10 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
         out["tangential_reaction_max"] = float(np.abs(tangential[steady]).max())
         if p.friction > 0:
             out["friction"] = _friction_reading(result, p, steady, normal, tangential)
+    if result.steps:
+        last = result.steps[-1].bodies
+        out["contact_force_block"] = last["block"].contact_force.sum(axis=0).tolist()
+        out["contact_force_punch"] = last["punch"].contact_force.sum(axis=0).tolist()
     worst = 0.0
     for step in result.steps:
         both = largest_penetrations(result, step)
@@ -208,7 +230,64 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
     summary = example_summary("sliding", result, p)
     if result.steps:
         summary["sliding"] = evaluate(result, p)
+        if result.converged and result.steps[-1].load_factor == 2.0 \
+                and "normal_reaction_mean" in summary["sliding"]:
+            summary["verification"] = verification(summary["sliding"], p)
     return summary
+
+
+def verification(e: dict, p: Parameters) -> list[dict]:
+    """The sliding run's checks (``summary.json``'s ``verification``;
+    :mod:`vfem.io.verification`).
+
+    * The normal reaction over the steady slide against its mean: constant on a long block
+      (frictionless sliding over an elastic body stores no energy in the motion). As the block's
+      nodes pass the punch's vertices the depth they see changes by up to the punch facets'
+      chord sag h_p^2 / (8 R), and the force with it by at most 3/2 times that over the depth
+      (a force growing as depth^(3/2) at most, a Winkler layer's; measured 1.27 from the press
+      steps); the block's ends add :func:`ends`, twice.
+    * The contact forces on the two bodies, equal and opposite.
+    * The largest penetration of any node of either body into the other's deformed facets:
+      the punch's vertices (they carry equilibrium, not compatibility) lie below the block's
+      straight facets by up to the arc's sag over one block facet, h_b^2 / (8 R) (docs/method.md
+      §10), with 50 % for the bodies' deformation.
+    * With friction, every node in contact slipping: the tangential tractions' force over the
+      normal tractions' is Coulomb's mu, exactly (the tangent at each node is its normal
+      turned by 90 degrees, so the two resultants have the magnitudes' ratio of the tractions).
+    """
+    from vfem.io.verification import check
+
+    settings = ContactSettings()
+    h_punch = p.punch_width / p.punch_columns  # the columns are equally spaced in x
+    h_block = p.block_length / p.block_columns
+    jump = 1.5 * h_punch**2 / (8 * p.punch_radius) / p.depth
+    sag = h_block**2 / (8 * p.punch_radius)
+    block, punch = np.asarray(e["contact_force_block"]), np.asarray(e["contact_force_punch"])
+    records = [
+        check("normal reaction, largest deviation from its mean",
+              e["normal_reaction_max_deviation"], 0.0, "constant on a long block",
+              jump + 2 * ends(p),
+              f"discretisation: the punch's faceting moves the depth by its chord sag "
+              f"h_p^2/8R, the force by 3/2 of that over the depth ({jump:.2%}), plus twice the "
+              f"block's ends' {ends(p):.2%} (docs/examples.md, Sliding)", measure="absolute"),
+        check("contact forces' sum, punch + block", float(np.linalg.norm(block + punch)), 0.0,
+              "equal and opposite", settings.equilibrium_tolerance,
+              "the contact iteration's equilibrium tolerance (contact.equilibrium_tolerance)",
+              measure="scaled", scale=float(np.linalg.norm(block))),
+        check("penetration of any node, deformed surfaces", e["largest_penetration_any_node"],
+              0.0, "no interpenetration but the faceting's", 1.5 * sag,
+              f"faceting: the arc's sag over one block facet, h_b^2/8R = {sag:.2e}, with 50 % "
+              "for the deformation (docs/method.md §10)", measure="absolute"),
+    ]
+    f = e.get("friction")
+    if f:
+        records.append(check(
+            "tangential / normal tractions' force, slid", f["friction_over_normal_part"], f["mu"],
+            "the Coulomb ratio mu when sliding", 1e-9,
+            "round-off: each slipping node's tangential traction is mu times its normal one, "
+            "along its normal turned 90 degrees, a tie each linear solve meets exactly (1e-9: "
+            "the round-off of the Newton steps, with margin)"))
+    return records
 
 
 def run(p: Parameters, out, on_step=None, figures: bool = True,

@@ -68,6 +68,9 @@ class SphereParameters:
 
 Parameters = SphereParameters
 
+#: ``vfem verify --slow``: the mesh refined once (12 facets across a, 92 172 dofs)
+VERIFY_SLOW = ("refinement=1",)
+
 
 def theory(p: SphereParameters) -> dict[str, float]:
     """Hertz's contact radius and peak pressure for the force on the whole sphere."""
@@ -153,15 +156,30 @@ def build(p: SphereParameters | None = None) -> Model:
     return config(p).build()
 
 
-def contour(mesh, boundary: str, touching: np.ndarray) -> np.ndarray:
-    """The contact zone's edge on ``boundary``: the midpoints (x, y) of the boundary facets'
-    edges that join a node in contact (``touching``, per mesh node) to one that is not."""
+def cut_edges(mesh, boundary: str, touching: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The ends (two node arrays) of the facet edges on ``boundary`` that join a node in
+    contact (``touching``, per mesh node) to one that is not."""
     facets = mesh.facets[:, mesh.boundaries[boundary]]
     # a facet's edges: consecutive nodes (quadrilaterals in cyclic order; a triangle's three)
     a = facets.ravel()
     b = np.roll(facets, -1, axis=0).ravel()
     cut = touching[a] != touching[b]
-    return 0.5 * (mesh.p[:2, a[cut]] + mesh.p[:2, b[cut]]).T
+    return a[cut], b[cut]
+
+
+def contour(mesh, boundary: str, touching: np.ndarray) -> np.ndarray:
+    """The contact zone's edge on ``boundary``: the midpoints (x, y) of the boundary facets'
+    edges that join a node in contact (``touching``, per mesh node) to one that is not."""
+    a, b = cut_edges(mesh, boundary, touching)
+    return 0.5 * (mesh.p[:2, a] + mesh.p[:2, b]).T
+
+
+def contour_edge(mesh, boundary: str, touching: np.ndarray) -> float:
+    """The longest of the facet edges whose midpoints :func:`contour` reads as the contact
+    zone's edge (0 when none): each midpoint lies within half of it of where the zone ends, so
+    it bounds how far a round zone's edge, read there, can seem from a circle."""
+    a, b = cut_edges(mesh, boundary, touching)
+    return float(np.linalg.norm(mesh.p[:, a] - mesh.p[:, b], axis=0).max(initial=0.0))
 
 
 def evaluate(result: AnalysisResult, p: SphereParameters) -> dict:
@@ -191,6 +209,7 @@ def evaluate(result: AnalysisResult, p: SphereParameters) -> dict:
             "p_max_error": float(r.contact_pressure.max() / p0 - 1),
             "a_estimate": float(edge.mean()) if len(edge) else 0.0,
             "contour_spread": float(edge.max() - edge.min()) if len(edge) else 0.0,
+            "contour_edge": contour_edge(body.mesh, boundary, on),
             "rms_error_over_p0": rms,
             "total_contact_force": float(up * share * r.contact_force[:, 2].sum()),
             "contact_nodes": int(on.sum()),
@@ -209,7 +228,54 @@ def summarize(result: AnalysisResult, p: SphereParameters) -> dict:
     summary = solid_summary("sphere", result, p, "hertz", evaluate)
     for record, step in zip(summary["steps"], result.steps):
         record["platen_displacement"] = step.platen_displacement
+    if result.converged and "hertz" in summary:  # converged at full load
+        summary["verification"] = verification(summary["hertz"], p)
     return summary
+
+
+#: Hertz's closed form for a sphere on a flat (the source of a and p0)
+HERTZ = "Hertz (sphere on a flat)"
+
+
+def verification(h: dict, p: SphereParameters) -> list[dict]:
+    """The sphere run's checks (``summary.json``'s ``verification``;
+    :mod:`vfem.io.verification`) against Hertz's sphere on a flat (Johnson, *Contact
+    Mechanics*, §4.2), its own load and Newton's third law. The tolerances: the peak pressure's
+    discretisation error falls about as (h/a)^2 (docs/examples.md's refinement study: -2.21,
+    -1.33, -0.50 % at a/6, a/8, a/12, under 0.8 (h/a)^2), allowed (h/a)^2 with h the sphere's
+    contact facet; the contact radius is read at the midpoints of the facet edges between
+    touching and free nodes, within a facet of the zone's end; Hertz's zone is a circle, and
+    each of those midpoints lies within half its edge of the zone's end, so the edge's radius
+    varies around it by at most the longest such edge; the platen's force is met to
+    ``contact.platen_tolerance``, and the flat's contact forces are the sphere's, equal and
+    opposite, to round-off (invariant (a)'s tolerance)."""
+    from vfem.contact.invariants.measures import FORCE_BALANCE_TOLERANCE
+    from vfem.io.verification import check
+
+    sph = h["sphere"]
+    a, facet = h["a_theory"], h["facet_size"]
+    whole = "whole sphere: 4 x the quarter model's" if p.quarter else "whole sphere"
+    return [
+        check("peak pressure p_max (the sphere's)", sph["p_max"], h["p0_theory"], HERTZ,
+              (facet / a) ** 2,
+              "discretisation: falls about as (h/a)^2, under 0.8 (h/a)^2 at a/6, a/8, a/12 "
+              "(docs/examples.md's refinement study); allowed (h/a)^2, h the sphere's facet"),
+        check("contact radius (the edge's mean radius)", sph["a_estimate"], a, HERTZ, facet,
+              "the edge is read between the last node in contact and the next: one facet (h)",
+              measure="absolute"),
+        check("contact edge's roundness (radius max - min)", sph["contour_spread"], 0.0,
+              "Hertz (a round contact zone)", sph["contour_edge"],
+              "each point of the edge is read within half a facet edge of the zone's end: "
+              "the longest edge it crosses", measure="absolute"),
+        check(f"contact force on the sphere ({whole})", sph["total_contact_force"],
+              h["applied_force"], "the platen's force", ContactSettings().platen_tolerance,
+              "the platen's force is met to contact.platen_tolerance"),
+        check(f"contact force on the flat ({whole})", h["flat"]["total_contact_force"],
+              sph["total_contact_force"], "the sphere's, equal and opposite",
+              FORCE_BALANCE_TOLERANCE,
+              "exact: both sides' forces follow from one traction (the paired variant), to "
+              "round-off: invariant (a)'s tolerance (FORCE_BALANCE_TOLERANCE)"),
+    ]
 
 
 def run(p: SphereParameters, out, on_step=None, figures: bool = True,

@@ -11,12 +11,21 @@ force and a 109 lb equilibrium error.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from dataclasses import asdict, dataclass
 
 from vfem.contact.formulations import SecantSpring, Step1D, solve_step
 
 log = logging.getLogger(__name__)
+
+#: The springs' stiffening (thesis eqs. 4.3.1 and 4.3.2): K_A = k_A (1 + 10 c) and
+#: K_B = k_B (1 + 20 c^2), c the fractional compression
+STIFFENING_A = 10.0
+STIFFENING_B = 20.0
+#: The thesis's answer after the last step (§4.2.1): the springs meet at 12.431 in (distances to
+#: the nearest 0.001 in) with a contact force of "893 ± 1 lb"
+THESIS_LAST_STEP = {"contact point": (12.431, 0.0005), "contact force": (893.0, 1.0)}
 
 
 @dataclass(frozen=True)
@@ -44,8 +53,8 @@ def run(params: SpringsParameters | None = None, out=None, on_step=None) -> dict
     """
     p = params or SpringsParameters()
     start = time.perf_counter()
-    a = SecantSpring(length=p.length_a, k0=p.stiffness_a, a=10.0)
-    b = SecantSpring(length=p.length_b, k0=p.stiffness_b, b=20.0)
+    a = SecantSpring(length=p.length_a, k0=p.stiffness_a, a=STIFFENING_A)
+    b = SecantSpring(length=p.length_b, k0=p.stiffness_b, b=STIFFENING_B)
     left_a = 0.0  # prescribed displacement of A's left end
     da = db = 0.0  # compressions of A and B (their contact ends move into the bodies)
     b_left = p.length_a + p.gap
@@ -80,11 +89,94 @@ def run(params: SpringsParameters | None = None, out=None, on_step=None) -> dict
         "parameters": asdict(p),
         "timings": {"total_s": time.perf_counter() - start},
     }
+    if summary["converged"]:
+        summary["verification"] = verification(summary, p)
     if out is not None:
         from vfem.io.results import write_summary
 
         write_summary(out, summary)
     return summary
+
+
+def exact(p: SpringsParameters, step: int) -> tuple[float, float, float, float] | None:
+    """The exact state after ``step``, solved directly from F_A = F_B (not by the contact
+    iteration): (contact point, contact force, A's and B's tangent stiffness there); None while
+    the springs are apart.
+
+    A's end has moved ``step`` x ``step_size``, so the compressions share the overlap
+    s = step x step_size - gap: d_A + d_B = s, with k_A (1 + 10 d_A / L_A) d_A =
+    k_B (1 + 20 (d_B / L_B)^2) d_B. Both forces grow with their compression, so the difference
+    falls strictly from F_A(s) > 0 at d_B = 0 to -F_B(s) < 0 at d_B = s: one root, found by
+    bisection to the last bit.
+    """
+    s = step * p.step_size - p.gap
+    if s <= 0.0:
+        return None
+
+    def force_a(d: float) -> float:
+        return p.stiffness_a * (1.0 + STIFFENING_A * d / p.length_a) * d
+
+    def force_b(d: float) -> float:
+        return p.stiffness_b * (1.0 + STIFFENING_B * (d / p.length_b) ** 2) * d
+
+    lo, hi = 0.0, s
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid in (lo, hi):
+            break
+        lo, hi = (mid, hi) if force_a(s - mid) > force_b(mid) else (lo, mid)
+    db = 0.5 * (lo + hi)
+    da = s - db
+    tangent_a = p.stiffness_a * (1.0 + 2.0 * STIFFENING_A * da / p.length_a)
+    tangent_b = p.stiffness_b * (1.0 + 3.0 * STIFFENING_B * (db / p.length_b) ** 2)
+    return p.length_a + p.gap + db, force_b(db), tangent_a, tangent_b
+
+
+def verification(s: dict, p: SpringsParameters) -> list[dict]:
+    """The checks of a converged run (``summary.json``'s ``verification``;
+    :mod:`vfem.io.verification`): where the springs meet and the force between them after the
+    last two steps in contact, against the exact state (:func:`exact`), and after the last step
+    against the thesis's numbers (§4.2.1) when the model is the thesis's.
+
+    The tolerances are what the iteration's stopping test allows: it stops with the penetration
+    P within ``penetration_tolerance`` and the equilibrium error E = F_A - F_B within
+    ``equilibrium_tolerance`` (lb). To first order about the exact state (tangent stiffnesses
+    k_A, k_B) that moves B's end, the contact point, by (k_A P + E) / (k_A + k_B) and the force
+    by k_A (k_B P + E) / (k_A + k_B). Against the thesis, its rounding is added: distances to
+    0.001 in, the force "± 1 lb".
+    """
+    from vfem.io.verification import check
+
+    records = []
+    contact = [k for k in range(1, p.steps + 1) if exact(p, k) is not None]
+    pt, et = p.penetration_tolerance, p.equilibrium_tolerance
+    basis = (f"the contact iteration's stopping test (penetration_tolerance {pt:g} in, "
+             f"equilibrium_tolerance {et:g} lb), to first order through the springs' tangent "
+             "stiffnesses")
+    # (a step the run left apart has no contact point: nan, which fails)
+    point = [math.nan if x is None else x for x in s["contact_point"]]
+    force = s["contact_force"]
+    tolerance = {}
+    for k in contact[-2:]:
+        x, f, ka, kb = exact(p, k)
+        tolerance[k] = (ka * pt + et) / (ka + kb), ka * (kb * pt + et) / (ka + kb)
+        records.append(check(f"step {k}: contact point (in)", point[k - 1], x,
+                             "exact, F_A = F_B", tolerance[k][0], basis, measure="absolute"))
+        records.append(check(f"step {k}: contact force (lb)", force[k - 1], f,
+                             "exact, F_A = F_B", tolerance[k][1], basis, measure="absolute"))
+    thesis = SpringsParameters()
+    if contact and all(getattr(p, name) == getattr(thesis, name) for name in (
+            "length_a", "length_b", "gap", "stiffness_a", "stiffness_b", "step_size", "steps")):
+        k = contact[-1]
+        (x, dx), (f, df) = THESIS_LAST_STEP["contact point"], THESIS_LAST_STEP["contact force"]
+        also = " and the contact iteration's stopping test, as against the exact state"
+        records.append(check(f"step {k}: contact point (in), thesis", point[k - 1], x,
+                             "thesis §4.2.1", dx + tolerance[k][0],
+                             "the thesis's rounding to 0.001 in" + also, measure="absolute"))
+        records.append(check(f"step {k}: contact force (lb), thesis", force[k - 1], f,
+                             "thesis §4.2.1", df + tolerance[k][1],
+                             "the thesis's '± 1 lb'" + also, measure="absolute"))
+    return records
 
 
 def report(s: dict) -> list[str]:

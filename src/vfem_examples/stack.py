@@ -67,6 +67,12 @@ class Parameters:
     reverse_bodies: bool = False  # list the plates from the top down
 
 
+#: ``vfem verify --slow``: every plate's elements halved (16 divisions across, 4 layers)
+VERIFY_SLOW = ("divisions=16", "layers=4")
+
+#: The verification lists each interface's forces up to this many interfaces, else the worst.
+LISTED_INTERFACES = 4
+
 def validate(p: Parameters) -> None:
     """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
     if p.dim not in (2, 3):
@@ -177,7 +183,7 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
     interfaces = []
     for k in range(p.blocks - 1):
         up, down = face_force(f"plate{k + 1}", "bottom"), face_force(f"plate{k}", "top")
-        interfaces.append({"force": up, "equal_and_opposite_error":
+        interfaces.append({"force": up, "force_below": down, "equal_and_opposite_error":
                            abs(up + down) / max(abs(up), 1e-300)})
     return {"press_force": press, "held_force": held,
             "balance_error": abs(press - held) / abs(press), "interfaces": interfaces,
@@ -189,7 +195,41 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
     """The ``summary.json`` dictionary of a stack run."""
     from vfem.io.results import solid_summary
 
-    return solid_summary("stack", result, p, "stack", evaluate)
+    summary = solid_summary("stack", result, p, "stack", evaluate)
+    if result.converged and "stack" in summary:  # converged at full load
+        summary["verification"] = verification(summary["stack"], p)
+    return summary
+
+
+def verification(m: dict, p: Parameters) -> list[dict]:
+    """The run's checks (``summary.json``'s ``verification``; :mod:`vfem.io.verification`).
+    No closed form: exact properties of the problem, each to round-off (invariant (a)'s
+    tolerance): the press's force against the reactions of the base and the rims (nothing
+    else holds the stack vertically, and each plate's own solve balances its forces), and at
+    each interface (the worst, beyond :data:`LISTED_INTERFACES`) the upper plate's contact
+    force against the lower one's, equal and opposite (both follow from one traction)."""
+    from vfem.contact.invariants.measures import FORCE_BALANCE_TOLERANCE
+    from vfem.io.verification import check
+
+    part = "quarter model" if p.dim == 3 else "half model"
+    tol = FORCE_BALANCE_TOLERANCE
+    records = [check(
+        f"press force ({part})", m["press_force"], m["held_force"],
+        "the base's and rims' reactions (forces balance)", tol,
+        "exact: each plate's own solve balances its forces, to round-off: invariant (a)'s "
+        "tolerance (FORCE_BALANCE_TOLERANCE)")]
+    rows = list(enumerate(m["interfaces"]))
+    where = part
+    if len(rows) > LISTED_INTERFACES:
+        rows = [max(rows, key=lambda r: r[1]["equal_and_opposite_error"])]
+        where = f"{part}; the worst of {len(m['interfaces'])} interfaces"
+    for k, i in rows:
+        records.append(check(
+            f"contact force on plate{k + 1}'s bottom ({where})", i["force"], -i["force_below"],
+            f"plate{k}'s top, equal and opposite", tol,
+            "exact: both sides' forces follow from one traction (the paired variant), to "
+            "round-off: invariant (a)'s tolerance (FORCE_BALANCE_TOLERANCE)"))
+    return records
 
 
 def run(p: Parameters, out, on_step=None, figures: bool = True, resume: bool = False) -> dict:

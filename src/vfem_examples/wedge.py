@@ -63,6 +63,21 @@ OVERLAYS = (((1, 3, 5), "5.11"), ((1, 2, 3), "5.12"), ((3, 4, 5), "5.13"))
 MESHES = ("graded", "coarse")
 #: Margin of the automatic step count on the rind rule (see :func:`planned_steps`).
 RIND_MARGIN = 1.1
+#: The reference of the verification (:func:`verification`): each case's plate share on the
+#: graded mesh refined three times (``vfem run wedge --set refinement=3``, 23 100 dofs, about
+#: 30 s; docs/examples.md, Wedge, *Refinement*), to the 5 decimals that leave its rounding far
+#: below the tolerance.
+REFINED_PLATE_SHARE = {1: 0.99942, 2: 0.57685, 3: 0.40462, 4: 0.25354, 5: 0.00068}
+#: The reference model's refinement level (its element size at the tip: h_contact / 2^3)
+REFINED_LEVEL = 3
+#: How far a plate share may move per refinement level (a halving of the element sizes): the
+#: study's largest change from one level to the next is 6.2e-4 of the overlap up to level 3
+#: (case 2, levels 1 to 2) and 9.9e-4 from level 3 to 4 (case 3, which runs at level 4 only
+#: with the compatibility side switched; case 2 stops there), not yet falling; with margin 2
+SHARE_PER_LEVEL = 2.0e-3
+#: ``vfem verify --slow``: the graded mesh refined twice (6 222 dofs; about 5 s to solve, 40 s
+#: with its files)
+VERIFY_SLOW = ("refinement=2",)
 
 
 @dataclass(frozen=True)
@@ -315,6 +330,56 @@ def evaluate(model: Model, steps: list[StepResult], p: WedgeParameters) -> dict:
     }
 
 
+def reference_levels(p: WedgeParameters) -> float | None:
+    """How many halvings of the element size lie between this run's mesh and the reference's
+    (:data:`REFINED_PLATE_SHARE`), or None where the reference is not this model: another
+    geometry, Poisson's ratio or motion, the coarse mesh, or a graded mesh of another family
+    (its size at the tip is the only size allowed to differ)."""
+    d = WedgeParameters()
+    same = ("poissons_ratio", "half_width", "plate_thickness", "edge_thickness",
+            "centre_thickness", "motion", "mesh", "growth")
+    if any(getattr(p, k) != getattr(d, k) for k in same) or loaded_width(p) != loaded_width(d):
+        return None
+    if p.h_max / p.h_contact != d.h_max / d.h_contact:
+        return None
+    tip = p.h_contact * 0.5**p.refinement
+    return abs(math.log2(tip / (d.h_contact * 0.5**REFINED_LEVEL)))
+
+
+def verification(s: dict, p: WedgeParameters) -> list[dict]:
+    """The wedge's checks (``summary.json``'s ``verification``; :mod:`vfem.io.verification`),
+    one per case: how the overlap at the tip is shared, the plate's share against the same
+    model on the graded mesh refined three times (:data:`REFINED_PLATE_SHARE`). The thesis gives
+    the shares only as figures (Figs. 5.6-5.13: all the deflection in the plate in case 1, in the
+    wedge in case 5, the contact a little above the middle of the overlap in case 3, §5.3).
+
+    The tolerance is the discretisation: :data:`SHARE_PER_LEVEL` of the overlap per halving of
+    the element sizes between this mesh and the reference's (at least one). Where the reference
+    is not this model (:func:`reference_levels`), each case is checked instead for what holds
+    exactly at convergence: the plate's and the wedge's shares add up to 1, the tips meeting to
+    within the contact iteration's penetration tolerance (over the motion)."""
+    from vfem.io.verification import check
+
+    levels = reference_levels(p)
+    records = []
+    for c in s["cases"]:
+        case = c["case"]
+        if levels is not None:
+            records.append(check(
+                f"case {case}: plate share", c["plate_share"], REFINED_PLATE_SHARE[case],
+                f"the model refined {REFINED_LEVEL} times", SHARE_PER_LEVEL * max(1.0, levels),
+                f"discretisation: {SHARE_PER_LEVEL:g} of the overlap per halving of the "
+                f"elements, {max(1.0, levels):g} between this mesh and the reference's (the "
+                "refinement study, docs/examples.md)", measure="absolute"))
+        else:
+            records.append(check(
+                f"case {case}: plate share + wedge share", c["share_sum"], 1.0,
+                "exact: the tips meet", c["penetration_tolerance"] / p.motion,
+                "the contact iteration's penetration tolerance over the motion",
+                measure="absolute"))
+    return records
+
+
 def summarize_case(p: WedgeParameters, case: int, model: Model, steps: list[StepResult],
                    converged: bool, message: str, seconds: float,
                    compatibility: str | None = None) -> dict:
@@ -348,8 +413,10 @@ def summarize_case(p: WedgeParameters, case: int, model: Model, steps: list[Step
 
 # -- the run ------------------------------------------------------------------------------------
 
-def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False) -> dict:
-    """Run the cases, writing ``out/caseN/`` (VTU/PVD), the figures and ``summary.json``."""
+def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False,
+        figures: bool = True) -> dict:
+    """Run the cases, writing ``out/caseN/`` (VTU/PVD), the figures (unless ``figures`` or
+    ``p.figures`` is false) and ``summary.json``."""
     from vfem.io.results import write_summary
 
     start = time.perf_counter()
@@ -367,6 +434,7 @@ def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False) -> dic
         converged = result.converged
         entries.append(summarize_case(p, case, model, steps, converged, message,
                                       time.perf_counter() - t0, compatibility))
+        entries[-1]["penetration_tolerance"] = result.penetration_tolerance
         models[case] = model
         if steps and steps[-1].load_factor == 1.0:
             finals[case] = steps[-1]
@@ -393,9 +461,11 @@ def run(p: WedgeParameters, out=None, on_step=None, resume: bool = False) -> dic
     }
     summary["timings"] = {"total_s": time.perf_counter() - start,
                           "cases_s": float(sum(c["seconds"] for c in entries))}
+    if summary["converged"] and all("plate_share" in c for c in entries):
+        summary["verification"] = verification(summary, p)
     if out is not None:
         write_summary(out, summary)
-        if p.figures:
+        if p.figures and figures:
             from vfem.io.replot import draw_run, write_frames
 
             summary["figure_data"] = {
