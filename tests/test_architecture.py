@@ -10,6 +10,8 @@ faces."""
 import ast
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1] / "src" / "vfem"
 
 #: The import cycles still there, each as its sorted modules (none since 2026-11-24: the result
@@ -126,6 +128,7 @@ def cycles(graph: dict[str, set[str]]) -> set[tuple[str, ...]]:
     return out
 
 
+@pytest.mark.slow
 def test_no_import_cycle_but_the_known_ones():
     assert cycles(import_graph()) == KNOWN_CYCLES
     assert cycles(import_graph(typing=False)) <= KNOWN_CYCLES
@@ -147,6 +150,7 @@ def upward(graph: dict[str, set[str]]) -> list[str]:
                   for m, targets in graph.items() for t in targets if layer(t) > layer(m))
 
 
+@pytest.mark.slow
 def test_no_module_imports_from_a_layer_above_its_own():
     assert not upward(import_graph()), "\n".join(upward(import_graph()))
 
@@ -163,6 +167,7 @@ def stage(module: str) -> int:
     return 0
 
 
+@pytest.mark.slow
 def test_contact_imports_only_from_its_own_stage_or_those_below():
     graph = import_graph()
     inside = [m for m in graph if m.startswith("vfem.contact.")]
@@ -182,6 +187,7 @@ def reaching_in(graph: dict[str, set[str]]) -> list[str]:
                   and not (m == stem(t) or m.startswith(stem(t) + ".")))
 
 
+@pytest.mark.slow
 def test_a_stage_is_reached_through_its_face():
     """Outside a stage (the rest of contact, the solver, the writers, the examples) its names
     come from its face, ``vfem.contact.<stage>``: what a stage offers is what its
@@ -208,6 +214,7 @@ def test_the_cycle_finder_finds_a_cycle():
     assert cycles(graph) == {("a", "b", "c")}
 
 
+@pytest.mark.slow
 def test_nothing_under_contact_imports_the_solver():
     graph = import_graph()
     assert not [m for m, targets in graph.items()
@@ -232,6 +239,7 @@ def outside_imports(module_path: Path) -> set[str]:
 BESIDE = ("vfem_examples", "vfem_tools")
 
 
+@pytest.mark.slow
 def test_the_library_never_imports_the_examples_or_the_tools():
     """The examples and the tools are packages beside the library (``src/vfem_examples``,
     ``src/vfem_tools``), out of its import path: nothing under ``vfem`` imports them but the
@@ -286,6 +294,7 @@ def inheritance_depths(sources: dict[str, str]) -> dict[str, int]:
     return {name: depth(name) for name in bases if not error(name)}
 
 
+@pytest.mark.slow
 def test_no_class_derives_more_than_one_level_for_reuse():
     """Issue 38: formulations are composed of parts (the surface group, the friction part, the
     pairs' making), not one class per combination built on the one before; a class of the

@@ -30,6 +30,7 @@ def test_sphere_dofs_table_is_measured(facets, dofs):
     assert sum(3 * b.mesh.p.shape[1] for b in model.bodies) == dofs
 
 
+@pytest.mark.slow
 def test_bench_sphere_prints_and_saves_its_rows(tmp_path, capsys):
     path = tmp_path / "bench.json"
     assert main(["bench", "sphere", "--dofs", "8k", "--in-process", "--json", str(path),

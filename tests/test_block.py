@@ -75,6 +75,7 @@ def test_the_edge_of_the_zone_carries_compatibility_even_where_the_other_face_is
     assert result.steps[-1].invariants["max_penetration_any_body"] <= result.penetration_tolerance
 
 
+@pytest.mark.slow
 def test_run_writes_summary_and_figures(tmp_path):
     s = block.run(block.Parameters(), tmp_path)
     assert s["converged"] and "block" in s
@@ -83,6 +84,7 @@ def test_run_writes_summary_and_figures(tmp_path):
         assert (tmp_path / name).stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_figures_are_drawn_after_a_no_figures_run_in_the_same_process(tmp_path):
     """`vfem run --no-figures` defers the figures for its own run only: a library run after it
     in the same process draws them (a test order that ran the CLI first left them deferred,

@@ -74,6 +74,7 @@ def test_half_cylinder_is_half_the_whole():
         solids.cylinder(6.0, 5.0, half=True, **kw)
 
 
+@pytest.mark.slow
 def test_fast_invariants_balance_and_stick_radius(fast):
     p = FAST
     for step in fast.steps:
@@ -93,6 +94,7 @@ def test_fast_invariants_balance_and_stick_radius(fast):
     assert ratios == sorted(ratios)
 
 
+@pytest.mark.slow
 def test_body_order_does_not_matter(fast, swapped):
     p = FAST
     mu_p0 = cattaneo3d.theory(p)["mu_p0"]

@@ -89,6 +89,7 @@ def test_bench_prints_and_saves_the_table(tmp_path, capsys):
     assert row["dofs"] > 1000 and row["ratio"] > 0 and abs(row["p_max_error"]) < 0.03
 
 
+@pytest.mark.slow
 def test_bench_times_the_whole_run_against_a_plain_run_writing_the_same_files(tmp_path, capsys):
     """``--whole-run``: the run end to end beside a plain linear run of the same bodies that
     writes the same VTU series (one file per body and step), with the run's phases."""
@@ -131,6 +132,7 @@ def test_the_thesis_variant_from_the_command_line(tmp_path, capsys):
     assert (tmp_path / "pressure.png").exists() and len(list(tmp_path.glob("*.vtu"))) == 10
 
 
+@pytest.mark.slow
 def test_study_writes_the_table_and_the_convergence_plot(tmp_path):
     assert main(["-q", "study", "hertz", "--levels", "0", "1", "--quadratic-levels", "0",
                  "--out", str(tmp_path)]) == 0
@@ -143,6 +145,7 @@ def test_study_writes_the_table_and_the_convergence_plot(tmp_path):
     assert (tmp_path / "convergence.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_bench_compares_contact_methods_and_their_patch_tests(tmp_path, capsys):
     """vfem bench: each contact method on the same Hertz mesh and the patch test. vfem passes
     the patch test to round-off; single-pass node-to-segment Lagrange multipliers do not on

@@ -66,6 +66,7 @@ def no_solve(monkeypatch):
 
 
 @pytest.mark.parametrize("chunk", range(8))
+@pytest.mark.slow
 def test_hostile_example_parameters_are_refused_or_accepted(chunk, tmp_path, capsys, no_solve):
     for name, field, value in CASES[chunk::8]:
         status = main(["run", name, "--set", f"{field}={value}", "--out", str(tmp_path / "o"),

@@ -54,7 +54,7 @@ def test_paired_variant_condenses_to_candidates_and_thesis_variant_to_the_rind()
             assert len(analysis.contact.positions(analysis.contact.new_state())[0]) > 0
 
 
-@pytest.mark.parametrize("m", [1, 7, 1030, 2100])
+@pytest.mark.parametrize("m", [1, 7, 1030, pytest.param(2100, marks=pytest.mark.slow)])
 def test_in_place_inverse_is_the_inverse_to_the_bit(m):
     """The in-place inverse reads the upper triangle only (the lower may hold anything, as
     PARDISO's output does), returns the very bits of :func:`spd_inverse` of the symmetric

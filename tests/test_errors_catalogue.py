@@ -208,22 +208,26 @@ def message_sites():
                 yield module, node.lineno, node.args[index]
 
 
-SITES = list(message_sites())
+@pytest.fixture(scope="module")
+def sites() -> list:
+    """Every message site, scanned once when a test asks (not at collection: the scan parses
+    every module of the package, seconds that each worker would spend before any test)."""
+    return list(message_sites())
 
 
-def test_the_scan_finds_the_messages():
+def test_the_scan_finds_the_messages(sites):
     """A guard on the scan itself: the catalogue test below is only as good as what it sees."""
-    assert len(SITES) > 150
-    modules = {m for m, _, _ in SITES}
+    assert len(sites) > 150
+    modules = {m for m, _, _ in sites}
     assert {"cli/run.py", "config.py", "solver.py", "bodies/validation.py", "io/input.py",
             "mesh/imports.py", "mesh/shapes.py", "contact/formulations/paired.py",
             "nonlinear.py", "vfem_examples/wedge.py"} <= modules
 
 
-def test_every_message_is_in_the_catalogue():
+def test_every_message_is_in_the_catalogue(sites):
     catalogue = normalise(CATALOGUE.read_text(encoding="utf-8"))
     missing, wrappers_seen = [], set()
-    for module, line, expr in SITES:
+    for module, line, expr in sites:
         source = ast.unparse(expr)
         for parts in _pieces(expr):
             text = fragment(parts)

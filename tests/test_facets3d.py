@@ -273,7 +273,9 @@ def test_shape_functions_are_scikit_fems():
 
 
 @pytest.mark.parametrize("count", [400, pytest.param(2500, marks=pytest.mark.slow)])
-@pytest.mark.parametrize("k", [3, 4, 6, 9])
+@pytest.mark.parametrize("k", [3, pytest.param(4, marks=pytest.mark.slow),
+                               pytest.param(6, marks=pytest.mark.slow),
+                               pytest.param(9, marks=pytest.mark.slow)])
 def test_closest_points_match_brute_force(k, count):
     """2,500 points per kind (10⁴ in all, ``slow``; 400 per kind in the default suite: in the
     box, above and below warped facets, exactly on facets, edges and nodes, far away, beyond

@@ -248,6 +248,7 @@ def test_cattaneo_mindlin_partial_slip_of_similar_cylinders():
     assert abs(abs(last.tangential) / (p.friction * last.normal) - 1) < 1e-4  # sliding
 
 
+@pytest.mark.slow
 def test_mindlin_deresiewicz_unloading_and_the_hysteresis_loop():
     """The Cattaneo model sheared to Q* (0.67 mu P), back to -Q*, forward to Q* again
     (``cycle``): while Q falls from Q*, the contact slips back from its edges and sticks over
@@ -655,6 +656,7 @@ def test_the_lagrange_baseline_with_coulomb_friction_slides_and_sticks():
     np.testing.assert_allclose(stuck, ours, rtol=0, atol=3e-3 * np.abs(ours).max())
 
 
+@pytest.mark.slow
 def test_the_lagrange_baseline_reads_cattaneo_with_its_stick_zone_near_c():
     """Cattaneo–Mindlin with the Lagrange baseline (``benchmarks/cattaneo.py --baseline``): the
     stick zone within a facet of c at every step of partial slip (measured on the 12 / 17

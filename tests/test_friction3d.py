@@ -205,6 +205,7 @@ def test_the_elastoplastic_law_in_3d():
 
 
 @pytest.mark.parametrize("rollers", [False, True], ids=["free", "rollers"])
+@pytest.mark.slow
 def test_the_3d_friction_patch_sticks_under_large_kinematics(rollers):
     """The sticking patch with both boxes under total Lagrangian kinematics
     (vfem.contact.formulations.large_friction; tests/test_large_friction3d.py slides): two

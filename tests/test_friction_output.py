@@ -63,6 +63,7 @@ def test_a_run_that_only_sticks_prints_zero_work_not_a_negative_round_off(tmp_pa
     assert "work dissipated -" not in printed
 
 
+@pytest.mark.slow
 def test_the_cattaneo_and_sliding_screens_give_the_total_work(tmp_path, capsys):
     printed, summary = _run(capsys, "cattaneo", *_sets(CATTANEO), "--out", str(tmp_path / "c"),
                             "--no-figures")
@@ -166,6 +167,7 @@ def lines(monkeypatch):
     ("patch_stick", "upper", {"upper: ±mu q = 0.3 q, Coulomb limit": 0.3}),
     ("pushed_block", "block", {"block: ±mu_s q = 0.3 q, stick limit": 0.3,
                                "block: ±mu_d q = 0.2 q, slip": 0.2})])
+@pytest.mark.slow
 def test_friction_png_draws_the_coulomb_limit_beside_the_traction(model, body, bounds, tmp_path,
                                                                  lines):
     """friction.png: the lines +mu q and -mu q, q the normal traction at the nodes in contact
@@ -236,6 +238,7 @@ def test_the_differences_are_named_briefly():
 
 # -- vfem plot on an unfinished example run ------------------------------------------------------
 
+@pytest.mark.slow
 def test_plotting_an_unfinished_example_run_says_why_its_own_figures_are_not_drawn(
         tmp_path, capsys, monkeypatch):
     """A sliding run interrupted after step 3: ``vfem plot`` says in one line which example,

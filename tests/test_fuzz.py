@@ -191,6 +191,7 @@ def mutated_example(draw):
      "count = -1", "[contact]", "x = nan", "= 1", "[", "\"", "bodies = 3", "[output]",
      "directory = '/'", "a.b.c = 1", "[[bodies.supports]]", "boundary = 'left'"]),
     max_size=12).map("\n".join))
+@pytest.mark.slow
 def test_random_toml_text_is_read_or_refused(text):
     accepted(lambda: loads(text, "<fuzz>"))
 
@@ -205,6 +206,7 @@ def test_random_bytes_in_a_file_are_refused_or_read(tmp_path, content):
 
 @settings(FUZZ, max_examples=1500)
 @given(mutated_example())
+@pytest.mark.slow
 def test_mutated_example_files_are_checked_or_refused(case):
     path, data = case
     accepted(lambda: check(from_data(ModelConfig, data, ""), path.parent))
@@ -212,6 +214,7 @@ def test_mutated_example_files_are_checked_or_refused(case):
 
 @settings(FUZZ, max_examples=200)
 @given(mutated_example())
+@pytest.mark.slow
 def test_command_line_check_exits_0_or_2_without_a_traceback(tmp_path, capsys, case):
     path, data = case
     (tmp_path / "hertz.msh").write_text("not a mesh\n")  # hertz_gmsh's file, unreadable here
@@ -252,6 +255,7 @@ def shape_parameters(draw):
 
 @settings(FUZZ, max_examples=1200)
 @given(shape_parameters())
+@pytest.mark.slow
 def test_random_shape_parameters_make_a_sound_mesh_or_are_refused(case):
     shape, params = case
 
@@ -359,6 +363,7 @@ def mesh_file(draw):
 
 @settings(FUZZ, max_examples=1500)
 @given(mesh_file(), st.sampled_from(["body", None, "bottom", "nothing"]))
+@pytest.mark.slow
 def test_random_mesh_files_are_read_and_checked_or_refused(tmp_path, case, cells):
     suffix, text = case
     (tmp_path / f"mesh{suffix}").write_text(text)
@@ -377,6 +382,8 @@ def test_the_fuzzer_generates_at_least_2000_inputs():
     assert len(examples) == 6 and sum(examples) >= 2000
 
 
-@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow)  # seconds to check
+                                  if p.stem == "cattaneo3d" else p for p in EXAMPLES],
+                         ids=lambda p: p.stem)
 def test_the_unmutated_examples_pass_the_same_route(path):
     assert accepted(lambda: check(load(path), path.parent)) or path.parent.name == "hertz_gmsh"

@@ -452,6 +452,7 @@ def quiet_solver():
                    radius=1.25, centre=0.0, gap=-6.5019676097128454e-06, push=0.001,
                    stiffness_ratio=1.0, poissons_ratio=0.0, steps=2, kinematics="total",
                    upper_first=False))
+@pytest.mark.slow
 def test_placements_converge_with_the_invariants_or_stop_clearly(p):
     check(p)
 
@@ -463,6 +464,7 @@ def test_more_placements(p):
     check(p)
 
 
+@pytest.mark.slow
 def test_the_placements_reach_what_they_should():
     """The generator draws what the property is about: overlaps inside the rind, touching and
     far-apart starts, overhangs, extreme stiffness ratios, each shape, large kinematics."""

@@ -54,6 +54,7 @@ def test_contact_ignored_each_gasket_moves_rigidly_with_its_back():
         assert np.allclose(u[:, 1], 0.0, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_every_step_converges_without_cuts(coarse):
     _, s = coarse
     assert s["converged"]
@@ -63,6 +64,7 @@ def test_every_step_converges_without_cuts(coarse):
         gasket.load_factors(COARSE))
 
 
+@pytest.mark.slow
 def test_first_overlap_at_step_five_and_largest_force_at_step_ten(coarse):
     _, s = coarse
     assert s["first_overlap_step"] == 5
@@ -73,12 +75,14 @@ def test_first_overlap_at_step_five_and_largest_force_at_step_ten(coarse):
     assert np.all(np.diff(F[4:11]) > 0)  # grows with every loading step after the first touch
 
 
+@pytest.mark.slow
 def test_after_unloading_every_node_is_back_where_it_started(coarse):
     _, s = coarse
     assert s["reversibility"] < 1e-6
     assert s["steps"][-1]["force_magnitude"] == 0.0
 
 
+@pytest.mark.slow
 def test_unloading_mirrors_loading_within_one_percent(coarse):
     _, s = coarse
     assert s["mirror_error"] < 0.01
@@ -86,6 +90,7 @@ def test_unloading_mirrors_loading_within_one_percent(coarse):
     assert F[:11] == pytest.approx(F[::-1][:11], rel=0.01, abs=1e-9 * F.max())
 
 
+@pytest.mark.slow
 def test_listing_the_bodies_the_other_way_round_changes_nothing(coarse):
     _, s = coarse
     s2 = gasket.summarize(Analysis(gasket.build(dataclasses.replace(COARSE, swap_bodies=True)))
@@ -95,6 +100,7 @@ def test_listing_the_bodies_the_other_way_round_changes_nothing(coarse):
     assert s2["first_overlap_step"] == 5 and s2["largest_force_step"] == 10
 
 
+@pytest.mark.slow
 def test_the_candidate_surfaces_reach_past_the_contact(coarse):
     """A longer candidate surface (search distance 0.6 instead of 0.4) changes nothing: the
     contact never reaches the end of the surfaces chosen in the undeformed configuration."""
@@ -105,6 +111,7 @@ def test_the_candidate_surfaces_reach_past_the_contact(coarse):
     assert F2 == pytest.approx(F, rel=1e-6, abs=1e-9 * F.max())
 
 
+@pytest.mark.slow
 def test_no_face_overlaps_the_other_in_the_current_configuration(coarse):
     """Checked geometrically on the deformed meshes, not with the algorithm's own gaps."""
     _, s = coarse
@@ -113,6 +120,7 @@ def test_no_face_overlaps_the_other_in_the_current_configuration(coarse):
         assert r["max_penetration"] < 1e-9
 
 
+@pytest.mark.slow
 def test_the_linear_prediction_overlaps_less_than_the_rind(coarse):
     """Each step's prediction drives the faces about 0.05 into each other; with one element
     through the 0.1 thickness that stays inside the rind, so no step is cut."""
@@ -123,6 +131,7 @@ def test_the_linear_prediction_overlaps_less_than_the_rind(coarse):
     assert all(v == 0.0 for v in pred[10:])  # retreating never overlaps
 
 
+@pytest.mark.slow
 def test_gap_left_by_the_undeformed_pairing_stays_small(coarse):
     """The paired variant's linear kinematics: at step 10 the nodes in contact sit about 0.015
     clear of the other face in the deformed configuration, forces up to about 10 degrees off
@@ -134,6 +143,7 @@ def test_gap_left_by_the_undeformed_pairing_stays_small(coarse):
     assert worst_angle < 15.0
 
 
+@pytest.mark.slow
 def test_the_two_gaskets_receive_equal_and_opposite_forces(coarse):
     _, s = coarse
     assert s["max_force_imbalance"] < 1e-6
@@ -145,6 +155,7 @@ def test_the_two_gaskets_receive_equal_and_opposite_forces(coarse):
             assert back["stiff"][0] == pytest.approx(-r["contact_force_stiff"][0], rel=1e-6)
 
 
+@pytest.mark.slow
 def test_each_back_holds_the_contact_force_on_its_gasket(coarse):
     """Equilibrium of each gasket alone: its back's reaction balances its contact force."""
     _, s = coarse
@@ -155,6 +166,7 @@ def test_each_back_holds_the_contact_force_on_its_gasket(coarse):
             assert reaction == pytest.approx(-f, abs=1e-6 * max(r["force_magnitude"], 1.0))
 
 
+@pytest.mark.slow
 def test_files_figures_and_report(coarse):
     out, s = coarse
     on_disk = json.loads((out / "summary.json").read_text())

@@ -61,6 +61,7 @@ def test_hertz_file_reproduces_the_built_in_run_exactly(hertz_level0):
     assert np.array_equal(cyl.displacement, result.steps[-1].bodies["cylinder"].displacement)
 
 
+@pytest.mark.slow
 def test_block_file_via_the_command_line_matches_the_built_in_run(tmp_path, capsys):
     assert main(["-q", "run", "block", "--out", str(tmp_path / "builtin")]) == 0
     assert main(["run", str(EXAMPLES / "block.toml"), "--out", str(tmp_path / "file")]) == 0
@@ -175,6 +176,7 @@ def test_the_export_header_is_plain_text_naming_the_whole_command(capsys, tmp_pa
         assert written and not any("`" in x for x in written), path
 
 
+@pytest.mark.slow
 def test_plot_redraws_the_figures_of_a_results_folder(tmp_path, capsys):
     assert main(["-q", "run", str(EXAMPLES / "patch" / "2x10_nu0.toml"), "--out",
                  str(tmp_path)]) == 0
@@ -186,12 +188,14 @@ def test_plot_redraws_the_figures_of_a_results_folder(tmp_path, capsys):
     assert "nothing" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_progress_prints_a_line_per_step_when_not_on_a_terminal(tmp_path, capsys):
     assert main(["run", str(EXAMPLES / "patch" / "4x7_nu0.toml"), "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert re.search(r"\[#{20}\] step +1 +load factor +1\.0000 +1 iterations", out)
 
 
+@pytest.mark.slow
 def test_hertz_meshed_in_gmsh_agrees_with_the_built_in_hertz(tmp_path, hertz_level0, capsys):
     """examples/hertz_gmsh: make the mesh with the gmsh API, solve it from its input file."""
     pytest.importorskip("gmsh")

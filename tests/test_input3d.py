@@ -256,6 +256,7 @@ def test_an_input_file_with_a_3d_mesh_file_runs(tmp_path):
         assert on.any() and np.abs(p[name][on] / EXACT - 1).max() < 1e-8
 
 
+@pytest.mark.slow
 def test_vfem_export_of_a_3d_example_runs_as_the_example(tmp_path):
     """``vfem export sphere`` (a coarse quarter, one step) read back is the example's own
     configuration, and ``vfem run`` of the file writes the example's contact and reaction

@@ -35,6 +35,7 @@ def small_load_hertz():
     return out
 
 
+@pytest.mark.slow
 def test_small_loads_reproduce_the_linear_hertz_peak_pressure(small_load_hertz):
     linear = _p_max(small_load_hertz["small"][1])
     for kinematics in ("total", "updated"):
@@ -69,6 +70,7 @@ def slide():
     return p, analysis, result
 
 
+@pytest.mark.slow
 def test_sliding_ten_facets_keeps_the_normal_reaction_steady(slide):
     p, _, result = slide
     assert result.converged and len(result.steps) == p.press_steps + p.slide_steps

@@ -218,25 +218,35 @@ def patch_id(case):
     return f"{cl}{nl}-{cu}{nu}" + ("-upper-first" if swap else "")
 
 
-@pytest.fixture(scope="module")
-def patch_runs():
-    """Per case and kinematics: the model and its result."""
-    out = {}
-    for case in PATCH_CASES:
+#: the cases of the fast suite (a second each); the others with ``-m slow``
+QUICK_PATCH_CASES = {"hex3-hex5", "tet5-hex2"}
+
+
+def patch_cases() -> list:
+    return [case if patch_id(case) in QUICK_PATCH_CASES else
+            pytest.param(case, marks=pytest.mark.slow) for case in PATCH_CASES]
+
+
+_patch_runs: dict = {}
+
+
+def patch_run(case, kinematics: str):
+    """The model and result of a patch case under ``kinematics``, solved once per session."""
+    key = patch_id(case), kinematics
+    if key not in _patch_runs:
         lower, upper, swap = case
-        for kinematics in FORMULATIONS:
-            model = stacked(lower, upper, swap=swap)
-            for b in model.bodies:
-                b.kinematics = kinematics
-                b.material = LinearElastic(E, 0.0)
-            out[patch_id(case), kinematics] = model, Analysis(model).run()
-    return out
+        model = stacked(lower, upper, swap=swap)
+        for b in model.bodies:
+            b.kinematics = kinematics
+            b.material = LinearElastic(E, 0.0)
+        _patch_runs[key] = model, Analysis(model).run()
+    return _patch_runs[key]
 
 
 @pytest.mark.parametrize("kinematics", FORMULATIONS)
-@pytest.mark.parametrize("case", PATCH_CASES, ids=patch_id)
-def test_3d_patch_test_under_large_kinematics(patch_runs, case, kinematics):
-    model, result = patch_runs[patch_id(case), kinematics]
+@pytest.mark.parametrize("case", patch_cases(), ids=patch_id)
+def test_3d_patch_test_under_large_kinematics(case, kinematics):
+    model, result = patch_run(case, kinematics)
     assert result.converged, result.message
     for step in result.steps:
         assert step.invariants["passed"], step.invariants
@@ -261,9 +271,9 @@ def test_3d_patch_test_under_large_kinematics(patch_runs, case, kinematics):
             assert np.abs(s[k]).max() < 1e-12 * exact
 
 
-@pytest.mark.parametrize("case", PATCH_CASES, ids=patch_id)
-def test_3d_patch_total_and_updated_lagrangian_agree(patch_runs, case):
-    (mt, rt), (_, ru) = (patch_runs[patch_id(case), k] for k in FORMULATIONS)
+@pytest.mark.parametrize("case", patch_cases(), ids=patch_id)
+def test_3d_patch_total_and_updated_lagrangian_agree(case):
+    (mt, rt), (_, ru) = (patch_run(case, k) for k in FORMULATIONS)
     for body in mt.bodies:
         a, b = rt.steps[-1].bodies[body.name], ru.steps[-1].bodies[body.name]
         difference = np.abs(a.displacement - b.displacement).max()

@@ -47,6 +47,7 @@ def crushed():
     return out
 
 
+@pytest.mark.slow
 def test_large_kinematics_gasket_runs_without_cuts(crushed):
     for result in crushed.values():
         assert result.converged, result.message
@@ -63,6 +64,7 @@ def test_large_kinematics_gasket_runs_without_cuts(crushed):
         assert max(np.abs(r.displacement).max() for r in result.steps[-1].bodies.values()) < 1e-10
 
 
+@pytest.mark.slow
 def test_total_and_updated_lagrangian_agree(crushed):
     for a, b in zip(crushed["total"].steps, crushed["updated"].steps):
         assert a.load_factor == b.load_factor
@@ -72,6 +74,7 @@ def test_total_and_updated_lagrangian_agree(crushed):
 
 
 @pytest.mark.parametrize("model", ["sliding", "gasket"])
+@pytest.mark.slow
 def test_follower_stiffness_coloured_equals_one_coordinate_at_a_time(model, monkeypatch):
     """Perturbing together the coordinates that move the normals of disjoint sets of loaded
     nodes (``follower.follower_moves``) gives the follower stiffness of one

@@ -55,6 +55,7 @@ def test_a_frictional_large_kinematics_model_picks_the_frictional_large_formulat
     assert "coefficients" in caps.friction and "large" in caps.kinematics
 
 
+@pytest.mark.slow
 def test_a_block_slid_far_carries_mu_times_its_normal_force():
     """Slid over 12 facets of the base, every node in contact slips: the tangential force is
     mu times the normal one (measured: 0.29928 to 0.30005 over the sliding steps from the
@@ -78,12 +79,14 @@ def test_a_block_slid_far_carries_mu_times_its_normal_force():
     assert np.all(slipping[slipping > 0] == 2)  # every node in contact slips
 
 
+@pytest.mark.slow
 def test_the_slide_does_not_depend_on_the_body_order():
     base = resultant(run(slide()), "block")
     swapped = resultant(run(slide(swap=True)), "block")
     np.testing.assert_allclose(swapped, base, rtol=0, atol=1e-8 * np.abs(base).max())
 
 
+@pytest.mark.slow
 def test_a_small_push_sticks_as_under_small_kinematics():
     """Pressed and then pushed sideways by 6 % of the press (far less than the slide the
     friction allows), the block sticks (but at its corners) and its tangential force grows with
@@ -136,6 +139,7 @@ def test_what_large_kinematics_friction_does_not_solve_yet_is_refused_by_validat
         model.validate()
 
 
+@pytest.mark.slow
 def test_the_sliding_example_with_friction_slips_at_mu_in_the_contact_frame():
     """``vfem run sliding --set friction=0.3``, coarser: the punch slid 10 block facets over the
     block with mu = 0.3. Every node in contact slips; the tangential tractions' force is mu
@@ -160,6 +164,7 @@ def test_the_sliding_example_with_friction_slips_at_mu_in_the_contact_frame():
     assert abs(last / 0.3 - 1) < 0.04
 
 
+@pytest.mark.slow
 def test_a_resumed_large_frictional_run_equals_an_uninterrupted_one(tmp_path):
     """Stopped after the third sliding step and resumed from its checkpoint, the slide ends
     with every number of the uninterrupted run: the anchors (material points of the other
@@ -173,6 +178,7 @@ def test_a_resumed_large_frictional_run_equals_an_uninterrupted_one(tmp_path):
                                 before_resume=as_written_before_columns)
 
 
+@pytest.mark.slow
 def test_the_sliding_reactions_tend_to_mu_as_the_indentation_shrinks():
     """The reactions' ratio differs from mu by the tilt of the normal tractions' resultant,
     which shrinks with the indentation (the pressure's asymmetry over the punch's curved face
@@ -197,6 +203,7 @@ def test_the_sliding_reactions_tend_to_mu_as_the_indentation_shrinks():
     assert abs(ratio / 0.3 - 1) < 0.01
 
 
+@pytest.mark.slow
 def test_a_frictionless_pair_in_a_frictional_model_slides_freely():
     """Two blocks pressed on one base and pushed along it, under large kinematics: the left
     pair with Coulomb's mu = 0.3, the right one frictionless (``[[contact.pairs]]`` friction

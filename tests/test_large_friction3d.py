@@ -45,20 +45,22 @@ def turned(mesh, degrees: float):
 
 def slide(degrees: float = 30.0, shift: float = 1.0, kinematics: str = "total",
           swap: bool = False, press: float = 0.005, tetrahedra: bool = False,
-          factors=FACTORS, mu: float = MU, turn: float = 0.0) -> Model:
+          factors=FACTORS, mu: float = MU, turn: float = 0.0, coarse: bool = False) -> Model:
     """The block slid ``shift`` along ``degrees`` over a 2 x 2 base of 8 x 8 facets (4 of them
     for 1.0), centred on the base's middle; ``press``: the block top's downward motion;
-    ``turn``: the whole model turned by that many degrees about the vertical (the slide too)."""
+    ``turn``: the whole model turned by that many degrees about the vertical (the slide too);
+    ``coarse``: the base in 4 x 4 x 1 elements and the block in 2 x 2 x 1 (the fast suite's)."""
     d = direction(degrees + turn)
     mat = LinearElastic(1000.0, 0.3)
-    base = Body("base", turned(box(-1.0, -1.0, -0.5, 2.0, 2.0, 0.5, 8, 8, 2), turn), mat,
+    nb, nk, layers = (4, 2, 1) if coarse else (8, 4, 2)
+    base = Body("base", turned(box(-1.0, -1.0, -0.5, 2.0, 2.0, 0.5, nb, nb, layers), turn), mat,
                 supports=(Support("bottom"),), contact_boundaries=("top",),
                 kinematics=kinematics)
     start = -0.5 * shift * direction(degrees)[:2] - 0.25
     top = [PrescribedDisplacement("top", "z", -press, amplitude=PRESS)]
     top += [PrescribedDisplacement("top", c, shift * d[i], amplitude=SHOVE)
             for i, c in enumerate("xy")]
-    block = Body("block", turned(box(start[0], start[1], 0.0, 0.5, 0.5, 0.25, 4, 4, 2,
+    block = Body("block", turned(box(start[0], start[1], 0.0, 0.5, 0.5, 0.25, nk, nk, layers,
                                      tetrahedra=tetrahedra), turn), mat, prescribed=tuple(top),
                  contact_boundaries=("bottom",), kinematics=kinematics)
     bodies = [block, base] if swap else [base, block]
@@ -81,11 +83,29 @@ def statuses(step) -> np.ndarray:
     return np.concatenate(out)
 
 
+def test_a_coarse_block_pressed_and_slid_in_3d_slips_at_mu_against_the_slide():
+    """The fast suite's 3D large-kinematics friction: the slide on coarse meshes, pressed in
+    one step and slid in one. Every node of the block slips, its tangential force is mu times
+    its normal one (to the 3e-3 the finer slide holds) and points against the slide (the
+    cosine to 1e-4: the nine nodes slip along directions their elastic stretch turns a little,
+    measured 1e-5 here, 1e-6 on the finer slide), the two bodies' forces balance to round-off
+    and every invariant holds."""
+    result = run(slide(factors=(0.5, 0.6), coarse=True))
+    block, base = resultant(result), resultant(result, "base")
+    np.testing.assert_allclose(block, -base, rtol=0, atol=1e-12 * np.abs(block).max())
+    assert all(s.invariants["passed"] for s in result.steps)
+    assert np.all(statuses(result.steps[-1]) == 2)
+    tangential = np.linalg.norm(block[-1, :2])
+    assert tangential / block[-1, 2] == pytest.approx(MU, rel=3e-3)
+    assert -block[-1, :2] @ direction(30.0)[:2] / tangential > 1 - 1e-4
+
+
 @pytest.fixture(scope="module")
 def slid():
     return run(slide())
 
 
+@pytest.mark.slow
 def test_a_block_slid_far_in_3d_carries_mu_times_its_normal_force_along_the_slide(slid):
     """Slid over four facets of the base at 30 degrees: from the first sliding step every node
     in contact slips, the tangential force is mu times the normal force (measured: 0.2993 to
@@ -107,6 +127,7 @@ def test_a_block_slid_far_in_3d_carries_mu_times_its_normal_force_along_the_slid
     np.testing.assert_allclose(work[-1], tangential[-1] * 1.0 * 0.4 / 1.5, rtol=5e-3)
 
 
+@pytest.mark.slow
 def test_the_3d_slide_does_not_depend_on_the_body_order_nor_the_lagrangian_form(slid):
     """Bodies listed the other way round, or both updated Lagrangian: the same forces at every
     step (the press and two sliding steps; measured: to 1e-14 and 1e-15 of the largest)."""
@@ -118,6 +139,7 @@ def test_the_3d_slide_does_not_depend_on_the_body_order_nor_the_lagrangian_form(
 
 
 @pytest.mark.parametrize("degrees", [0.0, -135.0])
+@pytest.mark.slow
 def test_the_3d_slide_turns_with_its_direction(degrees):
     """The slide along x, and along a diagonal backwards (from the mirrored start): the
     tangential force is mu times the normal one against the slide (measured 0.2998 to
@@ -130,6 +152,7 @@ def test_the_3d_slide_turns_with_its_direction(degrees):
     assert np.all(along > 1 - 1e-6)
 
 
+@pytest.mark.slow
 def test_the_3d_slide_turned_about_the_vertical_gives_the_turned_forces():
     """The whole model (meshes, slide) turned by 37 degrees about the vertical: the tangents
     are measured from other axes, the answer is the same turned. Each answer is its Newton
@@ -143,6 +166,7 @@ def test_the_3d_slide_turned_about_the_vertical_gives_the_turned_forces():
     np.testing.assert_allclose(other, base @ R.T, rtol=0, atol=1e-9 * np.abs(base).max())
 
 
+@pytest.mark.slow
 def test_a_small_push_in_3d_is_the_small_kinematics_one_to_the_strain():
     """Pressed and then pushed sideways by a tenth of the press (far less than the slide the
     friction allows), the block's middle sticks (its rim slips, where the pressure is singular)
@@ -182,6 +206,7 @@ def test_a_small_push_in_3d_is_the_small_kinematics_one_to_the_strain():
     assert all(t <= a for t, a in zip(tangential, allowed)), (tangential, allowed)
 
 
+@pytest.mark.slow
 def test_a_resumed_3d_slide_equals_an_uninterrupted_one(tmp_path):
     """``examples/friction/slide3d.toml`` (the slide above as an input file) to its first two
     sliding steps, stopped after the first and resumed from its checkpoint: every number of
@@ -216,6 +241,7 @@ def test_the_3d_slide_with_mu_1():
         assert np.all(statuses(step) == 2)
 
 
+@pytest.mark.slow
 def test_a_normal_turned_onto_its_tangent_axis_stops_the_step_with_a_message():
     """A node carrying traction whose normal has turned onto the axis its tangents are measured
     from (the tangents would jump) is refused by the check, naming the body and node: set here
@@ -236,6 +262,7 @@ def test_a_normal_turned_onto_its_tangent_axis_stops_the_step_with_a_message():
         contact._further_errors(state)
 
 
+@pytest.mark.slow
 def test_a_tilted_block_started_apart_lands_on_its_edge_and_slides():
     """Own model: the block (half as stiff as the base) tilted 8 degrees about x through its
     lower front edge and lifted 0.001: the edge lands, the block is pressed onto it and slid:

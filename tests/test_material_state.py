@@ -177,6 +177,7 @@ def pressed_block(material, law: str, load_factors: list[float]):
     return result, block
 
 
+@pytest.mark.slow
 def test_a_contact_analysis_carries_the_law_unchanged(monkeypatch):
     """A block of a law with state under large kinematics, pressed by a stiffer punch in
     three steps (down, further, back up): contact sees only the body's mechanics, so the

@@ -58,11 +58,13 @@ def example_config(name, **parameters):
     return module.config(module.Parameters(**parameters))
 
 
-@pytest.mark.parametrize("name", ["hertz", "block", "punch", "gasket"])
+@pytest.mark.parametrize("name", ["hertz", "block", "punch",
+                                  pytest.param("gasket", marks=pytest.mark.slow)])
 def test_2d_examples_agree_with_the_dense_route(name):
     assert_same(*run_both(example_config(name)))
 
 
+@pytest.mark.slow
 def test_the_sphere_and_its_platen_agree_with_the_dense_route():
     assert_same(*run_both(example_config("sphere")))
 
@@ -81,8 +83,9 @@ def test_3d_patch_test_is_met_to_round_off_matrix_free(lower, upper):
 
 @pytest.mark.parametrize("dim,parameters", [
     (2, {"blocks": 5, "divisions": 12}),
-    (3, {"blocks": 2, "divisions": 24, "thickness": 0.1, "shrink": 0.2}),
-    (3, {"blocks": 3, "divisions": 6, "tetrahedra": True}),
+    pytest.param(3, {"blocks": 2, "divisions": 24, "thickness": 0.1, "shrink": 0.2},
+                 marks=pytest.mark.slow),
+    pytest.param(3, {"blocks": 3, "divisions": 6, "tetrahedra": True}, marks=pytest.mark.slow),
 ])
 def test_stacks_agree_with_the_dense_route(dim, parameters, monkeypatch):
     if parameters.get("divisions", 0) == 24:
@@ -95,6 +98,7 @@ def test_stacks_agree_with_the_dense_route(dim, parameters, monkeypatch):
         assert max(s.nc for s in free.surfaces) > pairmaking.SIDE_SAMPLE
 
 
+@pytest.mark.slow
 def test_relaxed_corrections_solve_their_sets_matrix_free():
     """Settings that relax the corrections take the pairs' active sets one correction at a
     time (PairedContact._solve_pairs), not by complementarity: the same answers."""
@@ -139,6 +143,7 @@ def test_the_setting_is_checked():
         ContactSettings(dense_limit_mib=0.0).validate()
 
 
+@pytest.mark.slow
 def test_stack_balances_and_body_order_changes_nothing():
     p = stack.Parameters(dim=3, blocks=3, divisions=5)
     results = [Analysis(stack.build(dataclasses.replace(p, reverse_bodies=r))).run()

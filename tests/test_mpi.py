@@ -72,6 +72,7 @@ def run_both(tmp_path: Path, args: list[str], ranks: int) -> tuple[Path, Path]:
     (2, ["sphere", "--set", "steps=1"]),
 ], ids=["2d-5-plates-n2", "2d-5-plates-n4", "3d-3-plates-n2", "3d-matrix-free-n2",
         "sphere-n2"])
+@pytest.mark.slow
 def test_ranks_give_the_serial_answers(tmp_path, ranks, args):
     serial, spread = run_both(tmp_path, args, ranks)
     assert same_results(serial, spread) >= 2
@@ -84,6 +85,7 @@ def test_ranks_give_the_serial_answers(tmp_path, ranks, args):
     assert not any(Path(p).name.startswith("vfem-rank") for p in os.listdir(tmp_path))
 
 
+@pytest.mark.slow
 def test_the_ranks_launcher_runs_the_same_command(tmp_path):
     """``vfem run --ranks 2`` is ``mpiexec -n 2 vfem run``."""
     out = tmp_path / "launched"
@@ -102,6 +104,7 @@ def test_the_ranks_launcher_runs_the_same_command(tmp_path):
     same_results(serial, out)
 
 
+@pytest.mark.slow
 def test_resume_after_a_kill_under_mpi_is_the_uninterrupted_run(tmp_path):
     args = ["stack", "--set", "divisions=14", "--set", "steps=8", "--set",
             "flexibility=matrix_free", "--no-figures"]
@@ -129,6 +132,26 @@ def test_resume_after_a_kill_under_mpi_is_the_uninterrupted_run(tmp_path):
     assert summary["converged"] and len(summary["steps"]) == 8
 
 
+def test_two_plates_on_two_ranks_give_the_serial_answers(tmp_path):
+    """The fast suite's MPI test: two coarse 2D plates, one per rank, through ``vfem run
+    --ranks 2``: every VTU field the serial run's to 1e-10 of its largest value, the same
+    iterations, one rank printing."""
+    args = ["stack", "--set", "dim=2", "--set", "blocks=2", "--set", "divisions=4",
+            "--set", "steps=1"]
+    serial, spread = tmp_path / "serial", tmp_path / "ranks2"
+    from vfem.cli import main
+
+    assert main(["-q", "run", *args, "--out", str(serial), "--no-figures"]) == 0
+    done = vfem(["run", "--ranks", "2", *args, "--out", str(spread), "--no-figures"])
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count("vfem: stack, results in") == 1
+    assert same_results(serial, spread) >= 2
+    a = json.loads((serial / "summary.json").read_text())
+    b = json.loads((spread / "summary.json").read_text())
+    assert [s["iterations"] for s in a["steps"]] == [s["iterations"] for s in b["steps"]]
+
+
+@pytest.mark.slow
 def test_a_failure_on_every_rank_is_one_message_and_no_hang(tmp_path):
     done = vfem(["run", "stack", "--set", "flexibility=matrix_free", "--set", "dim=2",
                  "--set", "press=1.0", "--out", str(tmp_path / "x")], ranks=2)
@@ -137,6 +160,7 @@ def test_a_failure_on_every_rank_is_one_message_and_no_hang(tmp_path):
     assert "Traceback" not in done.stderr
 
 
+@pytest.mark.slow
 def test_step_cutting_under_mpi_is_the_serial_runs(tmp_path):
     """A model whose steps are cut (random model 2d-278: at the first tries a block node goes
     deeper into the punch than its outer layer of elements) cuts them at the same steps under

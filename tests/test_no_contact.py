@@ -84,6 +84,7 @@ def test_a_platen_pulling_a_touching_body_away_is_named():
     assert "allow more iterations" not in result.message
 
 
+@pytest.mark.slow
 def test_a_platen_whose_bodies_meet_edge_or_corner_first_is_held_on_either_side(
         monkeypatch):
     """Random model 3d-17 (a tilted box over a block's corner, pushed by a platen): with the

@@ -48,6 +48,7 @@ def hertz(tmp_path_factory) -> tuple[Path, subprocess.CompletedProcess]:
     return cwd / "hertz", vfem("run", "hertz", "--out", "hertz", cwd=cwd)
 
 
+@pytest.mark.slow
 def test_every_module_imports_without_matplotlib():
     code = ("import sys, importlib, pkgutil\n"
             "sys.modules['matplotlib'] = None\n"
@@ -78,6 +79,7 @@ def test_a_run_that_draws_figures_writes_the_rest_and_says_so_in_one_line(hertz)
     assert not list(out.glob("*.png"))
 
 
+@pytest.mark.slow
 def test_springs_runs_without_matplotlib(tmp_path):
     """The 1D example draws no figure: nothing to say about figures."""
     p = vfem("run", "springs", "--out", "springs", cwd=tmp_path)
@@ -88,6 +90,7 @@ def test_springs_runs_without_matplotlib(tmp_path):
 
 
 @pytest.mark.parametrize("folder", ["hertz", "springs"])
+@pytest.mark.slow
 def test_plot_names_the_fix_and_exits_2(hertz, tmp_path, folder):
     out, _ = hertz
     if folder == "springs":  # a folder whose run drew no figure: plot still needs matplotlib
@@ -101,6 +104,7 @@ def test_plot_names_the_fix_and_exits_2(hertz, tmp_path, folder):
     assert not list(out.glob("*.png"))
 
 
+@pytest.mark.slow
 def test_plot_draws_the_figures_once_matplotlib_is_there(hertz, tmp_path):
     """The folder a run without matplotlib wrote holds all the figures need."""
     from vfem.cli import main

@@ -44,6 +44,7 @@ def tilted_cube(block_divisions: int, tilt: float = 8.0, cube_modulus: float = 1
 
 @pytest.mark.parametrize("divisions,tilt,modulus", [(28, 8.0, 1e5), (14, 0.0, 1e5), (14, 8.0, 1e3)],
                          ids=["finer-block", "flat-cube", "equal-stiffness"])
+@pytest.mark.slow
 def test_cube_on_a_block_every_step_balanced_and_apart(divisions, tilt, modulus):
     result = tilted_cube(divisions, tilt, modulus)
     assert result.converged, result.message
@@ -55,6 +56,7 @@ def test_cube_on_a_block_every_step_balanced_and_apart(divisions, tilt, modulus)
     assert result.steps[-1].bodies["cube"].contact_force[:, 2].sum() > 0
 
 
+@pytest.mark.slow
 def test_stiff_tilted_cube_on_a_coarser_soft_block():
     """A strict expected failure until issue 37: a stiff edge first touching between a soft
     coarser surface's nodes was not seen by the compatibility side; the equilibrium side's
@@ -76,6 +78,7 @@ def test_stiff_flat_cube_on_a_soft_block_twice_as_coarse():
     assert result.converged, result.message
 
 
+@pytest.mark.slow
 def test_turned_soft_punch_on_a_graded_stiff_block():
     """A tetrahedral punch turned 20 degrees about z (its edges and corners cross the block's
     grid obliquely, all inside the contact), started 0.005 above a hexahedral block graded

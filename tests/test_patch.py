@@ -20,6 +20,7 @@ def thesis():
     return run(Parameters(variant="thesis")), run(Parameters(variant="thesis", tight=True))
 
 
+@pytest.mark.slow
 def test_paired_variant_passes_every_case_to_round_off(paired):
     for summary in paired:  # defaults and tight tolerances alike
         assert summary["converged"] and len(summary["cases"]) == 12
@@ -30,6 +31,7 @@ def test_paired_variant_passes_every_case_to_round_off(paired):
             assert not c["stopped_at_fixed_point"]
 
 
+@pytest.mark.slow
 def test_thesis_variant_is_uniform_to_a_few_per_mille(thesis):
     default, _ = thesis
     assert len(default["cases"]) == 12
@@ -41,6 +43,7 @@ def test_thesis_variant_is_uniform_to_a_few_per_mille(thesis):
     assert default["converged"] is not any(c["stopped_at_fixed_point"] for c in default["cases"])
 
 
+@pytest.mark.slow
 def test_sliding_base_cases_are_mirror_images(thesis):
     cases = {(c["lower_elements"], c["upper_elements"], c["poissons_ratio"]): c
              for c in thesis[0]["cases"]}
@@ -50,6 +53,7 @@ def test_sliding_base_cases_are_mirror_images(thesis):
             cases[(b, a, 0.3)]["pressure_deviation"], rel=1e-6)
 
 
+@pytest.mark.slow
 def test_thesis_variant_stalls_at_a_fixed_point_with_tight_tolerances(thesis):
     """Its fixed point is outside the tight tolerance (1e-13): not converged (issue 37), every
     case run to its end and measured."""

@@ -104,7 +104,7 @@ STIFF_PUNCH = input_file(
     load_factors=[0.25, 0.5, 0.75, 1.0])
 
 
-@pytest.mark.parametrize("n", [9, 18])
+@pytest.mark.parametrize("n", [9, pytest.param(18, marks=pytest.mark.slow)])
 def test_a_stiff_punch_with_corners_inside_the_contact_starting_apart(n):
     """Not in the issue: a tetrahedral punch 100 times stiffer than a hexahedral base, started
     0.01 above it, its corners and edges inside the contact, pressed 0.02 into it. On the

@@ -21,6 +21,7 @@ def test_the_phases_add_up_to_the_run():
                                 if any(k in timings for k in keys)]
 
 
+@pytest.mark.slow
 def test_a_run_writes_its_phases(tmp_path):
     assert main(["-q", "run", "hertz", "--out", str(tmp_path)]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())

@@ -44,6 +44,7 @@ def test_lame():
     assert u_hub - u_shaft == pytest.approx(d, rel=1e-14)
 
 
+@pytest.mark.slow
 def test_pressure_within_2_percent_of_lame(default):
     p, model, result = default
     assert [s.iterations for s in result.steps] == [1]
@@ -60,6 +61,7 @@ def test_pressure_within_2_percent_of_lame(default):
     assert f_hub[0] == pytest.approx(ev["lame_pressure"] * p.bore_radius * p.length, rel=0.005)
 
 
+@pytest.mark.slow
 def test_body_order_does_not_matter(default):
     p, _, a = default
     _, _, b = solve(swap_bodies=True)
@@ -69,6 +71,7 @@ def test_body_order_does_not_matter(default):
         assert np.abs(pa - pb).max() < 1e-8 * press_fit.lame(p)
 
 
+@pytest.mark.slow
 def test_finer_facets_come_closer(default):
     p, _, result = solve(around=32)
     coarse = press_fit.evaluate(default[2], default[0])["hub"]["largest_error"]
@@ -100,6 +103,7 @@ def test_bad_parameters_are_refused():
         press_fit.validate(press_fit.Parameters(hub_radius=0.5))
 
 
+@pytest.mark.slow
 def test_push_out_force_with_friction():
     """The shaft's end faces pushed along the axis after the fit (mu = 0.3): every contact node
     slips and the axial force is 2 pi b L mu p. The end faces' rim nodes are contact nodes whose
@@ -122,6 +126,7 @@ def test_push_out_force_with_friction():
     assert forces[1] == pytest.approx(forces[0], rel=1e-8)
 
 
+@pytest.mark.slow
 def test_a_longer_shaft_pushed_at_its_far_ends():
     """A model of our own: the shaft twice the hub's length, pushed at its far end faces (its
     contact nodes then carry no supports). The hub's pressure is no longer Lame's (end effects:

@@ -113,6 +113,7 @@ def test_two_punches_on_one_block():
     assert left == pytest.approx(right, rel=1e-8, abs=1e-8 * load)
 
 
+@pytest.mark.slow
 def test_large_kinematics_punch_and_drop(reference):
     """Under large kinematics the same: balance, nothing beyond the block facets next to the
     corners (the punch's corners slide outwards over them); the force is 1.49 % below the
@@ -196,6 +197,7 @@ def sadowsky(facets: int, graded: float | None = None):
     return error, totals, force, across
 
 
+@pytest.mark.slow
 def test_sadowsky_punch_under_refinement():
     """Issue 16, item 8: the pressure under a rigid flat punch on a half-plane is
     P / (pi sqrt(a^2 - x^2)) (Sadowsky). Measured over |x| < 0.8a on the block's nodes, with

@@ -73,21 +73,38 @@ def _same(before: dict, after: dict) -> None:
         assert np.array_equal(after[name], pixels), f"{name} redrawn differently"
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """Every built-in example run once at its small settings: example -> results folder."""
-    out = {}
-    for name, sets in SMALL.items():
-        folder = tmp_path_factory.mktemp(name)
+class Runs(dict):
+    """Each built-in example run at its small settings when a test first asks for it:
+    example -> results folder (so the fast suite runs only the examples its tests name)."""
+
+    def __init__(self, factory):
+        super().__init__()
+        self.factory = factory
+
+    def __missing__(self, name: str) -> Path:
+        folder = self.factory.mktemp(name)
         args = ["-q", "run", name, "--out", str(folder)]
-        for s in sets:
+        for s in SMALL[name]:
             args += ["--set", s]
         assert main(args) == 0, name
-        out[name] = folder
-    return out
+        self[name] = folder
+        return folder
 
 
-@pytest.mark.parametrize("example", list(SMALL))
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    return Runs(tmp_path_factory)
+
+
+#: the examples whose small runs take seconds each: their figure tests are in the slow set
+SLOW = {"block", "gasket", "sliding", "wedge"}
+
+
+def examples(names) -> list:
+    return [pytest.param(n, marks=pytest.mark.slow) if n in SLOW else n for n in names]
+
+
+@pytest.mark.parametrize("example", examples(SMALL))
 def test_plot_redraws_every_figure_of_the_example_run(runs, example):
     folder = runs[example]
     summary = json.loads((folder / "summary.json").read_text())
@@ -99,6 +116,7 @@ def test_plot_redraws_every_figure_of_the_example_run(runs, example):
     _same(before, after)
 
 
+@pytest.mark.slow
 def test_plot_redraws_the_figures_of_an_input_file_run(tmp_path):
     assert main(["-q", "run", str(ROOT / "examples" / "hertz.toml"), "--out",
                  str(tmp_path)]) == 0
@@ -110,6 +128,7 @@ def test_plot_redraws_the_figures_of_an_input_file_run(tmp_path):
 
 
 @pytest.mark.parametrize("example", ["gasket", "input"])
+@pytest.mark.slow
 def test_no_figures_leaves_them_to_vfem_plot_which_draws_the_same(runs, example, tmp_path,
                                                                    capsys):
     """``vfem run --no-figures``: every result but the figures, a line saying so, and
@@ -188,7 +207,7 @@ BODIES = {"hertz": ("cylinder", "flat"), "punch": ("block", "punch"), "block": (
           "gasket": ("soft", "stiff"), "sliding": ("block", "punch"), "wedge": ("wedge", "plate")}
 
 
-@pytest.mark.parametrize("example", list(SHAPES))
+@pytest.mark.parametrize("example", examples(SHAPES))
 def test_deformed_shapes_name_every_body_the_scale_and_the_units(runs, example, drawn):
     assert main(["-q", "plot", str(runs[example])]) == 0
     for name in SHAPES[example]:
@@ -210,6 +229,7 @@ def test_the_title_names_a_classical_method(tmp_path, drawn):
     assert "contact: lagrange" in drawn["pressure.png"]["titles"]
 
 
+@pytest.mark.slow
 def test_the_pressure_plot_draws_every_step_it_names(tmp_path, drawn):
     """A step whose profile is a single node (the first touch) is a point, which a line without
     a marker leaves undrawn although the legend names it; a step with no node in contact says
@@ -279,8 +299,8 @@ def legends(monkeypatch):
 
 
 @pytest.mark.parametrize("model, figure", [
-    (["sliding", *(a for s in SMALL["sliding"] + ["friction=0.3"] for a in ("--set", s))],
-     "reactions.png"),
+    pytest.param(["sliding", *(a for s in SMALL["sliding"] + ["friction=0.3"]
+                               for a in ("--set", s))], "reactions.png", marks=pytest.mark.slow),
     ([str(ROOT / "examples" / "friction" / "pushed_block.toml")], "history.png")])
 def test_the_legends_of_the_step_histories_stand_beside_the_curves(model, figure, tmp_path,
                                                                   legends):

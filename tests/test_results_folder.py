@@ -9,6 +9,8 @@ import dataclasses
 import json
 from pathlib import Path
 
+import pytest
+
 from vfem.cli import main
 from vfem.io.folders import RECORD
 
@@ -20,6 +22,7 @@ def vtus(folder: Path) -> list[str]:
     return sorted(p.name for p in folder.glob("*.vtu"))
 
 
+@pytest.mark.slow
 def test_a_shorter_run_of_the_same_model_leaves_no_stale_step(tmp_path, capsys):
     model = tmp_path / "hertz.toml"
     model.write_text(HERTZ.read_text())
@@ -45,6 +48,7 @@ def test_a_shorter_run_of_the_same_model_leaves_no_stale_step(tmp_path, capsys):
     assert run["command"].endswith(str(out)) and run["vfem_version"]
 
 
+@pytest.mark.slow
 def test_two_models_in_one_folder(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["-q", "run", str(TWO), "--out", str(out), "--set", "steps.count=1"]) == 0
@@ -59,6 +63,7 @@ def test_two_models_in_one_folder(tmp_path, capsys):
     assert {"summary.json", "results.pvd", "cylinder_step0005.vtu", RECORD} <= names
 
 
+@pytest.mark.slow
 def test_a_folder_written_before_the_record(tmp_path):
     out = tmp_path / "old"
     out.mkdir()
@@ -71,6 +76,7 @@ def test_a_folder_written_before_the_record(tmp_path):
                                 for k in range(1, 6)] + ["mine.vtu"])
 
 
+@pytest.mark.slow
 def test_default_folder_carries_the_settings(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["-q", "run", "hertz", "--set", "force=1000"]) == 0
@@ -80,6 +86,7 @@ def test_default_folder_carries_the_settings(tmp_path, monkeypatch):
     assert a["parameters"]["force"] == 1000 and a["run"]["settings"] == ["force=1000"]
 
 
+@pytest.mark.slow
 def test_set_changes_an_input_file_key_checked_like_the_file(tmp_path, capsys):
     out = tmp_path / "changed"
     assert main(["-q", "run", str(HERTZ), "--out", str(out), "--set", "contact.max_iterations=150",
@@ -115,6 +122,7 @@ def test_ctrl_c_before_the_first_step_offers_no_resume(tmp_path, monkeypatch, ca
     assert "nothing to resume" in err and "--resume" not in err
 
 
+@pytest.mark.slow
 def test_the_python_api_keeps_its_folder_the_same_way(tmp_path):
     import vfem
     from vfem.errors import InputError
@@ -144,6 +152,7 @@ def test_a_model_name_cannot_send_results_elsewhere(tmp_path, monkeypatch):
         assert folder.parent == Path("results") and folder.name not in ("", ".", ".."), folder
 
 
+@pytest.mark.slow
 def test_a_refused_resume_changes_nothing_and_a_resume_keeps_the_description(tmp_path, capsys):
     out = tmp_path / "r"
     assert main(["-q", "run", str(HERTZ), "--out", str(out)]) == 0

@@ -136,6 +136,7 @@ def test_vtu_series_has_every_field_and_step(patch):
         assert m.point_data["displacement"].shape[1] == 3
 
 
+@pytest.mark.slow
 def test_plot_results_writes_the_figures(patch):
     out = patch[0]
     paths = plot_results(out)
@@ -147,6 +148,7 @@ def test_plot_results_writes_the_figures(patch):
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
 def test_plot_results_without_contact_csv_or_summary(patch, tmp_path):
     """Older results (no contact.csv) and no summary.json: the VTU fields suffice."""
     src = patch[0]
@@ -158,6 +160,7 @@ def test_plot_results_without_contact_csv_or_summary(patch, tmp_path):
     assert all(p.stat().st_size > 1000 for p in paths)
 
 
+@pytest.mark.slow
 def test_plot_results_with_quadratic_elements(tmp_path):
     _, _, result, _ = _patch(tmp_path, order=2, load_factors=(1.0,))
     assert len(result.steps) == 1

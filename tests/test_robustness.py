@@ -49,7 +49,8 @@ def _large_gasket():
 
 
 @pytest.mark.parametrize("make", [lambda: hertz.build(hertz.HertzParameters(steps=3)),
-                                  _large_gasket], ids=["hertz-linear", "gasket-updated"])
+                                  pytest.param(_large_gasket, marks=pytest.mark.slow)],
+                         ids=["hertz-linear", "gasket-updated"])
 def test_a_failed_step_restarts_from_the_saved_state_exactly(make):
     """Step 2's first attempt iterates (moving forces, traction values and the large bodies'
     trial states), then is made to fail; the retry must see the state saved after step 1, bit
@@ -109,6 +110,7 @@ def test_cycling_contact_sets_are_noticed():
     assert "nodes 11, 12 of body 'block' keep switching" in messages[4]
 
 
+@pytest.mark.slow
 def test_one_step_runs_converge_to_the_stepped_answers():
     """All the load at once: Hertz converges directly, the wedge through step cutting (its
     tip would cross the plate's surface layer), both to the stepped runs' answers."""
@@ -129,6 +131,7 @@ def test_one_step_runs_converge_to_the_stepped_answers():
         assert e["plate_share"] == pytest.approx(e_ref["plate_share"], rel=1e-2, abs=1e-4)
 
 
+@pytest.mark.slow
 def test_resume_continues_to_the_same_answer(tmp_path):
     """Checkpoints of the last steps removed (as if the run had stopped after step 2): the
     resumed run rewrites steps 3-5 identically, and a checkpoint of another model is refused."""
@@ -165,6 +168,7 @@ def _steps_on_disk(out: Path) -> tuple[int, dict]:
         n += 1
 
 
+@pytest.mark.slow
 def test_a_killed_run_keeps_its_steps_and_resumes_to_the_same_answer(tmp_path):
     """SIGKILL in the middle of a run: the steps completed are readable, summary.json is valid
     and lists them, and ``--resume`` reaches the uninterrupted answer to 1e-12."""
@@ -200,6 +204,7 @@ def test_a_killed_run_keeps_its_steps_and_resumes_to_the_same_answer(tmp_path):
         reference["largest_force"], rel=1e-12)
 
 
+@pytest.mark.slow
 def test_resume_mistakes_are_one_message_and_exit_2(tmp_path, capsys):
     from vfem.cli import main
 

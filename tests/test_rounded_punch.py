@@ -194,6 +194,7 @@ def against_lagrange(mesh: dict):
     return vfem_result, lagrange
 
 
+@pytest.mark.slow
 def test_fine_mesh_against_the_lagrange_baseline():
     """Acceptance: total force and peak pressure within 1 % of the Lagrange baseline on a fine
     mesh (17k dofs; 0.001 at the tangent points). Measured: 9.4726e6 against 9.4684e6 (+0.045 %),

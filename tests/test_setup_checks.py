@@ -86,6 +86,7 @@ def test_fill_model_is_close_to_superlus_factors(triangles):
         assert actual <= vfem.memory.factor_entries(b.ndofs, len(s.tracked_dofs)) <= 2 * actual
 
 
+@pytest.mark.slow
 def test_fill_model_in_3d_is_close_to_superlus_factors():
     """3D (vfem.memory.SUPERLU_3D, fitted on the sphere example at 5,000-21,000 dofs a body):
     a coarser sphere than the fit's, hexahedra within 0.7 to 1.5 times SuperLU's nnz(L + U), a
@@ -111,6 +112,7 @@ def test_fill_model_in_3d_is_close_to_superlus_factors():
 
 
 @pytest.mark.skipif(not vfem.linalg.pardiso.available(), reason="PARDISO is not installed")
+@pytest.mark.slow
 def test_pardiso_3d_bytes_per_factor_entry():
     """vfem.memory counts a 3D body's PARDISO factors at PARDISO_3D_FACTOR_BYTES per entry of
     nnz(L): PARDISO's own count of its memory agrees, to within the indices' share, which

@@ -52,6 +52,7 @@ def build(k: int, folder: Path, side: str | None = None):
 
 
 @pytest.mark.parametrize(("k", "other"), [(75, "block"), (215, "upper")])
+@pytest.mark.slow
 def test_the_switched_side_solves_and_ends_where_that_side_forced_ends(k, other, tmp_path):
     p, config, info = build(k, tmp_path / "a")
     result = vfem.solve(config.build(tmp_path / "a"))
@@ -107,6 +108,7 @@ def test_a_side_that_cannot_reach_the_steps_before_is_not_kept(tmp_path, monkeyp
     analysis.contact.penetrations(analysis.state)  # the state is that formulation's
 
 
+@pytest.mark.slow
 def test_a_run_resumed_after_the_switch_ends_as_the_whole_run(tmp_path):
     """The switch is part of the checkpoint: resumed after it, the run goes on with the
     switched side (every step's contact forces as the whole run's, contact.csv the same)."""

@@ -43,6 +43,7 @@ def test_theory():
     assert th["p0_theory"] == pytest.approx(3 * 15000 / (2 * math.pi * th["a_theory"] ** 2))
 
 
+@pytest.mark.slow
 def test_coarse_quarter_sphere(coarse):
     model, result = coarse
     for step in result.steps:
@@ -56,6 +57,7 @@ def test_coarse_quarter_sphere(coarse):
     assert s["contour_spread"] < ev["facet_size"]  # a round contact zone
 
 
+@pytest.mark.slow
 def test_body_order_does_not_matter(coarse, swapped):
     (_, a), (_, b) = coarse, swapped
     p0 = sphere.theory(COARSE)["p0_theory"]
@@ -98,6 +100,7 @@ def test_refinement_study():
     assert abs(whole / quarter - 1) < 0.005
 
 
+@pytest.mark.slow
 def test_run_writes_the_3d_figures_and_plot_redraws_them(tmp_path):
     from vfem.io.replot import plot_results
 
@@ -152,6 +155,7 @@ def _stiff_sphere_pressed_by_motion(quarter: bool):
              contact_boundaries=("top",))], contact=ContactSettings(max_step_cuts=0))
 
 
+@pytest.mark.slow
 def test_stiff_sphere_moved_onto_a_soft_flat_whole_and_quarter_models():
     """The soft flat carries compatibility. On the quarter model its corner node under the
     pole pairs with the sphere's pole, on both of the sphere patch's symmetry edges: before

@@ -25,6 +25,7 @@ def by_case(summary):
     return {c["case"]: c for c in summary["cases"]}
 
 
+@pytest.mark.slow
 def test_every_case_converges_in_every_step(default):
     _, s = default
     assert s["converged"] and [c["case"] for c in s["cases"]] == [1, 2, 3, 4, 5]
@@ -35,6 +36,7 @@ def test_every_case_converges_in_every_step(default):
         assert c["max_penetration"] < 1e-10  # the paired variant closes the gaps exactly
 
 
+@pytest.mark.slow
 def test_the_stiffer_body_is_the_one_that_does_not_deform(default):
     c = by_case(default[1])
     assert c[1]["plate_share"] >= 0.99  # wedge 1000 times stiffer: all in the plate
@@ -44,6 +46,7 @@ def test_the_stiffer_body_is_the_one_that_does_not_deform(default):
     assert 0.35 <= c[3]["plate_share"] <= 0.50
 
 
+@pytest.mark.slow
 def test_shares_add_up_and_follow_the_stiffness_ratio(default):
     c = by_case(default[1])
     for k in range(1, 6):
@@ -52,6 +55,7 @@ def test_shares_add_up_and_follow_the_stiffness_ratio(default):
     assert np.all(np.diff(shares) < 0)
 
 
+@pytest.mark.slow
 def test_contact_forces_balance_the_support_and_the_drive(default):
     for c in default[1]["cases"]:
         f = c["contact_force"]
@@ -62,6 +66,7 @@ def test_contact_forces_balance_the_support_and_the_drive(default):
         assert c["plate_balance_error"] < 1e-9 and c["action_reaction_error"] < 1e-9
 
 
+@pytest.mark.slow
 def test_files_and_summary(default):
     out, s = default
     names = ["mesh.png", "prediction.png"] + [f"case{k}.png" for k in range(1, 6)] + [
@@ -82,6 +87,7 @@ def test_files_and_summary(default):
     assert "converged" in lines[0] and len([x for x in lines if x.startswith("     ")]) == 5
 
 
+@pytest.mark.slow
 def test_listing_the_bodies_the_other_way_round_changes_nothing(default):
     _, s = default
     swapped = run(Parameters(swap_bodies=True, figures=False))
@@ -121,6 +127,7 @@ def test_coarse_mesh_takes_the_motion_in_one_step_like_the_thesis():
     assert c[3]["plate_share"] == pytest.approx(default["plate_share"], abs=0.01)
 
 
+@pytest.mark.slow
 def test_thesis_variant_converges_or_says_why():
     """The thesis's plain reading: with its 1 % criterion on the coarse mesh, case 3 converges
     in one step; with the default criterion it cycles and the run stops with a message (the

@@ -147,6 +147,7 @@ name = "right\""""
                                        atol=1e-9 * abs(totals(ref, "block")[1]))
 
 
+@pytest.mark.slow
 def test_a_frictionless_pair_in_a_frictional_3d_model_has_no_nan():
     """Three plates of ``examples/stack.toml``, the lower pair with friction, the upper one
     frictionless: the upper pair's nodes slip with no traction, whose direction -s/|s| was
@@ -213,6 +214,7 @@ def run_cli(tmp_path: Path, name: str, *changes: str) -> tuple[int, dict]:
     return status, json.loads((out / "summary.json").read_text())
 
 
+@pytest.mark.slow
 def test_the_thesis_variant_outside_its_tolerance_is_not_converged(tmp_path, capsys):
     """The stiff flat punch (200 times the block's modulus): the thesis variant stops every
     step at its fixed point, penetrations of 1e-3 where its tolerance is 3.7e-7, the block and

@@ -31,7 +31,8 @@ def check(quantity: str, value: float, reference: float, source: str, tolerance:
     """One verified quantity: ``value`` against ``reference`` (from ``source``), passed when its
     error by ``measure`` is at most ``tolerance`` (whose ``basis`` the record states)."""
     if measure not in MEASURES:
-        raise ValueError(f"measure {measure!r}: one of {', '.join(MEASURES)}")
+        raise ValueError(f"{quantity}: unknown measure {measure!r}; the measures are "
+                         f"{', '.join(MEASURES)}")
     value, reference = float(value), float(reference)
     difference = abs(value - reference)
     if measure == "relative":
