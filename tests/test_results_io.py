@@ -197,3 +197,19 @@ def test_pvd_names_bodies_and_keeps_the_load_factor_exactly(tmp_path):
     assert float(e0["timestep"]) == result.steps[0].load_factor == 1.0 / 3.0
     assert (e0["name"], e1["name"]) == ("lower", "upper")
     assert np.isclose(float(e1["timestep"]), 1.0 / 3.0)
+
+
+def test_contact_csv_marks_no_node_free_that_carries_force(tmp_path):
+    """A node whose own gap is open but which carries the opposing surface's force (the
+    cylinder's node just past the contact edge, loaded through a virtual element) reads
+    ``carrying``, not ``free``: every ``free`` row has no pressure (issue 39)."""
+    import csv
+
+    from vfem.cli import main
+
+    assert main(["-q", "run", "hertz", "--no-figures", "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "contact.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert {r["status"] for r in rows} == {"contact", "carrying", "free"}
+    assert all(float(r["pressure"]) == 0.0 for r in rows if r["status"] == "free")
+    assert all(float(r["pressure"]) > 0.0 for r in rows if r["status"] == "carrying")

@@ -35,7 +35,10 @@ x, y, ux, uy, pressure, gap, status``: ``node`` the point number in the body (th
 index), ``x, y`` its undeformed coordinates, ``ux, uy`` its displacement, ``pressure`` the
 nominal contact pressure (as ``contact_pressure``), ``gap`` = -``penetration`` (negative:
 overlapping; 0 where the contact algorithm measured none, e.g. the coarse side of a paired
-contact), ``status`` ``contact`` or ``free``; with friction then ``shear_x, shear_y, slip_increment,
+contact), ``status`` ``contact`` (in contact: ``contact_status`` 1), ``carrying`` (not in contact
+itself, its own gap open, yet carrying contact force: the opposing surface's equilibrium
+correction put it there through a virtual element, as at the nodes beside a stiff punch's corner;
+:func:`carrying`), or ``free``; with friction then ``shear_x, shear_y, slip_increment,
 accumulated_slip, friction`` (``stick``, ``slip``, ``free``, or empty on nodes that carry no
 pair's compatibility). Numbers are written with 17 significant digits (round-trip exact).
 
@@ -130,6 +133,23 @@ def _vector(v: np.ndarray) -> np.ndarray:
     return np.asarray(v)
 
 
+
+def carrying(r: BodyStepResult, nodes: np.ndarray) -> np.ndarray:
+    """Which of ``nodes`` carry contact force (a nonzero force or pressure) though not in
+    contact themselves (``contact_status`` 0): their own gap is open, and the force is the
+    opposing surface's, which its equilibrium correction placed on them through a virtual
+    element (the block's nodes beside a stiff punch's corner carry its corner's force). They
+    read ``carrying`` in ``contact.csv``, not ``free`` (issue 39)."""
+    force = np.any(r.contact_force[nodes] != 0.0, axis=1) | (r.contact_pressure[nodes] != 0.0)
+    return force & (r.contact_status[nodes] == 0)
+
+
+def contact_csv_status(r: BodyStepResult, nodes: np.ndarray) -> list[str]:
+    """``contact.csv``'s status of each of ``nodes``: ``contact``, ``carrying`` or ``free``."""
+    words = np.where(r.contact_status[nodes] > 0, "contact",
+                     np.where(carrying(r, nodes), "carrying", "free"))
+    return words.tolist()
+
 class ResultsWriter:
     """Writes the VTU/PVD series step by step into ``out`` (created if needed).
 
@@ -222,13 +242,13 @@ class ResultsWriter:
             X = body.points[:, nodes].T
             u = r.displacement[nodes]
             gap = 0.0 - r.penetration[nodes]  # 0.0 - x: no "-0" for an unmeasured gap
+            status = contact_csv_status(r, nodes)
             dim = body.dim
             for k, n in enumerate(nodes):
                 self.contact_rows.append(
                     [str(step.step), _num(step.load_factor), body.name, str(int(n)),
                      *(_num(X[k, c]) for c in range(dim)), *(_num(u[k, c]) for c in range(dim)),
-                     _num(r.contact_pressure[n]), _num(gap[k]),
-                     "contact" if r.contact_status[n] > 0 else "free"]
+                     _num(r.contact_pressure[n]), _num(gap[k]), status[k]]
                     + (self._friction_row(r, n, dim) if self.friction else []))
 
     @staticmethod
