@@ -289,8 +289,10 @@ def report(s: dict) -> list[str]:
                          f"{m['largest_error']:.2%} of Boussinesq's (at r = "
                          f"{m['largest_error_at']:.3f} a; RMS {m['rms_error']:.2%}, centre "
                          f"{m['centre_error']:+.2%})")
-        lines.append(f"  contact force {b['punch']['total_contact_force']:.6g} on the punch, "
-                     f"{b['block']['total_contact_force']:.6g} on the block (applied "
-                     f"{b['applied_force']:g}); block nodes beyond the rim carrying force: "
+        quarter = b["punch"]["total_contact_force"] / 4.0
+        lines.append(f"  contact force on the whole punch {b['punch']['total_contact_force']:.6g}, "
+                     f"on the whole block {b['block']['total_contact_force']:.6g} (applied "
+                     f"{b['applied_force']:g}; the quarter model below carries a quarter, "
+                     f"{quarter:.6g}); block nodes beyond the rim carrying force: "
                      f"{b['block']['nodes_beyond_rim_loaded']}")
     return lines
