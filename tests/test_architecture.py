@@ -8,6 +8,7 @@ pipeline's stages (:data:`CONTACT_STAGES`) import downwards only, each other thr
 faces."""
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -57,9 +58,11 @@ MODULE_LINES = 600
 KNOWN_LONG: set[str] = set()
 
 
+@functools.cache
 def import_graph(typing: bool = True) -> dict[str, set[str]]:
     """Module -> the modules of ``vfem`` it imports (``typing``: those under ``TYPE_CHECKING``
-    too)."""
+    too); parsed once per process (the rules below share it: a second each, not one per
+    rule), so the callers do not change what it returns."""
     modules = {}
     for f in ROOT.rglob("*.py"):
         name = "vfem." + ".".join(f.relative_to(ROOT).with_suffix("").parts)
@@ -128,7 +131,6 @@ def cycles(graph: dict[str, set[str]]) -> set[tuple[str, ...]]:
     return out
 
 
-@pytest.mark.slow
 def test_no_import_cycle_but_the_known_ones():
     assert cycles(import_graph()) == KNOWN_CYCLES
     assert cycles(import_graph(typing=False)) <= KNOWN_CYCLES
@@ -150,7 +152,6 @@ def upward(graph: dict[str, set[str]]) -> list[str]:
                   for m, targets in graph.items() for t in targets if layer(t) > layer(m))
 
 
-@pytest.mark.slow
 def test_no_module_imports_from_a_layer_above_its_own():
     assert not upward(import_graph()), "\n".join(upward(import_graph()))
 
@@ -167,7 +168,6 @@ def stage(module: str) -> int:
     return 0
 
 
-@pytest.mark.slow
 def test_contact_imports_only_from_its_own_stage_or_those_below():
     graph = import_graph()
     inside = [m for m in graph if m.startswith("vfem.contact.")]
@@ -187,7 +187,6 @@ def reaching_in(graph: dict[str, set[str]]) -> list[str]:
                   and not (m == stem(t) or m.startswith(stem(t) + ".")))
 
 
-@pytest.mark.slow
 def test_a_stage_is_reached_through_its_face():
     """Outside a stage (the rest of contact, the solver, the writers, the examples) its names
     come from its face, ``vfem.contact.<stage>``: what a stage offers is what its
@@ -214,7 +213,6 @@ def test_the_cycle_finder_finds_a_cycle():
     assert cycles(graph) == {("a", "b", "c")}
 
 
-@pytest.mark.slow
 def test_nothing_under_contact_imports_the_solver():
     graph = import_graph()
     assert not [m for m, targets in graph.items()

@@ -229,8 +229,10 @@ def test_a_folder_friction_and_one_body_are_told_plainly(tmp_path, capsys):
 
 def test_the_progress_reads_a_terminal_as_the_ranks_launcher_said(monkeypatch):
     """Under ``vfem run --ranks`` a rank's stdout is mpiexec's pseudo-terminal whatever the
-    user's screen is: the launcher's word (VFEM_TTY) decides, else the stream's isatty."""
+    user's screen is: the launcher's word (VFEM_TTY) decides for a launched rank's stdout;
+    elsewhere (a serial run, another stream) the stream's own isatty."""
     import io
+    import sys
 
     from vfem.cli.progress import TTY_ENV, Progress, is_terminal
 
@@ -238,12 +240,20 @@ def test_the_progress_reads_a_terminal_as_the_ranks_launcher_said(monkeypatch):
         def isatty(self):
             return True
 
-    monkeypatch.delenv(TTY_ENV, raising=False)
+    from vfem import parallel
+
+    for name in (TTY_ENV, *parallel.SIZE_VARIABLES):
+        monkeypatch.delenv(name, raising=False)
     assert is_terminal(Terminal()) and not is_terminal(io.StringIO())
+    monkeypatch.setattr(sys, "stdout", Terminal())
     monkeypatch.setenv(TTY_ENV, "0")
-    assert not is_terminal(Terminal()) and not Progress(stream=Terminal()).tty
+    assert is_terminal(sys.stdout)  # serial: a stray VFEM_TTY changes nothing
+    monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "2")  # a rank Open MPI's launcher started
+    assert not is_terminal(sys.stdout) and not Progress(stream=sys.stdout).tty
+    assert is_terminal(Terminal())  # another stream: its own isatty
+    monkeypatch.setattr(sys, "stdout", io.StringIO())
     monkeypatch.setenv(TTY_ENV, "1")
-    assert is_terminal(io.StringIO())
+    assert is_terminal(sys.stdout)
 
 
 def test_the_invariants_line_reads_as_passed_when_every_node_is_within_its_allowance():

@@ -145,6 +145,9 @@ def test_two_plates_on_two_ranks_give_the_serial_answers(tmp_path):
     done = vfem(["run", "--ranks", "2", *args, "--out", str(spread), "--no-figures"])
     assert done.returncode == 0, done.stderr
     assert done.stdout.count("vfem: stack, results in") == 1
+    # piped, a line per step: no carriage return, ESC[K or iteration line (issue 39)
+    assert "\r" not in done.stdout and "\x1b" not in done.stdout
+    assert " iteration " not in done.stdout and done.stdout.count("  step ") >= 1
     assert same_results(serial, spread) >= 2
     a = json.loads((serial / "summary.json").read_text())
     b = json.loads((spread / "summary.json").read_text())

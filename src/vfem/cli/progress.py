@@ -13,10 +13,13 @@ TTY_ENV = "VFEM_TTY"
 
 
 def is_terminal(stream) -> bool:
-    """Whether ``stream`` shows on a terminal: what ``vfem run --ranks`` said (:data:`TTY_ENV`)
-    where it launched this process, else the stream's own ``isatty``."""
+    """Whether ``stream`` shows on a terminal: for the standard output of a rank that an MPI
+    launcher started, what ``vfem run --ranks`` said (:data:`TTY_ENV`); else the stream's own
+    ``isatty`` (a stray ``VFEM_TTY`` in a serial run, or another stream, changes nothing)."""
+    from .. import parallel
+
     said = os.environ.get(TTY_ENV)
-    if said in ("0", "1"):
+    if said in ("0", "1") and stream is sys.stdout and parallel.launched_size() > 1:
         return said == "1"
     return bool(getattr(stream, "isatty", lambda: False)())
 

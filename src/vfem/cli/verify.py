@@ -5,17 +5,20 @@ install, in a few minutes. ``--slow`` runs the refined models the examples name
 
 from __future__ import annotations
 
-import inspect
 import json
+import shutil
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from ..io import verification
+from ..errors import InputError, VfemError
+from ..io import replot, verification
 
 
 def _run_example(name: str, out: Path, slow: bool) -> tuple[dict, float]:
+    """Run example ``name`` (its defaults, or with ``slow`` its ``VERIFY_SLOW`` settings) into
+    ``out`` as ``vfem run`` does, its figures left undrawn; (summary, seconds)."""
     from vfem_examples import load
 
     from .builtin import build_parameters
@@ -25,12 +28,26 @@ def _run_example(name: str, out: Path, slow: bool) -> tuple[dict, float]:
     params = build_parameters(name, assignments)
     if hasattr(module, "validate"):
         module.validate(params)
-    kwargs = {}
-    if "figures" in inspect.signature(module.run).parameters:
-        kwargs["figures"] = False
+    if out.exists():  # this command's own folder of an earlier verify
+        shutil.rmtree(out)
     start = time.perf_counter()
-    summary = module.run(params, out, **kwargs)
+    summary = module.run(params, out)
     return summary, time.perf_counter() - start
+
+
+def _folder(out: str | None) -> Path | None:
+    """The folder ``--out`` names, refused (InputError) if it is a file or a folder holding
+    something else than an earlier ``vfem verify``'s results."""
+    if out is None:
+        return None
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"vfem verify --out {folder}: a file, not a folder; name a new or "
+                         "empty folder")
+    if folder.is_dir() and any(folder.iterdir()) and not (folder / "verify.json").exists():
+        raise InputError(f"vfem verify --out {folder}: the folder holds other files (no "
+                         "verify.json); name a new or empty folder")
+    return folder
 
 
 def cmd_verify(args) -> int:
@@ -46,15 +63,20 @@ def cmd_verify(args) -> int:
         print(f"vfem verify: unknown example {', '.join(map(repr, unknown))}; the examples are "
               f"{', '.join(EXAMPLES)}", file=sys.stderr)
         return 2
-    keep = Path(args.out) if args.out else None
+    keep = _folder(args.out)
     rows: list[tuple[str, dict]] = []
     report = {"slow": bool(args.slow), "examples": {}}
     failed: list[str] = []
     start = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="vfem-verify-") as scratch:
-        root = keep if keep is not None else Path(scratch)
+    scratch = tempfile.TemporaryDirectory(prefix="vfem-verify-")
+    replot.defer(True)  # the figures are not what is verified: vfem plot draws them
+    try:
+        root = keep if keep is not None else Path(scratch.name)
         for name in names:
-            summary, seconds = _run_example(name, root / name, args.slow)
+            try:
+                summary, seconds = _run_example(name, root / name, args.slow)
+            except VfemError as exc:  # one example's failure is its row, not the end of all
+                summary, seconds = {"converged": False, "message": str(exc)}, 0.0
             records = summary.get("verification") or []
             ok = bool(summary.get("converged", True)) and verification.passed(records)
             if not ok:
@@ -70,6 +92,9 @@ def cmd_verify(args) -> int:
                 if not summary.get("converged", True):
                     what = f"NOT converged ({summary.get('message', '')}); " + what
                 print(f"vfem verify: {name}: {what}, {seconds:.1f} s", flush=True)
+    finally:
+        replot.defer(False)
+        scratch.cleanup()
     total = time.perf_counter() - start
     report["seconds"] = total
     report["passed"] = not failed

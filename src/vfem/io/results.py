@@ -133,15 +133,20 @@ def _vector(v: np.ndarray) -> np.ndarray:
     return np.asarray(v)
 
 
+#: A pressure below this fraction of the body's largest is round-off, not a force carried
+CARRYING = 1e-12
+
 
 def carrying(r: BodyStepResult, nodes: np.ndarray) -> np.ndarray:
-    """Which of ``nodes`` carry contact force (a nonzero force or pressure) though not in
-    contact themselves (``contact_status`` 0): their own gap is open, and the force is the
-    opposing surface's, which its equilibrium correction placed on them through a virtual
-    element (the block's nodes beside a stiff punch's corner carry its corner's force). They
-    read ``carrying`` in ``contact.csv``, not ``free`` (issue 39)."""
-    force = np.any(r.contact_force[nodes] != 0.0, axis=1) | (r.contact_pressure[nodes] != 0.0)
-    return force & (r.contact_status[nodes] == 0)
+    """Which of ``nodes`` carry contact force though not in contact themselves
+    (``contact_status`` 0): a compressive nominal pressure above round-off of the body's
+    largest (:data:`CARRYING`; a tensile one is no contact force carried). Their own gap is
+    open, and the force is the opposing surface's, which its equilibrium correction placed on
+    them through a virtual element (the block's nodes beside a stiff punch's corner carry its
+    corner's force). They read ``carrying`` in ``contact.csv``, not ``free`` (issue 39)."""
+    pressure = r.contact_pressure[nodes]
+    largest = float(np.abs(r.contact_pressure).max(initial=0.0))
+    return (pressure > CARRYING * largest) & (r.contact_status[nodes] == 0)
 
 
 def contact_csv_status(r: BodyStepResult, nodes: np.ndarray) -> list[str]:
@@ -149,6 +154,7 @@ def contact_csv_status(r: BodyStepResult, nodes: np.ndarray) -> list[str]:
     words = np.where(r.contact_status[nodes] > 0, "contact",
                      np.where(carrying(r, nodes), "carrying", "free"))
     return words.tolist()
+
 
 class ResultsWriter:
     """Writes the VTU/PVD series step by step into ``out`` (created if needed).
