@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import types
 
 import numpy as np
 import pytest
@@ -91,6 +92,7 @@ def test_what_is_not_drawn_is_recorded_and_said(run):
                                                 "stick_slip_base.png"}
     far = next(n for n in notes if n.startswith("pressure_far.png"))
     assert "no node of 'far' in contact at step 1" in far and "most loaded" in far
+    assert figures3d.MOST_LOADED in far
     assert "compatibility" in next(n for n in notes if n.startswith("stick_slip_base.png"))
 
 
@@ -198,3 +200,172 @@ def test_the_outline_of_a_box_is_its_twelve_edges():
     assert np.sum(~vertical) == 4 * 16  # the end rings, inner and outer, top and bottom
     np.testing.assert_allclose(np.sort(x[edges[vertical, 0], 0]), [-1.0, -0.5, 0.5, 1.0],
                                atol=1e-12)  # the silhouettes of the outer and inner sides
+
+
+# -- the reviewer's cases (issue 39, item 5's review) --------------------------------------------
+
+#: a unit cube's corners in VTK's hexahedron order
+CUBE = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1],
+                 [0, 1, 1]], dtype=float)
+TETRA = CUBE[[0, 1, 3, 4]]
+
+
+def quadratic_cell(cell_type: str) -> tuple[np.ndarray, np.ndarray]:
+    """One quadratic cell's points (corners, then mid-side nodes at the middle of what they lie
+    between, then hexahedron27's body centre) and its (1, k) connectivity."""
+    corners = TETRA if cell_type == "tetra10" else CUBE
+    x = np.vstack([corners] + [corners[list(m)].mean(axis=0) for m in figures3d.MIDS[cell_type]]
+                  + ([corners.mean(axis=0)] if cell_type == "hexahedron27" else []))
+    return x, np.arange(len(x))[None, :]
+
+
+def frame(x: np.ndarray, cells: np.ndarray, cell_type: str, name: str = "b", **point_data):
+    return types.SimpleNamespace(points=x, polygons=cells, cell_type=cell_type, name=name,
+                                 point_data=point_data, displacement=np.zeros_like(x),
+                                 cell_data={})
+
+
+def candidates(x: np.ndarray, touching) -> types.SimpleNamespace:
+    """The nodes at z = 0 as contact candidates (contact.csv's), ``touching`` in contact."""
+    node = np.flatnonzero(np.isclose(x[:, 2], 0.0) | np.isin(np.arange(len(x)), touching))
+    on = np.isin(node, touching)
+    return types.SimpleNamespace(node=node, contact=on, pressure=np.where(on, 2.0, 0.0))
+
+
+def maps(tmp_path, body, contact) -> tuple[list, list[str]]:
+    """:func:`figures3d._contact_maps` of ``body`` alone, at one step, into ``tmp_path``."""
+    folder = types.SimpleNamespace(directory=tmp_path, contact_source="contact.csv",
+                                   contact=lambda step, b: contact)
+    step = types.SimpleNamespace(bodies=[body], step=1, load_factor=1.0)
+    notes: list[str] = []
+    written, _ = figures3d._contact_maps(folder, step, [1.0], {}, "", notes)
+    return written, notes
+
+
+@pytest.mark.parametrize("cell_type, node, triangles", [
+    ("tetra10", 4, 4),  # the mid-edge node between corners 0 and 1 (the reviewer's)
+    ("hexahedron20", 8, 6),  # the mid-edge node between corners 0 and 1
+    ("hexahedron27", 24, 8)])  # the bottom face's centre
+def test_a_mid_side_node_alone_in_contact_is_drawn_and_counted(tmp_path, cell_type, node,
+                                                               triangles):
+    """Only a quadratic cell's mid-side node in contact: the face it lies on is the contact
+    surface, that node drawn and counted among the nodes in contact, the face split through its
+    mid-side nodes (so the contours show their pressure), and the pressure map drawn."""
+    x, cells = quadratic_cell(cell_type)
+    body = frame(x, cells, cell_type)
+    contact = candidates(x, [node])
+    (s,) = figures3d.surfaces(body, contact, figures3d.boundary_faces(cells, cell_type, x))
+    assert int(s.contact.sum()) == 1 and s.nodes[s.contact].tolist() == [node]
+    np.testing.assert_array_equal(s.nodes, contact.node)  # the bottom face's every node
+    assert len(s.triangles) == triangles and s.pressure.max() == 2.0
+    assert len(s.edges) == (6 if cell_type == "tetra10" else 8)  # through the mid-edge nodes
+    assert figures3d.axis_label(s.axes[2]) == "z"
+    written, notes = maps(tmp_path, body, contact)
+    assert [p.name for p in written] == ["pressure_b.png"] and notes == []
+
+
+def test_nodes_in_contact_on_no_candidate_face_are_a_note(tmp_path):
+    """A body whose nodes in contact lie on none of the faces of its candidates (here the
+    mid-edge node between corner 0, a candidate, and 3, not one) has no surface to map: its
+    pressure and stick/slip maps are left out with a note, not a crash."""
+    x, cells = quadratic_cell("tetra10")
+    body = frame(x, cells, "tetra10", friction_status=np.zeros(len(x)))
+    contact = candidates(x, [7])
+    assert figures3d.surfaces(body, contact, figures3d.boundary_faces(cells, "tetra10", x)) == []
+    written, notes = maps(tmp_path, body, contact)
+    assert written == [] and [n.split(":")[0] for n in notes] == ["pressure_b.png",
+                                                                 "stick_slip_b.png"]
+    assert "no boundary face of 'b' holds its nodes in contact (1 at step 1" in notes[0]
+
+
+def test_the_most_loaded_step_sums_the_nodal_forces_sizes():
+    """Contact that balances itself (a plate squeezed from both sides: its resultant zero)
+    loads a step more than a small unbalanced force does."""
+    def step(*forces):
+        return types.SimpleNamespace(bodies=[types.SimpleNamespace(
+            points=np.zeros((len(forces), 3)), point_data={"contact_force": np.array(forces)})])
+
+    squeezed = step([0.0, 0.0, 10.0], [0.0, 0.0, -10.0], [0.0, 0.0, 0.0])
+    nudged = step([1e-3, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    assert figures3d.total_contact_force(squeezed) == pytest.approx(20.0)
+    assert figures3d.total_contact_force(nudged) == pytest.approx(1e-3)
+    assert "sum of nodal contact force magnitudes" in figures3d.MOST_LOADED
+
+
+def test_the_deformed_outlines_fill_their_panels_far_from_the_origin(tmp_path, monkeypatch):
+    """A model at x, y, z = 1000-1003: each panel's window is the model's extent (padded),
+    not stretched to take in the origin."""
+    x, hexes = hex_box(3, 3, 1)
+    body = frame(x + 1000.0, hexes, "hexahedron")
+    windows = []
+    window = figures3d._window
+    monkeypatch.setattr(figures3d, "_window", lambda ax, xy: (window(ax, xy), windows.append(
+        ax.get_xlim() + ax.get_ylim())))
+    step = types.SimpleNamespace(bodies=[body], step=1, load_factor=1.0)
+    figures3d._deformed(tmp_path, step, {}, np.eye(3)[2], "", 1.0)
+    assert len(windows) == 2
+    for lo_x, hi_x, lo_y, hi_y in windows:
+        assert 999.8 < lo_x < 1000.0 and 1003.0 < hi_x < 1003.2
+        assert 999.8 < lo_y < 1000.0 and 1001.0 < hi_y < 1001.2  # x or y across, z up
+
+
+def test_2d_and_3d_figures_share_one_edge_table_and_one_friction_legend(tmp_path, monkeypatch):
+    """plots' edge table (:func:`vfem.io.plots.polygon_edges`) makes both the 2D outlines and
+    the 3D folds, and plots' friction markers mark the 3D stick/slip maps: one implementation
+    each. The 2D outline is the edges of one cell only, in ascending order."""
+    from vfem.io import plots
+
+    calls = []
+    edges = plots.polygon_edges
+    monkeypatch.setattr(plots, "polygon_edges", lambda p: calls.append(len(p)) or edges(p))
+    quads = np.array([[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]])
+    outline = plots._outline(quads)
+    assert outline.tolist() == [[0, 1], [0, 3], [1, 2], [2, 5], [3, 6], [5, 8], [6, 7], [7, 8]]
+    x, hexes = hex_box(1, 1, 1)
+    faces, _ = boundary_faces(hexes, "hexahedron", x)
+    (folds,) = outline_edges(x, faces, [np.array([0.0, 0.0, 1.0])])
+    assert len(folds) == 12 and calls == [4, 6]
+    markers = tuple((v, f"status {v}", style) for v, _, style in plots.FRICTION_MARKERS)
+    monkeypatch.setattr(plots, "FRICTION_MARKERS", markers)
+    drawn = []
+    monkeypatch.setattr(figures3d, "_finish", lambda plt, fig, path, title: (drawn.append(
+        fig.axes[0].get_legend_handles_labels()[1]), plt.close(fig)))
+    x, cells = quadratic_cell("tetra10")
+    s = figures3d.surfaces(frame(x, cells, "tetra10"), candidates(x, [0, 4]),
+                           boundary_faces(cells, "tetra10", x))
+    figures3d._stick_figure(tmp_path / "s.png", s, np.array([1, 0, -1, 0, 2, 0, 0, 0, 0, 0]), "")
+    assert drawn == [["status -1 (1)", "status 0 (3)", "status 2 (1)", "status 1 (1)"]]
+
+
+NO_CONTACT = input_file(
+    "apart",
+    toml_body("cube", box_mesh(x0=0.0, y0=0.0, z0=0.0, width=1.0, depth=1.0, height=1.0, nx=1,
+                               ny=1, nz=1), support("bottom"), prescribed("top", "z", -0.01)),
+    toml_body("wedge", box_mesh(x0=3.0, y0=0.0, z0=0.0, width=1.0, depth=1.0, height=0.5, nx=1,
+                                ny=1, nz=1, tetrahedra=True), support("bottom"),
+              prescribed("top", "x", 0.01)),
+    load_factors=[1.0]).replace('name = "wedge"', 'name = "wedge"\norder = 2')
+
+
+def test_a_run_with_no_contact_anywhere_notes_every_pressure_map(tmp_path):
+    """Two bodies that never touch (one of quadratic tetrahedra): each pressure map is left
+    out with a note; the deformed outlines, von Mises and the history are drawn. The quadratic
+    body's faces' mid-side nodes (:func:`figures3d.face_nodes`) are its edges' middles, as vfem
+    writes them."""
+    from vfem.io.replot import Folder
+
+    path = tmp_path / "apart.toml"
+    path.write_text(NO_CONTACT, encoding="utf-8")
+    status, err = _main("run", str(path), "--out", str(tmp_path / "out"))
+    assert status == 0, err
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text(encoding="utf-8"))
+    assert set(summary["figures"]) == {"deformed.png", "von_mises.png", "history.png"}
+    assert summary["figures_notes"] == _not_drawn(err) == [
+        f"pressure_{b}.png: no node of '{b}' in contact at any step" for b in ("cube", "wedge")]
+    wedge = Folder(tmp_path / "out").steps[-1].bodies[1]
+    assert wedge.cell_type == "tetra10"
+    faces, owner = boundary_faces(wedge.polygons, "tetra10", wedge.points)
+    full = figures3d.face_nodes(wedge.polygons, "tetra10", faces, owner)
+    assert full.shape == (len(faces), 6)
+    x = wedge.points
+    np.testing.assert_allclose(x[full[:, 3:]], 0.5 * (x[faces] + x[np.roll(faces, -1, axis=1)]))

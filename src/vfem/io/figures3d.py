@@ -1,14 +1,13 @@
 """The figures of a 3D model's run (issue 39, item 5), drawn from its results folder's files
 only (:func:`vfem.io.replot.generic` hands them the folder), so ``vfem plot`` redraws the same:
 
-* ``pressure_<body>.png`` — at the most loaded step (the largest sum over the bodies of their
-  resultant VTU ``contact_force``), the nominal pressure (``contact.csv``'s: normal force over
-  undeformed area) on each contact surface of the body, seen along the normal of the plane
-  fitted to its nodes in contact (:func:`plane_fit`): filled contours over the faces around
-  them (falling to zero at the free candidates next to them), those nodes marked. A contact
-  surface: a connected patch of boundary faces whose nodes are all candidates (a plate pressed
-  between two others has two), one panel each. Where the load goes through, which no section
-  shows.
+* ``pressure_<body>.png`` — at the most loaded step (the largest sum over the bodies and
+  their nodes of the size of the VTU's nodal ``contact_force``), the nominal pressure
+  (``contact.csv``'s: normal force over undeformed area) on each contact surface of the body,
+  seen along the normal of the plane fitted to its nodes in contact (:func:`plane_fit`): filled
+  contours over the faces around them (falling to zero at the free candidates next to them),
+  those nodes marked. A contact surface: a connected patch of boundary faces whose corners are
+  all candidates (a plate pressed between two others has two), one panel each.
 * ``stick_slip_<body>.png`` (with friction) — the same views, the nodes marked by the VTU's
   ``friction_status``: stick (1), slip (2), free (0); none for a body whose nodes carry no
   pair's compatibility (-1: the other side of a paired contact, whose map shows it).
@@ -23,10 +22,10 @@ only (:func:`vfem.io.replot.generic` hands them the folder), so ``vfem plot`` re
   algorithm: faces turned away left out, the rest drawn far to near as one 2D collection,
   100k faces in a second, where mplot3d takes minutes).
 
-Linear and quadratic tetrahedra and hexahedra (faces by their corners), vectorised over cells
-and faces. What is not drawn, and why, is a note ``"<figure>: <why>"`` (no node in contact,
-unknown cells, over :data:`MAX_FACES` faces): ``summary.json``'s ``figures_notes``, printed by
-``vfem run`` and ``vfem plot``.
+Linear and quadratic tetrahedra and hexahedra (faces by their corners; the maps' with their
+mid-side nodes, :func:`face_nodes`), vectorised. What is not drawn, and why, is a note
+``"<figure>: <why>"`` (no node in contact, unknown cells, over :data:`MAX_FACES` faces):
+``summary.json``'s ``figures_notes``, printed by ``vfem run`` and ``vfem plot``.
 """
 
 from __future__ import annotations
@@ -45,7 +44,21 @@ CELL_FACES = {8: ((0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3,
                   (3, 0, 4, 7)),
               4: ((0, 1, 2), (0, 1, 3), (1, 2, 3), (0, 2, 3))}
 #: The corners of the cell types vfem writes (VTK's first nodes of a quadratic cell).
-CORNERS = {"tetra": 4, "tetra10": 4, "hexahedron": 8, "hexahedron27": 8}
+CORNERS = {"tetra": 4, "tetra10": 4, "hexahedron": 8, "hexahedron20": 8, "hexahedron27": 8}
+_HEX_EDGES = ((0, 1), (1, 2), (2, 3), (0, 3), (4, 5), (5, 6), (6, 7), (4, 7), (0, 4), (1, 5),
+              (2, 6), (3, 7))
+#: The mid-side nodes of VTK's quadratic cells, after the corners: the corners each lies
+#: between (an edge's two; a face's four: hexahedron27's face centres; its body centre left out).
+MIDS = {"tetra10": ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)),
+        "hexahedron20": _HEX_EDGES,
+        "hexahedron27": _HEX_EDGES + ((0, 3, 4, 7), (1, 2, 5, 6), (0, 1, 4, 5), (2, 3, 6, 7),
+                                      (0, 1, 2, 3), (4, 5, 6, 7))}
+#: A face's triangles by its columns in :func:`face_nodes` (corners, then the mid-edge nodes,
+#: corner i's to i + 1's, then the centre), by their number.
+SPLIT = {3: ((0, 1, 2),), 4: ((0, 1, 2), (0, 2, 3)),
+         6: ((0, 3, 5), (3, 1, 4), (5, 4, 2), (3, 4, 5)),
+         8: ((0, 4, 7), (4, 1, 5), (5, 2, 6), (6, 3, 7), (4, 5, 6), (4, 6, 7)),
+         9: tuple(t for i in range(4) for t in ((i, 4 + i, 8), (i, 8, 4 + (i - 1) % 4)))}
 #: Edges where the boundary folds by more than this (degrees) are drawn in ``deformed.png``.
 FEATURE_ANGLE = 30.0
 #: A plane whose normal is this close (degrees) to a coordinate axis is seen in that axis' plane.
@@ -59,23 +72,6 @@ COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:b
 
 
 # -- geometry ------------------------------------------------------------------------------------
-
-
-def _runs(same: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The starts and lengths of the runs of equal items in a sorted list (``same[i]``: item
-    i + 1 equals item i)."""
-    start = np.flatnonzero(np.r_[True, ~same])
-    return start, np.diff(np.append(start, len(same) + 1))
-
-
-def _once(rows: np.ndarray) -> np.ndarray:
-    """The indices (ascending) of the rows of ``rows`` (integers, each row sorted) that occur
-    exactly once."""
-    order = np.lexsort(rows.T[::-1])
-    if not len(order):
-        return order
-    start, count = _runs(np.all(rows[order][1:] == rows[order][:-1], axis=1))
-    return np.sort(order[start[count == 1]])
 
 
 def boundary_faces(cells: np.ndarray, cell_type: str, points: np.ndarray | None = None
@@ -92,7 +88,7 @@ def boundary_faces(cells: np.ndarray, cell_type: str, points: np.ndarray | None 
     local = np.asarray(CELL_FACES[corners])
     faces = cells[:, local].reshape(-1, local.shape[1])
     owner = np.repeat(np.arange(len(cells)), len(local))
-    keep = _once(np.sort(faces, axis=1))
+    keep = plots.once(np.sort(faces, axis=1))
     faces, owner = faces[keep], owner[keep]
     if points is not None and len(faces):
         x = np.asarray(points, dtype=float)
@@ -100,6 +96,27 @@ def boundary_faces(cells: np.ndarray, cell_type: str, points: np.ndarray | None 
         out = np.einsum("ij,ij->i", normal, x[faces].mean(axis=1) - x[cells[owner]].mean(axis=1))
         faces[out < 0] = faces[out < 0, ::-1]
     return faces, owner
+
+
+def face_nodes(cells: np.ndarray, cell_type: str, faces: np.ndarray, owner: np.ndarray
+               ) -> np.ndarray:
+    """The nodes on each of ``faces`` (:func:`boundary_faces`'s, of cells ``owner``): its
+    corners, then a quadratic cell's (:data:`MIDS`) mid-edge node from each corner to the next
+    and face centre (hexahedron27): (f, 6, 8 or 9) point numbers; ``faces`` for linear cells."""
+    mids, k = MIDS.get(cell_type, ()), faces.shape[1]
+    cells = np.asarray(cells)
+    if not mids or cells.shape[1] < CORNERS[cell_type] + len(mids):
+        return faces
+    cells = cells[owner].astype(np.int64)
+    slots = [np.sort(faces[:, [i, (i + 1) % k]], axis=1) for i in range(k)]  # its edges
+    slots += [np.sort(faces, axis=1)] if len(mids[-1]) == k else []  # and its centre
+    out = np.column_stack([faces] + [np.full(len(faces), -1)] * len(slots))
+    for j, between in enumerate(mids, start=CORNERS[cell_type]):
+        on = np.sort(cells[:, between], axis=1)
+        for i, slot in enumerate(slots):
+            if slot.shape == on.shape:
+                out[:, k + i] = np.where(np.all(on == slot, axis=1), cells[:, j], out[:, k + i])
+    return out if np.all(out >= 0) else faces
 
 
 def _normals(x: np.ndarray, faces: np.ndarray, unit: bool = False) -> np.ndarray:
@@ -115,21 +132,6 @@ def _normals(x: np.ndarray, faces: np.ndarray, unit: bool = False) -> np.ndarray
     return n
 
 
-def edge_faces(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The edges of a surface of faces: ((e, 2) point numbers, (e,) a face on each, (e,) the
-    other face on it, -1 where the edge is on one face only or on more than two)."""
-    k = faces.shape[1]
-    a, b = faces.ravel(), np.roll(faces, -1, axis=1).ravel()
-    face = np.repeat(np.arange(len(faces)), k)
-    lo, hi = np.minimum(a, b).astype(np.int64), np.maximum(a, b).astype(np.int64)
-    key = lo * (int(hi.max(initial=0)) + 1) + hi
-    order = np.argsort(key, kind="stable")
-    start, count = _runs(key[order][1:] == key[order][:-1])
-    first = order[start]
-    other = np.where(count == 2, face[order[np.minimum(start + 1, len(key) - 1)]], -1)
-    return np.column_stack([lo[first], hi[first]]), face[first], other
-
-
 def outline_edges(x: np.ndarray, faces: np.ndarray, views: list[np.ndarray]
                   ) -> list[np.ndarray]:
     """The edges (e, 2) of the surface ``faces`` (outward corner order) at points ``x`` to draw
@@ -138,7 +140,7 @@ def outline_edges(x: np.ndarray, faces: np.ndarray, views: list[np.ndarray]
     silhouette there (one face on it turned to the viewer, the other away)."""
     if not len(faces):
         return [np.zeros((0, 2), dtype=np.int64) for _ in views]
-    edges, f1, f2 = edge_faces(faces)
+    edges, f1, f2, _ = plots.polygon_edges(faces)
     n = _normals(x, faces, unit=True)
     two = f2 >= 0
     fold = np.ones(len(edges), dtype=bool)
@@ -153,9 +155,8 @@ def outline_edges(x: np.ndarray, faces: np.ndarray, views: list[np.ndarray]
 
 def plane_fit(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The plane nearest (least squares) to ``points`` (n, 3): (its centre, its unit normal —
-    the direction of least spread, by an SVD of the centred points — signed so that its largest
-    component is positive, the singular values (3,), largest first: a second one near zero
-    says the points lie on a line, and the normal is then any direction across it)."""
+    the least spread, by an SVD — its largest component positive, the singular values (3,),
+    largest first: a second one near zero says the points lie on a line, the normal any across)."""
     x = np.asarray(points, dtype=float).reshape(-1, 3)
     centre = x.mean(axis=0) if len(x) else np.zeros(3)
     d = x - centre
@@ -171,10 +172,9 @@ _IN_PLANE = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
 
 
 def view_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Axes (u, v, n) to see a plane along its ``normal``: n the normal signed so that its
-    largest component is positive, made that coordinate axis when within
-    :data:`SNAP_ANGLE` of it; u and v the two other coordinate axes (x before y before z) made
-    orthogonal to n and each other (so a plane near z = const is seen with x across, y up)."""
+    """Axes (u, v, n) to see a plane along its ``normal``: n the normal, its largest component
+    positive, made that coordinate axis when within :data:`SNAP_ANGLE` of it; u and v the two
+    other axes (x before y before z) made orthogonal to n and each other (z = const: x, y)."""
     n = np.asarray(normal, dtype=float)
     n = n / np.linalg.norm(n) if np.any(n) else np.eye(3)[2]
     k = int(np.argmax(np.abs(n)))
@@ -218,18 +218,16 @@ def _components(faces: np.ndarray, npoints: int) -> np.ndarray:
 
 @dataclass
 class Surface:
-    """One contact surface of a body as its maps draw it: its points (numbers in the body),
-    their in-plane coordinates (n, 2), pressure, whether in contact, triangles (t, 3) and face
-    edges (e, 2) over them (local numbers), the view's axes (u, v, n), the fitted normal."""
+    """One contact surface of a body as its maps draw it (local numbers index ``nodes``)."""
 
-    nodes: np.ndarray
-    uv: np.ndarray
+    nodes: np.ndarray  # its points' numbers in the body (corners and mid-side nodes)
+    uv: np.ndarray  # (n, 2) their in-plane coordinates
     pressure: np.ndarray
-    contact: np.ndarray
-    triangles: np.ndarray
-    edges: np.ndarray  # (e, 2) the faces' edges, local numbers
-    axes: tuple[np.ndarray, np.ndarray, np.ndarray]
-    fitted: np.ndarray
+    contact: np.ndarray  # whether each is in contact
+    triangles: np.ndarray  # (t, 3) over them
+    edges: np.ndarray  # (e, 2) the faces' edges
+    axes: tuple[np.ndarray, np.ndarray, np.ndarray]  # the view's (u, v, n)
+    fitted: np.ndarray  # the fitted plane's normal
     at: float  # the nodes in contact's mean coordinate along the view's normal
 
     @property
@@ -261,10 +259,12 @@ def surfaces(frame, contact, found) -> list[Surface]:
     x = frame.points
     if found is None or not len(found[0]):
         return [_surface(x, np.flatnonzero(touching), touching, pressure, None)]
-    faces = found[0][candidate[found[0]].all(axis=1)]
-    if not len(faces):  # e.g. the VTU fields' nodes in contact only: the faces around them
-        faces = found[0][touching[found[0]].any(axis=1)]
-    label = _components(faces, n)
+    keep = candidate[found[0]].all(axis=1)  # their nodes then with the mid-side ones:
+    faces = face_nodes(frame.polygons, frame.cell_type, *(f[keep] if keep.any() else f
+                                                          for f in found))
+    if not keep.any():  # e.g. the VTU fields' nodes in contact only: the faces around them
+        faces = faces[touching[faces].any(axis=1)]
+    label = _components(faces[:, :found[0].shape[1]], n)
     out = []
     for patch in np.unique(label):  # (few: the body's contact boundaries)
         own = faces[label == patch]
@@ -277,17 +277,17 @@ def surfaces(frame, contact, found) -> list[Surface]:
 def _surface(x, nodes, touching, pressure, faces) -> Surface:
     on = nodes[touching[nodes]]
     _, fitted, s = plane_fit(x[on])
+    k = 3 if faces is not None and faces.shape[1] in (3, 6) else 4  # corners a face
     if (len(on) < 3 or s[1] <= 1e-9 * s[0]) and faces is not None:  # on a line: the faces'
-        fitted = view_axes(_normals(x, faces).sum(axis=0))[2]
+        fitted = view_axes(_normals(x, faces[:, :k]).sum(axis=0))[2]
     u, v, normal = view_axes(fitted)
     uv = x[nodes] @ np.column_stack([u, v])  # coordinates along u and v, not from the centre
     tri, edges = np.zeros((0, 3), dtype=np.int64), np.zeros((0, 2), dtype=np.int64)
     if faces is not None:
-        local = np.searchsorted(nodes, faces)
-        edges = edge_faces(local)[0]
-        tri = local[:, [0, 1, 2]]
-        if faces.shape[1] == 4:
-            tri = np.vstack([tri, local[:, [0, 2, 3]]])
+        local = np.searchsorted(nodes, faces)  # (mid-side nodes too: their pressure)
+        ring = np.arange(2 * k).reshape(2, k).T.ravel() if faces.shape[1] > k else range(k)
+        edges = plots.polygon_edges(local[:, ring])[0]
+        tri = local[:, SPLIT[faces.shape[1]]].reshape(-1, 3)
         e1, e2 = uv[tri[:, 1]] - uv[tri[:, 0]], uv[tri[:, 2]] - uv[tri[:, 0]]
         area = np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
         size = float(np.ptp(uv, axis=0).max()) if len(uv) else 0.0
@@ -296,10 +296,15 @@ def _surface(x, nodes, touching, pressure, faces) -> Surface:
                    fitted, float(np.mean(x[on] @ normal)) if len(on) else 0.0)
 
 
+#: how the maps' step is chosen, for their titles and notes (:func:`total_contact_force`)
+MOST_LOADED = "the largest sum of nodal contact force magnitudes"
+
+
 def total_contact_force(step) -> float:
-    """The sum over ``step``'s bodies of the size of their resultant VTU ``contact_force``."""
+    """The sum over ``step``'s bodies and nodes of the size of the VTU's ``contact_force`` (not
+    the resultant's: ~0 where contact balances itself, a shrink fit, a plate pressed both sides)."""
     return sum(float(np.linalg.norm(np.asarray(b.point_data["contact_force"], dtype=float)
-                                    [:, :3].sum(axis=0)))
+                                    [:, :3], axis=1).sum())
                for b in step.bodies if "contact_force" in b.point_data)
 
 
@@ -337,9 +342,8 @@ def figures(folder, steps: list, label: str, magnification: float, notes: list[s
 
 
 def _contact_maps(folder, step, loads, cache, label, notes) -> tuple[list[Path], np.ndarray]:
-    """The pressure (and, with friction, stick/slip) maps of each body at ``step``, the most
-    loaded; returns their paths and the normal of the surface with the most nodes in contact
-    (z where none touches), the contact normal the other figures are seen by."""
+    """The pressure (with friction, stick/slip) maps of each body at ``step``, the most loaded:
+    their paths, the normal of the surface with the most nodes in contact (z where none)."""
     written, best, normal = [], 0, np.eye(3)[2]
     when = _step_text(step) + (", the most loaded" if max(loads) > 0 else "")
     for b in step.bodies:
@@ -348,18 +352,21 @@ def _contact_maps(folder, step, loads, cache, label, notes) -> tuple[list[Path],
         figs = [f"pressure_{name}.png"] + ([f"stick_slip_{name}.png"] if frictional else [])
         c = folder.contact(step, b)
         if not np.any(c.contact):
-            why = ("at any step" if max(loads) == 0 else f"at {when} (largest total contact "
-                   "force)")
+            why = "at any step" if max(loads) == 0 else f"at {when} ({MOST_LOADED})"
             notes.extend(f"{f}: no node of {b.name!r} in contact {why}" for f in figs)
             continue
         shown = surfaces(b, c, _faces_of(b, cache))
+        if not shown:
+            notes.extend(f"{f}: no boundary face of {b.name!r} holds its nodes in contact "
+                         f"({int(np.sum(c.contact))} at {when})" for f in figs)
+            continue
         top = max(int(s.contact.sum()) for s in shown)
         if top > best:
             best, normal = top, shown[0].axes[2]
         path = folder.directory / figs[0]
-        _pressure_figure(path, shown, f"Contact pressure on {b.name!r}, {when}\n(the largest "
-                         f"total contact force; nominal: normal force / undeformed area, from "
-                         f"{folder.contact_source})\n{label}")
+        _pressure_figure(path, shown, f"Contact pressure on {b.name!r}, {when}\n({MOST_LOADED})"
+                         f"\nnominal: normal force / undeformed area, from "
+                         f"{folder.contact_source}\n{label}")
         written.append(path)
         if frictional:
             status = np.asarray(b.point_data["friction_status"]).ravel()
@@ -447,13 +454,6 @@ def _pressure_figure(path: Path, shown: list[Surface], title: str) -> None:
     _finish(plt, fig, path, title)
 
 
-#: friction_status -> (legend, marker style)
-_STATUS = ((-1, "no compatibility", dict(marker="x", ms=3, color="0.6")),
-           (0, "free", dict(marker=".", ms=2, color="0.5")), (2, "slip", dict(
-               marker="o", ms=4, mfc="none", color="tab:orange")),
-           (1, "stick", dict(marker="o", ms=4, color="tab:blue")))
-
-
 def _stick_figure(path: Path, shown: list[Surface], status: np.ndarray, title: str) -> None:
     """Each surface's nodes in its plane marked by their friction status, its faces' edges
     thin behind."""
@@ -461,7 +461,7 @@ def _stick_figure(path: Path, shown: list[Surface], status: np.ndarray, title: s
     fig, axes = _panels(plt, [np.ptp(s.uv, axis=0) for s in shown])
     for k, (ax, s) in enumerate(zip(axes, shown)):
         st = status[s.nodes]
-        for value, name, style in _STATUS:
+        for value, name, style in plots.FRICTION_MARKERS:
             on = st == value
             if on.any():
                 ax.plot(*s.uv[on].T, ls="", label=f"{name} ({on.sum()})", **style)
@@ -484,7 +484,8 @@ def _deformed(directory: Path, step, cache, normal, label, magnification) -> Pat
              if (found := _faces_of(b, cache)) is not None]
     shapes = [(j, b.name, faces, b.points, b.points + magnification * b.displacement)
               for j, b, faces in drawn]
-    everything = np.vstack([x for *_, x0, x1 in shapes for x in (x0, x1)] + [np.zeros((1, 3))])
+    everything = np.vstack([x for *_, x0, x1 in shapes for x in (x0, x1)]
+                           or [np.zeros((1, 3))])  # (the origin only when nothing is drawn)
     plt = plots.require_matplotlib()
     fig, axes = _panels(plt, [np.ptp(everything @ np.column_stack([h, normal]), axis=0)
                               for h, _ in views], 5.4)
