@@ -33,8 +33,25 @@ def test_springs_off_the_thesis_schedule_check_the_exact_state_only():
     assert all("thesis" not in r["source"] for r in records)
 
 
+def test_springs_record_no_contact_point_where_the_run_has_none():
+    """A step the run left apart has no contact point: no record of it (summary.json holds
+    finite numbers only), and its force, the springs' reaction, fails against the exact
+    state's."""
+    s = springs.run()
+    s["contact_point"][-1] = None
+    s["contact_force"][-1] = 0.0
+    records = springs.verification(s, springs.SpringsParameters())
+    assert [r["quantity"] for r in records] == [
+        "step 5: contact point (in)", "step 5: contact force (lb)", "step 6: contact force (lb)",
+        "step 6: contact force (lb), thesis"]
+    assert [r["passed"] for r in records] == [True, True, False, False]
+
+
 def test_patch_is_uniform_to_round_off_on_every_mesh_pair():
-    passed(patch.run(patch.Parameters()), 6)
+    s = patch.run(patch.Parameters())
+    records = passed(s, 6)
+    assert all(c["iterations"] == [1] for c in s["cases"])  # one correction closes every gap
+    assert all(r["tolerance"] == patch.UNIFORM_ROUND_OFF for r in records)
 
 
 def test_patch_records_the_baseline_failing_where_the_meshes_do_not_nest():
@@ -66,6 +83,21 @@ def test_wedge_case_2_share_agrees_with_the_refined_model():
     (record,) = passed(wedge.run(wedge.Parameters(case=2, figures=False)), 1)
     assert record["quantity"] == "case 2: plate share"
     assert record["tolerance"] == pytest.approx(3 * wedge.SHARE_PER_LEVEL)
+
+
+def test_wedge_at_or_beyond_the_reference_level_is_not_checked_against_it():
+    """The reference is the model refined three times: a coarser mesh is checked against it
+    (the tolerance per halving between them), the reference's own level (the model itself)
+    and finer ones (the reference coarser than the run) are not."""
+    levels = [wedge.reference_levels(wedge.Parameters(refinement=k)) for k in range(5)]
+    assert levels[:3] == [3.0, 2.0, 1.0] and levels[3:] == [None, None]
+    assert wedge.reference_levels(wedge.Parameters(h_contact=0.025, h_max=0.125)) == 2.0
+    share = {"plate_share": 0.5, "share_sum": 1.0, "penetration_tolerance": 1e-6}
+    s = {"cases": [{"case": k, **share} for k in (1, 2)]}
+    records = wedge.verification(s, wedge.Parameters(refinement=4))
+    assert [r["quantity"] for r in records] == [
+        "case 1: plate share + wedge share", "case 2: plate share + wedge share"]
+    assert "empirical margin" in wedge.verification(s, wedge.Parameters())[0]["basis"]
 
 
 def test_wedge_on_another_mesh_checks_that_the_shares_add_up_to_one():

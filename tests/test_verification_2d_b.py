@@ -57,6 +57,23 @@ def test_the_punch_example_verifies():
     assert force["source"] == punch.RIGID and force["value"] < force["reference"]
 
 
+def test_the_punch_reference_is_recorded_under_small_kinematics_only():
+    """The rigid-punch reference is a small-strain solve: under kinematics = "total" it is no
+    reference and there is no record; the corners' record is scaled by the largest nodal
+    force (what contact.equilibrium_tolerance bounds)."""
+    c = {"force": 1.0e7, "reference_force": 1.0e7, "punch_contact_force": [0.0, 1.0e7],
+         "block_contact_force": [0.0, -1.0e7], "sideways_force": 0.0,
+         "outside_punch_largest_force": 0.0, "largest_nodal_force": 1.0e6}
+    settings = punch.ContactSettings()
+    small = punch.verification(c, punch.Parameters(), settings)
+    total = punch.verification(c, punch.Parameters(kinematics="total"), settings)
+    assert small[0]["source"] == punch.RIGID and "no contact" in punch.RIGID
+    assert [r["quantity"] for r in total] == [r["quantity"] for r in small[1:]]
+    assert small[-1]["scale"] == 1.0e6
+    thesis = punch.verification(c, punch.Parameters(), punch.ContactSettings(variant="thesis"))
+    assert "contact force on the punch" not in [r["quantity"] for r in thesis]
+
+
 def test_the_cattaneo_example_verifies():
     p = cattaneo.Parameters()
     result, _ = cattaneo.solve(p)

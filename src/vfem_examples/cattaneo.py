@@ -46,7 +46,9 @@ VERIFY_SLOW = ("facets_upper=24", "facets_lower=34")
 #: Cattaneo's kink at c, a fraction about h / a of the nodes, so the RMS falls about as
 #: sqrt(h / a): over the steps of partial slip at most 4.0, 3.0 and 1.8 % at 12 / 17, 24 / 34 and
 #: 48 / 68 facets across a (``python3 benchmarks/cattaneo.py 12 17 24 34 48 68``,
-#: docs/method.md §11), under 0.17 sqrt(h / a) each
+#: docs/method.md §11), 0.165, 0.175 and 0.148 sqrt(h / a) (h / a = 1/17, 1/34, 1/68): under
+#: 0.18 sqrt(h / a) each. 0.3 is 1.7 times the largest of them: an empirical margin over the
+#: study, not a bound
 SHEAR_RMS_FACTOR = 0.3
 
 
@@ -267,8 +269,11 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
         inside = np.sort(x[np.abs(x) < a])
         if len(inside) > 1:
             facet = max(facet, float(np.diff(inside).max()))
+        # the platen's body's (the upper's) force along the platen: its reaction
+        platen_force = float(step.bodies["upper"].contact_force[:, 1].sum())
         row = {"load_factor": step.load_factor, "motion": shear_multiplier(p, step.load_factor),
                "normal_force": normal, "tangential_force": tangential,
+               "platen_force": platen_force,
                "Q_over_muP": tangential / (p.friction * normal),
                "c_over_a": c / a, "last_sticking_over_a": last / a, "stick_edge_over_a": edge / a,
                "sticking_nodes": int((status == 1).sum()),
@@ -290,7 +295,8 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
         summary["cattaneo"] = evaluate(result, p)
         end = 2.0 if p.cycle else 1.0
         if result.converged and result.steps[-1].load_factor == end:
-            summary["verification"] = verification(summary["cattaneo"], p)
+            summary["verification"] = verification(summary["cattaneo"], p,
+                                                   result.model.contact)
     return summary
 
 
@@ -298,7 +304,7 @@ def summarize(result: AnalysisResult, p: Parameters) -> dict:
 CATTANEO = "Cattaneo–Mindlin"
 
 
-def verification(ev: dict, p: Parameters) -> list[dict]:
+def verification(ev: dict, p: Parameters, settings: ContactSettings) -> list[dict]:
     """The Cattaneo run's checks (``summary.json``'s ``verification``;
     :mod:`vfem.io.verification`), over the first shear (load factors 0.5 to 1), each at its
     worst step:
@@ -313,11 +319,11 @@ def verification(ev: dict, p: Parameters) -> list[dict]:
       at x leans by x, so the resultants' ratio is mu only for a pressure centred on the
       contact's axis, as the theory's is: off by (mu + 1/mu) x_c for a centre at x_c. Allowed: a
       centre within one facet of the coarser contact surface, a / min(facets);
-    * P, the lower cylinder's normal contact force, against the platen's force.
+    * P, the upper cylinder's normal contact force (its platen's reaction), against the
+      platen's force, to the model's ``contact.platen_tolerance`` (``settings``).
     """
-    from vfem.io.verification import check
+    from vfem.io.verification import check, platen
 
-    settings = ContactSettings()
     shear = [r for r in ev["steps"] if r["load_factor"] <= 1.0 + 1e-12]
     records = []
     partial = [r for r in shear if r["c_over_a"] > 0 and r["slipping_nodes"] > 0]
@@ -336,8 +342,9 @@ def verification(ev: dict, p: Parameters) -> list[dict]:
             f"shear traction, RMS error / mu p0 (worst step, Q/(mu P) = {r['Q_over_muP']:.2f})",
             r["shear_rms_error"], 0.0, CATTANEO, SHEAR_RMS_FACTOR * math.sqrt(facet),
             f"discretisation: largest within a facet of c's kink, so falling as sqrt(h/a): "
-            f"under 0.17 sqrt(h/a) at 12 / 17, 24 / 34 and 48 / 68 facets across a "
-            f"(docs/method.md §11); allowed {SHEAR_RMS_FACTOR:g} sqrt(h/a)", measure="absolute"))
+            f"0.165, 0.175 and 0.148 sqrt(h/a) at 12 / 17, 24 / 34 and 48 / 68 facets across a "
+            f"(docs/method.md §11); allowed {SHEAR_RMS_FACTOR:g} sqrt(h/a), 1.7 times the "
+            "largest: an empirical margin", measure="absolute"))
     slipping = [r for r in shear if r["sticking_nodes"] == 0 and r["slipping_nodes"] > 0]
     if slipping:
         r = max(slipping, key=lambda r: abs(r["Q_over_muP"] - 1))
@@ -349,9 +356,8 @@ def verification(ev: dict, p: Parameters) -> list[dict]:
             "x_c = a / min(facets) of the axis", measure="absolute"))
     if ev["steps"]:
         r = ev["steps"][-1]
-        records.append(check(
-            "normal contact force P", r["normal_force"], p.force, "the platen's force",
-            settings.platen_tolerance, "the platen's force is met to contact.platen_tolerance"))
+        records.append(platen("normal contact force P (the upper's, the platen's body)",
+                              r["platen_force"], p.force, settings))
     return records
 
 

@@ -46,11 +46,13 @@ PLOTTED = 0.95
 CIRCLE, BLEND = 0.6, 0.3
 
 #: The verification's allowance for the block's nodal pressure over r < INNER a against
-#: Boussinesq's (a relative error): FINITE_BLOCK (the finite block's own difference from the
-#: half-space, where the facets-at-the-rim table's trend leads) plus a slope times rim_size / a
-#: (the discretisation), for the largest error and the RMS. docs/examples.md's table: largest
-#: 4.19, 3.25, 2.25, 1.86 % and RMS 2.97, 2.35, 1.66, 1.34 % at rim_size 0.04, 0.03, 0.02,
-#: 0.015: about 0.46 % + 0.93 rim_size/a and 0.36 % + 0.65 rim_size/a.
+#: Boussinesq's (a relative error): FINITE_BLOCK plus a slope times rim_size / a, for the largest
+#: error and the RMS. An empirical envelope of docs/examples.md's facets-at-the-rim study, not
+#: an error bound: the table's largest 4.19, 3.25, 2.25, 1.86 % and RMS 2.97, 2.35, 1.66,
+#: 1.34 % at rim_size 0.04, 0.03, 0.02, 0.015 fit about 0.46 % + 0.93 rim_size/a and
+#: 0.36 % + 0.65 rim_size/a (the discretisation falling as rim_size/a towards the finite
+#: block's own difference from the half-space), and the envelope lies 1.28 to 1.39 times above
+#: the table's values.
 FINITE_BLOCK = 0.005
 LARGEST_SLOPE, RMS_SLOPE = 1.25, 0.9
 
@@ -162,6 +164,8 @@ def evaluate(result: AnalysisResult, p: CircularPunchParameters) -> dict:
             "centre_error": float(rel[np.argmin(r[inner])]),
             "nodes_inside": int(inner.sum()),
             "total_contact_force": float(up * 4.0 * r_body.contact_force[:, 2].sum()),
+            # the quarter's total, all three components (invariant (a) reads these)
+            "quarter_contact_force": r_body.contact_force.sum(axis=0).tolist(),
         }
         if name == "block":
             beyond = nodes[r > a * (1 + 1e-9)]
@@ -177,7 +181,7 @@ def summarize(result: AnalysisResult, p: CircularPunchParameters) -> dict:
 
     summary = solid_summary("circular_punch", result, p, "boussinesq", evaluate)
     if result.converged and "boussinesq" in summary:  # converged at full load
-        summary["verification"] = verification(summary["boussinesq"], p)
+        summary["verification"] = verification(summary["boussinesq"], p, result.model.contact)
     return summary
 
 
@@ -185,21 +189,24 @@ def summarize(result: AnalysisResult, p: CircularPunchParameters) -> dict:
 BOUSSINESQ = "Boussinesq (rigid flat punch)"
 
 
-def verification(b: dict, p: CircularPunchParameters) -> list[dict]:
+def verification(b: dict, p: CircularPunchParameters,
+                 settings: ContactSettings) -> list[dict]:
     """The run's checks (``summary.json``'s ``verification``; :mod:`vfem.io.verification`):
     the block's nodal pressure over r < 0.8 a against Boussinesq's (largest and RMS relative
-    error, allowed :data:`FINITE_BLOCK` plus a slope times rim_size / a, from the
-    facets-at-the-rim table in docs/examples.md), the whole punch's contact force against the
-    platen's (to ``contact.platen_tolerance``), the block's against the punch's (equal and
-    opposite to round-off: invariant (a)'s tolerance), and no force beyond the rim (the two
-    meshes share the rim's line of nodes, so none can reach past it: exactly none)."""
-    from vfem.contact.invariants.measures import FORCE_BALANCE_TOLERANCE
-    from vfem.io.verification import check
+    error, allowed :data:`FINITE_BLOCK` plus a slope times rim_size / a: an empirical envelope
+    of the facets-at-the-rim table in docs/examples.md, 1.28 to 1.39 times its values, not an
+    error bound), the whole punch's contact force against the platen's (to the model's
+    ``contact.platen_tolerance``, ``settings``), the block's against the punch's (equal and
+    opposite: invariant (a), :func:`vfem.io.verification.balance`), and no force beyond the rim
+    (the two meshes share the rim's line of nodes, so none can reach past it: exactly none)."""
+    from vfem.io.verification import balance, check, platen
 
     blk = b["block"]
     rim = p.rim_size  # over a
-    table = ("docs/examples.md's facets-at-the-rim table (growth 0.2): the discretisation "
-             "falls as rim_size/a over the finite block's own difference")
+    table = ("an empirical envelope of docs/examples.md's facets-at-the-rim table (growth "
+             "0.2), 1.28-1.39 times its values, not an error bound")
+    largest = 4.0 * max(math.hypot(*b[name]["quarter_contact_force"])
+                        for name in ("punch", "block"))
     return [
         check(f"block's pressure, largest relative error, r < {INNER:g} a", blk["largest_error"],
               0.0, BOUSSINESQ, FINITE_BLOCK + LARGEST_SLOPE * rim,
@@ -209,15 +216,11 @@ def verification(b: dict, p: CircularPunchParameters) -> list[dict]:
               BOUSSINESQ, FINITE_BLOCK + RMS_SLOPE * rim,
               f"{table}: 1.34-2.97 % at 0.015-0.04 a; allowed {100 * FINITE_BLOCK:g} % + "
               f"{RMS_SLOPE:g} rim_size/a", measure="absolute"),
-        check("contact force on the punch (whole: 4 x the quarter model's)",
-              b["punch"]["total_contact_force"], b["applied_force"], "the platen's force",
-              ContactSettings().platen_tolerance,
-              "the platen's force is met to contact.platen_tolerance"),
-        check("contact force on the block (whole: 4 x the quarter model's)",
-              blk["total_contact_force"], b["punch"]["total_contact_force"],
-              "the punch's, equal and opposite", FORCE_BALANCE_TOLERANCE,
-              "exact: both sides' forces follow from one traction (the paired variant), to "
-              "round-off: invariant (a)'s tolerance (FORCE_BALANCE_TOLERANCE)"),
+        platen("contact force on the punch (whole: 4 x the quarter model's)",
+               b["punch"]["total_contact_force"], b["applied_force"], settings),
+        balance("contact force on the block (whole: 4 x the quarter model's)",
+                blk["total_contact_force"], b["punch"]["total_contact_force"],
+                "the punch's, equal and opposite", scale=largest),
         check("block nodes beyond the rim carrying force", blk["nodes_beyond_rim_loaded"], 0,
               "Boussinesq (contact only under the punch's face)", 0,
               "exact: the punch's face ends at the rim, a line of nodes of both meshes (a count)",

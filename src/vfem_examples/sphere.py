@@ -214,6 +214,11 @@ def evaluate(result: AnalysisResult, p: SphereParameters) -> dict:
             "total_contact_force": float(up * share * r.contact_force[:, 2].sum()),
             "contact_nodes": int(on.sum()),
         }
+    # invariant (a)'s scale for the whole's forces: the larger body's total contact force on the
+    # modelled part (all three components), times the share
+    out["largest_body_contact_force"] = share * max(
+        float(np.linalg.norm(last.bodies[name].contact_force.sum(axis=0)))
+        for name in ("sphere", "flat"))
     n = p.facets_per_radius * 2 ** p.refinement
     out["facet_size"] = a / n
     out["flat_facet_size"] = p.flat_size_ratio * a / n
@@ -229,7 +234,7 @@ def summarize(result: AnalysisResult, p: SphereParameters) -> dict:
     for record, step in zip(summary["steps"], result.steps):
         record["platen_displacement"] = step.platen_displacement
     if result.converged and "hertz" in summary:  # converged at full load
-        summary["verification"] = verification(summary["hertz"], p)
+        summary["verification"] = verification(summary["hertz"], p, result.model.contact)
     return summary
 
 
@@ -237,20 +242,21 @@ def summarize(result: AnalysisResult, p: SphereParameters) -> dict:
 HERTZ = "Hertz (sphere on a flat)"
 
 
-def verification(h: dict, p: SphereParameters) -> list[dict]:
+def verification(h: dict, p: SphereParameters, settings: ContactSettings) -> list[dict]:
     """The sphere run's checks (``summary.json``'s ``verification``;
     :mod:`vfem.io.verification`) against Hertz's sphere on a flat (Johnson, *Contact
     Mechanics*, §4.2), its own load and Newton's third law. The tolerances: the peak pressure's
     discretisation error falls about as (h/a)^2 (docs/examples.md's refinement study: -2.21,
-    -1.33, -0.50 % at a/6, a/8, a/12, under 0.8 (h/a)^2), allowed (h/a)^2 with h the sphere's
-    contact facet; the contact radius is read at the midpoints of the facet edges between
-    touching and free nodes, within a facet of the zone's end; Hertz's zone is a circle, and
-    each of those midpoints lies within half its edge of the zone's end, so the edge's radius
-    varies around it by at most the longest such edge; the platen's force is met to
-    ``contact.platen_tolerance``, and the flat's contact forces are the sphere's, equal and
-    opposite, to round-off (invariant (a)'s tolerance)."""
-    from vfem.contact.invariants.measures import FORCE_BALANCE_TOLERANCE
-    from vfem.io.verification import check
+    -1.33, -0.50 % at a/6, a/8, a/12, i.e. 0.80, 0.85 and 0.72 (h/a)^2); it is allowed (h/a)^2,
+    h the sphere's contact facet: 1.18 to 1.39 times the study's coefficients, an empirical
+    margin over them, not a bound; the contact radius is read at the midpoints of the facet
+    edges between touching and free nodes, within a facet of the zone's end; Hertz's zone is a
+    circle, and each of those midpoints lies within half its edge of the zone's end, so the
+    edge's radius varies around it by at most the longest such edge; the platen's force is met
+    to the model's ``contact.platen_tolerance`` (``settings``), and the flat's contact forces
+    are the sphere's, equal and opposite (invariant (a), :func:`vfem.io.verification.balance`).
+    """
+    from vfem.io.verification import balance, check, platen
 
     sph = h["sphere"]
     a, facet = h["a_theory"], h["facet_size"]
@@ -258,8 +264,9 @@ def verification(h: dict, p: SphereParameters) -> list[dict]:
     return [
         check("peak pressure p_max (the sphere's)", sph["p_max"], h["p0_theory"], HERTZ,
               (facet / a) ** 2,
-              "discretisation: falls about as (h/a)^2, under 0.8 (h/a)^2 at a/6, a/8, a/12 "
-              "(docs/examples.md's refinement study); allowed (h/a)^2, h the sphere's facet"),
+              "discretisation: falls about as (h/a)^2, 0.80, 0.85 and 0.72 (h/a)^2 at a/6, a/8, "
+              "a/12 (docs/examples.md's refinement study); allowed (h/a)^2, h the sphere's "
+              "facet: 1.18-1.39 times the study's coefficients, an empirical margin"),
         check("contact radius (the edge's mean radius)", sph["a_estimate"], a, HERTZ, facet,
               "the edge is read between the last node in contact and the next: one facet (h)",
               measure="absolute"),
@@ -267,14 +274,11 @@ def verification(h: dict, p: SphereParameters) -> list[dict]:
               "Hertz (a round contact zone)", sph["contour_edge"],
               "each point of the edge is read within half a facet edge of the zone's end: "
               "the longest edge it crosses", measure="absolute"),
-        check(f"contact force on the sphere ({whole})", sph["total_contact_force"],
-              h["applied_force"], "the platen's force", ContactSettings().platen_tolerance,
-              "the platen's force is met to contact.platen_tolerance"),
-        check(f"contact force on the flat ({whole})", h["flat"]["total_contact_force"],
-              sph["total_contact_force"], "the sphere's, equal and opposite",
-              FORCE_BALANCE_TOLERANCE,
-              "exact: both sides' forces follow from one traction (the paired variant), to "
-              "round-off: invariant (a)'s tolerance (FORCE_BALANCE_TOLERANCE)"),
+        platen(f"contact force on the sphere ({whole})", sph["total_contact_force"],
+               h["applied_force"], settings),
+        balance(f"contact force on the flat ({whole})", h["flat"]["total_contact_force"],
+                sph["total_contact_force"], "the sphere's, equal and opposite",
+                scale=h["largest_body_contact_force"]),
     ]
 
 
