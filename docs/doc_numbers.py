@@ -678,7 +678,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-stack": ("docs/examples.md", examples_stack, False),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
-    "patch-thesis": ("docs/examples.md", patch_thesis, True),
+    "patch-thesis": ("docs/examples.md", patch_thesis, False),
 }
 
 _TIME = re.compile(r"\b\d+(\.\d+)? s\b")

@@ -251,7 +251,9 @@ def test_two_punches_on_one_block(method):
 
 
 @pytest.mark.parametrize("method", METHODS)
-@pytest.mark.parametrize("case", ["faces only", "coarse punches", "coarse, faces only"])
+@pytest.mark.parametrize("case", ["faces only",
+                                  *(pytest.param(c, marks=pytest.mark.slow)
+                                    for c in ("coarse punches", "coarse, faces only"))])
 def test_two_punches_whose_faces_line_up(method, case):
     """The punches' faces lie on one line with the block's top. With their faces alone as
     candidates, every slave node projected beyond the end of the other punch's face, on that

@@ -81,6 +81,7 @@ def test_a_body_without_supports_is_one_message_and_exit_2(monkeypatch, capsys, 
     assert err.count("\n") == 1 and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_bench_prints_and_saves_the_table(tmp_path, capsys):
     path = tmp_path / "bench.json"
     assert main(["bench", "hertz", "--levels", "0", "--json", str(path)]) == 0
@@ -115,6 +116,7 @@ def test_bench_times_the_whole_run_against_a_plain_run_writing_the_same_files(tm
     assert set(plain.cell_data) == set(run.cell_data)
 
 
+@pytest.mark.slow
 def test_the_thesis_variant_from_the_command_line(tmp_path, capsys):
     """Every step stops at the thesis variant's fixed point outside its tolerance: the run goes
     to its end and writes everything, but is not converged (issue 37): exit status 1, as any

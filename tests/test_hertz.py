@@ -65,6 +65,7 @@ def test_swapping_the_bodies_changes_nothing(hertz_level0):
     assert [s.iterations for s in r2.steps] == [s.iterations for s in result.steps]
 
 
+@pytest.mark.slow
 def test_refinement_keeps_p_max_within_a_fraction_of_a_percent():
     errors = []
     for level in (1, 2):
@@ -159,6 +160,7 @@ def _pressure_reading():
     return module
 
 
+@pytest.mark.slow
 def test_pointwise_pressure_at_48_facets_and_no_dip_on_the_symmetry_plane():
     """Issue 16, item 5: at 48 facets across a the pressure is within 1 % of Hertz's at every
     node over |x| < 0.8 a, read either way (measured: nodal reading 0.10 %, traction q 0.10 %),

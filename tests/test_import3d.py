@@ -259,8 +259,9 @@ def box_mesh(z0, n, cells):
             + ("tetrahedra = true\n" if cells == "tet" else ""))
 
 
-@pytest.mark.parametrize("suffix, lower, upper", [(".msh", "hex", "tet"), (".msh", "tet", "hex"),
-                                                  (".inp", "hex", "tet")])
+@pytest.mark.parametrize("suffix, lower, upper", [
+    (".msh", "hex", "tet"), pytest.param(".msh", "tet", "hex", marks=pytest.mark.slow),
+    pytest.param(".inp", "hex", "tet", marks=pytest.mark.slow)])
 def test_the_patch_test_from_files_gives_the_built_in_answer(tmp_path, suffix, lower, upper):
     """Linear elements (3D contact supports those only). Pressure uniform to round-off on
     both sides of the non-matching interface (measured: 5e-15 relative), and the total force

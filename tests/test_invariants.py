@@ -409,6 +409,7 @@ def test_checkpoints_keep_the_invariants(tmp_path):
     assert back.steps[-1].invariants["passed"]
 
 
+@pytest.mark.slow
 def test_summary_json_and_closing_screen_show_the_invariants(tmp_path, capsys):
     out = tmp_path / "patch"
     assert main(["run", "examples/patch/4x7_nu0.3.toml", "--out", str(out)]) == 0

@@ -88,6 +88,7 @@ def test_sliding_ten_facets_keeps_the_normal_reaction_steady(slide):
     assert all(s.invariants["passed"] for s in result.steps)
 
 
+@pytest.mark.slow
 def test_sliding_contact_forces_balance_the_support_reaction(slide):
     """Newton's third law across the interface, and the block's equilibrium on its deformed
     shape: its base reaction equals the contact force it carries."""
@@ -107,6 +108,7 @@ def test_sliding_contact_forces_balance_the_support_reaction(slide):
         assert reaction == pytest.approx(-total[k], abs=1e-8 * np.abs(total).max())
 
 
+@pytest.mark.slow
 def test_sliding_nodes_of_the_other_side_indent_only_by_the_chord_sag(slide):
     """The punch's vertices are not constrained (its surface carries equilibrium); they can lie
     below the block's straight facets by the sag of the arc over one block facet, h^2 / (8 R)."""

@@ -245,6 +245,7 @@ def test_the_built_in_example_writes_its_numbers_and_figures(tmp_path, reference
     assert "0 outside it" in report and "rigid punch" in report
 
 
+@pytest.mark.slow
 def test_the_built_in_example_from_the_command_line(tmp_path, capsys):
     assert main(["run", "punch", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out

@@ -155,6 +155,7 @@ def test_no_figures_leaves_them_to_vfem_plot_which_draws_the_same(runs, example,
         assert _pngs(again)
 
 
+@pytest.mark.slow
 def test_a_folder_without_a_figure_set_gets_the_generic_figures(runs, tmp_path, capsys):
     """Results written before figure sets were recorded: the generic figures, no traceback."""
     src = runs["hertz"]
@@ -223,6 +224,7 @@ def test_deformed_shapes_name_every_body_the_scale_and_the_units(runs, example, 
         assert "contact: vfem, paired variant" in drawn[name]["titles"], name
 
 
+@pytest.mark.slow
 def test_the_title_names_a_classical_method(tmp_path, drawn):
     assert main(["-q", "run", "hertz", "--set", "method=lagrange", "--out", str(tmp_path)]) == 0
     assert "contact: lagrange" in drawn["deformed.png"]["titles"]
@@ -301,7 +303,8 @@ def legends(monkeypatch):
 @pytest.mark.parametrize("model, figure", [
     pytest.param(["sliding", *(a for s in SMALL["sliding"] + ["friction=0.3"]
                                for a in ("--set", s))], "reactions.png", marks=pytest.mark.slow),
-    ([str(ROOT / "examples" / "friction" / "pushed_block.toml")], "history.png")])
+    pytest.param([str(ROOT / "examples" / "friction" / "pushed_block.toml")], "history.png",
+                 marks=pytest.mark.slow)])
 def test_the_legends_of_the_step_histories_stand_beside_the_curves(model, figure, tmp_path,
                                                                   legends):
     """reactions.png (sliding) and history.png (an input file's run): each panel's legend

@@ -62,6 +62,7 @@ def test_patch_records_the_baseline_failing_where_the_meshes_do_not_nest():
     assert failed == ["meshes 4/7: pressure off uniform", "meshes 4/7: sigma_y off uniform"]
 
 
+@pytest.mark.slow
 def test_a_run_that_does_not_converge_records_no_list():
     """The thesis variant stops at its fixed point outside its tolerance in the patch test
     (docs/method.md §5): not converged, so its numbers are not verified."""

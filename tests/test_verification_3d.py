@@ -79,6 +79,7 @@ def test_stack_2d_lists_the_worst_interface():
     assert "worst of 6 interfaces" in records[1]["quantity"] and "half" in records[1]["quantity"]
 
 
+@pytest.mark.slow
 def test_no_list_short_of_full_load_or_not_converged():
     p = stack.Parameters(divisions=3, steps=2)
     result = Analysis(stack.build(p)).run()
