@@ -662,7 +662,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
     "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
     "examples-hertz": ("docs/examples.md", examples_hertz, False),
-    "method-pressure-reading": ("docs/method.md", method_pressure_reading, True),
+    "method-pressure-reading": ("docs/method.md", method_pressure_reading, False),
     "baselines-hertz": ("docs/baselines.md", baselines_hertz, False),
     "gasket-results": ("docs/examples.md", gasket_results, False),
     "gasket-steps": ("docs/examples.md", gasket_steps, False),

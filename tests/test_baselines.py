@@ -172,6 +172,7 @@ def test_settings_are_checked():
         hertz.build(hertz.HertzParameters(method="lagrange", order=2))
 
 
+@pytest.mark.slow
 def test_cli_runs_hertz_with_a_baseline(tmp_path, capsys):
     from vfem.cli import main
 

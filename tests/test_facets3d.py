@@ -273,7 +273,8 @@ def test_shape_functions_are_scikit_fems():
 
 
 @pytest.mark.parametrize("count", [400, pytest.param(2500, marks=pytest.mark.slow)])
-@pytest.mark.parametrize("k", [3, pytest.param(4, marks=pytest.mark.slow),
+@pytest.mark.parametrize("k", [pytest.param(3, marks=pytest.mark.slow),
+                               pytest.param(4, marks=pytest.mark.slow),
                                pytest.param(6, marks=pytest.mark.slow),
                                pytest.param(9, marks=pytest.mark.slow)])
 def test_closest_points_match_brute_force(k, count):

@@ -347,6 +347,7 @@ NO_CONTACT = input_file(
     load_factors=[1.0]).replace('name = "wedge"', 'name = "wedge"\norder = 2')
 
 
+@pytest.mark.slow
 def test_a_run_with_no_contact_anywhere_notes_every_pressure_map(tmp_path):
     """Two bodies that never touch (one of quadratic tetrahedra): each pressure map is left
     out with a note; the deformed outlines, von Mises and the history are drawn. The quadratic

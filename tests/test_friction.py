@@ -573,6 +573,7 @@ def test_a_wrong_pair_entry_is_refused_naming_it(entry, words):
         Analysis(model).setup()
 
 
+@pytest.mark.slow
 def test_cattaneo_does_not_depend_on_the_order_of_its_bodies():
     """The Cattaneo model with its bodies listed the other way round: every contact force of
     every step the same to 1e-8 of the largest (the role rule and the friction depend on the

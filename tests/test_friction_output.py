@@ -201,6 +201,7 @@ def test_friction_png_draws_the_coulomb_limit_beside_the_traction(model, body, b
 
 # -- a resume of another model names what differs ------------------------------------------------
 
+@pytest.mark.slow
 def test_a_resume_with_other_settings_names_each_setting_stored_and_now(tmp_path, capsys):
     out = tmp_path / "c"
     assert main(["-q", "run", "cattaneo", *_sets(CATTANEO), "--out", str(out),

@@ -155,7 +155,7 @@ def _scaled(load, factor: float):
     return Platen(load.boundary, load.component, factor * load.force)
 
 
-@pytest.mark.parametrize("kinematics", ["small", "total"])
+@pytest.mark.parametrize("kinematics", ["small", pytest.param("total", marks=pytest.mark.slow)])
 def test_a_traction_on_a_curve_is_the_proportional_traction_at_its_multiplier(kinematics):
     curve = ((0.0, 0.0), (0.5, 1.0), (1.0, 0.25))
     beam_load = Traction("top", (0.0, -0.006), amplitude=curve)
@@ -198,7 +198,7 @@ def _platen_model(kinematics: str, platen: Platen) -> list[Body]:
     return [block, punch]
 
 
-@pytest.mark.parametrize("kinematics", ["small", "total"])
+@pytest.mark.parametrize("kinematics", ["small", pytest.param("total", marks=pytest.mark.slow)])
 def test_a_platen_force_on_a_curve(kinematics):
     curve = ((0.0, 0.0), (0.5, 1.0), (1.0, 0.5))
     platen = Platen("top", "y", -10.0, amplitude=curve)

@@ -78,6 +78,7 @@ def test_finer_facets_come_closer(default):
     assert press_fit.evaluate(result, p)["hub"]["largest_error"] < coarse  # 0.23 % < 0.27 %
 
 
+@pytest.mark.slow
 def test_tetrahedral_hub():
     """A bore node at an end face and a symmetry plane was read as beyond the shaft's patch
     (invariant (b) failed there, 3.9e-4 inside) until symmetry-plane edges stopped being the

@@ -201,6 +201,7 @@ def test_resume_keeps_the_earlier_rows(tmp_path):
     assert (cut / "reactions.csv").read_text() == (full / "reactions.csv").read_text()
 
 
+@pytest.mark.slow
 def test_the_command_line_prints_reactions(tmp_path, capsys):
     _, path = _config(tmp_path)
     assert main(["run", str(path), "--out", str(tmp_path / "cli")]) == 0

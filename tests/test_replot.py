@@ -97,7 +97,7 @@ def runs(tmp_path_factory):
 
 
 #: the examples whose small runs take seconds each: their figure tests are in the slow set
-SLOW = {"block", "gasket", "sliding", "wedge"}
+SLOW = {"block", "gasket", "sliding", "wedge", "punch", "patch"}
 
 
 def examples(names) -> list:

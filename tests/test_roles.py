@@ -61,7 +61,8 @@ def test_hertz_with_the_roles_forced_each_way(case):
 
 
 @pytest.mark.parametrize("name, sides", [("flat_punch", ("block", "punch")),
-                                         ("two_punches", ("block", "left"))])
+                                         pytest.param("two_punches", ("block", "left"),
+                                                      marks=pytest.mark.slow)])
 def test_punches_with_the_roles_forced_each_way(name, sides):
     """Total forces within 0.5 % (measured 0.05 %). The punch's peak pressure is at its
     corners, where the exact pressure is singular: it is a property of the mesh, not compared.

@@ -70,7 +70,9 @@ def test_flat_ended_cylinder_and_refusals():
 
 
 @pytest.mark.parametrize("element,tetrahedra", [(ElementHex1, False), (ElementTetP1, True),
-                                                (ElementTetP2, True), (ElementHex2, False)],
+                                                (ElementTetP2, True),
+                                                pytest.param(ElementHex2, False,
+                                                             marks=pytest.mark.slow)],
                          ids=["hex1", "tet1", "tet2", "hex2"])
 def test_3d_stiffness_equals_scikit_fem_assembly(element, tetrahedra):
     mesh = cylinder(6.0, 5.0, end_radius=10.0, h=3.0 if element is ElementHex2 else 1.5,

@@ -84,7 +84,8 @@ def assert_same(a, b) -> None:
 
 
 @pytest.mark.parametrize("dim, friction, kinematics", [
-    (2, None, None), (2, 0.3, None), (2, None, "total"), (3, None, None)])
+    (2, None, None), (2, 0.3, None), pytest.param(2, None, "total", marks=pytest.mark.slow),
+    (3, None, None)])
 def test_a_side_named_by_its_boundary_is_the_body_with_that_boundary_as_its_contact_surface(
         dim, friction, kinematics):
     named = solved(punch_on_block(dim, '[["punch", "block:top"]]', friction=friction,
