@@ -94,9 +94,12 @@ def accuracy_hertz_study() -> str:
 
 
 @functools.cache
-def _summary(*argv: str, status_expected: int = 0) -> dict:
-    """``summary.json`` of ``vfem run ARGV`` (run in a fresh folder); ``status_expected``: its
+def _run(argv, status_expected: int = 0, contact_rows: bool = False):
+    """``summary.json`` of ``vfem run ARGV`` (a tuple; run once per process in a fresh folder,
+    silenced), and with ``contact_rows`` also ``contact.csv``'s rows; ``status_expected``: its
     exit status (1: the thesis variant, which stops outside its tolerance, issue 37)."""
+    import csv
+
     from vfem.cli import main
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -105,7 +108,16 @@ def _summary(*argv: str, status_expected: int = 0) -> dict:
             status = main(["-q", "run", *argv, "--out", tmp])
         if status != status_expected:
             raise RuntimeError(f"vfem run {' '.join(argv)} exited {status}")
-        return json.loads((Path(tmp) / "summary.json").read_text())
+        summary = json.loads((Path(tmp) / "summary.json").read_text())
+        if not contact_rows:
+            return summary
+        with open(Path(tmp) / "contact.csv", newline="", encoding="utf-8") as f:
+            return summary, list(csv.DictReader(f))
+
+
+def _summary(*argv: str, status_expected: int = 0) -> dict:
+    """``summary.json`` of ``vfem run ARGV`` (:func:`_run`)."""
+    return _run(argv, status_expected)
 
 
 def _thousands(x: float, digits: int) -> str:
@@ -137,29 +149,12 @@ def gasket_results() -> str:
     return "\n".join(rows) + "\n"
 
 
-def _run_files(*argv: str) -> tuple[dict, list[dict]]:
-    """``summary.json`` and ``contact.csv``'s rows of ``vfem run ARGV`` (a fresh folder)."""
-    import csv
-
-    from vfem.cli import main
-
-    with tempfile.TemporaryDirectory() as tmp:
-        with contextlib.redirect_stdout(io.StringIO()), \
-                contextlib.redirect_stderr(io.StringIO()):
-            status = main(["-q", "run", *argv, "--no-figures", "--out", tmp])
-        if status != 0:
-            raise RuntimeError(f"vfem run {' '.join(argv)} exited {status}")
-        with open(Path(tmp) / "contact.csv", newline="", encoding="utf-8") as f:
-            rows = list(csv.DictReader(f))
-        return json.loads((Path(tmp) / "summary.json").read_text()), rows
-
-
 def examples_block() -> str:
     """docs/examples.md, Block: what ``vfem run block`` measures (its summary and the small
     block's nodal pressure along its top face, from contact.csv)."""
     import numpy as np
 
-    s, rows = _run_files("block")
+    s, rows = _run(("block", "--no-figures"), contact_rows=True)
     b = s["block"]
     steps = s["steps"]
     last = str(steps[-1]["step"])

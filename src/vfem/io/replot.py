@@ -604,18 +604,13 @@ def _cell_field(frame: BodyFrame, name: str) -> np.ndarray:
     return np.asarray(frame.cell_data[name], dtype=float)
 
 
-#: The faces of VTK's 3D cells, by the cells' node positions (hexahedron: bottom 0-3, top
-#: 4-7; tetrahedron: any three of four).
-_VTK_FACES = figures3d.CELL_FACES
-
-
 def plane_section(frame: BodyFrame, axis: int, at: float
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A 3D body's faces that lie in the plane ``x[axis] = at`` (a symmetry plane of its
     model), for drawing as a 2D mesh: (points (n, 2), faces (m, k), displacement (n, 2)), the
     two other coordinates in order (y = 0: x and z). Linear cells (tetrahedra, hexahedra)."""
     cells = np.asarray(frame.polygons)
-    faces = _VTK_FACES.get(cells.shape[1])
+    faces = figures3d.CELL_FACES.get(cells.shape[1])  # VTK's faces of the linear cells
     keep = [a for a in range(3) if a != axis]
     if faces is None or not len(cells):
         return np.zeros((0, 2)), np.zeros((0, 3), dtype=int), np.zeros((0, 2))
