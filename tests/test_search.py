@@ -61,3 +61,30 @@ def test_direct_and_tree_candidates_choose_the_same_segments(monkeypatch):
                     0, 1)
         every = np.linalg.norm(pts[:, None] - (a + t[..., None] * d), axis=2)
         np.testing.assert_allclose(direct[2], every.min(axis=1), rtol=0, atol=1e-12)
+
+
+def test_an_input_file_run_searches_its_candidates_once(monkeypatch, tmp_path):
+    """``vfem run FILE`` checks the model (which builds its contact surfaces) and then solves
+    it: the candidate search is done once (issue 40), and again when what it read changes."""
+    from pathlib import Path
+
+    import vfem
+    from vfem import model as model_module
+    from vfem.config import check
+    from vfem.io import runner
+
+    calls = []
+    search = model_module.select_candidate_facets
+    monkeypatch.setattr(model_module, "select_candidate_facets",
+                        lambda *a, **k: calls.append(1) or search(*a, **k))
+    path = Path(__file__).parent.parent / "examples" / "hertz.toml"
+    config = vfem.load(path)
+    model = check(config, path.parent)
+    _, first = model.contact_surfaces()
+    summary = runner.run(config, tmp_path / "out", model=model, figures=False)
+    assert summary["converged"]
+    assert len(calls) == 1
+    model.load_factors = tuple(2 * f for f in model.load_factors)  # what it read changed
+    _, again = model.contact_surfaces()
+    assert len(calls) == 2
+    assert [s.nc for s in first] == [s.nc for s in again]

@@ -87,8 +87,8 @@ def test_large_kinematics_bodies_are_not_checked(caplog, monkeypatch):
     m.bodies[0] = dataclasses.replace(m.bodies[0], kinematics="total")
     analysis = Analysis(m)
     read = []
-    monkeypatch.setattr("vfem.solver.max_strain",
-                        lambda body, u: (read.append(body.name), (1.0, 0))[1])
+    monkeypatch.setattr("vfem.solver.strain_beyond",
+                        lambda body, u, limit: (read.append(body.name), (1.0, 0))[1])
     step = StepResult(1, 1.0, 1, True, [])
     step.bodies = {b.name: None for b in m.bodies}
     step.bodies["punch"] = type("R", (), {"displacement": np.zeros((3, 2))})()
@@ -98,3 +98,62 @@ def test_large_kinematics_bodies_are_not_checked(caplog, monkeypatch):
     assert read == ["punch"]  # the block is large, and the punch is named once
     assert len(strain_warnings(caplog)) == 1
     assert strain_warnings(caplog)[0].message.startswith("body 'punch': strain 100 %")
+
+
+def _bodies_of_every_kind():
+    """A small body of each element kind: 3D tetrahedra and hexahedra (distorted, linear and
+    quadratic), 2D triangles and quadrilaterals (linear and quadratic), each set up."""
+    from test_bodies3d import uniform_box
+    from vfem.bodies import Body, Support
+    from vfem.materials import LinearElastic
+    from vfem.mesh.shapes import rectangle
+
+    out = [uniform_box(cells, order, distort=True) for cells in ("tet", "hex")
+           for order in (1, 2)]
+    for triangles in (False, True):
+        for order in (1, 2):
+            mesh = rectangle(0.0, 0.0, 2.0, 1.0, nx=5, ny=3, triangles=triangles)
+            body = Body("plate", mesh, LinearElastic(100.0, 0.3),
+                        supports=(Support("bottom", ("x", "y")),), order=order)
+            body.setup()
+            out.append(body)
+    return out
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_strain_screen_answers_as_the_full_check(seed):
+    """strain_beyond (the solver's screen) gives max_strain's strain and element whenever it
+    exceeds the limit and None otherwise, for random fields on top of a large rigid motion, on
+    every element kind and at limits on either side of the true maximum."""
+    from vfem.bodies.stresses import strain_beyond
+
+    rng = np.random.default_rng(seed)
+    for body in _bodies_of_every_kind():
+        n = body.ndofs
+        rigid = np.tile(rng.uniform(-1e3, 1e3, body.dim), n // body.dim)
+        u = rigid + 0.01 * rng.standard_normal(n)
+        exact, element = max_strain(body, u)
+        assert exact > 0
+        for limit in (0.5 * exact, 0.999999 * exact, 1.000001 * exact, 3 * exact):
+            got = strain_beyond(body, u, limit)
+            if exact > limit:
+                assert got is not None, (body.mesh, limit)
+                assert got[0] == pytest.approx(exact, rel=1e-12) and got[1] == element
+            else:
+                assert got is None
+
+
+def test_the_strain_screen_skips_the_eigenvalues_of_a_body_well_within(monkeypatch):
+    """A field far below the limit is passed by the screen alone: no strain at any quadrature
+    point is computed (the point of the screen: issue 40)."""
+    from vfem.bodies import stresses
+
+    called = []
+    monkeypatch.setattr(stresses, "_max_strain_at_quadrature_3d",
+                        lambda *a: called.append(1) or (0.0, 0))
+    monkeypatch.setattr(stresses, "max_strain", lambda *a: called.append(1) or (0.0, 0))
+    for body in _bodies_of_every_kind():
+        u = np.tile([5.0, -7.0, 3.0][:body.dim], body.ndofs // body.dim)  # a rigid motion
+        u = u + 1e-6 * np.sin(np.arange(body.ndofs))
+        assert stresses.strain_beyond(body, u, SMALL_STRAIN_LIMIT) is None
+    assert not called

@@ -98,9 +98,27 @@ class Model:
         elif distance is None:
             diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in self.bodies]
             distance = 0.02 * min(diag)
-        facets = select_candidate_facets(self.bodies, pairs, distance, self.load_factors,
-                                         follow_path=large)
+        facets = self._candidate_facets(pairs, distance, large)
         surfaces = [ContactSurface.build(b, f) for b, f in zip(self.bodies, facets)]
         pairs = pairs.on(surfaces)
         check_initial_overlap(surfaces, pairs)
         return pairs, surfaces
+
+    def _candidate_facets(self, pairs: ContactPairs, distance: float, large: bool) -> list:
+        """Each body's candidate facets (:func:`select_candidate_facets`), searched once per
+        model: an input file's run checks its model (``vfem.config.check``, which builds the
+        contact surfaces) and then solves it (:meth:`vfem.solver.Analysis.setup`, again),
+        and the search was 2.8 s of ``vfem run cattaneo3d``'s 21 (issue 40). Kept with what it
+        read (the bodies and meshes by identity, their kinematics and prescribed motions, the
+        pairs, the distance and the load factors), searched afresh if any of it changed.
+        The arrays handed out are copies (the kept ones stay as searched)."""
+        key = (tuple((id(b), id(b.mesh), b.large, repr(b.prescribed), repr(b.platen),
+                      repr(b.contact_boundaries)) for b in self.bodies),
+               repr(self.contact_pairs), repr(pairs), float(distance),
+               tuple(float(f) for f in self.load_factors), large)
+        kept = self.__dict__.get("_facets")
+        if kept is None or kept[0] != key:
+            facets = select_candidate_facets(self.bodies, pairs, distance, self.load_factors,
+                                             follow_path=large)
+            kept = self.__dict__["_facets"] = (key, facets)
+        return [np.array(f, copy=True) for f in kept[1]]

@@ -37,7 +37,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .bodies import multiplier
-from .bodies.stresses import max_strain
+from .bodies.stresses import strain_beyond
 from .contact.formulations import formulation_class
 from .contact.geometry import ContactPairs, exterior_facets
 from .contact.invariants import InvariantCheck, Invariants
@@ -438,13 +438,17 @@ class Analysis:
     def warn_large_strain(self, step: StepResult) -> None:
         """After a converged step: warn (log, not fail) about each small-kinematics body whose
         largest principal strain (:meth:`Body.max_strain`) exceeds :data:`SMALL_STRAIN_LIMIT`,
-        naming the body, the strain, the step and where, once per body per run. One
-        interpolation per small body and step, none once every such body has been named."""
+        naming the body, the strain, the step and where, once per body per run. A screen per
+        small body and step (:func:`~vfem.bodies.stresses.strain_beyond`: the strain exactly
+        only in elements that could exceed the limit), none once every such body has been
+        named."""
         for b in self.model.bodies:
             if b.large or b.name in self.strain_warned or b.name not in step.bodies:
                 continue
-            strain, element = max_strain(b, step.bodies[b.name].displacement.ravel())
-            if strain > SMALL_STRAIN_LIMIT:
+            beyond = strain_beyond(b, step.bodies[b.name].displacement.ravel(),
+                                   SMALL_STRAIN_LIMIT)
+            if beyond is not None:
+                strain, element = beyond
                 self.strain_warned.add(b.name)
                 where = ", ".join(f"{c:.4g}" for c in
                                   b.mesh.p[:, b.mesh.t[:, element]].mean(axis=1))

@@ -30,7 +30,8 @@ from skfem.mapping import MappingIsoparametric
 CHUNK = 8192
 
 
-def cell_gradients(mesh, element, mapping=None, chunk: int | None = None):
+def cell_gradients(mesh, element, mapping=None, chunk: int | None = None,
+                   which: np.ndarray | None = None):
     """The shape functions' gradients and the quadrature weights of ``mesh``'s cells, a chunk of
     elements at a time: yields ``(elements, G, dx)``, ``elements`` a slice, ``G`` (scalar
     shape functions, dim, elements, quadrature points) the gradient of each scalar shape
@@ -43,16 +44,23 @@ def cell_gradients(mesh, element, mapping=None, chunk: int | None = None):
     million-dof sphere was killed for memory while building it). Per chunk, a scalar basis on
     the chunk's elements gives the same numbers (scikit-fem's ``ElementVector`` takes each
     component's gradient from the scalar element, and the mapping works element by element:
-    tests/test_solids.py checks that the stiffness is the same to the bit)."""
+    tests/test_solids.py checks that the stiffness is the same to the bit).
+
+    With ``which`` (element numbers), only those elements, and ``elements`` is then an array
+    of their numbers, not a slice."""
     from skfem import CellBasis, Dofs
 
     mapping = cell_mapping(mesh) if mapping is None else mapping
     dofs = Dofs(mesh, element)  # once, not per chunk
-    nel, chunk = mesh.nelements, chunk or CHUNK
+    nel, chunk = (mesh.nelements if which is None else len(which)), chunk or CHUNK
     for start in range(0, nel, chunk):
         elements = slice(start, min(start + chunk, nel))
+        numbers = (np.arange(elements.start, elements.stop) if which is None
+                   else np.asarray(which[elements]))
+        if which is not None:
+            elements = numbers
         basis = CellBasis(mesh, element, mapping=mapping, dofs=dofs, disable_doflocs=True,
-                          elements=np.arange(elements.start, elements.stop))
+                          elements=numbers)
         # contiguous, as the vector basis's were: einsum sums in another order otherwise
         # (a tetrahedron's gradients come strided from its affine mapping)
         yield (elements, np.ascontiguousarray(np.stack([f[0].grad for f in basis.basis])),
@@ -60,7 +68,8 @@ def cell_gradients(mesh, element, mapping=None, chunk: int | None = None):
 
 
 def elasticity_stiffness(mesh, element, lam: float, mu: float, element_dofs=None,
-                         mapping=None) -> csr_matrix:
+                         mapping=None, gradient_bound: np.ndarray | None = None
+                         ) -> csr_matrix:
     """The stiffness of isotropic linear elasticity (Lame's ``lam``, ``mu``) of ``mesh`` with
     the vector form of scalar ``element`` (scikit-fem's ``ElementVector``, its numbering:
     ``element_dofs``, (local dofs, elements), by default ``Dofs(mesh, ElementVector(element))``),
@@ -73,6 +82,10 @@ def elasticity_stiffness(mesh, element, lam: float, mu: float, element_dofs=None
 
     with the vector dof (a, c) at local index ``dim * a + c`` (scikit-fem's ``ElementVector``
     order, checked against its dof numbering below).
+
+    ``gradient_bound`` (an array of one entry per element), if given, receives each element's
+    max over its quadrature points of sum_a |grad N_a|, from the same gradients (no pass of its
+    own): the bound :func:`vfem.bodies.stresses.strain_beyond` screens strains with.
     """
     from skfem import Dofs, ElementVector
 
@@ -88,6 +101,8 @@ def elasticity_stiffness(mesh, element, lam: float, mu: float, element_dofs=None
     nloc = nnode * dim
     data = np.empty((nloc, nloc, nel))
     for e, g, dx in cell_gradients(mesh, element, mapping):
+        if gradient_bound is not None:
+            gradient_bound[e] = gradient_sums(g)
         gw = g * dx  # the weights on one factor
         cross = np.einsum("aceq,bdeq->acbde", gw, g)  # sum_q w G_ac G_bd
         dot = np.einsum("aceq,bceq->abe", gw, g)  # sum_q w G_a . G_b
@@ -102,6 +117,14 @@ def elasticity_stiffness(mesh, element, lam: float, mu: float, element_dofs=None
     rows = np.broadcast_to(dofs[:, None, :], data.shape).ravel()
     cols = np.broadcast_to(dofs[None, :, :], data.shape).ravel()
     return coo_matrix((data.ravel(), (rows, cols)), shape=(n, n)).tocsr()
+
+
+def gradient_sums(g: np.ndarray) -> np.ndarray:
+    """Per element, the largest over its quadrature points of sum_a |grad N_a| (``g``: (scalar
+    shape functions, dim, elements, quadrature points), as :func:`cell_gradients` gives)."""
+    if not g.size:
+        return np.zeros(g.shape[2] if g.ndim == 4 else 0)
+    return np.sqrt(np.einsum("adeq,adeq->aeq", g, g)).sum(axis=0).max(axis=1)
 
 
 class _RememberingIsoparametric(MappingIsoparametric):

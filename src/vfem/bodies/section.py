@@ -196,8 +196,13 @@ class Solid:
         return None
 
     def stiffness(self, body, lam, mu):
-        return elasticity_stiffness(body.mesh, body.element(), lam, mu,
-                                    body.dof_map.element_dofs)
+        # the strain screen's gradient bound from the assembly's own gradients (no pass of its
+        # own: :func:`~vfem.bodies.stresses.strain_beyond`)
+        bound = np.empty(body.mesh.nelements)
+        K = elasticity_stiffness(body.mesh, body.element(), lam, mu,
+                                 body.dof_map.element_dofs, gradient_bound=bound)
+        body.__dict__["_gradient_bound"] = (body.mesh, bound)
+        return K
 
     def average_strain_operator(self, body):
         return solid_average_strain_operator(body)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assembly import cell_gradients
+from .assembly import cell_gradients, gradient_sums
 
 
 def stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
@@ -159,6 +159,65 @@ def max_strain(body, u: np.ndarray) -> tuple[float, int]:
     return body.section.max_strain(body, u)
 
 
+def strain_beyond(body, u: np.ndarray, limit: float) -> tuple[float, int] | None:
+    """:func:`max_strain` where it exceeds ``limit``, else None: the solver's warning after
+    every step (:meth:`vfem.solver.Analysis.warn_large_strain`), at a fraction of its price.
+
+    A screen first, exact and cheap: in an element with nodal displacements u_a, since
+    sum_a grad N_a = 0, grad u(q) = sum_a (u_a - c) (x) grad N_a(q) for any constant c, so
+    with c the element's mean nodal displacement
+
+        max |eigenvalue of sym grad u(q)| <= |sym grad u(q)|_F <= |grad u(q)|_F
+                                         <= max_a |u_a - c| * sum_a |grad N_a(q)|
+
+    and the last factor's largest value over the element's quadrature points (its *gradient
+    bound*) is geometry alone, taken from the assembly's own gradients
+    (:func:`~vfem.bodies.assembly.elasticity_stiffness`) or, failing them, once per body. Only
+    the elements whose bound exceeds ``limit`` get :func:`max_strain`'s eigenvalues at their
+    quadrature points: none in a body that strains well within it (issue 40: every point's
+    eigenvalues every step were 22.6 % of ``vfem run cattaneo3d``). The value and element
+    returned are :func:`max_strain`'s whenever it exceeds ``limit``
+    (tests/test_strain_warning.py)."""
+    u = np.asarray(u, dtype=float)
+    dim = body.dim
+    element_dofs = body.dof_map.element_dofs  # (vector shape functions, elements)
+    nel = element_dofs.shape[1]
+    if not nel:
+        return None
+    ue = u[element_dofs].reshape(-1, dim, nel)  # (node, component, element)
+    centre = ue.mean(axis=0)
+    spread = np.sqrt(((ue - centre) ** 2).sum(axis=1)).max(axis=0)
+    # round-off: sum_a grad N_a is zero only to its own rounding, times the rigid motion c
+    slack = 1e-12 * np.sqrt((centre**2).sum(axis=0))
+    suspect = np.flatnonzero((spread + slack) * _gradient_bound(body) * (1 + 1e-9) > limit)
+    if not suspect.size:
+        return None
+    if dim == 3 and not (body.order == 1 and body.mesh.t.shape[0] == 4):
+        strain, element = _max_strain_at_quadrature_3d(body, u, suspect)
+    else:  # 2D (one vectorised pass) and linear tetrahedra (one sparse product): cheap whole
+        strain, element = max_strain(body, u)
+    return (strain, element) if strain > limit else None
+
+
+def _gradient_bound(body) -> np.ndarray:
+    """(elements,) each element's max over its quadrature points of sum_a |grad N_a| (the
+    scalar shape functions a): kept from the body's 3D assembly, or computed here once."""
+    kept = body.__dict__.get("_gradient_bound")
+    if kept is not None and kept[0] is body.mesh:
+        return kept[1]
+    if body.dim == 3:
+        bound = np.empty(body.mesh.nelements)
+        for e, grads, _ in cell_gradients(body.mesh, body.element()):
+            bound[e] = gradient_sums(grads)
+    else:  # the kept basis: scalar function a's gradient is vector function dim * a's own
+        basis = body.basis
+        g = np.stack([basis.basis[i][0].grad[i % body.dim]
+                      for i in range(0, basis.Nbfun, body.dim)])
+        bound = gradient_sums(g)
+    body.__dict__["_gradient_bound"] = (body.mesh, bound)
+    return bound
+
+
 def plane_max_strain(body, u: np.ndarray) -> tuple[float, int]:
     """:func:`max_strain` of a 2D body."""
     basis = body.basis
@@ -214,21 +273,24 @@ def _max_strain_at_quadrature(body, u: np.ndarray) -> tuple[float, int]:
     return float(per_element[element]), element
 
 
-def _max_strain_at_quadrature_3d(body, u: np.ndarray) -> tuple[float, int]:
+def _max_strain_at_quadrature_3d(body, u: np.ndarray, which: np.ndarray | None = None
+                                 ) -> tuple[float, int]:
     """:func:`max_strain` of a 3D body over every quadrature point, a chunk of elements at a
-    time (:func:`~vfem.bodies.assembly.cell_gradients`)."""
+    time (:func:`~vfem.bodies.assembly.cell_gradients`); over elements ``which`` alone if
+    given."""
     ue = np.asarray(u, dtype=float)[body.dof_map.element_dofs]  # (shape functions, elements)
     best, where = -1.0, 0
-    for e, grads, _ in cell_gradients(body.mesh, body.element()):
+    for e, grads, _ in cell_gradients(body.mesh, body.element(), which=which):
+        numbers = np.arange(e.start, e.stop) if isinstance(e, slice) else e
         # grad u_c = sum_a u_(a, c) grad N_a: (component, derivative, element, quadrature point)
-        grad = np.einsum("ace,adeq->cdeq", ue[:, e].reshape(-1, 3, e.stop - e.start), grads)
+        grad = np.einsum("ace,adeq->cdeq", ue[:, e].reshape(-1, 3, len(numbers)), grads)
         principal = _largest_eigenvalue(
             grad[0, 0], grad[1, 1], grad[2, 2], 0.5 * (grad[1, 2] + grad[2, 1]),
             0.5 * (grad[0, 2] + grad[2, 0]), 0.5 * (grad[0, 1] + grad[1, 0]))
         per_element = principal.max(axis=1)
         k = int(np.argmax(per_element))
         if per_element[k] > best:
-            best, where = float(per_element[k]), e.start + k
+            best, where = float(per_element[k]), int(numbers[k])
     return max(best, 0.0), where
 
 
