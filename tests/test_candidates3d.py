@@ -166,3 +166,52 @@ def test_locate_in_simplices_agrees_with_barycentric_coordinates(cells):
     assert not hit[best < -1e-12].any()
     assert hit[600:].all()  # every point on a face or corner
     assert (~hit[:600]).sum() > 100 and hit[:600].sum() > 100
+
+
+def _ray_triangles_all_pairs(points, a, b, c, e):
+    """Every point against every triangle (Moeller-Trumbore), the reference."""
+    best = np.inf
+    for p in points:
+        for ta, tb, tc in zip(a, b, c):
+            e1, e2 = tb - ta, tc - ta
+            pvec = np.cross(e, e2)
+            det = e1 @ pvec
+            if det == 0:
+                continue
+            w = p - ta
+            qvec = np.cross(w, e1)
+            u, v, t = (w @ pvec) / det, (qvec @ e) / det, (qvec @ e2) / det
+            if u >= 0 and v >= 0 and u + v <= 1 and t >= 0:
+                best = min(best, t)
+    return best
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_ray_search_tries_only_the_pairs_that_can_hit_and_finds_every_hit(seed):
+    """platen_approach's ray-triangle distance (pairs pruned by the triangles' projected
+    circles, issue 40) equals every point tried against every triangle, on wavy grids with
+    rays through vertices and edges and oblique rays."""
+    from vfem.contact.geometry.placement import _ray_triangles
+
+    rng = np.random.default_rng(seed)
+    n = 6
+    xs = np.linspace(0.0, 1.0, n + 1)
+    X, Y = np.meshgrid(xs, xs)
+    P = np.column_stack([X.ravel(), Y.ravel(), 0.1 * rng.standard_normal(X.size)])
+    idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    tris = np.array([t for i in range(n) for j in range(n) for t in (
+        (idx[i, j], idx[i, j + 1], idx[i + 1, j + 1]),
+        (idx[i, j], idx[i + 1, j + 1], idx[i + 1, j]))])
+    a, b, c = P[tris[:, 0]], P[tris[:, 1]], P[tris[:, 2]]
+    on_grid = np.column_stack([rng.choice(xs, 30), rng.choice(xs, 30), np.full(30, 2.0)])
+    scattered = np.column_stack([rng.uniform(-0.2, 1.2, (30, 2)), rng.uniform(1.0, 3.0, 30)])
+    oblique = rng.standard_normal(3)
+    oblique[2] = -abs(oblique[2]) - 1.0
+    for points in (on_grid, scattered):
+        for e in (np.array([0.0, 0.0, -1.0]), oblique / np.linalg.norm(oblique)):
+            expected = _ray_triangles_all_pairs(points, a, b, c, e)
+            got = _ray_triangles(points, a, b, c, e, 1000)
+            if points is on_grid and e[2] == -1.0:  # straight down onto the grid: hits
+                assert np.isfinite(expected)
+            # the reference's sums run in another order: the distance to its round-off
+            assert got == expected or abs(got - expected) <= 1e-14 * abs(expected)

@@ -285,6 +285,15 @@ def sphere_case(p, backend: str | None = None, repeat: int = 1) -> dict:
 
     backend = resolve(backend)
     vfem_s = plain = peak = None
+    # The first large allocations of a process are dearer than the same ones later: the
+    # kernel faults in and zeroes (with NumPy's huge pages, compacts) memory no one has used
+    # yet, while what is freed and asked for again is ready. Measured (2026-12-01, 104k dofs,
+    # the two bodies' assembly three times in one process): 5.32 s, then 3.17 and 3.97 s,
+    # the system time 2.5 s, then 0.6 and 1.4 s. Whichever of vfem and the plain solve ran
+    # first paid it: this was issue 40's "assembly 3.4 s slower than the plain run's for no
+    # known reason" at 278k. So one plain solve first, untimed, then the two alike.
+    plain_solve(build_sphere(p), backend)
+    gc.collect()
     for _ in range(repeat):
         model = build_sphere(p)
         t0 = time.perf_counter()
