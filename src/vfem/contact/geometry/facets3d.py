@@ -334,6 +334,48 @@ def _distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
+#: KD-tree queries of fewer points than this run on the calling thread: SciPy starts its
+#: worker threads afresh for every query, 1-3 ms each, and a pair's set-up makes hundreds of
+#: small queries (the bisections of :func:`~.held.held_edges`: 992 queries, 3.4 s of threads
+#: started and joined in the four-plate stack of ``benchmarks/ranks.py``; issue 40). Measured
+#: on the 2-core machine (2026-12-01, 20,000 facet centres, 16 nearest): 100 points 1.0 ms on
+#: one thread and 2.4 ms on all, 1,000 points 5.4 and 9.4 ms, 10,000 points 86 and 80 ms.
+#: The answers do not depend on it.
+PARALLEL_QUERY = 20_000
+
+
+def _workers(m: int) -> int:
+    return -1 if m >= PARALLEL_QUERY else 1
+
+
+#: the facet sets :func:`_facet_trees` keeps (the last ones asked for)
+TREES_KEPT = 4
+_trees: list = []
+
+
+def _facet_trees(x: np.ndarray, facets: np.ndarray) -> tuple:
+    """The bounding spheres of ``facets`` at ``x`` (:func:`bounding_spheres`), a KD-tree of
+    their centres, and per class of radii (a factor of 2 apart) the members and a KD-tree of
+    theirs: what :func:`candidate_pairs` searches. Kept for the last :data:`TREES_KEPT` sets
+    (the positions and facets compared exactly), since the searches of a pair's set-up ask
+    about the same surface hundreds of times (issue 40)."""
+    x = np.asarray(x, dtype=float)
+    for kx, kf, value in _trees:
+        if kx.shape == x.shape and kf.shape == facets.shape and np.array_equal(kf, facets) \
+                and np.array_equal(kx, x):
+            return value
+    centre, radius = bounding_spheres(x, facets)
+    level = np.floor(np.log2(np.maximum(radius, 1e-300) / max(radius.min(), 1e-300)))
+    levels = []
+    for c in np.unique(level):
+        members = np.flatnonzero(level == c)
+        levels.append((members, cKDTree(centre[members])))
+    value = (centre, radius, cKDTree(centre), levels)
+    _trees.append((x.copy(), np.array(facets, copy=True), value))
+    del _trees[:-TREES_KEPT]
+    return value
+
+
 def candidate_pairs(points: np.ndarray, x: np.ndarray, facets: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
     """(point, facet) index pairs that may be nearest: every facet whose bounding sphere
@@ -345,10 +387,9 @@ def candidate_pairs(points: np.ndarray, x: np.ndarray, facets: np.ndarray
     m, nf = len(points), len(facets)
     if m == 0 or nf == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    centre, radius = bounding_spheres(x, facets)
-    rmax = radius.max()
-    slack = TIE * rmax + 1e-300
     if m * nf <= DIRECT_PAIRS:
+        centre, radius = bounding_spheres(x, facets)
+        slack = TIE * radius.max() + 1e-300
         dc = _distance(points[:, None], centre[None])
         d0 = dc.min(axis=1)
         pt, fc = np.nonzero(dc - radius[None] <= (d0 + slack)[:, None])
@@ -358,18 +399,16 @@ def candidate_pairs(points: np.ndarray, x: np.ndarray, facets: np.ndarray
     # nearest, k doubled for the points whose k-th is still within reach: with one reach for
     # all, the largest facet's radius (a graded mesh's far field) set every point's search,
     # 0.6 GB of pairs for the quadrature points of the sphere at 316k dofs
-    tree = cKDTree(centre)
-    _, j = tree.query(points, k=min(nf, 16), workers=-1)
+    centre, radius, tree, levels = _facet_trees(x, facets)
+    slack = TIE * radius.max() + 1e-300
+    _, j = tree.query(points, k=min(nf, 16), workers=_workers(m))
     d0 = _distance(points, centre[j[:, 0] if j.ndim == 2 else j])
-    level = np.floor(np.log2(np.maximum(radius, 1e-300) / max(radius.min(), 1e-300)))
     pts, fcs = [], []
-    for c in np.unique(level):
-        members = np.flatnonzero(level == c)
-        sub = cKDTree(centre[members])
+    for members, sub in levels:
         reach = (d0 + radius[members].max() + slack) * (1 + 1e-12) + 1e-300
         todo, k = np.arange(m), min(len(members), 16)
         while len(todo):
-            d, jj = sub.query(points[todo], k=k, workers=-1)
+            d, jj = sub.query(points[todo], k=k, workers=_workers(len(todo)))
             d, jj = d.reshape(len(todo), -1), jj.reshape(len(todo), -1)
             done = (d[:, -1] > reach[todo]) | (k == len(members))
             rows, cols = np.nonzero(d[done] <= reach[todo][done, None])
