@@ -9,7 +9,9 @@
 The cases: springs, hertz, hertz with quadratic elements, patch, wedge, block, gasket (small and
 large kinematics), sliding, the thesis variant on Hertz, the block, the wedge and the patch test
 (the block's and the wedge's stop unconverged, before and after: their failures must match too),
-and each classical baseline on Hertz; each is ``vfem run`` of the
+each classical baseline on Hertz, Cattaneo's cylinder (and its cycle), the pushed block,
+and in 3D the sphere (built in and from its input file), Cattaneo's sphere and the stack of
+plates; each is ``vfem run`` of the
 built-in example into a fresh folder, and its ``summary.json`` is kept without what differs
 from run to run (wall-clock times, the run's command and date, file names). ``compare`` walks
 both trees: numbers must agree to 1e-10 relative (to the value, or to the largest magnitude the
@@ -56,6 +58,12 @@ CASES: dict[str, list[str]] = {
     "cattaneo_cycle": ["cattaneo", "--no-figures", "--set", "cycle=true", "--set",
                        "shift=5e-4"],
     "pushed_block": ["examples/friction/pushed_block.toml", "--no-figures"],
+    # 3D (issue 40: the fixed costs' changes are 3D first): the sphere, Cattaneo's sphere
+    # sheared, the stack of plates, and the sphere from its input file
+    "sphere": ["sphere", "--no-figures"],
+    "cattaneo3d": ["cattaneo3d", "--no-figures"],
+    "stack": ["stack", "--no-figures"],
+    "sphere_file": ["examples/sphere.toml", "--no-figures"],
 }
 
 #: Keys whose values differ from run to run (or name files), dropped wherever they appear.

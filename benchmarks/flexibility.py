@@ -1,6 +1,15 @@
 """Routes to the flexibility on the contact dofs (the inverse stiffness among them), timed.
 
     python benchmarks/flexibility.py [DOFS [BACKEND ...]]   # default 300k, every backend
+    python benchmarks/flexibility.py --sphere 30k 100k 300k  # 3D: each body of the sphere
+
+``--sphere``: each body of the ``sphere`` example (Hertz's sphere on a flat, hexahedra) at
+about the dofs given, PARDISO: the plain factorization of its free block (what a linear run
+pays), the factorization with its contact candidates' dofs last and their Schur complement
+(vfem's route), and the back-substitution route on the plain factor, timed on its first
+``--columns`` columns (512) and scaled to all of them (said so in its row). Printed per body:
+dofs, contact dofs, seconds and the factor's nonzeros of each route, and each route's cost in
+plain factorizations. Issue 40, item 1.
 
 For the Hertz example's cylinder (the body with all the dofs) and its tracked contact dofs, with
 every installed backend:
@@ -96,5 +105,68 @@ def main(dofs: int, backends: list[str]) -> None:
                   f"{np.abs(G - reference).max() / scale:>11.1e}", flush=True)
 
 
+def sphere(sizes: list[int], columns: int = 512, repeat: int = 2) -> list[dict]:
+    """The 3D routes per body of the sphere example (the module docstring); the faster of
+    ``repeat`` alternating runs of each factorization kept."""
+    import gc
+
+    from vfem.bodies.condensation import free_positions
+    from vfem_examples.sphere import build as build_sphere
+    from vfem_tools.bench import sphere_parameters
+
+    rows = []
+    print(f"{'dofs':>9} {'body':>7} {'body dofs':>9} {'contact':>7} {'plain s':>8} "
+          f"{'schur s':>8} {'ratio':>6} {'nnz plain':>11} {'nnz schur':>11} "
+          f"{'back-sub s':>11} {'ratio':>6}")
+    for size in sizes:
+        model = build_sphere(sphere_parameters(size, None))
+        surfaces = model.contact_surfaces()[1]
+        total = 0
+        for body in model.bodies:
+            body.assemble()
+            total += body.ndofs
+        for body, surface in zip(model.bodies, surfaces):
+            K = body.K_ff
+            pos, free = free_positions(body, np.asarray(surface.candidate_dofs, dtype=int))
+            trailing = pos[free]
+            m = len(trailing)
+            best = {"plain": np.inf, "schur": np.inf}
+            entries = {}
+            for _ in range(repeat):
+                for route in ("plain", "schur"):
+                    gc.collect()
+                    t0 = time.perf_counter()
+                    f = linalg.factorize(K, "pardiso",
+                                         trailing=trailing if route == "schur" else None)
+                    best[route] = min(best[route], time.perf_counter() - t0)
+                    entries[route] = f.factor_entries
+                    if route == "plain":
+                        cols = trailing[:columns]
+                        E = np.zeros((K.shape[0], len(cols)), order="F")
+                        E[cols, np.arange(len(cols))] = 1.0
+                        t0 = time.perf_counter()
+                        for start in range(0, len(cols), 256):
+                            f.solve(E[:, start:start + 256])
+                        back = (time.perf_counter() - t0) * m / max(len(cols), 1)
+                    del f
+            row = {"dofs": total, "body": body.name, "body_dofs": K.shape[0],
+                   "contact_dofs": m, "plain_s": best["plain"], "schur_s": best["schur"],
+                   "nnz_plain": entries["plain"], "nnz_schur": entries["schur"],
+                   "back_substitution_s": best["plain"] + back, "sampled_columns":
+                   min(columns, m)}
+            rows.append(row)
+            print(f"{total:>9} {body.name:>7} {K.shape[0]:>9} {m:>7} {best['plain']:>8.2f} "
+                  f"{best['schur']:>8.2f} {best['schur'] / best['plain']:>6.2f} "
+                  f"{entries['plain']:>11,} {entries['schur']:>11,} "
+                  f"{best['plain'] + back:>11.2f} {(best['plain'] + back) / best['plain']:>6.2f}",
+                  flush=True)
+        del model, surfaces
+        gc.collect()
+    return rows
+
+
 if __name__ == "__main__":
-    main(parse_size(sys.argv[1]) if len(sys.argv) > 1 else 300_000, sys.argv[2:])
+    if len(sys.argv) > 1 and sys.argv[1] == "--sphere":
+        sphere([parse_size(a) for a in sys.argv[2:]] or [30_000, 100_000, 300_000])
+    else:
+        main(parse_size(sys.argv[1]) if len(sys.argv) > 1 else 300_000, sys.argv[2:])
