@@ -15,7 +15,10 @@ carries compatibility). It checks
     boundary polygon (the sign of the distance along the facet's normal there, or along the mean
     of the two facets' normals at a vertex: exact for any polygon, holes included); for an
     untangled mesh that is the same as lying in one of its deformed elements, and it costs
-    O(boundary) where locating in the elements costs O(elements) per step.
+    O(boundary) where locating in the elements costs O(elements) per step. Of a node in the
+    other body's box, only one that may have entered it since the undeformed state is asked
+    (an exact bound on how far the two have moved, :meth:`InvariantCheck._may_enter`):
+    O(contact) per step.
     The allowance: a convex part of one piecewise-linear surface (turning through α) can
     protrude between two nodes of the other surface that lie on it (a facet of length L) by at
     most (L/2)·tan(α/2) (the isosceles case; (L/2)·sin(α/2) would miss it by 1/cos(α/2)). α is
@@ -59,6 +62,7 @@ step and treats a violation as a failed step (:class:`vfem.errors.InvariantViola
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -76,6 +80,36 @@ from .plane import PLANE
 
 if TYPE_CHECKING:
     from ...bodies import Body
+
+
+@dataclass
+class _Undeformed:
+    """Per boundary node of body i, undeformed, what the pre-filter of the pair (i, j) reads
+    (:meth:`InvariantCheck._may_enter`): its distance to body j's closed undeformed boundary
+    (every facet) and whether it lies inside it, computed for a node when first needed (a
+    node far from j is never asked), and whether it was in j's box at an earlier state."""
+
+    surfaces: tuple  # (body i's undeformed surface, body j's): what it was computed on
+    distance: np.ndarray  # (nb,) NaN where not computed
+    inside: np.ndarray  # (nb,) bool
+    known: np.ndarray  # (nb,) bool: distance and inside computed
+    seen: np.ndarray  # (nb,) bool
+
+    @classmethod
+    def of(cls, ri, rj) -> _Undeformed:
+        n = len(ri.x)
+        return cls((ri, rj), np.full(n, np.nan), np.zeros(n, dtype=bool),
+                   np.zeros(n, dtype=bool), np.zeros(n, dtype=bool))
+
+    def side(self, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The distance and inside of ``nodes`` (local numbers of body i), computed where not
+        yet known."""
+        todo = nodes[~self.known[nodes]]
+        if todo.size:
+            ri, rj = self.surfaces
+            self.inside[todo], self.distance[todo] = rj.side(ri.x[todo])
+            self.known[todo] = True
+        return self.distance[nodes], self.inside[nodes]
 
 
 class InvariantCheck:
@@ -126,6 +160,8 @@ class InvariantCheck:
         self._kind: SurfaceKind | None = None
         self._boundaries: list | None = None
         self._reference: list | None = None
+        #: (i, j) -> the pre-filter's reading of the pair (:meth:`_may_enter`)
+        self._undeformed: dict[tuple[int, int], _Undeformed] = {}
 
     @property
     def kind(self) -> SurfaceKind:
@@ -232,6 +268,7 @@ class InvariantCheck:
             near = np.flatnonzero(np.all((gi.x >= lo - pad) & (gi.x <= hi + pad), axis=1))
             if not near.size:
                 continue
+            near = self._may_enter(i, j, near, cur, ref)
             node = near[gj.inside(gi.x[near])]
             if not node.size:
                 continue
@@ -269,6 +306,70 @@ class InvariantCheck:
                      "into": self.bodies[j].name,
                      **{c: float(v) for c, v in zip(("x", "y", "z"), pos)},
                      "deformed_depth": deformed, "linearised_depth": linearised}
+
+    def _may_enter(self, i: int, j: int, near: np.ndarray, cur: list, ref: list
+                   ) -> np.ndarray:
+        """Of body i's boundary nodes ``near`` (local numbers, ascending: those in j's box),
+        those that may lie inside body j's boundary ``cur[j]``: the others are outside it, so
+        asking ``cur[j].inside`` of these alone finds the same nodes, in O(contact) where
+        asking of every node in j's box costs O(surface) per step (a sphere's whole lower
+        half in a block's box). A node in j's box for the first time is kept: its undeformed
+        side would cost what asking it costs (a one-state check spends nothing more); so are
+        all when they are fewer than j's surface's ``bound_from`` (2D: asking is cheap).
+
+        Exact, not a heuristic. With X the undeformed positions (``ref``), D = x − X the
+        displacements to the current ones and c any common translation (the centre of the
+        box of j's displacements: a rigid translation of j costs nothing), a node p of i
+        outside j undeformed, at a distance d0(p) from j's closed boundary (every facet,
+        symmetry planes included, as ``inside`` reads it; :class:`_Undeformed`), with
+        |D_p − c| + max_q |D_q − c| < d0(p) (q over j's boundary nodes) is outside j now:
+
+        1. each facet ``inside`` reads is linear in its nodes (a triangle, a quadrilateral's
+           two, a quadratic triangle's four corner-and-midpoint pieces; a segment, a
+           quadratic facet's two chords), so on the straight path X + t D, t from 0 to 1, a
+           point y = sum_a λ_a x_a of it (λ_a >= 0, summing to 1) moves by t sum_a λ_a D_a:
+           relative to t c, by at most t max_q |D_q − c|, a convex combination (a quadratic
+           facet's own shape functions, negative in places, would need the sum of their
+           magnitudes, 5/3 on a 6-node triangle; no facet is read so here);
+        2. p, moving by t (D_p − c) relative to it, stays farther than
+           d0(p) − |D_p − c| − max_q |D_q − c| > 0 from j's boundary all along the path;
+        3. so its winding number about j's closed boundary, an integer continuous in the
+           positions wherever the point is off the boundary, is the same now as undeformed:
+           0, outside. ``inside``'s sign of the closest point's offset along the feature's
+           pseudonormal is that winding number for a closed boundary that does not cross
+           itself (Bærentzen & Aanæs 2005), the premise its own answers rest on (the path's
+           intermediate boundaries may cross themselves).
+
+        Nodes inside j undeformed (an initial overlap, an interference fit) are always asked.
+        1e-9 of the coordinates' and displacements' magnitude is kept to spare for rounding
+        in the distances (O(ε) of those). ``inside`` answers each point alone, so its
+        answers for the nodes kept are those it gave among all of ``near``."""
+        gi, gj, ri, rj = cur[i], cur[j], ref[i], ref[j]
+        if len(near) < gj.bound_from or gi.b is not ri.b or gj.b is not rj.b or \
+                len(gi.x) != len(ri.x) or len(gj.x) != len(rj.x):
+            return near
+        pair = self._undeformed.get((i, j))
+        if pair is None or pair.surfaces[0] is not ri or pair.surfaces[1] is not rj:
+            pair = self._undeformed[(i, j)] = _Undeformed.of(ri, rj)
+        # a node in j's box for the first time is asked as it stands (a one-state check, or a
+        # node that passes by once, spends nothing on its undeformed side); from its second
+        # time on, the bound
+        again = pair.seen[near]
+        pair.seen[near] = True
+        bound = near[again]
+        if not bound.size:
+            return near
+        d0, inside0 = pair.side(bound)
+        Dj = gj.x - rj.x
+        Di = gi.x[bound] - ri.x[bound]
+        c = 0.5 * (Dj.min(axis=0) + Dj.max(axis=0))
+        spread = float(np.linalg.norm(Dj - c, axis=1).max(initial=0.0))
+        size = max(float(np.abs(a).max(initial=0.0)) for a in (ri.x, rj.x, Di, Dj))
+        reach = np.linalg.norm(Di - c, axis=1) + spread + 1e-9 * size
+        # (a distance that is not a number leaves its node asked)
+        outside = np.zeros(len(near), dtype=bool)
+        outside[again] = ~inside0 & (reach < d0)
+        return near[~outside]
 
     def _beyond_second_order(self, out: Invariants, i: int, j: int, node: np.ndarray,
                              deformed: np.ndarray, linearised: np.ndarray, allowed: np.ndarray,

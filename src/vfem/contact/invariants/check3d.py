@@ -37,13 +37,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from ..geometry import closest_on_facets, kind_of
-from .cached_boundary import CachedBoundary
+from .cached_boundary import CachedBoundary, scatter_add
 from .kind import SurfaceKind
 from .measures import nodal_tension
 from .polygon import symmetry_facets
@@ -126,6 +127,19 @@ class Boundary3:
                    corner_mid=None if corner_mid is None else lookup[corner_mid],
                    contact=contact)
 
+    @cached_property
+    def edges(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The triangles' edges, from the topology alone (once per boundary; the positions
+        change at every state, these do not): ``(half, count, opposite)``, with ``half``
+        (3 nt,) the edge of each triangle's side k (corners k, k + 1) triangle by triangle,
+        ``count`` the number of edges and ``opposite`` (nt, 3) the edge opposite each
+        corner (side k is opposite corner k + 2). An edge is its two nodes, unordered."""
+        t, nb = self.triangles, len(self.nodes)
+        a, b = t.ravel(), np.roll(t, -1, axis=1).ravel()
+        _, half = np.unique(np.minimum(a, b) * nb + np.maximum(a, b), return_inverse=True)
+        half = half.ravel()
+        return half, int(half.max(initial=-1)) + 1, half.reshape(-1, 3)[:, [1, 2, 0]]
+
 
 def _barycentric(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """(m, 3) barycentric coordinates of the projection of ``p`` on the planes of the
@@ -183,11 +197,11 @@ class Surface3(CachedBoundary):
         return self._get("angles", make)
 
     def _vertex_pseudonormals(self, keep: np.ndarray) -> np.ndarray:
-        out = np.zeros_like(self.x)
+        """(nb, 3) the angle-weighted sum of the normals of the triangles ``keep`` at each
+        node, added corner by corner (all first corners, then the second, the third)."""
         n, w = self.unit_normals[keep], self.angles[keep]
-        for k in range(3):
-            np.add.at(out, self.b.triangles[keep, k], w[:, k, None] * n)
-        return out
+        return scatter_add(len(self.x), self.b.triangles[keep].T,
+                           (w.T[:, :, None] * n).reshape(-1, 3))
 
     @property
     def pseudonormals(self) -> np.ndarray:
@@ -196,16 +210,13 @@ class Surface3(CachedBoundary):
             np.arange(len(self.b.triangles))))
 
     @property
-    def edge_normals(self) -> dict:
-        """{(lo, hi): the sum of the normals of the triangles sharing that edge}."""
+    def edge_normals(self) -> np.ndarray:
+        """(ne, 3) per edge (:attr:`Boundary3.edges`), the sum of the unit normals of the
+        triangles sharing it, added triangle by triangle (a vertex's or an edge's sum in one
+        order, as a point's feature reads it whichever triangle it is found on)."""
         def make():
-            out: dict = {}
-            n = self.unit_normals
-            for f, tri in enumerate(self.b.triangles):
-                for k in range(3):
-                    key = (min(tri[k], tri[(k + 1) % 3]), max(tri[k], tri[(k + 1) % 3]))
-                    out[key] = out.get(key, 0.0) + n[f]
-            return out
+            half, count, _ = self.b.edges
+            return scatter_add(count, half, np.repeat(self.unit_normals, 3, axis=0))
         return self._get("edge_normals", make)
 
     @property
@@ -226,15 +237,16 @@ class Surface3(CachedBoundary):
         (``vertex``: (nb, 3) the vertex pseudonormals to use)."""
         out = self.unit_normals[tri].copy()
         zero = lam <= FEATURE
-        nodes = self.b.triangles[tri]
-        edges = self.edge_normals
-        for m in np.flatnonzero(zero.any(axis=1)):
-            z = np.flatnonzero(zero[m])
-            if len(z) >= 2:  # a vertex: the one coordinate not zero
-                out[m] = vertex[nodes[m, 3 - z.sum()]]
-            else:  # an edge: the two corners other than z
-                e = nodes[m, [(z[0] + 1) % 3, (z[0] + 2) % 3]]
-                out[m] = edges[(min(e), max(e))]
+        count = zero.sum(axis=1)
+        # a vertex: the one coordinate not zero (3 minus the sum of the zero ones' places)
+        at = np.flatnonzero(count >= 2)
+        corner = 3 - (zero[at] * np.arange(3)).sum(axis=1)
+        out[at] = vertex[self.b.triangles[tri[at], corner]]
+        # an edge: the one opposite the zero coordinate's corner
+        at = np.flatnonzero(count == 1)
+        if len(at):
+            edge = self.b.edges[2][tri[at], np.argmax(zero[at], axis=1)]
+            out[at] = self.edge_normals[edge]
         return out
 
     def _closest(self, pts: np.ndarray, keep: np.ndarray, point_normals=None):
@@ -245,10 +257,16 @@ class Surface3(CachedBoundary):
 
     def inside(self, pts: np.ndarray) -> np.ndarray:
         """Which of ``pts`` (m, 3) lie inside the closed boundary (on it counts as inside)."""
-        tri, lam, c, _ = self._closest(pts, np.arange(len(self.b.triangles)))
+        return self.side(pts)[0]
+
+    def side(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Which of ``pts`` (m, 3) lie inside the closed boundary (:meth:`inside`), and their
+        distance to it (every triangle, symmetry planes included). A point's answer does not
+        depend on the other points asked with it."""
+        tri, lam, c, dist = self._closest(pts, np.arange(len(self.b.triangles)))
         direction = self.feature_normals(tri, lam, self.pseudonormals)
         return np.einsum("ij,ij->i", pts - c, direction) <= 1e-12 * np.maximum(
-            self.sizes[tri], 1e-300)
+            self.sizes[tri], 1e-300), dist
 
     def depth(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distance of ``pts`` to the surface triangles, the size of the closest one's facet
