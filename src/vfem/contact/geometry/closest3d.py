@@ -60,7 +60,7 @@ from .facets3d import (
     _evaluate,
     _unit,
     candidate_pairs,
-    check_facets,
+    checked,
     chord_deviation,
     closest_on_triangles,
     facet_shape,
@@ -429,7 +429,7 @@ def closest_on_facets(points: np.ndarray, x: np.ndarray, facets: np.ndarray,
     x = np.asarray(x, dtype=float)
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     m, nf = len(points), len(facets)
-    check_facets(x, facets)
+    surface = checked(x, facets)  # validated once per facet set
     if isinstance(pairs, str):
         if pairs != "all":
             raise ValueError(f"pairs must be (points, facets), 'all' or None, got {pairs!r}")
@@ -444,9 +444,11 @@ def closest_on_facets(points: np.ndarray, x: np.ndarray, facets: np.ndarray,
                           np.full((m, 2), np.nan))
     if len(pt) == 0:
         return out
-    C = x[facets[:, :kind.corners]]
-    diff = C[:, :, None] - C[:, None]
-    tol = TIE * np.sqrt(_dot(diff, diff).max()) + 1e-300
+    if "tie" not in surface:
+        C = x[facets[:, :kind.corners]]
+        diff = C[:, :, None] - C[:, None]
+        surface["tie"] = TIE * np.sqrt(_dot(diff, diff).max()) + 1e-300
+    tol = surface["tie"]
     chunks = _chunks(len(pt))
 
     if kind.name == "T3":

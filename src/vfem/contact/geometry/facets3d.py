@@ -348,32 +348,54 @@ def _workers(m: int) -> int:
     return -1 if m >= PARALLEL_QUERY else 1
 
 
-#: the facet sets :func:`_facet_trees` keeps (the last ones asked for)
-TREES_KEPT = 4
-_trees: list = []
+#: the facet sets whose derived data :func:`kept` keeps (the last ones asked about)
+SURFACES_KEPT = 4
+_kept: list = []
+
+
+def kept(x: np.ndarray, facets: np.ndarray) -> dict:
+    """A dictionary kept for the facet set ``facets`` at positions ``x`` (the last
+    :data:`SURFACES_KEPT` sets, the positions and facets compared exactly), for what is
+    derived from them alone: their validation (:func:`check_facets`), their corners' tie
+    tolerance and the search trees of :func:`candidate_pairs`. A pair's set-up and the
+    invariants ask about the same surface hundreds of times (the bisections of
+    :func:`~.held.held_edges`: 992 queries in the four-plate stack), each of which rebuilt
+    them (issue 40)."""
+    x = np.asarray(x, dtype=float)
+    facets = np.asarray(facets)
+    for kx, kf, value in _kept:
+        if kx.shape == x.shape and kf.shape == facets.shape and np.array_equal(kf, facets) \
+                and np.array_equal(kx, x):
+            return value
+    value: dict = {}
+    _kept.append((x.copy(), facets.copy(), value))
+    del _kept[:-SURFACES_KEPT]
+    return value
+
+
+def checked(x: np.ndarray, facets: np.ndarray) -> dict:
+    """:func:`check_facets` once per facet set (:func:`kept`); the set's kept dictionary."""
+    value = kept(x, facets)
+    if "checked" not in value:
+        check_facets(x, facets)  # raises: not kept
+        value["checked"] = True
+    return value
 
 
 def _facet_trees(x: np.ndarray, facets: np.ndarray) -> tuple:
     """The bounding spheres of ``facets`` at ``x`` (:func:`bounding_spheres`), a KD-tree of
     their centres, and per class of radii (a factor of 2 apart) the members and a KD-tree of
-    theirs: what :func:`candidate_pairs` searches. Kept for the last :data:`TREES_KEPT` sets
-    (the positions and facets compared exactly), since the searches of a pair's set-up ask
-    about the same surface hundreds of times (issue 40)."""
-    x = np.asarray(x, dtype=float)
-    for kx, kf, value in _trees:
-        if kx.shape == x.shape and kf.shape == facets.shape and np.array_equal(kf, facets) \
-                and np.array_equal(kx, x):
-            return value
-    centre, radius = bounding_spheres(x, facets)
-    level = np.floor(np.log2(np.maximum(radius, 1e-300) / max(radius.min(), 1e-300)))
-    levels = []
-    for c in np.unique(level):
-        members = np.flatnonzero(level == c)
-        levels.append((members, cKDTree(centre[members])))
-    value = (centre, radius, cKDTree(centre), levels)
-    _trees.append((x.copy(), np.array(facets, copy=True), value))
-    del _trees[:-TREES_KEPT]
-    return value
+    theirs: what :func:`candidate_pairs` searches, built once per facet set (:func:`kept`)."""
+    value = kept(x, facets)
+    if "trees" not in value:
+        centre, radius = bounding_spheres(x, facets)
+        level = np.floor(np.log2(np.maximum(radius, 1e-300) / max(radius.min(), 1e-300)))
+        levels = []
+        for c in np.unique(level):
+            members = np.flatnonzero(level == c)
+            levels.append((members, cKDTree(centre[members])))
+        value["trees"] = (centre, radius, cKDTree(centre), levels)
+    return value["trees"]
 
 
 def candidate_pairs(points: np.ndarray, x: np.ndarray, facets: np.ndarray
