@@ -4,6 +4,14 @@ benchmark run before/after on Hertz 100k and the sphere 100k: no slowdown over 3
     git worktree add /tmp/before <commit>
     python benchmarks/trees_speed.py /tmp/before/src src [--dofs 100k] [--repeat 5]
         [--cases hertz sphere]
+    python benchmarks/trees_speed.py /tmp/before/src src --cases --repeat 3 \
+        --runs "cattaneo3d --no-figures" "examples/sphere.toml --no-figures"
+
+``--runs``: whole ``vfem run`` commands instead (issue 40's before/after phase tables), each
+in a fresh process with its tree first on the path, run from the repository root of the
+second tree (input files' paths are relative to it), timed end to end; per command the two
+trees' median wall seconds and each phase's median from ``summary.json`` (the phases
+``vfem -v run`` prints).
 
 Each run is one case on one tree in a fresh subprocess (that tree first on the path), the trees
 taking turns ``--repeat`` times per case; the clock covers the analysis alone
@@ -66,15 +74,64 @@ def run(tree: str, case: str, dofs: int) -> dict:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
+def run_command(tree: str, command: str, cwd: str) -> dict:
+    """``vfem run COMMAND`` on ``tree`` in a process of its own: wall seconds and phases."""
+    import shlex
+    import tempfile
+    import time
+
+    env = dict(os.environ, PYTHONPATH=tree)
+    with tempfile.TemporaryDirectory(prefix="vfem-trees-") as tmp:
+        t0 = time.perf_counter()
+        done = subprocess.run([sys.executable, "-m", "vfem", "-q", "run", *shlex.split(command),
+                               "--out", os.path.join(tmp, "out")], env=env,
+                              capture_output=True, text=True, cwd=cwd)
+        seconds = time.perf_counter() - t0
+        if done.returncode:
+            raise SystemExit(f"{tree}: vfem run {command} failed:\n{done.stderr[-2000:]}")
+        with open(os.path.join(tmp, "out", "summary.json"), encoding="utf-8") as f:
+            summary = json.load(f)
+    return {"seconds": seconds, "phases": summary.get("phases", {}),
+            "dofs": summary.get("dofs")}
+
+
+def main_runs(trees: list[str], commands: list[str], repeat: int) -> int:
+    """``--runs``: the whole runs, alternately on the two trees, medians per phase."""
+    cwd = os.path.dirname(trees[1])
+    rows = {(c, t): [] for c in commands for t in trees}
+    for k in range(repeat):
+        for command in commands:
+            for tree in trees:
+                row = run_command(tree, command, cwd)
+                rows[command, tree].append(row)
+                print(f"{k + 1} {command:40s} {row['seconds']:8.2f} s  {tree}", flush=True)
+    for command in commands:
+        a, b = (statistics.median(r["seconds"] for r in rows[command, t]) for t in trees)
+        print(f"\nvfem run {command} ({rows[command, trees[1]][0]['dofs']} dofs): median "
+              f"{a:.2f} s then {b:.2f} s, ratio {b / a:.3f}")
+        print("| phase | before s | after s |\n|---|---:|---:|")
+        keys = list(rows[command, trees[0]][0]["phases"])
+        for key in keys:
+            a, b = (statistics.median(r["phases"].get(key, 0.0) for r in rows[command, t])
+                    for t in trees)
+            print(f"| {key} | {a:.2f} | {b:.2f} |")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("first", help="the first tree's src folder (before)")
     parser.add_argument("second", help="the second tree's src folder (after)")
     parser.add_argument("--dofs", default="100k", help="about this many dofs (10k, 100k, 1M)")
     parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--cases", nargs="+", default=["hertz", "sphere"],
+    parser.add_argument("--cases", nargs="*", default=["hertz", "sphere"],
                         choices=("hertz", "sphere"))
+    parser.add_argument("--runs", nargs="+", metavar="COMMAND",
+                        help="whole vfem run commands instead of the cases")
     args = parser.parse_args(argv)
+    if args.runs:
+        return main_runs([os.path.abspath(args.first), os.path.abspath(args.second)],
+                         args.runs, args.repeat)
     from vfem_tools.bench import parse_size  # (vfem bench --dofs's sizes)
 
     dofs = parse_size(args.dofs)
