@@ -113,7 +113,8 @@ def locate_in_triangles(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> n
     return locate_in_simplices(x, tri, points)
 
 
-def locate_in_simplices(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> np.ndarray:
+def locate_in_simplices(x: np.ndarray, tri: np.ndarray, points: np.ndarray,
+                        keep: bool = False) -> np.ndarray:
     """The simplex (row of ``tri``, (nt, dim + 1) numbers of the positions ``x`` (n, dim))
     containing each of ``points`` (m, dim), or -1: triangles in 2D, tetrahedra in 3D (points
     on an edge or a face count as inside: every barycentric coordinate >= -1e-12).
@@ -122,14 +123,15 @@ def locate_in_simplices(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> n
     map gives a point's local coordinates in a simplex. Nearby simplices (by centroid) are
     tried first; points they do not contain are tried against every simplex whose centroid is
     close enough for it to hold them, since elements may be long and thin.
+
+    ``keep``: keep the simplices' search structures for the next call on the same ones
+    (:func:`_simplex_search`; let go by :func:`forget_simplex_sets`).
     """
     found = np.full(len(points), -1)
     if len(points) == 0 or len(tri) == 0:
         return found
     three = x.shape[1] == 3
-    mesh = (MeshTet if three else MeshTri)(x.T.copy(), tri.T.copy(), sort_t=False,
-                                             validate=False)
-    mapping = mesh._mapping()
+    mapping, centres, tree, reach = _simplex_search(x, tri, keep)
 
     def inside(tind, pts):
         loc = mapping.invF(pts.T[:, :, None], tind=tind)[:, :, 0]
@@ -139,8 +141,6 @@ def locate_in_simplices(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> n
                     & (1 - loc[0] - loc[1] - loc[2] >= -eps))
         return (loc[0] >= -eps) & (loc[1] >= -eps) & (1 - loc[0] - loc[1] >= -eps)
 
-    centres = x[tri].mean(axis=1)
-    tree = cKDTree(centres)
     k = min(6, len(tri))
     _, near = tree.query(points, k)
     near = near.reshape(len(points), k)
@@ -149,7 +149,6 @@ def locate_in_simplices(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> n
         found[hit] = near[hit, j]
     # the rest: every triangle whose centre is close enough for it to hold the point (within
     # the largest centre-to-corner distance of any triangle), a few points at a time
-    reach = float(np.linalg.norm(x[tri] - centres[:, None], axis=2).max()) * (1 + 1e-9)
     rest = np.flatnonzero(found < 0)
     for lo in range(0, len(rest), 16):
         idx = rest[lo:lo + 16]
@@ -162,3 +161,37 @@ def locate_in_simplices(x: np.ndarray, tri: np.ndarray, points: np.ndarray) -> n
             hit = inside(cand, points[owner])
             found[owner[hit]] = cand[hit]  # any triangle that holds the point
     return found
+
+
+#: the simplex sets whose search structures :func:`_simplex_search` keeps (the last ones)
+SIMPLEX_SETS_KEPT = 2
+_simplex_sets: list = []
+
+
+def _simplex_search(x: np.ndarray, tri: np.ndarray, keep: bool) -> tuple:
+    """What :func:`locate_in_simplices` searches ``tri`` at ``x`` with: scikit-fem's affine
+    mapping of the simplices, their centroids, a KD-tree of those and the largest
+    centre-to-corner distance. With ``keep``, kept for the last :data:`SIMPLEX_SETS_KEPT` sets
+    (positions and simplices compared exactly) until :func:`forget_simplex_sets`: the
+    candidate search asks about the same body mesh at every sampled load factor (17 times in
+    ``vfem run cattaneo3d``, 0.8 s rebuilding them; issue 40)."""
+    x, tri = np.asarray(x, dtype=float), np.asarray(tri)
+    for kx, kt, value in _simplex_sets:  # (:func:`forget_simplex_sets` lets them go)
+        if kx.shape == x.shape and kt.shape == tri.shape and np.array_equal(kt, tri) \
+                and np.array_equal(kx, x):
+            return value
+    mesh = (MeshTet if x.shape[1] == 3 else MeshTri)(x.T.copy(), tri.T.copy(), sort_t=False,
+                                                      validate=False)
+    centres = x[tri].mean(axis=1)
+    reach = float(np.linalg.norm(x[tri] - centres[:, None], axis=2).max()) * (1 + 1e-9)
+    value = (mesh._mapping(), centres, cKDTree(centres), reach)
+    if keep:
+        _simplex_sets.append((x.copy(), tri.copy(), value))
+        del _simplex_sets[:-SIMPLEX_SETS_KEPT]
+    return value
+
+
+def forget_simplex_sets() -> None:
+    """Let go of the search structures :func:`_simplex_search` keeps (a body mesh's every
+    simplex: some 200 MB at a million dofs), once the searches that reuse them are done."""
+    _simplex_sets.clear()

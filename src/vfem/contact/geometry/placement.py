@@ -13,6 +13,7 @@ from ...errors import InputError
 from ..search import project_points
 from .bodymesh import (
     exterior_facets,
+    forget_simplex_sets,
     locate_in_simplices,
     mesh_simplices,
 )
@@ -258,6 +259,17 @@ def select_candidate_facets(bodies: list[Body], pairs: ContactPairs,
     slide far): the samples are refined so that no body moves more than half the search
     distance between two of them (:func:`_path_samples`).
     """
+    try:
+        return _select_candidate_facets(bodies, pairs, search_distance, load_factors,
+                                        follow_path)
+    finally:
+        forget_simplex_sets()  # the body meshes' simplices, searched at every sample
+
+
+def _select_candidate_facets(bodies: list[Body], pairs: ContactPairs, search_distance: float,
+                             load_factors: tuple[float, ...], follow_path: bool
+                             ) -> list[np.ndarray]:
+    """:func:`select_candidate_facets`."""
     ext = [exterior_facets(b) for b in bodies]
     lf = np.concatenate([[0.0], np.asarray(load_factors, dtype=float)])
     samples = np.unique(np.concatenate([lf, np.linspace(lf.min(), lf.max(), 17)]))
@@ -313,6 +325,6 @@ def select_candidate_facets(bodies: list[Body], pairs: ContactPairs,
             if len(box) and i != j:
                 tri = mesh_simplices(mesh) if tri is None else tri
                 inside = locate_in_simplices(mesh.p[:, : mesh.nvertices].T, tri,
-                                             x[box]) >= 0
+                                             x[box], keep=True) >= 0
                 keep[own[box[inside]]] = True
     return [f[keep] for f, keep in zip(ext, keeps)]
