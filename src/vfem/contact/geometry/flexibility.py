@@ -50,16 +50,33 @@ class SurfaceFlexibility:
 
     def normal_compliance(self, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
         """n^T C_jj n at candidate nodes ``nodes`` along unit ``normals``: each node's motion
-        along its normal under a unit force along it (one back-substitution a node,
-        :data:`PROBE_CHUNK` at a time); what ``ContactSurface.normal_stiffness`` inverts."""
+        along its normal under a unit force along it; what ``ContactSurface.normal_stiffness``
+        inverts (the side choice's compliance densities, whose values also blend the two
+        surfaces' normals: exact, not estimated).
+
+        f^T K^-1 f for f the unit force: where the body's factorization is a Cholesky one
+        (PARDISO's positive definite type, K = P^T L L^T P) that is |L^-1 P f|^2, a forward
+        substitution alone (:func:`forward_substitution`: half a back-substitution's work,
+        equal to round-off); otherwise a whole back-substitution. :data:`PROBE_CHUNK` nodes
+        at a time."""
         nodes = np.asarray(nodes, dtype=int)
         d = self.dim
         out = np.zeros(len(nodes))
+        factor = self.body.factor
+        half = forward_substitution(factor, None) is not None
         for start in range(0, len(nodes), PROBE_CHUNK):
             chunk = nodes[start:start + PROBE_CHUNK]
             n = normals[start:start + PROBE_CHUNK]
             cols = d * chunk[:, None] + np.arange(d)  # (k, d)
             k = np.arange(len(chunk))
+            free = self._col_free[cols]
+            if half:  # |L^-1 P f|^2, f the unit force on the node's free dofs
+                rhs = np.zeros((self.n_free, len(chunk)), order="F")
+                rhs[self._col_pos[cols][free], np.broadcast_to(k[:, None], cols.shape)[free]] \
+                    = n[free]
+                y = forward_substitution(factor, rhs)
+                out[start:start + len(chunk)] = np.einsum("ik,ik->k", y, y)
+                continue
             F = np.zeros((self.n_cols, len(chunk)))
             F[cols, k[:, None]] = n
             U = self.apply(F, rows=self.n_cols)
@@ -82,3 +99,13 @@ class SurfaceFlexibility:
         blocks = np.where(mask, blocks, np.eye(d)[None])
         inv = np.linalg.inv(blocks)
         return np.where(mask, inv, 0.0)
+
+
+def forward_substitution(factor, rhs: np.ndarray | None) -> np.ndarray | None:
+    """L^-1 P ``rhs`` ((n, k)) for a Cholesky factorization K = P^T L L^T P, or None where
+    ``factor`` is not one (``rhs`` None: only whether it is): PARDISO's positive definite
+    type solves the forward half alone (``forward_solve``); the other backends here do not
+    offer it."""
+    if not getattr(factor, "cholesky", False):
+        return None
+    return np.zeros(0) if rhs is None else factor.forward_solve(rhs)

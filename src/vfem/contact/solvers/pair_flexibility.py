@@ -5,7 +5,10 @@ sparse nodal forces on both bodies of its pair (its node's facets on one side, t
 its virtual node on the other: :func:`force_rows`); each body's flexibility on its contact dofs
 turns them into motion, read at the pair's nodes and virtual nodes. Formed densely from each
 body's condensed flexibility, or, where the surfaces' flexibility is applied rather than formed
-(issue 22), as the :class:`~vfem.contact.solvers.matrix_free.PairOperator` that applies it."""
+(issue 22), as the :class:`~vfem.contact.solvers.matrix_free.PairOperator` that applies it from
+each body's sparse forces (:func:`force_rows`) and readings (:func:`read_rows`). Both are read
+from the nonzero entries of the pairs' transfer and interpolation matrices, a few a row, without
+a dense copy of them (:func:`nonzeros`; issue 40)."""
 
 from __future__ import annotations
 
@@ -14,32 +17,114 @@ import scipy.sparse as sp
 
 from .matrix_free import PairOperator
 
+#: columns (or rows) of a pair's dense transfer and interpolation matrices read at once when
+#: their nonzero entries are gathered (:func:`nonzeros`): at most this many numbers copied
+NONZERO_CHUNK = 1 << 22
+
+
+def nonzeros(A, rows: np.ndarray | None = None, cols: np.ndarray | None = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(i, j, value) of the nonzero entries of ``A[rows][:, cols]`` (None: all), positions in
+    that submatrix, without copying it whole: a pair's N, T and virtual-node weights are
+    stored dense over every candidate node (``ContactPair.mass``, ``transfer``, ``interp``,
+    ``at``: (nc, nc) numbers a pair, 4 GB each at 23,000 nodes) but have a few entries a
+    row, so they are read :data:`NONZERO_CHUNK` numbers at a time (a sparse ``A`` directly)."""
+    if sp.issparse(A):
+        B = sp.csr_matrix(A)
+        if rows is not None:
+            B = B[rows]
+        if cols is not None:
+            B = B[:, cols]
+        B = B.tocoo()
+        keep = B.data != 0
+        return B.row[keep], B.col[keep], B.data[keep]
+    A = np.asarray(A)
+    nr = A.shape[0] if rows is None else len(rows)
+    nc = A.shape[1] if cols is None else len(cols)
+    out_i, out_j, out_v = [], [], []
+    if cols is not None:  # by column blocks (a few of the columns of a large matrix)
+        step = max(1, NONZERO_CHUNK // max(nr, 1))
+        for start in range(0, nc, step):
+            c = np.asarray(cols[start:start + step])
+            block = A[:, c] if rows is None else A[np.ix_(rows, c)]
+            i, j = np.nonzero(block)
+            out_i.append(i), out_j.append(j + start), out_v.append(block[i, j])
+    else:  # by row blocks
+        step = max(1, NONZERO_CHUNK // max(nc, 1))
+        for start in range(0, nr, step):
+            block = A[start:start + step] if rows is None else A[rows[start:start + step]]
+            i, j = np.nonzero(block)
+            out_i.append(i + start), out_j.append(j), out_v.append(block[i, j])
+    if not out_i:
+        return np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0)
+    return np.concatenate(out_i), np.concatenate(out_j), np.concatenate(out_v)
+
 
 def force_rows(surfaces: list, pairs: list, directions: list[list[np.ndarray]]
                ) -> tuple[np.ndarray, list[sp.csr_matrix]]:
     """The unknowns' offsets (pair by pair, each pair's directions in turn: (pairs + 1,)) and
     per body the sparse nodal forces on its candidate dofs per unit traction value
-    ((dim nc, m)); ``directions``: per pair the directions of its unknowns, each (nodes, dim)."""
+    ((dim nc, m)); ``directions``: per pair the directions of its unknowns, each (nodes, dim).
+    A unit traction value of a compatibility node forces its facets' nodes (N, the pair's
+    ``mass`` columns) and the other surface's nodes under them (T, ``transfer``); a held
+    point, its own node (or its edge's two, ``at``) and the nodes of the facet under it
+    (``interp`` transposed): :meth:`~vfem.contact.geometry.ContactPair.fine_columns`,
+    ``coarse_columns``, read here from their nonzero entries only (:func:`nonzeros`)."""
     offsets = np.cumsum([0] + [len(p.nodes) * len(dirs) for p, dirs in zip(pairs, directions)])
     m = int(offsets[-1])
     parts: list[list] = [[] for _ in surfaces]  # (rows, cols, values) per body
     for k, pair in enumerate(pairs):
         n = len(pair.nodes)
-        for body, columns, sign in ((pair.fine, pair.fine_columns(), 1.0),
-                                    (pair.coarse, pair.coarse_columns(), -1.0)):
-            r, c = np.nonzero(columns)
-            v = sign * columns[r, c]
+        if pair.at is None:
+            fine = nonzeros(pair.mass, cols=pair.nodes)
+            coarse = nonzeros(pair.transfer, cols=pair.nodes)
+        else:  # held points: their own weights, and the shape functions under them
+            c, r, v = nonzeros(pair.at)
+            fine = (r, c, v)
+            c, r, v = nonzeros(pair.interp)
+            coarse = (r, c, v)
+        for body, (r, c, v), sign in ((pair.fine, fine, 1.0), (pair.coarse, coarse, -1.0)):
+            v = sign * v
             dim = surfaces[body].dim
             for j, direction in enumerate(directions[k]):
                 for d in range(dim):  # the force along the direction's components
                     parts[body].append((dim * r + d, offsets[k] + j * n + c,
                                         v * direction[c, d]))
-    dF = [sp.csr_matrix((np.concatenate([p[2] for p in ps]) if ps else [],
-                         (np.concatenate([p[0] for p in ps]) if ps else [],
-                          np.concatenate([p[1] for p in ps]) if ps else [])),
-                        shape=(s.dim * s.nc, m))
-          for s, ps in zip(surfaces, parts)]  # body forces per unit traction value
-    return offsets, dF
+    dF = [_csr(ps, (s.dim * s.nc, m)) for s, ps in zip(surfaces, parts)]
+    return offsets, dF  # body forces per unit traction value
+
+
+def read_rows(surfaces: list, pairs: list, directions: list[list[np.ndarray]],
+              offsets: np.ndarray) -> list[sp.csr_matrix]:
+    """Per body the sparse reading of its candidate dofs' motion by each unknown ((m, dim nc)):
+    the relative displacement of a pair's point and its virtual point along the unknown's
+    reading direction (``ContactPair.reading``), + at the point (its node, or ``at``'s
+    weights), - at the virtual point (``interp``'s weights): W = sum over bodies of
+    ``read[b] @ C_b @ dF[b]`` (eq. 4.2.4 in matrix form, :func:`force_rows`)."""
+    m = int(offsets[-1])
+    parts: list[list] = [[] for _ in surfaces]
+    for k, pair in enumerate(pairs):
+        n = len(pair.nodes)
+        own = ((np.arange(n), pair.nodes, np.ones(n)) if pair.at is None
+               else nonzeros(pair.at))
+        for body, (i, node, w), sign in ((pair.fine, own, 1.0),
+                                         (pair.coarse, nonzeros(pair.interp), -1.0)):
+            dim = surfaces[body].dim
+            for j, direction in enumerate(directions[k]):
+                along = pair.reading(j, direction)
+                for d in range(dim):
+                    parts[body].append((offsets[k] + j * n + i, dim * node + d,
+                                        sign * w * along[i, d]))
+    return [_csr(ps, (m, s.dim * s.nc)) for s, ps in zip(surfaces, parts)]
+
+
+def _csr(parts: list, shape: tuple[int, int]) -> sp.csr_matrix:
+    """The sparse matrix of (rows, cols, values) parts."""
+    if not parts:
+        return sp.csr_matrix(shape)
+    return sp.csr_matrix((np.concatenate([p[2] for p in parts]),
+                          (np.concatenate([p[0] for p in parts]),
+                           np.concatenate([p[1] for p in parts]))), shape=shape)
 
 
 def platen_rows(surfaces: list, platen_body: int | None, dF: list[sp.csr_matrix], m: int
@@ -62,8 +147,8 @@ def pair_matrix(surfaces: list, pairs: list, directions: list[list[np.ndarray]],
     m = int(offsets[-1])
     dp_dplaten = np.concatenate(platen_rates or [np.zeros(0)])
     if any(s.matrix_free for s in surfaces):
-        W = PairOperator(surfaces, [s.flexibility for s in surfaces], dF, pairs, directions,
-                         offsets, executor)
+        W = PairOperator(surfaces, [s.flexibility for s in surfaces], dF,
+                         read_rows(surfaces, pairs, directions, offsets), executor)
         return W, dp_dplaten
 
     def motion(b: int) -> np.ndarray:  # C f as (f^T C^T)^T, on the body's owner
