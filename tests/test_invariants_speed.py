@@ -239,26 +239,17 @@ def test_scatter_add_is_np_add_at_bit_for_bit(n, m, seed):
 # -- the pre-filter -------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("order", [1, 2])
-def test_2d_random_displacements_keep_every_inside_node(order):
-    bodies = disk_on_block(order)
+@pytest.mark.parametrize(("make", "rigid_motions", "examples"), [
+    (lambda: disk_on_block(1), [0.0, 1e-4, 0.05, 0.5], None),
+    (lambda: disk_on_block(2), [0.0, 1e-4, 0.05, 0.5], None),
+    (lambda: sphere_on_box(quarter=True), [0.0, 1e-4, 0.05, 0.3], 12)],
+    ids=["2d-linear", "2d-quadratic", "3d"])
+def test_random_displacements_keep_every_inside_node(make, rigid_motions, examples):
+    bodies = make()
     check = InvariantCheck(bodies, None, TOL)
 
-    @DRAWS
-    @given(seed=st.integers(0, 2**32 - 1), rigid=st.sampled_from([0.0, 1e-4, 0.05, 0.5]),
-           noise=st.sampled_from([0.0, 1e-6, 1e-3, 0.05]))
-    def draw(seed, rigid, noise):
-        assert_keeps_every_inside_node(check, moved(bodies, seed, rigid, noise))
-
-    draw()
-
-
-def test_3d_random_displacements_keep_every_inside_node():
-    bodies = sphere_on_box(quarter=True)
-    check = InvariantCheck(bodies, None, TOL)
-
-    @settings(DRAWS, max_examples=12)
-    @given(seed=st.integers(0, 2**32 - 1), rigid=st.sampled_from([0.0, 1e-4, 0.05, 0.3]),
+    @(DRAWS if examples is None else settings(DRAWS, max_examples=examples))
+    @given(seed=st.integers(0, 2**32 - 1), rigid=st.sampled_from(rigid_motions),
            noise=st.sampled_from([0.0, 1e-6, 1e-3, 0.05]))
     def draw(seed, rigid, noise):
         assert_keeps_every_inside_node(check, moved(bodies, seed, rigid, noise))
