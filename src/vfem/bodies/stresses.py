@@ -179,6 +179,11 @@ def strain_beyond(body, u: np.ndarray, limit: float) -> tuple[float, int] | None
     returned are :func:`max_strain`'s whenever it exceeds ``limit``
     (tests/test_strain_warning.py)."""
     u = np.asarray(u, dtype=float)
+    if body.section.space not in ("2D", "3D"):
+        # the bound is of the displacement's gradient alone: a section whose strain has more
+        # (a body of revolution's hoop strain u_r / r) reads every point
+        strain, element = max_strain(body, u)
+        return (strain, element) if strain > limit else None
     dim = body.dim
     element_dofs = body.dof_map.element_dofs  # (vector shape functions, elements)
     nel = element_dofs.shape[1]
