@@ -118,14 +118,14 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray,
     the pair set-up of the sphere at 100k dofs (issue 40)."""
     args = (x, xo, zone, ozone)
     kept = s.__dict__.setdefault("_facing", [])
-    for other, before, patch in kept:
-        if other is so and all((a is None and b is None) or (
+    for owner, other, before, patch in kept:
+        if owner == id(s) and other is so and all((a is None and b is None) or (
                 a is not None and b is not None and np.array_equal(a, b))
                 for a, b in zip(args, before)):
             return patch.copy()
     patch = _facing(s, x, so, xo, zone, ozone)
-    kept.append((so, tuple(None if a is None else np.array(a, copy=True) for a in args),
-                 patch.copy()))
+    kept.append((id(s), so, tuple(None if a is None else np.array(a, copy=True) for a in args),
+                 patch.copy()))  # (whose: a shallow copy of s shares the list)
     del kept[:-FACING_KEPT]
     return patch
 
