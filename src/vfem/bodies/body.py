@@ -118,11 +118,13 @@ class Body:
         the prescribed value of every supported or prescribed dof."""
         return condensation.assemble(self)
 
-    def setup(self, backend: str | None = None, condensed_dofs: np.ndarray | None = None) -> None:
+    def setup(self, backend: str | None = None, condensed_dofs: np.ndarray | None = None,
+              assembled: dict[int, float] | None = None) -> None:
         """Validate, assemble, factorize and solve the load cases
         (:func:`.condensation.setup`); with ``condensed_dofs``, keep the flexibility among
-        them (``condensed_flexibility``)."""
-        condensation.setup(self, backend, condensed_dofs)
+        them (``condensed_flexibility``); ``assembled``: what :meth:`assemble` returned, if
+        it was called already (then not again)."""
+        condensation.setup(self, backend, condensed_dofs, assembled)
 
     # -- the body's mechanics (vfem.bodies.mechanics) ---------------------------------------
 

@@ -65,14 +65,15 @@ def assemble(body) -> dict[int, float]:
     return fixed
 
 
-def setup(body, backend: str | None = None, condensed_dofs: np.ndarray | None = None) -> None:
+def setup(body, backend: str | None = None, condensed_dofs: np.ndarray | None = None,
+          assembled: dict[int, float] | None = None) -> None:
     """Validate, assemble the stiffness (:func:`assemble`), factorize it and solve the unit
     load cases.
 
     With ``condensed_dofs`` (the dofs contact follows), the factorization also yields the
     inverse stiffness among them (``condensed_flexibility``, supports kept: zero on fixed dofs).
     """
-    fixed = assemble(body)
+    fixed = assemble(body) if assembled is None else assembled
     t1 = time.perf_counter()
     platen_dofs = body.platen_dofs
     K_ff = body.K_ff
