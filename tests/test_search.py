@@ -88,3 +88,28 @@ def test_an_input_file_run_searches_its_candidates_once(monkeypatch, tmp_path):
     _, again = model.contact_surfaces()
     assert len(calls) == 2
     assert [s.nc for s in first] == [s.nc for s in again]
+
+
+def test_kept_answers_are_found_by_their_arguments_compared_exactly():
+    """vfem.contact.geometry.kept.Kept (issue 40): an answer comes back only for the same
+    arrays (entry for entry, copied when kept: a caller's later change misses), the same
+    integers and the same objects; the oldest is let go past its size."""
+    from vfem.contact.geometry.kept import Kept
+
+    made = []
+    kept = Kept(2)
+
+    def make(tag):
+        return lambda: made.append(tag) or tag
+
+    x, owner = np.arange(6.0), object()
+    assert kept.get((x, 7, owner), make("a")) == "a"
+    assert kept.get((x.copy(), 7, owner), make("b")) == "a"  # equal arrays: found
+    x[0] = -1.0  # the caller's array changed: the kept copy no longer matches
+    assert kept.get((x, 7, owner), make("c")) == "c"
+    assert kept.get((np.arange(6.0), 8, owner), make("d")) == "d"  # another integer
+    assert kept.get((np.arange(6.0), 7, object()), make("e")) == "e"  # another object
+    assert made == ["a", "c", "d", "e"]
+    assert len(kept.entries) == 2
+    assert kept.get((np.arange(6.0), 7, owner), make("f")) == "f"  # "a" was let go
+    assert kept.get((None, 1), make("g"), keep=False) == "g" and len(kept.entries) == 2

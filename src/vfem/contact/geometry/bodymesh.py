@@ -14,6 +14,7 @@ from skfem import MeshHex, MeshTet, MeshTri
 
 from ...bodies import Body
 from ...mesh.checks import _corners
+from .kept import Kept
 
 
 def symmetry_planes(body) -> list[tuple[np.ndarray, int]]:
@@ -165,30 +166,26 @@ def locate_in_simplices(x: np.ndarray, tri: np.ndarray, points: np.ndarray,
 
 #: the simplex sets whose search structures :func:`_simplex_search` keeps (the last ones)
 SIMPLEX_SETS_KEPT = 2
-_simplex_sets: list = []
+_simplex_sets = Kept(SIMPLEX_SETS_KEPT)
 
 
 def _simplex_search(x: np.ndarray, tri: np.ndarray, keep: bool) -> tuple:
     """What :func:`locate_in_simplices` searches ``tri`` at ``x`` with: scikit-fem's affine
     mapping of the simplices, their centroids, a KD-tree of those and the largest
     centre-to-corner distance. With ``keep``, kept for the last :data:`SIMPLEX_SETS_KEPT` sets
-    (positions and simplices compared exactly) until :func:`forget_simplex_sets`: the
-    candidate search asks about the same body mesh at every sampled load factor (17 times in
-    ``vfem run cattaneo3d``, 0.8 s rebuilding them; issue 40)."""
+    (:class:`~.kept.Kept`) until :func:`forget_simplex_sets`: the candidate search asks about
+    the same body mesh at every sampled load factor (17 times in ``vfem run cattaneo3d``,
+    0.8 s rebuilding them; issue 40)."""
     x, tri = np.asarray(x, dtype=float), np.asarray(tri)
-    for kx, kt, value in _simplex_sets:  # (:func:`forget_simplex_sets` lets them go)
-        if kx.shape == x.shape and kt.shape == tri.shape and np.array_equal(kt, tri) \
-                and np.array_equal(kx, x):
-            return value
-    mesh = (MeshTet if x.shape[1] == 3 else MeshTri)(x.T.copy(), tri.T.copy(), sort_t=False,
-                                                      validate=False)
-    centres = x[tri].mean(axis=1)
-    reach = float(np.linalg.norm(x[tri] - centres[:, None], axis=2).max()) * (1 + 1e-9)
-    value = (mesh._mapping(), centres, cKDTree(centres), reach)
-    if keep:
-        _simplex_sets.append((x.copy(), tri.copy(), value))
-        del _simplex_sets[:-SIMPLEX_SETS_KEPT]
-    return value
+
+    def make():
+        mesh = (MeshTet if x.shape[1] == 3 else MeshTri)(x.T.copy(), tri.T.copy(),
+                                                          sort_t=False, validate=False)
+        centres = x[tri].mean(axis=1)
+        reach = float(np.linalg.norm(x[tri] - centres[:, None], axis=2).max()) * (1 + 1e-9)
+        return mesh._mapping(), centres, cKDTree(centres), reach
+
+    return _simplex_sets.get((x, tri), make, keep)
 
 
 def forget_simplex_sets() -> None:

@@ -45,6 +45,8 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .kept import Kept
+
 #: up to this many point-facet pairs the candidates come from all centre distances at once,
 #: above it from a KD-tree on the facets' centres (as
 #: :data:`vfem.contact.search.closest.DIRECT_PAIRS`)
@@ -350,27 +352,17 @@ def _workers(m: int) -> int:
 
 #: the facet sets whose derived data :func:`kept` keeps (the last ones asked about)
 SURFACES_KEPT = 4
-_kept: list = []
+_surfaces = Kept(SURFACES_KEPT)
 
 
 def kept(x: np.ndarray, facets: np.ndarray) -> dict:
-    """A dictionary kept for the facet set ``facets`` at positions ``x`` (the last
-    :data:`SURFACES_KEPT` sets, the positions and facets compared exactly), for what is
-    derived from them alone: their validation (:func:`check_facets`), their corners' tie
-    tolerance and the search trees of :func:`candidate_pairs`. A pair's set-up and the
-    invariants ask about the same surface hundreds of times (the bisections of
-    :func:`~.held.held_edges`: 992 queries in the four-plate stack), each of which rebuilt
-    them (issue 40)."""
-    x = np.asarray(x, dtype=float)
-    facets = np.asarray(facets)
-    for kx, kf, value in _kept:
-        if kx.shape == x.shape and kf.shape == facets.shape and np.array_equal(kf, facets) \
-                and np.array_equal(kx, x):
-            return value
-    value: dict = {}
-    _kept.append((x.copy(), facets.copy(), value))
-    del _kept[:-SURFACES_KEPT]
-    return value
+    """A dictionary kept for the facet set ``facets`` at positions ``x`` (:class:`~.kept.Kept`:
+    the last :data:`SURFACES_KEPT` sets), for what is derived from them alone: their
+    validation (:func:`check_facets`), their corners' tie tolerance and the search trees of
+    :func:`candidate_pairs`. A pair's set-up and the invariants ask about the same surface
+    hundreds of times (the bisections of :func:`~.held.held_edges`: 992 queries in the
+    four-plate stack), each of which rebuilt them (issue 40)."""
+    return _surfaces.get((np.asarray(x, dtype=float), np.asarray(facets)), dict)
 
 
 def checked(x: np.ndarray, facets: np.ndarray) -> dict:

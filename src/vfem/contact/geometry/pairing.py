@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .kept import Kept
 from .surface import ContactSurface
 from .transfer import transfer_matrices
 
@@ -116,18 +117,10 @@ def facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray,
     Kept on ``s`` for the last few arguments: a pair's set-up asks for the same patches
     three times (each side's compliance for the side choice, then the overlap), a third of
     the pair set-up of the sphere at 100k dofs (issue 40)."""
-    args = (x, xo, zone, ozone)
-    kept = s.__dict__.setdefault("_facing", [])
-    for owner, other, before, patch in kept:
-        if owner == id(s) and other is so and all((a is None and b is None) or (
-                a is not None and b is not None and np.array_equal(a, b))
-                for a, b in zip(args, before)):
-            return patch.copy()
-    patch = _facing(s, x, so, xo, zone, ozone)
-    kept.append((id(s), so, tuple(None if a is None else np.array(a, copy=True) for a in args),
-                 patch.copy()))  # (whose: a shallow copy of s shares the list)
-    del kept[:-FACING_KEPT]
-    return patch
+    kept = s.__dict__.setdefault("_facing", Kept(FACING_KEPT))
+    # (whose: a shallow copy of s would share the answers)
+    key = (id(s), so, *(None if a is None else np.asarray(a) for a in (x, xo, zone, ozone)))
+    return kept.get(key, lambda: _facing(s, x, so, xo, zone, ozone)).copy()
 
 
 #: how many of :func:`facing`'s last answers a surface keeps
