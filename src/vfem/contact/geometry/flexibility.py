@@ -56,14 +56,14 @@ class SurfaceFlexibility:
 
         f^T K^-1 f for f the unit force: where the body's factorization is a Cholesky one
         (PARDISO's positive definite type, K = P^T L L^T P) that is |L^-1 P f|^2, a forward
-        substitution alone (:func:`forward_substitution`: half a back-substitution's work,
+        substitution alone (``forward_solve``, PARDISO's: half a back-substitution's work,
         equal to round-off); otherwise a whole back-substitution. :data:`PROBE_CHUNK` nodes
         at a time."""
         nodes = np.asarray(nodes, dtype=int)
         d = self.dim
         out = np.zeros(len(nodes))
         factor = self.body.factor
-        half = forward_substitution(factor, None) is not None
+        half = getattr(factor, "cholesky", False)  # (other backends: the whole solve)
         for start in range(0, len(nodes), PROBE_CHUNK):
             chunk = nodes[start:start + PROBE_CHUNK]
             n = normals[start:start + PROBE_CHUNK]
@@ -74,7 +74,7 @@ class SurfaceFlexibility:
                 rhs = np.zeros((self.n_free, len(chunk)), order="F")
                 rhs[self._col_pos[cols][free], np.broadcast_to(k[:, None], cols.shape)[free]] \
                     = n[free]
-                y = forward_substitution(factor, rhs)
+                y = factor.forward_solve(rhs)
                 out[start:start + len(chunk)] = np.einsum("ik,ik->k", y, y)
                 continue
             F = np.zeros((self.n_cols, len(chunk)))
@@ -99,13 +99,3 @@ class SurfaceFlexibility:
         blocks = np.where(mask, blocks, np.eye(d)[None])
         inv = np.linalg.inv(blocks)
         return np.where(mask, inv, 0.0)
-
-
-def forward_substitution(factor, rhs: np.ndarray | None) -> np.ndarray | None:
-    """L^-1 P ``rhs`` ((n, k)) for a Cholesky factorization K = P^T L L^T P, or None where
-    ``factor`` is not one (``rhs`` None: only whether it is): PARDISO's positive definite
-    type solves the forward half alone (``forward_solve``); the other backends here do not
-    offer it."""
-    if not getattr(factor, "cholesky", False):
-        return None
-    return np.zeros(0) if rhs is None else factor.forward_solve(rhs)
