@@ -65,6 +65,9 @@ class Section(Protocol):
     space: str
     #: whether large kinematics (:mod:`vfem.nonlinear`) has this section
     takes_large: bool
+    #: whether its small strain is sym(∇u) alone (a body of revolution's also has u_r / r):
+    #: what the strain warning's screen bounds (:func:`~.stresses.strain_beyond`)
+    strain_is_gradient: bool
 
     def weight(self, x: np.ndarray) -> np.ndarray | float:
         """The measure per unit of the mesh's length, area or volume at the points ``x``
@@ -110,6 +113,7 @@ class _Plane:
     """A 2D section of measure 1 (plane strain or plane stress): what they share."""
 
     space = "2D"
+    strain_is_gradient = True
 
     def __repr__(self) -> str:
         return f"<section {self.name}>"
@@ -180,6 +184,7 @@ class Solid:
     name = "3D"
     space = "3D"
     takes_large = True
+    strain_is_gradient = True
 
     def __repr__(self) -> str:
         return "<section 3D>"

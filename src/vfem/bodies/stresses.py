@@ -179,7 +179,7 @@ def strain_beyond(body, u: np.ndarray, limit: float) -> tuple[float, int] | None
     returned are :func:`max_strain`'s whenever it exceeds ``limit``
     (tests/test_strain_warning.py)."""
     u = np.asarray(u, dtype=float)
-    if body.section.space not in ("2D", "3D"):
+    if not body.section.strain_is_gradient:
         # the bound is of the displacement's gradient alone: a section whose strain has more
         # (a body of revolution's hoop strain u_r / r) reads every point
         strain, element = max_strain(body, u)
