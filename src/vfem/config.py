@@ -334,7 +334,9 @@ def check(config: ModelConfig, base: Path | None = None) -> Model:
     model = config.build(base)
     for body in model.bodies:
         body.check_supports()
-    model.contact_surfaces()
+    from .parallel import current
+
+    model.contact_surfaces(current())  # (the pairs' search spread over MPI ranks: kept)
     return model
 
 

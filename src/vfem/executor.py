@@ -11,6 +11,8 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from typing import Protocol
 
+import numpy as np
+
 
 class Executor(Protocol):
     #: how many processes share the work (owners run from 0 to size - 1)
@@ -21,6 +23,12 @@ class Executor(Protocol):
         """``compute(i)`` for every ``i`` of ``indices`` (each body's work on its owner, or on
         ``owners[i]``), every value to every caller, keyed by ``i``."""
 
+    def total(self, indices: Iterable[int], compute: Callable[[int], np.ndarray],
+              shape: tuple[int, ...]) -> np.ndarray:
+        """The sum of ``compute(i)`` (arrays of ``shape``) over ``indices``, each on its
+        owner; the sum, the same numbers, to every caller (what each body adds to a shared
+        matrix, without sending any body's part to every rank)."""
+
 
 class Serial:
     """Every body in this process, in order."""
@@ -30,6 +38,13 @@ class Serial:
     def map(self, indices: Iterable[int], compute: Callable[[int], object],
             owners: list[int] | None = None) -> dict:
         return {i: compute(i) for i in indices}
+
+    def total(self, indices: Iterable[int], compute: Callable[[int], np.ndarray],
+              shape: tuple[int, ...]) -> np.ndarray:
+        out = np.zeros(shape)
+        for i in indices:
+            out += compute(i)
+        return out
 
 
 #: the executor of a serial run (and of formulations built without one)

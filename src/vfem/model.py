@@ -22,6 +22,7 @@ from .contact.geometry import (
 )
 from .contact.settings import ContactSettings
 from .errors import InputError
+from .executor import SERIAL
 
 
 @dataclass
@@ -79,7 +80,7 @@ class Model:
         return ContactPairs.parse(self.contact_pairs, self.bodies,
                                   f"model {self.name!r}: contact pair")
 
-    def contact_surfaces(self) -> tuple[ContactPairs, list[ContactSurface]]:
+    def contact_surfaces(self, executor=SERIAL) -> tuple[ContactPairs, list[ContactSurface]]:
         """The pairs of surface sides that may touch (:meth:`pairs`, their zones read on the
         surfaces) and each body's contact surface: candidate facets within
         ``contact.search_distance`` of a side it may touch (by default every facet that may
@@ -88,7 +89,8 @@ class Model:
 
         Depends on the meshes only, so it is also part of ``vfem check``: bodies that start
         deeper into each other than the outer layer of elements are refused here
-        (:func:`~vfem.contact.geometry.placement.check_initial_overlap`).
+        (:func:`~vfem.contact.geometry.placement.check_initial_overlap`). ``executor``: where
+        each pair's search runs (:mod:`vfem.executor`; over MPI ranks, spread).
         """
         pairs = self.pairs()
         distance = self.contact.search_distance
@@ -98,13 +100,14 @@ class Model:
         elif distance is None:
             diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in self.bodies]
             distance = 0.02 * min(diag)
-        facets = self._candidate_facets(pairs, distance, large)
+        facets = self._candidate_facets(pairs, distance, large, executor)
         surfaces = [ContactSurface.build(b, f) for b, f in zip(self.bodies, facets)]
         pairs = pairs.on(surfaces)
         check_initial_overlap(surfaces, pairs)
         return pairs, surfaces
 
-    def _candidate_facets(self, pairs: ContactPairs, distance: float, large: bool) -> list:
+    def _candidate_facets(self, pairs: ContactPairs, distance: float, large: bool,
+                          executor=SERIAL) -> list:
         """Each body's candidate facets (:func:`select_candidate_facets`), searched once per
         model: an input file's run checks its model (``vfem.config.check``, which builds the
         contact surfaces) and then solves it (:meth:`vfem.solver.Analysis.setup`, again),
@@ -119,6 +122,6 @@ class Model:
         kept = self.__dict__.get("_facets")
         if kept is None or kept[0] != key:
             facets = select_candidate_facets(self.bodies, pairs, distance, self.load_factors,
-                                             follow_path=large)
+                                             follow_path=large, executor=executor)
             kept = self.__dict__["_facets"] = (key, facets)
         return [np.array(f, copy=True) for f in kept[1]]

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import logging
 import os
+import time
 from collections.abc import Callable, Iterable
 
 import numpy as np
@@ -57,6 +58,12 @@ class Ranks:
         self.local = False
         #: this rank's scratch results folder (ranks other than 0, :func:`scratch_folder`)
         self.scratch = None
+        #: seconds this rank spent on its own share of the work that is spread over the
+        #: ranks (each body's on its owner, each pair's on one rank: :meth:`own`); the rest of
+        #: a run's time on a rank is done by every rank alike, or waiting for the others
+        #: (``benchmarks/ranks.py``'s replicated fraction, issue 40)
+        self.busy = 0.0
+        self._depth = 0
 
     @property
     def parallel(self) -> bool:
@@ -84,6 +91,19 @@ class Ranks:
         """Whether body ``i`` is this rank's."""
         return not self.owner or self.owner[i] == self.rank
 
+    def own(self, compute: Callable, *args) -> object:
+        """``compute(*args)``, this rank's share of spread work, timed into :attr:`busy`
+        (the outermost call only: a share within a share is counted once)."""
+        if self._depth:
+            return compute(*args)
+        self._depth += 1
+        t = time.perf_counter()
+        try:
+            return compute(*args)
+        finally:
+            self.busy += time.perf_counter() - t
+            self._depth -= 1
+
     def share(self, i: int, make: Callable[[], object]) -> object:
         """``make()`` on body ``i``'s owner, its value on every rank; an error raised there is
         raised on every rank (the same type and message where it can be rebuilt)."""
@@ -92,7 +112,7 @@ class Ranks:
         value = error = None
         if self.mine(i):
             try:
-                value = make()
+                value = self.own(make)
             except Exception as e:  # noqa: BLE001 - carried to every rank, raised there
                 error = e
         value, error = self.comm.bcast((value, error), root=self.owner[i])
@@ -106,8 +126,9 @@ class Ranks:
         ``owners[i]``: work that is no body's, spread), all owners at once; every rank gets
         every value. In serial, simply in order."""
         indices = list(indices)
-        if not self.parallel:
-            return {i: compute(i) for i in indices}
+        if not self.parallel or (owners is None and not self.owner):
+            # (no bodies placed: a run every rank does whole, a baseline's)
+            return {i: self.own(compute, i) for i in indices}
 
         def owner(i: int) -> int:
             return owners[i] if owners is not None else self.owner[i]
@@ -118,7 +139,7 @@ class Ranks:
             for i in indices:
                 if owner(i) == self.rank:
                     try:
-                        out[i] = compute(i)
+                        out[i] = self.own(compute, i)
                     except Exception as e:  # noqa: BLE001 - carried to every rank
                         errors[i] = e
         finally:
@@ -128,6 +149,42 @@ class Ranks:
             if error is not None:
                 raise error
             out[i] = value
+        return out
+
+    def total(self, indices: Iterable[int], compute: Callable[[int], np.ndarray],
+              shape: tuple[int, ...]) -> np.ndarray:
+        """The sum over ``indices`` of ``compute(i)`` (arrays of ``shape``), each computed on
+        body ``i``'s owner and summed there with the others it owns, the owners' sums added
+        on rank 0 (``MPI_Reduce``) and sent from it to every rank, so that every rank holds the
+        same numbers (its decisions depend on them). What crosses is one array of ``shape``
+        per rank, not every body's (issue 40: the pair matrix W, each body's part on its
+        owner). An error raised on an owner is raised on every rank. In serial, in order."""
+        indices = list(indices)
+        if not self.parallel or not self.owner:
+            out = np.zeros(shape)
+            for i in indices:
+                out += self.own(compute, i)
+            return out
+        partial, error = np.zeros(shape), None
+        self.local = True
+        try:
+            for i in indices:
+                if self.owner[i] == self.rank:
+                    partial += self.own(compute, i)
+        except Exception as e:  # noqa: BLE001 - carried to every rank
+            error = e
+        finally:
+            self.local = False
+        errors = [e for e in self.comm.allgather(error) if e is not None]
+        if errors:
+            raise errors[0]
+        from mpi4py import MPI
+
+        out = np.zeros(shape) if self.root else None
+        self.comm.Reduce(partial, out, op=MPI.SUM, root=0)
+        if not self.root:
+            out = partial  # (its own sum no longer needed: the buffer the total comes into)
+        self.comm.Bcast(out, root=0)
         return out
 
     def finish(self, status: int) -> None:
@@ -176,11 +233,13 @@ class SharedFactor:
 def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None],
                   share_flexibility: bool = False) -> None:
     """Set every body up on its owner (``setup(i)``: assemble, factorize, solve its load
-    cases), all owners at once; on the other ranks only assemble it (the invariants and the
-    results read its stiffness), then hand them what the contact iteration reads of it and a
-    :class:`SharedFactor` in place of its factorization. ``share_flexibility``: also its dense
-    flexibility on its contact dofs (a formulation that reads it on every rank: the thesis
-    variant); the paired variant reads it on the owner only (:meth:`Ranks.map`)."""
+    cases), all owners at once; on the other ranks only what every rank reads of it (its
+    dofs, supports and loads; not its stiffness: what reads it, a step's fields and
+    reactions, runs on the owner, issue 40), then hand them what the contact iteration reads
+    of it and a :class:`SharedFactor` in place of its factorization. ``share_flexibility``:
+    also its dense flexibility on its contact dofs (a formulation that reads it on every
+    rank: the thesis variant); the paired variant reads it on the owner only
+    (:meth:`Ranks.map`)."""
     from .bodies.mechanics import LinearMechanics
 
     ranks.place([b.dim * b.npoints for b in bodies])
@@ -189,11 +248,11 @@ def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None],
     for i, b in enumerate(bodies):
         if ranks.mine(i):
             try:
-                setup(i)
+                ranks.own(setup, i)
             except Exception as e:  # noqa: BLE001 - raised on every rank by share, below
                 b._setup_error = e
         else:
-            b.assemble()
+            b.assemble(stiffness=False)
     for i, b in enumerate(bodies):
         def payload(b=b):
             error = b.__dict__.pop("_setup_error", None)

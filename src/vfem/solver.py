@@ -301,7 +301,8 @@ class Analysis:
         t0 = time.perf_counter()
         log.info("linear solver: %s", self.backend)
         bodies = self.model.bodies
-        pairs, self.surfaces = self.model.contact_surfaces()
+        # (each pair's search on one rank under MPI, vfem.parallel)
+        pairs, self.surfaces = self.model.contact_surfaces(current_ranks())
         self.pairs = pairs
         # condensed to the candidate dofs alone unless the formulation reads the rind (issue 19)
         reads_rind = self._formulation().capabilities.reads_rind
@@ -335,11 +336,10 @@ class Analysis:
                 # bodies' assembly 2.8-3.5 s this way, 4.3-5.2 s assembling the second body
                 # beside the first one's factors; issue 40), as a plain run assembles its
                 # whole model first
-                assembled = [b.assemble() for b in bodies]
+                assembled = [ranks.own(b.assemble) for b in bodies]
                 for b, s, a in zip(bodies, self.surfaces, assembled):
-                    b.setup(self.backend,
-                            condensed_dofs=None if self.matrix_free else s.condensed_dofs,
-                            assembled=a)
+                    ranks.own(b.setup, self.backend,
+                              None if self.matrix_free else s.condensed_dofs, a)
             t2 = time.perf_counter()
             # the bodies' unloaded state (a switch of a compatibility side under large
             # kinematics goes through the steps again from it: :meth:`_replay`)
@@ -449,11 +449,14 @@ class Analysis:
         small body and step (:func:`~vfem.bodies.stresses.strain_beyond`: the strain exactly
         only in elements that could exceed the limit), none once every such body has been
         named."""
-        for b in self.model.bodies:
-            if b.large or b.name in self.strain_warned or b.name not in step.bodies:
-                continue
-            beyond = strain_beyond(b, step.bodies[b.name].displacement.ravel(),
-                                   SMALL_STRAIN_LIMIT)
+        bodies = self.model.bodies
+        screened = [i for i, b in enumerate(bodies) if not (
+            b.large or b.name in self.strain_warned or b.name not in step.bodies)]
+        # each body on the rank that owns it (the bound comes from its assembly, vfem.parallel)
+        found = current_ranks().map(screened, lambda i: strain_beyond(
+            bodies[i], step.bodies[bodies[i].name].displacement.ravel(), SMALL_STRAIN_LIMIT))
+        for i in screened:
+            b, beyond = bodies[i], found[i]
             if beyond is not None:
                 strain, element = beyond
                 self.strain_warned.add(b.name)

@@ -111,15 +111,10 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
     """Force balance and residual penetration of the last step."""
     last = result.steps[-1]
     bodies = {b.name: b for b in result.model.bodies}
-    surfaces = {s.body.name: s for s in result.surfaces}
     out = {}
     for name, boundary in (("small", "bottom"), ("large", "top")):
         b, r = bodies[name], last.bodies[name]
-        f = np.zeros(b.ndofs)
-        s = surfaces[name]
-        f[s.candidate_dofs] = r.contact_force[s.nodes[: s.nc]].ravel()
-        out[f"{name}_reaction_y"] = b.reaction(r.displacement.ravel(), boundary, "y",
-                                               last.load_factor, f)
+        out[f"{name}_reaction_y"] = b.reaction_of(r, boundary, "y")
         out[f"{name}_contact_force_y"] = float(r.contact_force[:, 1].sum())
     # invariant (a)'s scale: the larger block's total contact force (x and y)
     out["largest_body_contact_force"] = max(

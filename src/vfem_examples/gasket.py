@@ -359,9 +359,7 @@ def summarize(result: AnalysisResult, p: GasketParameters) -> dict:
         F, F_stiff = total_force(s), total_force(s, "stiff")
         back = {}
         for b in model.bodies:
-            u = disp[b.name].ravel()
-            back[b.name] = [b.reaction(u, "back", c, s.load_factor, forces[b.name].ravel())
-                            for c in ("x", "y")]
+            back[b.name] = [b.reaction_of(s.bodies[b.name], "back", c) for c in ("x", "y")]
         rows.append({
             **step_record(s),
             "step": k + 1,

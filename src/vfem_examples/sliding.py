@@ -144,19 +144,15 @@ def reactions(result: AnalysisResult) -> dict[str, list[float]]:
     """Per converged step: the slide so far and the force the punch's top support applies to
     it (the punch's reaction), along x (tangential) and y (normal, negative: pressing down)."""
     punch = next(b for b in result.model.bodies if b.name == "punch")
-    surface = next(s for s in result.surfaces if s.body is punch)
     rows: dict[str, list[float]] = {"load_factor": [], "slide": [], "normal": [],
                                     "tangential": []}
     top = punch.boundary_points("top")
     for step in result.steps:
         r = step.bodies["punch"]
-        f = np.zeros(punch.ndofs)
-        f[surface.candidate_dofs] = r.contact_force[surface.nodes[: surface.nc]].ravel()
-        u = r.displacement.ravel()
         rows["load_factor"].append(step.load_factor)
         rows["slide"].append(float(np.mean(r.displacement[top, 0])))
-        rows["normal"].append(punch.reaction(u, "top", "y", step.load_factor, f))
-        rows["tangential"].append(punch.reaction(u, "top", "x", step.load_factor, f))
+        rows["normal"].append(punch.reaction_of(r, "top", "y"))
+        rows["tangential"].append(punch.reaction_of(r, "top", "x"))
     return rows
 
 

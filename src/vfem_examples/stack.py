@@ -159,19 +159,14 @@ def evaluate(result: AnalysisResult, p: Parameters) -> dict:
     axis = p.dim - 1
     component = "zy"[p.dim == 2]
     bodies = {b.name: b for b in result.model.bodies}
-    surfaces = {s.body.name: s for s in result.surfaces}
 
     def reaction(name: str, face: str | None = None) -> float:
         """The vertical force the constraints on ``face`` (every constraint of the body:
         each constrained dof once) apply to body ``name``."""
         body, r = bodies[name], last.bodies[name]
-        s = surfaces[name]
-        f = np.zeros(body.ndofs)
-        f[s.candidate_dofs] = r.contact_force[s.nodes[: s.nc]].ravel()
-        u = r.displacement.ravel()
         if face is not None:
-            return body.reaction(u, face, component, last.load_factor, f)
-        return float(body.nodal_reaction(u, last.load_factor, f)[axis::p.dim].sum())
+            return body.reaction_of(r, face, component)
+        return float(np.asarray(r.reaction).ravel()[axis::p.dim].sum())
 
     def face_force(name: str, face: str) -> float:
         body = bodies[name]

@@ -305,10 +305,8 @@ def evaluate(model: Model, steps: list[StepResult], p: WedgeParameters) -> dict:
     wedge_share = (float(rw.displacement[tw, 1]) - predicted) / p.motion
     f_wedge = rw.contact_force.sum(axis=0)  # on the wedge, from the plate
     f_plate = rp.contact_force.sum(axis=0)
-    support = plate.reaction(rp.displacement.ravel(), "bottom", "y", last.load_factor,
-                             rp.contact_force.ravel())
-    drive = upper.reaction(rw.displacement.ravel(), "top_loaded", "y", last.load_factor,
-                           rw.contact_force.ravel())
+    support = plate.reaction_of(rp, "bottom", "y")
+    drive = upper.reaction_of(rw, "top_loaded", "y")
     force = float(f_wedge[1])
     scale = max(abs(force), 1e-300)
     x_contact = upper.points[0][rw.contact_status > 0]

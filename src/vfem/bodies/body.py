@@ -113,10 +113,11 @@ class Body:
 
     # -- set-up (vfem.bodies.condensation) --------------------------------------------------------
 
-    def assemble(self) -> dict[int, float]:
-        """Validate and assemble without factorizing (:func:`.condensation.assemble`); returns
-        the prescribed value of every supported or prescribed dof."""
-        return condensation.assemble(self)
+    def assemble(self, stiffness: bool = True) -> dict[int, float]:
+        """Validate and assemble without factorizing (:func:`.condensation.assemble`; without
+        the stiffness on an MPI rank that does not own the body); returns the prescribed value
+        of every supported or prescribed dof."""
+        return condensation.assemble(self, stiffness)
 
     def setup(self, backend: str | None = None, condensed_dofs: np.ndarray | None = None,
               assembled: dict[int, float] | None = None) -> None:
@@ -299,6 +300,12 @@ class Body:
         """Per constrained boundary, the total of ``nodal_reaction`` by component
         (:func:`.reactions.boundary_reactions`)."""
         return reactions.boundary_reactions(self, nodal_reaction)
+
+    def reaction_of(self, result, boundary: str, component: str) -> float:
+        """Total force the supports on ``boundary`` apply to the body along ``component`` in a
+        converged step's results ``result`` (:func:`.reactions.reaction_of`: no stiffness
+        read, so on any MPI rank)."""
+        return reactions.reaction_of(self, result, boundary, component)
 
     def reaction(self, u: np.ndarray, boundary: str, component: str, load_factor: float = 1.0,
                  contact_force: np.ndarray | None = None) -> float:

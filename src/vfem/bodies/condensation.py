@@ -28,7 +28,7 @@ from .validation import check_supported, validate
 log = logging.getLogger(__name__)
 
 
-def assemble(body) -> dict[int, float]:
+def assemble(body, stiffness: bool = True) -> dict[int, float]:
     """Validate and assemble, without factorizing anything: the basis, the stiffness ``K``
     (all dofs), the constrained dofs (``fixed_dofs``, ``platen_dofs``, ``free_dofs``), the
     load vector ``f_load`` and ``u_prescribed`` (the constrained dofs' values, 0 on supports
@@ -39,7 +39,9 @@ def assemble(body) -> dict[int, float]:
 
     :func:`setup` starts with it; the classical baselines
     (:mod:`vfem.contact.formulations.baselines`), which solve every body in one global system,
-    need only this part.
+    need only this part. ``stiffness`` False: all but ``K`` (an :class:`Elsewhere` in its
+    place), for a rank that does not own the body (:mod:`vfem.parallel`, issue 40: its owner
+    alone computes what reads the stiffness).
     """
     validate(body)
     t0 = time.perf_counter()
@@ -48,8 +50,12 @@ def assemble(body) -> dict[int, float]:
     basis = section.basis(body)
     if basis is not None:
         body.basis = basis
-    body.K = section.stiffness(body, lam, mu)
-    body.ndofs = body.K.shape[0]
+    if stiffness:
+        body.K = section.stiffness(body, lam, mu)
+        body.ndofs = body.K.shape[0]
+    else:
+        body.K = Elsewhere(body.name)
+        body.ndofs = body.dim * body.npoints
     t1 = time.perf_counter()
     fixed = constraints(body)
     check_supported(body)
@@ -63,6 +69,26 @@ def assemble(body) -> dict[int, float]:
         body.u_prescribed = sum(c.prescribed for c in body.load_cases)
     body.timings = {"assemble_s": t1 - t0, "constraints_s": time.perf_counter() - t1}
     return fixed
+
+
+class Elsewhere:
+    """A body's stiffness on an MPI rank that does not own the body (:mod:`vfem.parallel`):
+    it was not assembled there, and what reads it runs on the owner. Any use is a bug, said
+    as one (not a numpy error about an object array)."""
+
+    def __init__(self, name: str):
+        self.name = name
+
+    def _refuse(self, *args, **kwargs):
+        raise RuntimeError(f"body {self.name!r}: its stiffness is assembled on the MPI rank that "
+                           "owns it only (vfem.parallel), and was read on another")
+
+    __matmul__ = __rmatmul__ = __getitem__ = __array__ = _refuse
+
+    def __getattr__(self, attr: str):
+        if attr.startswith("__"):
+            raise AttributeError(attr)
+        self._refuse()
 
 
 def setup(body, backend: str | None = None, condensed_dofs: np.ndarray | None = None,

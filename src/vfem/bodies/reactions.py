@@ -73,3 +73,12 @@ def reaction(body, u: np.ndarray, boundary: str, component: str, load_factor: fl
     over the boundary's dofs of that component (zero where none of them is constrained)."""
     r = nodal_reaction(body, u, load_factor, contact_force)
     return float(r[boundary_dofs(body, boundary, component)].sum())
+
+
+def reaction_of(body, result, boundary: str, component: str) -> float:
+    """What :func:`reaction` gives for a converged step, read from its results
+    (``result``: the body's :class:`~vfem.bodies.results.BodyStepResult`, whose nodal
+    reactions were computed once, where the body's stiffness is: on the MPI rank that owns
+    it, :mod:`vfem.parallel`), the same number without the stiffness."""
+    r = np.asarray(result.reaction, dtype=float).ravel()
+    return float(r[boundary_dofs(body, boundary, component)].sum())

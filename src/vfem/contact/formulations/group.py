@@ -165,18 +165,12 @@ class SurfaceGroup:
         displacements under the state's loads, platen motion and contact forces, the contact
         forces, pressure (nodal force over tributary length), the formulation's traction where
         it has one, contact status and penetration (``result.pairings``), and the reactions."""
-        def displacement(i: int) -> np.ndarray:
-            s = self.surfaces[i]
-            f = np.zeros(s.body.ndofs)
-            f[s.candidate_dofs] = state.forces[i].ravel()
-            return s.body.displacement(state.load_factor, state.platen_displacement, f)
-
-        # each body's back-substitution on the rank that owns it (vfem.parallel)
-        displacements = self.executor.map(range(len(self.surfaces)), displacement)
-        out = {}
-        for i, (s, F, p) in enumerate(zip(self.surfaces, state.forces, result.pairings)):
+        def body_result(i: int) -> BodyStepResult:
+            s, F, p = self.surfaces[i], state.forces[i], result.pairings[i]
             b = s.body
-            u = displacements[i]
+            f = np.zeros(b.ndofs)
+            f[s.candidate_dofs] = F.ravel()
+            u = b.displacement(state.load_factor, state.platen_displacement, f)
             nv = b.npoints
             cand = s.nodes[: s.nc]
             force = np.zeros((nv, s.dim))
@@ -194,10 +188,14 @@ class SurfaceGroup:
                 status[cand] = p.participating & (p.force > 0)
             pen = np.zeros(nv)
             pen[cand] = np.where(np.isfinite(p.penetration), p.penetration, 0.0)
-            out[b.name] = add_reactions(
+            return add_reactions(
                 b, BodyStepResult(u.reshape(-1, s.dim), force, pressure, status, pen, traction),
                 state.load_factor)
-        return out
+
+        # each body's back-substitution and reactions on the rank that owns it
+        # (vfem.parallel: the others hold neither its factorization nor its stiffness)
+        results = self.executor.map(range(len(self.surfaces)), body_result)
+        return {s.body.name: results[i] for i, s in enumerate(self.surfaces)}
 
     def opponents(self, i: int) -> list[int]:
         """The bodies body ``i`` may touch that have candidate facets."""

@@ -10,6 +10,7 @@ import numpy as np
 
 from ...bodies import COMPONENTS, Body
 from ...errors import InputError
+from ...executor import SERIAL
 from ..search import project_points
 from .bodymesh import (
     exterior_facets,
@@ -241,7 +242,7 @@ def _path_samples(bodies: list[Body], samples: np.ndarray, search_distance: floa
 def select_candidate_facets(bodies: list[Body], pairs: ContactPairs,
                             search_distance: float,
                             load_factors: tuple[float, ...] = (),
-                            follow_path: bool = False) -> list[np.ndarray]:
+                            follow_path: bool = False, executor=SERIAL) -> list[np.ndarray]:
     """Per body, the exterior facets within ``search_distance`` of a body it may touch, at any
     load factor of the schedule: of each pair's sides (:class:`~.sides.ContactPairs`), the
     facets of one side near the other side's.
@@ -257,18 +258,19 @@ def select_candidate_facets(bodies: list[Body], pairs: ContactPairs,
     bring it within reach of the other body (:func:`platen_approach`): a cylinder pressed onto
     a flat from a small gap finds the flat. ``follow_path`` (large kinematics, where a body may
     slide far): the samples are refined so that no body moves more than half the search
-    distance between two of them (:func:`_path_samples`).
+    distance between two of them (:func:`_path_samples`). ``executor``: where each oriented
+    pair's search runs (:mod:`vfem.executor`: spread over MPI ranks, every result to all).
     """
     try:
         return _select_candidate_facets(bodies, pairs, search_distance, load_factors,
-                                        follow_path)
+                                        follow_path, executor)
     finally:
         forget_simplex_sets()  # the body meshes' simplices, searched at every sample
 
 
 def _select_candidate_facets(bodies: list[Body], pairs: ContactPairs, search_distance: float,
-                             load_factors: tuple[float, ...], follow_path: bool
-                             ) -> list[np.ndarray]:
+                             load_factors: tuple[float, ...], follow_path: bool,
+                             executor=SERIAL) -> list[np.ndarray]:
     """:func:`select_candidate_facets`."""
     ext = [exterior_facets(b) for b in bodies]
     lf = np.concatenate([[0.0], np.asarray(load_factors, dtype=float)])
@@ -282,17 +284,21 @@ def _select_candidate_facets(bodies: list[Body], pairs: ContactPairs, search_dis
         ends.append(facets)
         mids.append(mid)
         half.append(h)
-    keeps = [np.zeros(len(f), dtype=bool) for f in ext]
-    for side, facing in pairs.oriented():
+    oriented = list(pairs.oriented())
+
+    def near(k: int) -> np.ndarray | None:
+        """The oriented pair k's side's facets near the facing side, as a mask of the side
+        body's exterior facets (None: none looked at)."""
+        side, facing = oriented[k]
         i, j = side.body, facing.body
-        keep = keeps[i]
+        keep = np.zeros(len(ext[i]), dtype=bool)
         # each side's facets (all of the body's, or its zone's)
         own, oth = (np.arange(len(ext[s.body])) if z is None else
                     np.flatnonzero(np.isin(ext[s.body], z))
                     for s, z in ((side, side.mesh_facets(bodies[i])),
                                  (facing, facing.mesh_facets(bodies[j]))))
         if len(oth) == 0 or len(own) == 0:
-            continue
+            return None
         relative = moves[i] - moves[j]
         for mover, other, sign, moving, fixed in ((i, j, 1.0, own, oth), (j, i, -1.0, oth, own)):
             platen = bodies[mover].platen
@@ -327,4 +333,15 @@ def _select_candidate_facets(bodies: list[Body], pairs: ContactPairs, search_dis
                 inside = locate_in_simplices(mesh.p[:, : mesh.nvertices].T, tri,
                                              x[box], keep=True) >= 0
                 keep[own[box[inside]]] = True
+        return keep
+
+    # the oriented pairs spread over the ranks by the body they face (vfem.parallel, issue
+    # 40: the search structures of a body's facets are then made on one rank), every mask to
+    # every rank
+    found = executor.map(range(len(oriented)), near,
+                         owners=[facing.body % executor.size for _, facing in oriented])
+    keeps = [np.zeros(len(f), dtype=bool) for f in ext]
+    for k, (side, _) in enumerate(oriented):
+        if found[k] is not None:
+            keeps[side.body] |= found[k]
     return [f[keep] for f, keep in zip(ext, keeps)]

@@ -151,21 +151,21 @@ def pair_matrix(surfaces: list, pairs: list, directions: list[list[np.ndarray]],
                          read_rows(surfaces, pairs, directions, offsets), executor)
         return W, dp_dplaten
 
-    def motion(b: int) -> np.ndarray:  # C f as (f^T C^T)^T, on the body's owner
-        s, f = surfaces[b], dF[b]
-        return np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T).reshape(
-            s.nc, s.dim, m)
+    read = read_rows(surfaces, pairs, directions, offsets)
 
-    du = executor.map(range(len(surfaces)), motion)
-    W = np.zeros((m, m))
-    for k, pair in enumerate(pairs):
-        n = len(pair.nodes)
-        uf = pair.fine_read(du[pair.fine])  # (nodes, dim, m)
-        coarse = du[pair.coarse]  # the virtual nodes' motion: a few coarse nodes each
-        uc = (sp.csr_matrix(pair.interp) @ coarse.reshape(len(coarse), -1)).reshape(uf.shape)
-        for j, direction in enumerate(directions[k]):
-            rows = slice(offsets[k] + j * n, offsets[k] + (j + 1) * n)
-            # along the normal: penetration p = -(gap0 + n.(u_f - u_c)), W = -dp/dq; along a
-            # tangent t: the relative displacement t.(u_f - u_c) per unit traction
-            W[rows] = np.einsum("id,idm->im", pair.reading(j, direction), uf - uc)
+    def part(b: int) -> np.ndarray:
+        """Body b's part of W, read[b] C_b dF[b], on its owner: its motion under the unit
+        forces (C f as (f^T C^T)^T), read at the pairs' points (+) and virtual points (-)
+        along each unknown's direction (along the normal: penetration p = -(gap0 + n.(u_f -
+        u_c)), W = -dp/dq; along a tangent t: the relative displacement t.(u_f - u_c) per
+        unit traction)."""
+        s, f = surfaces[b], dF[b]
+        if read[b].nnz == 0 or f.nnz == 0:
+            return np.zeros((m, m))
+        motion = np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T)
+        return read[b] @ motion
+
+    # each body's part where its flexibility is (vfem.parallel: summed over the owners, the
+    # sum to every rank; no body's motion sent to every rank)
+    W = executor.total(range(len(surfaces)), part, (m, m))
     return W, dp_dplaten
