@@ -6,16 +6,25 @@ more, so the bodies are nearly equal). It is solved in one process (the default 
 the sparse factorization on every core), in one process on one thread, and under
 ``mpiexec -n N`` for each N of ``--ranks`` (one thread a rank); the wall time of
 ``Analysis.run`` (set-up, steps, results in memory; nothing written) on rank 0, the answers
-compared with the serial run's, and beside each the prediction of the scaling model of
-docs/scaling.md from the serial run's own timings:
+compared with the serial run's.
 
-    T(P) = T(1) - sum_b w_b + max_r sum_{b on r} w_b - S + S / min(P, pairs) - C + C s_max
+**The replicated fraction.** Every rank runs the analysis; the work spread over the ranks is
+what runs inside :class:`vfem.parallel.Ranks`' ``own`` (a body's set-up, fields, reactions,
+strain screen and part of the pair matrix W on its owner; a pair's search and geometry on one
+rank), timed there (``Ranks.busy``). The rest of a run is done by every rank alike: the
+replicated fraction is (T(1) - busy) / T(1) of the serial run on one thread. Of the replicated
+time, the complementarity solves on W (dense over every pair's unknowns, m of them) are timed
+apart: they grow as m^3, the rest as the bodies.
 
-with w_b body b's work that its owner alone does (its factorization and its load cases'
-back-substitutions, ``Body.timings``), S the pairs' set-up (their geometry, spread over the
-ranks) and, matrix-free, C the contact iterations (the products of W: a back-substitution per
-body, all owners at once; s_max the largest rank's share of the dofs), all from the serial run
-on one thread.
+**The scaling model** (docs/scaling.md), from the serial run on one thread:
+
+    T(P) = R + max_r sum_{b on r} w_b + (busy - sum_b w_b) / P
+
+with R the replicated time, w_b body b's set-up (assembly, factorization, load cases) placed
+as vfem.parallel places the bodies, the rest of the spread work shared evenly; beside the
+measurement. ``--extrapolate``: a stack of P plates, one a rank (P - 1 pairs, m growing as
+P - 1): each rank's own work, the replicated work per body times P, the complementarity times
+((P - 1) / (B - 1))^3, and each step's exchange.
 
     python3 benchmarks/ranks.py                                  # 4 plates, 2 ranks
     python3 benchmarks/ranks.py --blocks 4 --divisions 30 --layers 8 --ranks 2 4
@@ -37,6 +46,7 @@ import numpy as np
 def one(args, out: str) -> None:
     """Solve the model in this process (one rank of an MPI run or the serial run)."""
     from vfem import parallel
+    from vfem.contact.formulations import paired
     from vfem.solver import Analysis
     from vfem_examples import stack
 
@@ -45,27 +55,47 @@ def one(args, out: str) -> None:
                          thickness=args.thickness, flexibility=args.flexibility,
                          steps=args.steps)
     model = stack.build(p)
+    # the complementarity solves timed (replicated on every rank: growing as m^3)
+    solve, spent = paired.linear_complementarity, [0.0]
+
+    def timed(*a, **k):
+        t = time.perf_counter()
+        try:
+            return solve(*a, **k)
+        finally:
+            spent[0] += time.perf_counter() - t
+
+    paired.linear_complementarity = timed
     if ranks.parallel:
         ranks.comm.Barrier()
+    busy0 = ranks.busy
     t = time.perf_counter()
     analysis = Analysis(model)
     result = analysis.run()
-    if ranks.parallel:
-        ranks.comm.Barrier()
     wall = time.perf_counter() - t
+    busy = ranks.busy - busy0
+    if ranks.parallel:
+        per_rank = ranks.comm.gather(busy, root=0)
+        ranks.comm.Barrier()
+    else:
+        per_rank = [busy]
     if not ranks.root:
         return
     answers = np.concatenate([np.concatenate([b.displacement.ravel(), b.contact_force.ravel()])
                               for b in result.steps[-1].bodies.values()])
     np.save(out + ".npy", answers)
     owner = ranks.owner or [0] * len(model.bodies)
+    full = getattr(analysis.contact, "_full", None)
     record = {"ranks": ranks.size, "wall_s": wall, "converged": result.converged,
               "invariants": all(s.invariants["passed"] for s in result.steps),
               "dofs": int(sum(b.ndofs for b in model.bodies)),
               "contact_dofs": int(sum(s.dim * s.nc for s in result.surfaces)),
-              "flexibility": result.flexibility,
+              "unknowns": int(full[0].shape[0]) if full is not None else 0,
+              "flexibility": result.flexibility, "busy_s": per_rank,
+              "complementarity_s": spent[0],
               "bodies": [{"name": b.name, "dofs": int(b.ndofs), "owner": int(owner[i]),
-                          "own_s": float(b.timings.get("factorize_s", 0.0)
+                          "own_s": float(b.timings.get("assemble_s", 0.0)
+                                         + b.timings.get("factorize_s", 0.0)
                                          + b.timings.get("load_cases_s", 0.0))}
                          for i, b in enumerate(model.bodies)],
               "timings": {k: float(v) for k, v in result.timings.items()}}
@@ -73,11 +103,15 @@ def one(args, out: str) -> None:
         json.dump(record, f)
 
 
+def replicated(serial: dict) -> float:
+    """The serial run's time that every rank would do alike: all but the spread work."""
+    return serial["wall_s"] - serial["busy_s"][0]
+
+
 def predicted(serial: dict, n: int) -> float:
-    """The scaling model's wall time on ``n`` ranks from a serial run's record: the owners'
-    work split as vfem.parallel places the bodies (largest first, least loaded rank), and the
-    pairs' set-up (their geometry and the compliance densities: ``flexibility_s``) spread
-    over as many ranks as there are pairs, at most ``n``; the rest as in serial."""
+    """The scaling model's wall time on ``n`` ranks from a serial run's record: the bodies'
+    set-up split as vfem.parallel places them (largest first, least loaded rank), the rest of
+    the spread work evenly, the replicated time on every rank."""
     from vfem.parallel import Ranks
 
     work = [b["own_s"] for b in serial["bodies"]]
@@ -85,16 +119,8 @@ def predicted(serial: dict, n: int) -> float:
     ranks.size = n
     owner = ranks.place([b["dofs"] for b in serial["bodies"]])
     per_rank = [sum(w for w, o in zip(work, owner) if o == r) for r in range(n)]
-    pairs = serial["timings"].get("flexibility_s", 0.0)
-    spread = min(n, max(1, len(serial["bodies"]) - 1))
-    # matrix-free: the contact iteration is the products of W, one back-substitution per body,
-    # all owners at once: its share of the largest rank (by dofs)
-    contact = serial["timings"].get("contact_s", 0.0) if serial["flexibility"] == \
-        "matrix_free" else 0.0
-    dofs = [b["dofs"] for b in serial["bodies"]]
-    share = max(sum(d for d, o in zip(dofs, owner) if o == r) for r in range(n)) / sum(dofs)
-    return (serial["wall_s"] - sum(work) + max(per_rank) - pairs + pairs / spread
-            - contact + contact * share)
+    rest = serial["busy_s"][0] - sum(work)
+    return replicated(serial) + max(per_rank) + rest / n
 
 
 #: the broadcast bandwidth assumed for the extrapolation (bytes/s: a cluster's interconnect,
@@ -104,24 +130,28 @@ BANDWIDTH, LATENCY = 5e9, 5e-6
 
 def extrapolate(serial: dict, sizes=(2, 4, 16, 64, 256, 1024)) -> list[dict]:
     """The scaling model for P ranks with one body each (a stack of P plates like the serial
-    run's, P - 1 pairs): each rank's own work w (the mean of the serial run's bodies), the
-    replicated work r per body (T(1) - sum w - S, over the bodies) done for all P bodies on
-    every rank, one pair's set-up s on each rank, and each step's broadcast of every body's
-    displacement (P n 8 bytes, log2 P stages, :data:`BANDWIDTH`, :data:`LATENCY`)."""
+    run's, P - 1 pairs): each rank's own work (the mean body's share of the spread work), the
+    replicated work other than the complementarity per body done for all P bodies on every
+    rank, the complementarity solves on W growing as m^3 (m the pairs' unknowns, as P - 1),
+    W's own size (8 m^2 bytes on every rank), and each step's exchange of every body's
+    fields (P n 8 bytes, log2 P stages, :data:`BANDWIDTH`, :data:`LATENCY`)."""
     bodies = serial["bodies"]
-    w = sum(b["own_s"] for b in bodies) / len(bodies)
-    pairs = serial["timings"].get("flexibility_s", 0.0)
-    s = pairs / max(1, len(bodies) - 1)
-    r = (serial["wall_s"] - sum(b["own_s"] for b in bodies) - pairs) / len(bodies)
-    n = sum(b["dofs"] for b in bodies) / len(bodies)
-    ideal = w + r + s
+    b = len(bodies)
+    own = serial["busy_s"][0] / b
+    lcp = serial["complementarity_s"]
+    rest = (replicated(serial) - lcp) / b
+    n = sum(x["dofs"] for x in bodies) / b
+    m = serial["unknowns"]
     out = []
     for p in sizes:
+        grow = (p - 1) / max(b - 1, 1)
         stages = max(1.0, float(np.log2(p)))
         comm = p * (n * 8 / BANDWIDTH + LATENCY) * stages
-        t = w + p * r + s + comm
-        out.append({"ranks": p, "bodies": p, "time_s": t, "efficiency": ideal / t,
-                    "own_s": w, "replicated_s": p * r, "broadcast_s": comm})
+        t = own + p * rest + lcp * grow**3 + comm
+        out.append({"ranks": p, "bodies": p, "time_s": t, "efficiency": own / t,
+                    "own_s": own, "replicated_s": p * rest, "complementarity_s": lcp * grow**3,
+                    "broadcast_s": comm, "unknowns": m * grow,
+                    "W_gib": 8 * (m * grow) ** 2 / 2**30})
     return out
 
 
@@ -175,28 +205,36 @@ def main(argv: list[str] | None = None) -> int:
         rows = [serial, one_thread] + [launch(f"{n} ranks", n, None) for n in args.ranks]
         print(f"{len(serial['bodies'])} bodies, {serial['dofs']:,} dofs "
               f"({', '.join(str(b['dofs']) for b in serial['bodies'])}), "
-              f"{serial['contact_dofs']:,} contact dofs, {serial['flexibility']}")
+              f"{serial['contact_dofs']:,} contact dofs, {serial['unknowns']:,} pair unknowns, "
+              f"{serial['flexibility']}")
+        rep = replicated(one_thread)
+        print(f"replicated on every rank (serial run on one thread): {rep:.2f} s of "
+              f"{one_thread['wall_s']:.2f} s = {100 * rep / one_thread['wall_s']:.1f} % "
+              f"(the complementarity solves {one_thread['complementarity_s']:.2f} s)")
         print(f"{'run':>18} {'wall s':>8} {'speed-up':>9} {'predicted s':>12} "
-              f"{'difference':>10}")
+              f"{'busy s per rank':>18} {'difference':>10}")
         reference = serial["answers"]
         for row in rows:
             diff = float(np.abs(row["answers"] - reference).max() / np.abs(reference).max())
             n = row["ranks"]
             pred = predicted(one_thread, n) if n > 1 else float("nan")
             ok = "" if row["converged"] and row["invariants"] else "  (not converged!)"
+            busy = " ".join(f"{x:.1f}" for x in row["busy_s"])
             print(f"{row['label']:>18} {row['wall_s']:>8.2f} "
-                  f"{serial['wall_s'] / row['wall_s']:>9.2f} {pred:>12.2f} {diff:>10.1e}{ok}")
+                  f"{serial['wall_s'] / row['wall_s']:>9.2f} {pred:>12.2f} {busy:>18} "
+                  f"{diff:>10.1e}{ok}")
             row["difference"], row["predicted_s"] = diff, pred
             del row["answers"]
     if args.extrapolate:
         size = serial["dofs"] // len(serial["bodies"])
         print(f"\nscaling model, one body a rank (bodies of {size:,} dofs; from the serial run "
               "on one thread):")
-        print(f"{'ranks':>6} {'own s':>7} {'replicated s':>13} {'broadcast s':>12} {'T s':>8} "
-              f"{'efficiency':>11}")
+        print(f"{'ranks':>6} {'own s':>7} {'replicated s':>13} {'complementarity s':>18} "
+              f"{'W GiB':>8} {'broadcast s':>12} {'T s':>9} {'efficiency':>11}")
         for e in extrapolate(one_thread):
             print(f"{e['ranks']:>6} {e['own_s']:>7.2f} {e['replicated_s']:>13.2f} "
-                  f"{e['broadcast_s']:>12.4f} {e['time_s']:>8.2f} {e['efficiency']:>11.2f}")
+                  f"{e['complementarity_s']:>18.2f} {e['W_gib']:>8.2f} "
+                  f"{e['broadcast_s']:>12.4f} {e['time_s']:>9.2f} {e['efficiency']:>11.3f}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)
