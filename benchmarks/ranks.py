@@ -108,19 +108,24 @@ def replicated(serial: dict) -> float:
     return serial["wall_s"] - serial["busy_s"][0]
 
 
-def predicted(serial: dict, n: int) -> float:
+def predicted(serial: dict, n: int, cores: int | None = None) -> float:
     """The scaling model's wall time on ``n`` ranks from a serial run's record: the bodies'
     set-up split as vfem.parallel places them (largest first, least loaded rank), the rest of
-    the spread work evenly, the replicated time on every rank."""
+    the spread work evenly, the replicated time on every rank. On ``cores`` cores (default
+    all of this machine's) fewer than the ranks (oversubscribed), the ranks share them: the
+    replicated work of all n ranks and the spread work each take their share of the cores,
+    the longest rank's own work no less than alone."""
     from vfem.parallel import Ranks
 
+    cores = cores or os.cpu_count() or 1
     work = [b["own_s"] for b in serial["bodies"]]
     ranks = Ranks()
     ranks.size = n
     owner = ranks.place([b["dofs"] for b in serial["bodies"]])
-    per_rank = [sum(w for w, o in zip(work, owner) if o == r) for r in range(n)]
     rest = serial["busy_s"][0] - sum(work)
-    return replicated(serial) + max(per_rank) + rest / n
+    per_rank = [sum(w for w, o in zip(work, owner) if o == r) + rest / n for r in range(n)]
+    share = max(1.0, n / cores)
+    return replicated(serial) * share + max(max(per_rank), sum(per_rank) / cores)
 
 
 #: the broadcast bandwidth assumed for the extrapolation (bytes/s: a cluster's interconnect,

@@ -101,9 +101,18 @@ class Model:
             diag = [float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in self.bodies]
             distance = 0.02 * min(diag)
         facets = self._candidate_facets(pairs, distance, large, executor)
-        surfaces = [ContactSurface.build(b, f) for b, f in zip(self.bodies, facets)]
+        surfaces = [ContactSurface.build(b, f, tributary=False)
+                    for b, f in zip(self.bodies, facets)]
+        # the facets' mass matrices (the tributary areas) each body's on one rank
+        # (vfem.parallel, issue 40), every one to every rank
+        entries = executor.map(
+            range(len(surfaces)), lambda i: surfaces[i]._facet_mass_entries()
+            if len(surfaces[i].facets) else None,
+            owners=[i % executor.size for i in range(len(surfaces))])
+        for i, s in enumerate(surfaces):
+            s.set_tributary(entries[i])
         pairs = pairs.on(surfaces)
-        check_initial_overlap(surfaces, pairs)
+        check_initial_overlap(surfaces, pairs, executor)
         return pairs, surfaces
 
     def _candidate_facets(self, pairs: ContactPairs, distance: float, large: bool,

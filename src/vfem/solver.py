@@ -400,8 +400,10 @@ class Analysis:
 
     def _invariant_check(self) -> InvariantCheck:
         """The invariants every converged step must satisfy (:mod:`vfem.contact.invariants.check`),
-        to the contact's penetration tolerance."""
-        return InvariantCheck(self.model, None, self.contact.penetration_tolerance)
+        to the contact's penetration tolerance; each pair's (b) read on one MPI rank."""
+        check = InvariantCheck(self.model, None, self.contact.penetration_tolerance)
+        check.executor = current_ranks()
+        return check
 
     def check_invariants(self, fields: dict[str, BodyStepResult],
                          history: list[IterationRecord]) -> Invariants:

@@ -23,7 +23,8 @@ from .sides import ContactPairs, zone_nodes
 from .surface import ContactSurface
 
 
-def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs) -> None:
+def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs,
+                          executor=SERIAL) -> None:
     """Refuse bodies that start deeper into each other than the outer layer of elements.
 
     The contact iteration finds a node's partner on the other surface only while the node is
@@ -37,15 +38,22 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs) -
     elements (not behind a thin body, beyond its far side), is refused. An overlap within the
     rind is allowed: the first step resolves it.
 
+    ``executor``: where each oriented pair is looked at (:mod:`vfem.executor`: spread over
+    MPI ranks, what each found to every rank).
+
     Raises:
         InputError: naming both bodies, the node, its position and depth, and the rind there.
     """
-    worst, count = None, 0
-    for side, facing in pairs.oriented():
+    oriented = list(pairs.oriented())
+
+    def deepest(k: int):
+        """The oriented pair k's nodes too deep: (how many, depth, rind, the side's body,
+        the facing body, position, node) of the deepest, or None."""
+        side, facing = oriented[k]
         si, sj = surfaces[side.body], surfaces[facing.body]
         own, other = side.facets, facing.facets
         if si.nc == 0 or len(sj.facets) == 0 or (other is not None and not len(other)):
-            continue
+            return None
         # the nodes of one side, against the other's facets (their zones: :mod:`.sides`)
         local = zone_nodes(si, own)
         x, node = si.X[local], si.nodes[local]
@@ -64,13 +72,23 @@ def check_initial_overlap(surfaces: list[ContactSurface], pairs: ContactPairs) -
             deep = deep[locate_in_simplices(mesh.p[:, : mesh.nvertices].T,
                                             mesh_simplices(mesh), x[deep]) >= 0]
         if not deep.size:
-            continue
-        count += deep.size
+            return None
         k = int(deep[np.argmax(depth[deep])])
-        if worst is None or depth[k] > worst[0]:
-            worst = (float(depth[k]), float(rind[k]), si, sj, x[k], int(node[k]))
+        return (int(deep.size), float(depth[k]), float(rind[k]), side.body, facing.body, x[k],
+                int(node[k]))
+
+    found = executor.map(range(len(oriented)), deepest,
+                         owners=[facing.body % executor.size for _, facing in oriented])
+    worst, count = None, 0
+    for k in range(len(oriented)):  # (in order: the first of equal depths, as before)
+        if found[k] is None:
+            continue
+        count += found[k][0]
+        if worst is None or found[k][1] > worst[0]:
+            worst = found[k][1:]
     if worst is not None:
-        depth, rind, si, sj, x_k, k = worst
+        depth, rind, i, j, x_k, k = worst
+        si, sj = surfaces[i], surfaces[j]
         a, b = si.body.name, sj.body.name
         where = ", ".join(f"{v:.6g}" for v in x_k)  # (x, y) or (x, y, z)
         raise InputError(

@@ -105,7 +105,11 @@ class ContactSurface:
             self.kind = Segment(self.facets.shape[1] - 1)
 
     @classmethod
-    def build(cls, body: Body, facet_ids: np.ndarray) -> ContactSurface:
+    def build(cls, body: Body, facet_ids: np.ndarray, tributary: bool = True
+              ) -> ContactSurface:
+        """The surface of ``body``'s candidate facets ``facet_ids``; ``tributary`` False: its
+        tributary areas (from the facets' mass matrices, the costliest part) left to
+        :meth:`set_tributary` (made where the body's work is: :mod:`vfem.parallel`)."""
         mesh = body.mesh
         fn = body.facet_points(facet_ids).copy()  # (nf, 2 or 3) point numbers
         if body.dim == 3 and not len(fn):
@@ -133,11 +137,19 @@ class ContactSurface:
         surface = cls(body=body, facet_ids=np.asarray(facet_ids), facets=facets, nodes=nodes,
                       nc=len(cand), X=X, lengths=lengths, tributary=np.zeros(len(cand)),
                       rind=local[t_rind], kind=kind)
-        if len(facets):
-            # a unit pressure's consistent nodal forces: the integral of each shape function
-            ones = np.ones(len(facets))
-            surface.tributary = np.asarray(surface.mass_matrix(ones).sum(axis=1)).ravel()
+        if tributary:
+            surface.set_tributary()
         return surface
+
+    def set_tributary(self, entries=None) -> None:
+        """A unit pressure's consistent nodal forces (``tributary``): the integral of each
+        shape function, from the facets' mass matrices (``entries``: theirs, made elsewhere,
+        :meth:`_facet_mass_entries`; else made here)."""
+        if entries is not None:
+            self._mass_entries = entries
+        if len(self.facets):
+            ones = np.ones(len(self.facets))
+            self.tributary = np.asarray(self.mass_matrix(ones).sum(axis=1)).ravel()
 
     @classmethod
     def _untouched(cls, body: Body, fn: np.ndarray) -> ContactSurface:

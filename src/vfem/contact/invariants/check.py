@@ -67,6 +67,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...executor import SERIAL
 from .check3d import SOLID
 from .kind import SurfaceKind
 from .measures import (
@@ -162,6 +163,8 @@ class InvariantCheck:
         self._reference: list | None = None
         #: (i, j) -> the pre-filter's reading of the pair (:meth:`_may_enter`)
         self._undeformed: dict[tuple[int, int], _Undeformed] = {}
+        #: where each pair's (b) is read (:mod:`vfem.executor`; the solver's MPI ranks)
+        self.executor = SERIAL
 
     @property
     def kind(self) -> SurfaceKind:
@@ -257,21 +260,25 @@ class InvariantCheck:
         # per body: its boundary nodes that carry contact force or neighbour one that does
         touched = None if forces is None else [_loaded_or_next(g.b.segments, f)
                                                for g, f in zip(cur, forces)]
-        best = None  # (excess, depth, allowed, i, local node, j, deformed, linearised)
-        deepest = 0.0
-        for i, j in self.pairs:
+
+        def one(k: int):
+            """Pair k's reading (i's nodes into j): the node furthest beyond its allowed depth
+            (excess, depth, allowed, i, local node, j, deformed, linearised), the deepest
+            depth and the second-order record (:meth:`_beyond_second_order`); None where no
+            node of i is inside j."""
+            i, j = self.pairs[k]
             gi, gj = cur[i], cur[j]
             if len(gi.x) == 0 or len(gj.b.segments) == 0:
-                continue
+                return None
             lo, hi = gj.box
             pad = 1e-9 * max(float(np.linalg.norm(hi - lo)), 1e-300)
             near = np.flatnonzero(np.all((gi.x >= lo - pad) & (gi.x <= hi + pad), axis=1))
             if not near.size:
-                continue
+                return None
             near = self._may_enter(i, j, near, cur, ref)
             node = near[gj.inside(gi.x[near])]
             if not node.size:
-                continue
+                return None
             depth, L, ends = gj.depth(gi.x[node])
             if touched is not None:
                 # the faceting allowance is for a node between two nodes of the other surface
@@ -286,13 +293,30 @@ class InvariantCheck:
             alpha = np.minimum(gi.turning_within(node, L), 0.5 * np.pi)
             allowed = tol + second + np.minimum(0.5 * L * np.tan(0.5 * alpha),
                                                 np.maximum(gi.adjacent[node], 0.5 * L))
+            second_order = Invariants()  # (this pair's alone)
             if linearised is not None:
-                self._beyond_second_order(out, i, j, node, deformed, linearised, allowed, cur)
-            deepest = max(deepest, float(depth.max()))
-            k = int(np.argmax(depth - allowed))
-            cand = (float(depth[k] - allowed[k]), float(depth[k]), float(allowed[k]), i,
-                    int(node[k]), j, float(deformed[k]),
-                    None if linearised is None else float(linearised[k]))
+                self._beyond_second_order(second_order, i, j, node, deformed, linearised,
+                                          allowed, cur)
+            n = int(np.argmax(depth - allowed))
+            cand = (float(depth[n] - allowed[n]), float(depth[n]), float(allowed[n]), i,
+                    int(node[n]), j, float(deformed[n]),
+                    None if linearised is None else float(linearised[n]))
+            return cand, float(depth.max()), second_order.second_order
+
+        # each pair on one rank (vfem.parallel, issue 40: by the body entered), its reading to
+        # every rank; then taken in the pairs' order, as one loop over them would
+        found = self.executor.map(range(len(self.pairs)), one,
+                                  owners=[j % self.executor.size for _, j in self.pairs])
+        best = None  # (excess, depth, allowed, i, local node, j, deformed, linearised)
+        deepest = 0.0
+        for k in range(len(self.pairs)):
+            if found[k] is None:
+                continue
+            cand, depth_max, second = found[k]
+            if second is not None and (out.second_order is None
+                                       or second["beyond"] > out.second_order["beyond"]):
+                out.second_order = second
+            deepest = max(deepest, depth_max)
             if best is None or (cand[0] > 0 and cand[0] > best[0]) or (
                     best[0] <= 0 and cand[0] <= 0 and cand[1] > best[1]):
                 best = cand
