@@ -3,23 +3,35 @@
 vfem's structure is made for it: every body has its own stiffness and factorization, and the
 bodies meet only through their contact data. Under ``mpiexec -n N vfem run MODEL`` (or
 ``vfem run --ranks N MODEL``, which launches it) every rank runs the same analysis on the same
-model, step by step and iteration by iteration, with one difference: a body's factorization and
-every back-substitution through it happen on the rank that owns the body
-(:meth:`Ranks.place`: largest bodies first, each to the least loaded rank), and what the others
-need of it comes to them by broadcast. So every rank holds the same contact state, the same
-numbers, and takes the same decisions (step cuts, invariants, the end), and the answers are the
-serial run's (the owner computes exactly what the serial run computes; only threads per
-process differ: 1e-12 and below, tests/test_mpi.py).
+model, step by step and iteration by iteration, and takes the same decisions (step cuts,
+invariants, the end); the work is spread (issue 40):
+
+* on the rank that owns a body (:meth:`Ranks.place`: largest bodies first, each to the least
+  loaded rank): its stiffness (the others assemble its dofs, supports and loads only), its
+  factorization and every back-substitution through it, its load cases, its compliance
+  densities, its part of the pair matrix W (:meth:`Ranks.total`), each step's fields,
+  reactions and strain screen;
+* on one rank per pair: the candidate search, the initial-overlap check, the pair's geometry,
+  invariant (b) of the pair; the facets' mass matrices one body a rank;
+* on every rank alike: the contact problem on W (its complementarity solves) and the rest of
+  the invariants.
+
+What each rank computed comes to the others (:meth:`Ranks.map`, :meth:`Ranks.share`), so every
+rank holds the same numbers, and the answers are the serial run's to round-off (W's parts are
+summed rank by rank; tests/test_mpi.py: 1e-10, 3e-14 measured). :meth:`Ranks.own` times each
+rank's share of the spread work (``Ranks.busy``): the rest of a run is what every rank does
+alike (``benchmarks/ranks.py``, docs/scaling.md).
 
 What crosses between ranks:
 
 * at set-up, per body, what the contact iteration reads of it: its displacement under each load
   case and under a unit platen motion, the platen's reactions and stiffness, and on the dense
-  route its flexibility on its contact dofs (:meth:`Ranks.share`);
+  route of the thesis variant its flexibility on its contact dofs (:meth:`Ranks.share`); per
+  pair its geometry; W (m x m, reduced to rank 0 and broadcast);
 * per contact iteration on the matrix-free route, each body's motion under its contact forces
   at its condensed dofs (:meth:`Ranks.map`: every owner solves its own bodies at once, then they
   are exchanged);
-* per converged step, each body's displacement (the invariants and the results read them all).
+* per converged step, each body's fields and reactions from its owner.
 
 Rank 0 writes the results and prints; the others write nothing. Serial runs never import
 mpi4py (:func:`current` is a one-rank :class:`Ranks` unless the process was started by an MPI
