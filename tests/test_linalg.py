@@ -61,6 +61,25 @@ def test_every_backend_solves_and_gives_the_flexibility(backend):
 
 
 @pytest.mark.parametrize("backend", INSTALLED)
+def test_every_dof_trailing_gives_the_whole_inverse(backend):
+    """A body whose every free dof is a contact dof (one layer of elements touched on both
+    faces): the flexibility is the whole inverse (PARDISO takes it dense, its Schur mode on
+    the whole matrix read outside its arrays), in the order of the dofs given, and the
+    factorization still solves. Round-off: the inverse's condition times machine epsilon."""
+    K = stiffness()
+    dense = np.linalg.inv(K.toarray())
+    n = K.shape[0]
+    trailing = np.random.default_rng(2).permutation(n)  # every dof, unsorted
+    f = linalg.factorize(K, backend, trailing=trailing)
+    G = f.trailing_inverse
+    ref = dense[np.ix_(trailing, trailing)]
+    assert G.shape == (n, n)
+    assert np.abs(G - ref).max() <= 1e-10 * np.abs(ref).max()
+    b = np.arange(n, dtype=float)
+    assert np.linalg.norm(K @ f.solve(b) - b) <= 1e-10 * np.linalg.norm(b)
+
+
+@pytest.mark.parametrize("backend", INSTALLED)
 def test_a_factorization_of_the_same_pattern_takes_over_the_analysis(backend):
     """A large body's next tangent (same sparsity, same Schur set, new values): given the last
     factorization as ``analysis``, PARDISO skips its ordering and gives the same solution and

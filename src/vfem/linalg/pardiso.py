@@ -154,6 +154,14 @@ class PardisoFactorization:
         self._perm = np.zeros(self.n, dtype=np.int32)
         self.trailing_inverse = None
         m = 0
+        whole = None
+        if trailing is not None and len(trailing) == self.n and spd:
+            # every dof trailing (a body whose every free dof is a contact dof: one layer of
+            # elements touched on both faces, a tiny body): the flexibility is the whole
+            # inverse, taken dense below; PARDISO's Schur mode on the whole matrix read
+            # outside its arrays (a segmentation fault in mkl_pds_lp64_permutetips in about
+            # half the runs of one test sequence, MKL 2025; issue 40)
+            whole, trailing = np.asarray(trailing, dtype=int), None  # (in the order given)
         if trailing is not None and len(trailing) and spd:
             trailing = np.asarray(trailing, dtype=int)
             self._perm[trailing] = 1
@@ -183,6 +191,11 @@ class PardisoFactorization:
             if not np.array_equal(rank, np.arange(m)):
                 inv = inv[np.ix_(rank, rank)]
             self.trailing_inverse = inv
+        if whole is not None:  # (the same numbers the Schur complement's inverse would be)
+            dense = np.ascontiguousarray(sp.csr_matrix(A)[whole][:, whole].toarray(),
+                                         dtype=float)
+            with dense_threads(len(dense)):
+                self.trailing_inverse = spd_inverse_in_place(dense)
 
     def _same_pattern(self, other: PardisoFactorization | None) -> bool:
         """Whether ``other`` still holds an analysis that fits this matrix."""
