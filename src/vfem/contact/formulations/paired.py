@@ -39,6 +39,7 @@ from __future__ import annotations
 import logging
 
 import numpy as np
+import scipy.sparse as sp
 
 from ...errors import PlatenUnheld, PlatenUnpaired
 from ..capabilities import Capabilities
@@ -490,6 +491,8 @@ class PairedContact(PairSet):
             self._full = self._full_flexibility()
         W, dp_dplaten, dR, offsets = self._full
         index = np.concatenate([offsets[k] + a for k, a in enumerate(active)])
+        if sp.issparse(W):  # (a sparse W's active block, dense for its factors)
+            return W[index][:, index].toarray(), dp_dplaten[index], dR[index]
         return W[np.ix_(index, index)], dp_dplaten[index], dR[index]
 
     def _full_flexibility(self):
@@ -505,8 +508,9 @@ class PairedContact(PairSet):
         rates = [pair.platen_rate if j == 0 else self._tangent_platen_rate(k, direction)
                  for k, pair in enumerate(self.contact_pairs)
                  for j, direction in enumerate(directions[k])]
+        # (kept sparse where few pairs share a body; the friction part reads it dense)
         W, dp_dplaten = pair_matrix(self.surfaces, self.contact_pairs, directions, offsets, dF,
-                                    rates, self.executor)
+                                    rates, self.executor, sparse_ok=self.friction is None)
         dR = platen_rows(self.surfaces, self.platen_body, dF, int(offsets[-1]))
         return W, dp_dplaten, dR, offsets
 

@@ -69,6 +69,24 @@ class ReusedFactor:
         self.key = None
         self.factors = None
 
+    def solve_sparse(self, key, matrix, b: np.ndarray) -> np.ndarray | None:
+        """:meth:`solve` for a sparse ``matrix()``: SuperLU's factors (its fill-reducing
+        ordering, partial pivoting) kept while ``key`` recurs; None when singular."""
+        key = ("sparse", key)  # (never a dense factorization's key)
+        if key != self.key:
+            import scipy.sparse as sp
+            import scipy.sparse.linalg as spla
+
+            self.key = None
+            try:
+                self.factors = spla.splu(sp.csc_matrix(matrix()))
+            except RuntimeError:  # "Factor is exactly singular"
+                self.factors = None
+            self.key = key
+        if self.factors is None:
+            return None
+        return self.factors.solve(b)
+
     def solve(self, key, matrix, b: np.ndarray) -> np.ndarray | None:
         """The solution of ``matrix() x = b``, ``matrix`` called only when ``key`` is new;
         None when the matrix is singular (an exactly zero pivot)."""

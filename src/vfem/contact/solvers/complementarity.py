@@ -16,6 +16,7 @@ from __future__ import annotations
 import logging
 
 import numpy as np
+import scipy.sparse as sp
 
 from .bordered import ReusedFactor, bordered_matrix, bordered_solve
 
@@ -224,12 +225,35 @@ class DenseSystem:
     ``numpy.linalg.solve`` for a plain one). The matrix-free route's counterpart is
     :class:`~vfem.contact.solvers.matrix_free.PairOperator` (issue 22)."""
 
-    def __init__(self, W: np.ndarray, factor: ReusedFactor | None = None):
-        self.W = W
+    def __init__(self, W, factor: ReusedFactor | None = None):
+        self.W = W  # dense, or sparse (pairs that share no body: pair_matrix's sparse_ok)
         self.factor = factor
 
     def matvec(self, x: np.ndarray) -> np.ndarray:
         return self.W @ x
+
+    def _solve_sparse(self, a: np.ndarray, rhs: np.ndarray, border=None
+                      ) -> tuple[np.ndarray, float]:
+        """:meth:`solve` with a sparse W: the set's block (bordered by the platen's row and
+        column) factorized sparse, its factors kept while the set recurs; where singular,
+        least squares on the block made dense, as the dense W's."""
+        A = self.W[a][:, a]
+        if border is not None:
+            column, row, corner, extra = border
+            M = sp.bmat([[A, sp.csr_matrix(np.asarray(column)[:, None])],
+                         [sp.csr_matrix(np.asarray(row)[None, :]), sp.csr_matrix([[corner]])]])
+            b = np.concatenate([rhs, [extra]])
+        else:
+            M, b = A, rhs
+        factor = self.factor if self.factor is not None else ReusedFactor()
+        x = factor.solve_sparse((border is not None, a.tobytes()), lambda: M, b)
+        if border is not None:
+            if x is None:  # no node of the platen's body in the set: least squares
+                return bordered_solve(A.toarray(), column, row, corner, rhs, extra)
+            return x[:-1], float(x[-1])
+        if x is None:
+            return np.linalg.solve(A.toarray(), rhs), 0.0  # (singular: LinAlgError, as dense)
+        return x, 0.0
 
     def solve(self, a: np.ndarray, rhs: np.ndarray, border=None, x0=None
               ) -> tuple[np.ndarray, float]:
@@ -237,6 +261,8 @@ class DenseSystem:
         ``border`` = (column, row, corner, extra) the platen's bordered system
         (:func:`~vfem.contact.solvers.bordered.bordered_solve`). ``x0`` (a first guess) is not
         needed."""
+        if sp.issparse(self.W):
+            return self._solve_sparse(a, rhs, border)
         W, factor = self.W, self.factor
         if border is not None:
             column, row, corner, extra = border

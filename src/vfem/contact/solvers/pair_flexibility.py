@@ -137,13 +137,25 @@ def platen_rows(surfaces: list, platen_body: int | None, dF: list[sp.csr_matrix]
     return dR
 
 
+#: W is kept sparse (:func:`pair_matrix`, ``sparse_ok``) where its bodies' blocks cover at most
+#: this fraction of it: pairs that share no body do not couple (a stack of plates: W block
+#: tridiagonal), and a dense W over many pairs is O(m^2) memory and its solves O(m^3) on every
+#: MPI rank (docs/scaling.md, issue 40). Dense factorizations are faster than sparse ones on a
+#: matrix this full or fuller, so a few bodies' W stays dense.
+SPARSE_DENSITY = 0.25
+
+#: ... and it has at least this many unknowns (below, dense solves take milliseconds)
+SPARSE_MIN = 1000
+
+
 def pair_matrix(surfaces: list, pairs: list, directions: list[list[np.ndarray]],
                 offsets: np.ndarray, dF: list[sp.csr_matrix], platen_rates: list[np.ndarray],
-                executor):
-    """W over every unknown of every pair (dense (m, m), or the operator that applies it) and
-    the readings' change per unit platen motion ((m,): ``platen_rates``, per pair and direction
-    in the unknowns' order, concatenated). Each body's motion under the unit forces is computed
-    on the rank that owns it (``executor``)."""
+                executor, sparse_ok: bool = False):
+    """W over every unknown of every pair (dense (m, m), sparse where ``sparse_ok`` and its
+    bodies' blocks cover little of it (:data:`SPARSE_DENSITY`), or the operator that applies
+    it) and the readings' change per unit platen motion ((m,): ``platen_rates``, per pair and
+    direction in the unknowns' order, concatenated). Each body's motion under the unit forces
+    is computed on the rank that owns it (``executor``)."""
     m = int(offsets[-1])
     dp_dplaten = np.concatenate(platen_rates or [np.zeros(0)])
     if any(s.matrix_free for s in surfaces):
@@ -152,6 +164,34 @@ def pair_matrix(surfaces: list, pairs: list, directions: list[list[np.ndarray]],
         return W, dp_dplaten
 
     read = read_rows(surfaces, pairs, directions, offsets)
+    # each body's block: the unknowns that read its motion (rows) by those that force it
+    rows = [np.flatnonzero(np.diff(r.indptr)) for r in read]
+    cols = [np.unique(f.indices) for f in dF]
+    # W's entries that may be nonzero: pairs k and l couple where they share a body
+    sizes = np.diff(offsets)
+    shared = np.array([[bool({a.fine, a.coarse} & {b.fine, b.coarse}) for b in pairs]
+                       for a in pairs], dtype=bool).reshape(len(pairs), len(pairs))
+    covered = float(sizes @ shared @ sizes) if len(pairs) else 0.0
+    if sparse_ok and m >= SPARSE_MIN and covered <= SPARSE_DENSITY * m * m:
+        def block(b: int) -> np.ndarray:
+            """Body b's block of W (rows[b], cols[b]), on its owner."""
+            s = surfaces[b]
+            if not len(rows[b]) or not len(cols[b]):
+                return np.zeros((len(rows[b]), len(cols[b])))
+            f = dF[b][:, cols[b]]
+            motion = np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T)
+            return read[b][rows[b]] @ motion
+
+        # every block to every rank (together the size of the sparse W), summed in the
+        # bodies' order on each: the same W everywhere, and the serial run's
+        blocks = executor.map(range(len(surfaces)), block)
+        W = sp.csr_matrix((np.concatenate([blocks[b].ravel() for b in range(len(surfaces))]),
+                           (np.concatenate([np.repeat(rows[b], len(cols[b]))
+                                            for b in range(len(surfaces))]),
+                            np.concatenate([np.tile(cols[b], len(rows[b]))
+                                            for b in range(len(surfaces))]))), shape=(m, m))
+        W.sum_duplicates()
+        return W, dp_dplaten
 
     def part(b: int) -> np.ndarray:
         """Body b's part of W, read[b] C_b dF[b], on its owner: its motion under the unit
