@@ -112,4 +112,4 @@ def test_a_stiffness_not_assembled_on_this_rank_says_so():
                        "the MPI rank that owns it only"):
         b.K @ np.zeros(ndofs)
     with pytest.raises(RuntimeError, match="owns it only"):
-        b.K.shape
+        _ = b.K.shape
