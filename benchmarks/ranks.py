@@ -24,7 +24,8 @@ with R the replicated time, w_b body b's set-up (assembly, factorization, load c
 as vfem.parallel places the bodies, the rest of the spread work shared evenly; beside the
 measurement. ``--extrapolate``: a stack of P plates, one a rank (P - 1 pairs, m growing as
 P - 1): each rank's own work, the replicated work per body times P, the complementarity times
-((P - 1) / (B - 1))^3, and each step's exchange.
+((P - 1) / (B - 1))^3 while W is dense, to the power 1.5 once it is kept sparse
+(:data:`SPARSE_GROWTH`), and each step's exchange.
 
     python3 benchmarks/ranks.py                                  # 4 plates, 2 ranks
     python3 benchmarks/ranks.py --blocks 4 --divisions 30 --layers 8 --ranks 2 4
@@ -133,13 +134,24 @@ def predicted(serial: dict, n: int, cores: int | None = None) -> float:
 BANDWIDTH, LATENCY = 5e9, 5e-6
 
 
+#: the complementarity's growth with the pairs where W is kept sparse (block tridiagonal: a
+#: stack's pairs couple only through the plates they share; vfem.contact.solvers.
+#: pair_flexibility.SPARSE_DENSITY): t ~ m^1.5, measured on stacks of 10 x 10 x 2 plates on one
+#: thread, 8 plates (1,961 unknowns, W dense) 0.10 s and 32 plates (8,793, sparse) 0.94 s
+SPARSE_GROWTH = 1.5
+
+
 def extrapolate(serial: dict, sizes=(2, 4, 16, 64, 256, 1024)) -> list[dict]:
     """The scaling model for P ranks with one body each (a stack of P plates like the serial
     run's, P - 1 pairs): each rank's own work (the mean body's share of the spread work), the
     replicated work other than the complementarity per body done for all P bodies on every
-    rank, the complementarity solves on W growing as m^3 (m the pairs' unknowns, as P - 1),
-    W's own size (8 m^2 bytes on every rank), and each step's exchange of every body's
-    fields (P n 8 bytes, log2 P stages, :data:`BANDWIDTH`, :data:`LATENCY`)."""
+    rank, the complementarity solves on W (m the pairs' unknowns, growing as P - 1): dense
+    while the pairs' coupled blocks cover more than vfem's ``SPARSE_DENSITY`` of W (time as
+    m^3, 8 m^2 bytes on every rank), sparse beyond (time as m^:data:`SPARSE_GROWTH`, its
+    blocks' bytes); and each step's exchange of every body's fields (P n 8 bytes, log2 P
+    stages, :data:`BANDWIDTH`, :data:`LATENCY`)."""
+    from vfem.contact.solvers.pair_flexibility import SPARSE_DENSITY, SPARSE_MIN
+
     bodies = serial["bodies"]
     b = len(bodies)
     own = serial["busy_s"][0] / b
@@ -150,13 +162,18 @@ def extrapolate(serial: dict, sizes=(2, 4, 16, 64, 256, 1024)) -> list[dict]:
     out = []
     for p in sizes:
         grow = (p - 1) / max(b - 1, 1)
+        pairs = p - 1
+        # a chain of pairs: each couples with itself and its two neighbours
+        coverage = min(1.0, (3 * pairs - 2) / pairs**2) if pairs > 1 else 1.0
+        sparse = coverage <= SPARSE_DENSITY and m * grow >= SPARSE_MIN
+        solves = lcp * grow ** (SPARSE_GROWTH if sparse else 3)
         stages = max(1.0, float(np.log2(p)))
         comm = p * (n * 8 / BANDWIDTH + LATENCY) * stages
-        t = own + p * rest + lcp * grow**3 + comm
+        t = own + p * rest + solves + comm
         out.append({"ranks": p, "bodies": p, "time_s": t, "efficiency": own / t,
-                    "own_s": own, "replicated_s": p * rest, "complementarity_s": lcp * grow**3,
-                    "broadcast_s": comm, "unknowns": m * grow,
-                    "W_gib": 8 * (m * grow) ** 2 / 2**30})
+                    "own_s": own, "replicated_s": p * rest, "complementarity_s": solves,
+                    "sparse": sparse, "broadcast_s": comm, "unknowns": m * grow,
+                    "W_gib": 8 * (m * grow) ** 2 * (coverage if sparse else 1.0) / 2**30})
     return out
 
 
@@ -235,11 +252,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"\nscaling model, one body a rank (bodies of {size:,} dofs; from the serial run "
               "on one thread):")
         print(f"{'ranks':>6} {'own s':>7} {'replicated s':>13} {'complementarity s':>18} "
-              f"{'W GiB':>8} {'broadcast s':>12} {'T s':>9} {'efficiency':>11}")
+              f"{'W':>7} {'W GiB':>8} {'broadcast s':>12} {'T s':>9} {'efficiency':>11}")
         for e in extrapolate(one_thread):
             print(f"{e['ranks']:>6} {e['own_s']:>7.2f} {e['replicated_s']:>13.2f} "
-                  f"{e['complementarity_s']:>18.2f} {e['W_gib']:>8.2f} "
-                  f"{e['broadcast_s']:>12.4f} {e['time_s']:>9.2f} {e['efficiency']:>11.3f}")
+                  f"{e['complementarity_s']:>18.2f} {'sparse' if e['sparse'] else 'dense':>7} "
+                  f"{e['W_gib']:>8.2f} {e['broadcast_s']:>12.4f} {e['time_s']:>9.2f} "
+                  f"{e['efficiency']:>11.3f}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)
