@@ -25,9 +25,9 @@ class Executor(Protocol):
 
     def total(self, indices: Iterable[int], compute: Callable[[int], np.ndarray],
               shape: tuple[int, ...]) -> np.ndarray:
-        """The sum of ``compute(i)`` (arrays of ``shape``) over ``indices``, each on its
-        owner; the sum, the same numbers, to every caller (what each body adds to a shared
-        matrix, without sending any body's part to every rank)."""
+        """The sum of ``compute(i)`` (arrays of ``shape``, or 0 for nothing to add) over
+        ``indices``, each on its owner; the sum, the same numbers, to every caller (what each
+        body adds to a shared matrix, without sending any body's part to every rank)."""
 
 
 class Serial:

@@ -47,6 +47,8 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
+from .executor import SERIAL
+
 log = logging.getLogger(__name__)
 
 #: seconds a failed rank other than 0 waits before stopping the run, for rank 0 to report a
@@ -173,10 +175,7 @@ class Ranks:
         owner). An error raised on an owner is raised on every rank. In serial, in order."""
         indices = list(indices)
         if not self.parallel or not self.owner:
-            out = np.zeros(shape)
-            for i in indices:
-                out += self.own(compute, i)
-            return out
+            return SERIAL.total(indices, lambda i: self.own(compute, i), shape)
         partial, error = np.zeros(shape), None
         self.local = True
         try:

@@ -10,6 +10,8 @@ import warnings
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from ...threads import dense_threads
 
@@ -74,9 +76,6 @@ class ReusedFactor:
         ordering, partial pivoting) kept while ``key`` recurs; None when singular."""
         key = ("sparse", key)  # (never a dense factorization's key)
         if key != self.key:
-            import scipy.sparse as sp
-            import scipy.sparse.linalg as spla
-
             self.key = None
             try:
                 self.factors = spla.splu(sp.csc_matrix(matrix()))

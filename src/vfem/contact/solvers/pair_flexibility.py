@@ -164,15 +164,17 @@ def pair_matrix(surfaces: list, pairs: list, directions: list[list[np.ndarray]],
         return W, dp_dplaten
 
     read = read_rows(surfaces, pairs, directions, offsets)
-    # each body's block: the unknowns that read its motion (rows) by those that force it
-    rows = [np.flatnonzero(np.diff(r.indptr)) for r in read]
-    cols = [np.unique(f.indices) for f in dF]
     # W's entries that may be nonzero: pairs k and l couple where they share a body
-    sizes = np.diff(offsets)
-    shared = np.array([[bool({a.fine, a.coarse} & {b.fine, b.coarse}) for b in pairs]
-                       for a in pairs], dtype=bool).reshape(len(pairs), len(pairs))
-    covered = float(sizes @ shared @ sizes) if len(pairs) else 0.0
+    touches = np.zeros((len(pairs), len(surfaces)))
+    for k, pair in enumerate(pairs):
+        touches[k, [pair.fine, pair.coarse]] = 1.0
+    sizes = np.diff(offsets).astype(float)
+    covered = float(sizes @ ((touches @ touches.T) > 0) @ sizes) if len(pairs) else 0.0
     if sparse_ok and m >= SPARSE_MIN and covered <= SPARSE_DENSITY * m * m:
+        # each body's block: the unknowns that read its motion (rows) by those that force it
+        rows = [np.flatnonzero(np.diff(r.indptr)) for r in read]
+        cols = [np.unique(f.indices) for f in dF]
+
         def block(b: int) -> np.ndarray:
             """Body b's block of W (rows[b], cols[b]), on its owner."""
             s = surfaces[b]
@@ -201,7 +203,7 @@ def pair_matrix(surfaces: list, pairs: list, directions: list[list[np.ndarray]],
         unit traction)."""
         s, f = surfaces[b], dF[b]
         if read[b].nnz == 0 or f.nnz == 0:
-            return np.zeros((m, m))
+            return 0.0  # (in no pair: nothing to add, no (m, m) of zeros made)
         motion = np.asarray((f.T @ (s.C if s.exactly_symmetric else s.C.T)).T)
         return read[b] @ motion
 
