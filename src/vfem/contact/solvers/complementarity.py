@@ -40,10 +40,11 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
 
     Block principal pivoting (every violation swapped at once), which finds the set in a few
     solves; if a set repeats (it may cycle), one violation at a time, the lowest index first
-    (Murty's rule, finite when W is a P-matrix). A set on which the platen's equilibrium cannot
-    hold (nothing else holds its body) takes the nodes that touch within the tolerance. Without
-    a complementary solution in ``max_pivots`` solves, the last set's solution with its negative
-    values set to zero.
+    (Murty's rule, finite when W is a P-matrix; where it is not, a set met again under that
+    rule is a cycle, and the search ends there with no set). A set on which the platen's
+    equilibrium cannot hold (nothing else holds its body) takes the nodes that touch within the
+    tolerance. Without a complementary solution in ``max_pivots`` solves (or at a cycle), the
+    last set's solution with its negative values set to zero.
 
     ``W``: the matrix (:class:`DenseSystem`), or an operator with its ``matvec`` and ``solve``
     (:class:`~vfem.contact.solvers.matrix_free.PairOperator`, issue 22). ``factor``: with a matrix,
@@ -109,7 +110,7 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
     def pivoting(active, eligible, limit):
         """Block principal pivoting over the ``eligible`` nodes from the set ``active``:
         (q, d, penetrations, set, whether it is complementary)."""
-        seen = set()
+        seen, once = set(), set()
         single = False
         for pivot in range(limit):
             q, d, pen = on(active)
@@ -120,6 +121,14 @@ def linear_complementarity(W, q0: np.ndarray, p: np.ndarray, tol: float,
                 log.debug("complementarity: the contact set in %d solves", pivot + 1)
                 return q, d, pen, active, True
             key = active.tobytes()
+            if single and key in once:
+                # one violation at a time, the next set is a function of this one: a set
+                # met again is a cycle that never ends (W is not a P-matrix here: held nodes)
+                log.debug("complementarity: one-at-a-time pivoting cycles after %d solves",
+                          pivot + 1)
+                return q, d, pen, active, False
+            if single:
+                once.add(key)
             single = single or key in seen
             seen.add(key)
             if single:
