@@ -76,7 +76,7 @@ def test_the_pair_matrix_is_the_bodies_parts_summed():
     for k, pair in enumerate(pc.contact_pairs):
         n = len(pair.nodes)
         uf = pair.fine_read(du[pair.fine])
-        uc = np.einsum("ij,jdm->idm", np.asarray(pair.interp), du[pair.coarse])
+        uc = np.einsum("ij,jdm->idm", pair.interp.toarray(), du[pair.coarse])
         for j, direction in enumerate(directions[k]):
             rows = slice(offsets[k] + j * n, offsets[k] + (j + 1) * n)
             reference[rows] = np.einsum("id,idm->im", pair.reading(j, direction), uf - uc)

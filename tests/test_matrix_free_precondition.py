@@ -153,16 +153,14 @@ def test_a_singular_H_falls_back_to_the_diagonal(both):
     assert np.abs(x - exact).max() <= 1e-9 * np.abs(exact).max()
 
 
-def test_sparse_rows_are_the_dense_routes(both, monkeypatch):
-    """dF from the pairs' nonzero entries equals dF from their dense columns, entry for
-    entry (whatever the chunk), and sum_b read_b C_b dF_b is the dense route's W."""
+def test_sparse_rows_are_the_dense_routes(both):
+    """dF from the pairs' nonzero entries equals dF from their columns made dense, entry for
+    entry, and sum_b read_b C_b dF_b is the dense route's W."""
     free, dense = both
     form = dense.contact
     pairs = form.contact_pairs
     directions = [form.directions(k) for k in range(len(pairs))]
     offsets, dF = pf.force_rows(form.surfaces, pairs, directions)
-    monkeypatch.setattr(pf, "NONZERO_CHUNK", 7)
-    _, chunked = pf.force_rows(form.surfaces, pairs, directions)
     m = int(offsets[-1])
     for b, s in enumerate(form.surfaces):  # the columns of fine_columns, coarse_columns
         rows, cols, vals = [], [], []
@@ -172,6 +170,7 @@ def test_sparse_rows_are_the_dense_routes(both, monkeypatch):
                                         (pair.coarse, pair.coarse_columns(), -1.0)):
                 if body != b:
                     continue
+                columns = columns.toarray()
                 r, c = np.nonzero(columns)
                 for j, direction in enumerate(directions[k]):
                     for d in range(s.dim):
@@ -180,20 +179,20 @@ def test_sparse_rows_are_the_dense_routes(both, monkeypatch):
                         vals.append(sign * columns[r, c] * direction[c, d])
         reference = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
                                    np.concatenate(cols))), shape=(s.dim * s.nc, m))
-        for built in (dF[b], chunked[b]):
-            assert (built != reference).nnz == 0
+        assert (dF[b] != reference).nnz == 0
     read = pf.read_rows(form.surfaces, pairs, directions, offsets)
     W = sum(np.asarray(read[b] @ (s.C @ dF[b].toarray()))
             for b, s in enumerate(form.surfaces))
     Wd = form._full[0]
     assert np.abs(W - Wd).max() <= 1e-12 * np.abs(Wd).max()
-    # a sparse matrix gives the same entries as its dense form
+    # the nonzero entries of a pair's columns are those of its dense form
     A = pairs[0].transfer
-    for got in (pf.nonzeros(sp.csr_matrix(A), cols=pairs[0].nodes),):
-        want = pf.nonzeros(A, cols=pairs[0].nodes)
-        order = np.lexsort(got[:2]), np.lexsort(want[:2])
-        for g, w in zip(got, want):
-            np.testing.assert_array_equal(g[order[0]], w[order[1]])
+    got = pf.nonzeros(A, cols=pairs[0].nodes)
+    dense = A.toarray()[:, pairs[0].nodes]
+    want = (*np.nonzero(dense), dense[np.nonzero(dense)])
+    order = np.lexsort(got[:2]), np.lexsort(want[:2])
+    for g, w in zip(got, want):
+        np.testing.assert_array_equal(g[order[0]], w[order[1]])
 
 
 def test_the_side_choice_compliances_by_half_a_back_substitution(both, monkeypatch):

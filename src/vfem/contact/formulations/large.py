@@ -70,6 +70,7 @@ from __future__ import annotations
 import logging
 
 import numpy as np
+import scipy.sparse as sp
 
 from ...errors import AnalysisError, InputError
 from ..capabilities import Capabilities
@@ -154,8 +155,8 @@ class LargeDeformationContact(PairSet):
             geo = overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes, pair.zones)
             if geo is None:  # the surfaces no longer face each other anywhere
                 pair.carries = np.zeros(len(pair.nodes), dtype=bool)
-                pair.mass = np.zeros_like(pair.mass)
-                pair.transfer = np.zeros_like(pair.transfer)
+                pair.mass = sp.csr_array(pair.mass.shape)
+                pair.transfer = sp.csr_array(pair.transfer.shape)
                 pair.patches = None
                 self.tractions(state, k)[:] = 0.0
                 out.append(np.full(len(pair.nodes), -np.inf))
@@ -392,9 +393,9 @@ class LargeDeformationContact(PairSet):
                 cols = slice(col, col + len(s_))
                 for d in range(dim):  # component d of every node's force: every dim-th dof
                     A[off[pair.fine] + d:off[pair.fine + 1]:dim, cols] += (
-                        pair.mass[:, pair.nodes[s_]] * n[:, d])
+                        pair.mass[:, pair.nodes[s_]].toarray() * n[:, d])
                     A[off[pair.coarse] + d:off[pair.coarse + 1]:dim, cols] -= (
-                        pair.transfer[:, pair.nodes[s_]] * n[:, d])
+                        pair.transfer[:, pair.nodes[s_]].toarray() * n[:, d])
                 col += len(s_)
         CA = np.zeros((nt, m))
         for b in range(len(self.surfaces)):
@@ -474,7 +475,9 @@ class LargeDeformationContact(PairSet):
         sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
         uf = u[off[pair.fine]:off[pair.fine + 1]].reshape((sf.nc, sf.dim) + u.shape[1:])
         uc = u[off[pair.coarse]:off[pair.coarse + 1]].reshape((sc.nc, sc.dim) + u.shape[1:])
-        rel = uf[pair.nodes[nodes]] - np.tensordot(pair.interp[nodes], uc, axes=(1, 0))
+        w = pair.interp[nodes]
+        rel = uf[pair.nodes[nodes]] - (w @ uc.reshape(sc.nc, -1)).reshape((w.shape[0],)
+                                                                          + uc.shape[1:])
         return np.einsum("id,id...->i...", direction[nodes], rel)
 
     def _add_unknowns(self, state: ContactState, sets: list[np.ndarray], dq: np.ndarray

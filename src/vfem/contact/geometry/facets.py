@@ -27,6 +27,7 @@ from __future__ import annotations
 from typing import Protocol
 
 import numpy as np
+import scipy.sparse as sp
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
@@ -331,7 +332,8 @@ class Segment:
 
     def material_points(self, facets, seg, interp):
         """``facet + t`` (t clipped below 1, so the facet is its integer part)."""
-        t = np.asarray(interp[np.arange(len(seg)), facets[seg, 1]]).ravel()
+        t = interp[np.arange(len(seg)), facets[seg, 1]]
+        t = (t.toarray() if sp.issparse(t) else np.asarray(t)).ravel()
         return seg + np.clip(t, 0.0, 1.0 - 1e-12)
 
     def material_positions(self, x, facets, points):
@@ -425,7 +427,8 @@ class _Facet3D:
         """(n, 1 + nodes): the facet, then its nodes' shape function values at the point
         (the large-kinematics friction's anchors, issue 21): the point moves with them."""
         seg = np.asarray(seg)
-        weights = np.asarray(interp)[np.arange(len(seg))[:, None], facets[seg]]
+        weights = interp[np.arange(len(seg))[:, None], facets[seg]]
+        weights = weights.toarray() if sp.issparse(weights) else np.asarray(weights)
         return np.column_stack([seg.astype(float), weights])
 
     def material_positions(self, x, facets, points):

@@ -60,12 +60,12 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     nodes, interp, normal, gap, seg, past = (v[keep] for v in (nodes, interp, normal, gap, seg,
                                                                past))
     if approach is not None:
-        ray_pairing(s, so, opatch, nodes, (normal, gap, interp, seg), past, approach(
+        interp = ray_pairing(s, so, opatch, nodes, (normal, gap, interp, seg), past, approach(
             Overlap(nodes, normal, gap, interp, None, past, None, None, None, patch, opatch)))
-    mass = np.zeros((s.nc, s.nc))
-    mass[nodes, nodes] = 1.0
-    transfer = np.zeros((so.nc, s.nc))
-    transfer[:, nodes] = interp.T
+    # (sparse: the identity at the nodes, and their virtual nodes' weights transposed)
+    mass = sp.csr_array((np.ones(len(nodes)), (nodes, nodes)), shape=(s.nc, s.nc))
+    w = sp.coo_array(interp)
+    transfer = sp.csr_array((w.data, (w.col, np.asarray(nodes)[w.row])), shape=(so.nc, s.nc))
     geo = Overlap(nodes, normal, gap, interp, so.rind_depth[seg], past,
                   np.ones(len(nodes), dtype=bool), mass, transfer, patch, opatch)
     guard = np.where(past[:, None], -1, so.facets[seg])
@@ -254,10 +254,9 @@ def held_edges(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     if not keep.any():
         return None
     e, tc, seg, tt, m, gap = e[keep], tc[keep], seg[keep], tt[keep], m[keep], gap[keep]
-    at = np.zeros((len(e), s.nc))
     rows = np.arange(len(e))
-    at[rows, edges[e, 0]] = 1 - tc
-    at[rows, edges[e, 1]] = tc
+    at = sp.csr_array((np.r_[1 - tc, tc], (np.r_[rows, rows], np.r_[edges[e, 0], edges[e, 1]])),
+                      shape=(len(e), s.nc))
     nodes = np.where(tc < 0.5, edges[e, 0], edges[e, 1])
     guard = np.full((len(e), so.facets.shape[1]), -1) if feature else so.facets[seg]
     return (at, nodes, m, gap, so.interpolation(seg, tt), guard, so.sizes[seg],
@@ -389,9 +388,10 @@ def _body_turn(s: ContactSurface, edges: np.ndarray, facet: np.ndarray) -> np.nd
 
 
 def ray_pairing(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, nodes: np.ndarray,
-                pairing: tuple, past: np.ndarray, approach: np.ndarray) -> None:
+                pairing: tuple, past: np.ndarray, approach: np.ndarray) -> sp.csr_array:
     """Held nodes of ``s`` paired where they will meet ``so``: (in place on ``pairing`` =
-    (normal, gap, interp, facet), :func:`held_nodes`' closest-point pairing) the virtual node
+    (normal, gap, interp, facet), :func:`held_nodes`' closest-point pairing, interp returned
+    with its rows replaced: it is sparse) the virtual node
     moved to where the ray along the loads' relative motion ``approach`` ((m, dim)) enters
     the patch ``opatch`` (:func:`ray_entry`), the gap read along that facet's normal; only
     where the node approaches that facet clearly (within 60 degrees of its inward normal).
@@ -406,12 +406,12 @@ def ray_pairing(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, nodes
     u, moving = _unit_motion(approach)
     use = ~past & moving & (np.einsum("ij,ij->i", normal, u) <= -0.5)
     if not use.any():
-        return
+        return interp
     idx = np.flatnonzero(use)
     t = ray_entry(so, s.X[nodes[idx]], u[idx])
     idx, t = idx[np.isfinite(t)], t[np.isfinite(t)]
     if not len(idx):
-        return
+        return interp
     hit = s.X[nodes[idx]] + t[:, None] * u[idx]
     seg2, t2, dist, m, tf = so.closest(hit, None, opatch)
     # (near the closest point: within the facet it lies on, as a node may slide before its
@@ -422,12 +422,23 @@ def ray_pairing(s: ContactSurface, so: ContactSurface, opatch: np.ndarray, nodes
           & (np.einsum("ij,ij->i", m, u[idx]) <= -0.5))
     idx, seg2, t2, m = idx[on], seg2[on], t2[on], m[on]
     if not len(idx):
-        return
+        return interp
     point, _ = so.surface_map(seg2, t2)
     normal[idx] = m
     gap[idx] = np.einsum("ij,ij->i", s.X[nodes[idx]] - point, m)
-    interp[idx] = so.interpolation(seg2, t2)
     seg[idx] = seg2
+    return _replace_rows(interp, idx, so.interpolation(seg2, t2))
+
+
+def _replace_rows(A: sp.csr_array, idx: np.ndarray, B: sp.csr_array) -> sp.csr_array:
+    """``A`` with its rows ``idx`` replaced by the rows of ``B`` (both sparse)."""
+    keep = np.ones(A.shape[0], dtype=bool)
+    keep[idx] = False
+    a, b = sp.coo_array(A), sp.coo_array(B)
+    on = keep[a.row]
+    return sp.csr_array((np.r_[a.data[on], b.data],
+                         (np.r_[a.row[on], np.asarray(idx)[b.row]], np.r_[a.col[on], b.col])),
+                        shape=A.shape)
 
 
 #: radians: the least turning of a held node's own surface that makes it a feature

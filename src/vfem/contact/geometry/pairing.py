@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from .kept import Kept
 from .surface import ContactSurface
@@ -32,9 +33,10 @@ class ContactPair:
     nodes: np.ndarray  # (m,) candidate nodes of the fine body in this pair
     normal: np.ndarray  # (m, 2) outward normal of the coarse surface at the virtual node
     gap0: np.ndarray  # (m,) undeformed gap (> 0 open)
-    interp: np.ndarray  # (m, nc_coarse) virtual node = interp @ coarse candidate nodes
-    transfer: np.ndarray  # (nc_coarse, nc_fine) coarse nodal force per unit fine traction value
-    mass: np.ndarray  # (nc_fine, nc_fine) the fine surface's N over the overlap
+    # (the three sparse, a few entries a row or column: issue 40)
+    interp: sp.csr_array  # (m, nc_coarse) virtual node = interp @ coarse candidate nodes
+    transfer: sp.csr_array  # (nc_coarse, nc_fine) coarse nodal force per unit fine traction
+    mass: sp.csr_array  # (nc_fine, nc_fine) the fine surface's N over the overlap
     rind_depth: np.ndarray  # (m,) thickness of the coarse element under each virtual node
     carries: np.ndarray  # (m,) whose traction reaches the other surface
     patches: tuple[np.ndarray, np.ndarray] | None  # each side's facets facing the other
@@ -62,7 +64,7 @@ class ContactPair:
     #: box's edge crosses the other surface's facets, :func:`~.held.held_edges`): each point's
     #: position, and its force's share, over the body's candidate nodes (``nodes`` is then
     #: the nearer corner, for messages and output); None: the points are ``nodes``
-    at: np.ndarray | None = None
+    at: sp.csr_array | None = None
     #: the facets of the ``fine`` and ``coarse`` surfaces on the pair's sides, within which
     #: it is paired again as the bodies move (:class:`~.sides.Side`; None: all)
     zones: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
@@ -82,7 +84,7 @@ class ContactPair:
         if self.at is None:
             return v[self.nodes]
         nc = self.at.shape[1]
-        return (self.at @ v[:nc].reshape(nc, -1)).reshape((len(self.at),) + v.shape[1:])
+        return (self.at @ v[:nc].reshape(nc, -1)).reshape((self.at.shape[0],) + v.shape[1:])
 
     def reading(self, j: int, direction: np.ndarray) -> np.ndarray:
         """The direction along which the unknowns ``j`` (0 the normal ones) read the relative
@@ -400,17 +402,18 @@ class Overlap:
     nodes: np.ndarray  # candidate nodes of the compatibility side
     normal: np.ndarray  # (m, 2) the normal along which the gap is measured
     gap: np.ndarray  # (m,) > 0 open
-    interp: np.ndarray  # (m, nc_other) virtual node = interp @ the other surface's nodes
+    interp: sp.csr_array  # (m, nc_other) virtual node = interp @ the other surface's nodes
     rind_depth: np.ndarray  # (m,) thickness of the other body's element there
     beyond: np.ndarray  # (m,) not over the other surface (no virtual node)
     carries: np.ndarray  # (m,) whose traction reaches the other surface (overlap under it)
-    mass: np.ndarray  # (nc_fine, nc_fine) N over the overlap
-    transfer: np.ndarray  # (nc_other, nc_fine) T over the overlap
+    mass: sp.csr_array  # (nc_fine, nc_fine) N over the overlap
+    transfer: sp.csr_array  # (nc_other, nc_fine) T over the overlap
     fpatch: np.ndarray  # the facets of each side that face the other (:func:`facing`)
     cpatch: np.ndarray
 
     def subset(self, keep: np.ndarray) -> Overlap:
-        return Overlap(self.nodes[keep], self.normal[keep], self.gap[keep], self.interp[keep],
+        return Overlap(self.nodes[keep], self.normal[keep], self.gap[keep],
+                       self.interp[np.flatnonzero(keep) if keep.dtype == bool else keep],
                        self.rind_depth[keep], self.beyond[keep], self.carries[keep], self.mass,
                        self.transfer, self.fpatch, self.cpatch)
 
@@ -447,6 +450,6 @@ def overlap(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray | None = None
     mass, transfer = transfer_matrices(sf, sc, fpatch, cpatch,
                                              sc.node_normals(xc, cpatch),
                                              sc.patch_boundary(cpatch), reach, xf, xc)
-    carries = mass[:, nodes].any(axis=0)
+    carries = abs(mass[:, nodes]).sum(axis=0) > 0
     return Overlap(nodes, normal, gap, interp, sc.rind_depth[seg], past, carries, mass,
                    transfer, fpatch, cpatch)

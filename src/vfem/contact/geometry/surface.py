@@ -176,12 +176,13 @@ class ContactSurface:
         (:meth:`~vfem.contact.geometry.facets.FacetKind.traction_shape`)."""
         return self._rows(seg, self.kind.traction_shape(t))
 
-    def _rows(self, seg: np.ndarray, values: np.ndarray) -> np.ndarray:
-        out = np.zeros((len(seg), self.nc))
-        rows = np.arange(len(seg))
-        for col, phi in zip(self.facets[seg].T, values.T):
-            out[rows, col] += phi
-        return out
+    def _rows(self, seg: np.ndarray, values: np.ndarray) -> sp.csr_array:
+        """Sparse (len(seg), nc): a facet's few nodes a row (issue 40: stored dense, the
+        virtual nodes' weights of two 152 x 152 plates took 4 GB)."""
+        k = self.facets.shape[1]
+        rows = np.repeat(np.arange(len(seg)), k)
+        return sp.csr_array((np.asarray(values, dtype=float).reshape(-1),
+                             (rows, self.facets[seg].reshape(-1))), shape=(len(seg), self.nc))
 
     def shape(self, t: np.ndarray) -> np.ndarray:
         """(n, 2 or 3) facet shape functions at local coordinates t (0 at the first node, 1 at

@@ -12,13 +12,14 @@ and back.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from .surface import ContactSurface
 
 
 def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray,
               cpatch: np.ndarray, cnormals: np.ndarray, ends: np.ndarray, gap: float,
-              xf: np.ndarray, xc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+              xf: np.ndarray, xc: np.ndarray) -> tuple[sp.csr_array, sp.csr_array]:
     """Both sides' nodal forces per unit traction value, from one integral over the overlap.
 
     ``N[i, k] = int phi_i(y) psi_k(y) dy`` (the compatibility side, eq. 4.4.11) and
@@ -27,9 +28,9 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
     (:meth:`~vfem.contact.geometry.facets.FacetKind.traction_shape`: the shape functions, piecewise
     linear on 3-node segments), both over the part of the patch ``fpatch`` of
     ``sf`` that lies over the patch ``cpatch`` of ``sc`` (points beyond its ends count
-    nothing). Since the shape functions of each side sum to one, the two sides' forces are
-    equal and opposite for any traction, to round-off, and force reaches only nodes whose
-    facets overlap the other surface.
+    nothing); both sparse, a facet's few nodes a column. Since the shape functions of each
+    side sum to one, the two sides' forces are equal and opposite for any traction, to
+    round-off, and force reaches only nodes whose facets overlap the other surface.
 
     ``ends`` is the coarse patch's boundary (:meth:`ContactSurface.patch_boundary`). The
     quadrature is the fine side's kind's
@@ -52,16 +53,25 @@ def transfer_matrices(sf: ContactSurface, sc: ContactSurface, fpatch: np.ndarray
     own = jn / np.maximum(np.linalg.norm(jn, axis=1), 1e-300)[:, None]
     seg, tt, dist, _, tf = sc.closest(pts, xc, cpatch, own)
     wts = np.where(sc.beyond(seg, tf, ends) | (dist > reach), 0.0, wts)
-    N = np.zeros((sf.nc, sf.nc))
-    T = np.zeros((sc.nc, sf.nc))
     fend, cend = sf.facets[fac], sc.facets[seg]
     fshape, tshape = sf.shape(sloc).T, sf.kind.traction_shape(sloc).T
+    N, T = ([], [], []), ([], [], [])
     for fi, fw in zip(fend.T, tshape):  # the traction's interpolation (piecewise linear)
         for ci, cw in zip(cend.T, sc.shape(tt).T):
-            np.add.at(T, (ci, fi), wts * cw * fw)
+            T[0].append(ci), T[1].append(fi), T[2].append(wts * cw * fw)
         for gi, gw in zip(fend.T, fshape):
-            np.add.at(N, (gi, fi), wts * gw * fw)
-    return N, T
+            N[0].append(gi), N[1].append(fi), N[2].append(wts * gw * fw)
+    return _summed(N, (sf.nc, sf.nc)), _summed(T, (sc.nc, sf.nc))
+
+
+def _summed(parts: tuple[list, list, list], shape: tuple[int, int]) -> sp.csr_array:
+    """The sparse matrix of the (rows, cols, values) parts, repeated entries summed: N and T
+    have a facet's few nodes a column (issue 40: stored dense, (nc, nc) numbers a pair, 4 GB
+    each at 23,000 nodes)."""
+    rows, cols, vals = (np.concatenate(p) if p else np.zeros(0) for p in parts)
+    A = sp.csr_array((vals, (rows.astype(np.int64), cols.astype(np.int64))), shape=shape)
+    A.sum_duplicates()
+    return A
 
 
 def traction_from_forces(s: ContactSurface, F: np.ndarray) -> np.ndarray:

@@ -7,8 +7,8 @@ turns them into motion, read at the pair's nodes and virtual nodes. Formed dense
 body's condensed flexibility, or, where the surfaces' flexibility is applied rather than formed
 (issue 22), as the :class:`~vfem.contact.solvers.matrix_free.PairOperator` that applies it from
 each body's sparse forces (:func:`force_rows`) and readings (:func:`read_rows`). Both are read
-from the nonzero entries of the pairs' transfer and interpolation matrices, a few a row, without
-a dense copy of them (:func:`nonzeros`; issue 40)."""
+from the nonzero entries of the pairs' transfer and interpolation matrices, which are sparse, a
+few a row (:func:`nonzeros`; issue 40)."""
 
 from __future__ import annotations
 
@@ -17,47 +17,20 @@ import scipy.sparse as sp
 
 from .matrix_free import PairOperator
 
-#: columns (or rows) of a pair's dense transfer and interpolation matrices read at once when
-#: their nonzero entries are gathered (:func:`nonzeros`): at most this many numbers copied
-NONZERO_CHUNK = 1 << 22
-
 
 def nonzeros(A, rows: np.ndarray | None = None, cols: np.ndarray | None = None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(i, j, value) of the nonzero entries of ``A[rows][:, cols]`` (None: all), positions in
-    that submatrix, without copying it whole: a pair's N, T and virtual-node weights are
-    stored dense over every candidate node (``ContactPair.mass``, ``transfer``, ``interp``,
-    ``at``: (nc, nc) numbers a pair, 4 GB each at 23,000 nodes) but have a few entries a
-    row, so they are read :data:`NONZERO_CHUNK` numbers at a time (a sparse ``A`` directly)."""
-    if sp.issparse(A):
-        B = sp.csr_matrix(A)
-        if rows is not None:
-            B = B[rows]
-        if cols is not None:
-            B = B[:, cols]
-        B = B.tocoo()
-        keep = B.data != 0
-        return B.row[keep], B.col[keep], B.data[keep]
-    A = np.asarray(A)
-    nr = A.shape[0] if rows is None else len(rows)
-    nc = A.shape[1] if cols is None else len(cols)
-    out_i, out_j, out_v = [], [], []
-    if cols is not None:  # by column blocks (a few of the columns of a large matrix)
-        step = max(1, NONZERO_CHUNK // max(nr, 1))
-        for start in range(0, nc, step):
-            c = np.asarray(cols[start:start + step])
-            block = A[:, c] if rows is None else A[np.ix_(rows, c)]
-            i, j = np.nonzero(block)
-            out_i.append(i), out_j.append(j + start), out_v.append(block[i, j])
-    else:  # by row blocks
-        step = max(1, NONZERO_CHUNK // max(nc, 1))
-        for start in range(0, nr, step):
-            block = A[start:start + step] if rows is None else A[rows[start:start + step]]
-            i, j = np.nonzero(block)
-            out_i.append(i + start), out_j.append(j), out_v.append(block[i, j])
-    if not out_i:
-        return np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0)
-    return np.concatenate(out_i), np.concatenate(out_j), np.concatenate(out_v)
+    that submatrix: a pair's N, T and virtual-node weights (``ContactPair.mass``,
+    ``transfer``, ``interp``, ``at``) are sparse, a few entries a row (issue 40)."""
+    B = sp.csr_array(A)
+    if rows is not None:
+        B = B[np.asarray(rows)]
+    if cols is not None:
+        B = B[:, np.asarray(cols)]
+    B = sp.coo_array(B)
+    keep = B.data != 0
+    return B.row[keep], B.col[keep], B.data[keep]
 
 
 def force_rows(surfaces: list, pairs: list, directions: list[list[np.ndarray]]
