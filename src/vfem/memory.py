@@ -15,10 +15,11 @@ The model (bytes), per body, summed over the bodies:
 (``PARDISO_DENSE_BYTES`` for ``DENSE_BYTES`` under PARDISO)
 
 plus ``BASE_BYTES``, plus ``PAIR_BYTES * nc_i * nc_j`` per pair of contact surfaces that may
-touch, plus ``LARGE_BYTES * ndofs * 2 nc`` per large-kinematics body (fitted when its tangent
-flexibility for the candidate dofs was built dense, ndofs x 2 nc, in each Newton iteration;
-since issue 19 it comes from the Schur complement, or from back-substitutions in blocks of
-columns, so the term is an upper bound: total-Lagrangian Hertz at 119k dofs, estimate 2,642
+touch (matrix-free: ``SPARSE_PAIR_BYTES * (nc_i + nc_j)``, nothing dense), plus
+``LARGE_BYTES * ndofs * 2 nc`` per large-kinematics body (fitted when its tangent flexibility
+for the candidate dofs was built dense, ndofs x 2 nc, in each Newton iteration; since issue 19
+it comes from the Schur complement, or from back-substitutions in blocks of columns, so the
+term is an upper bound: total-Lagrangian Hertz at 119k dofs, estimate 2,642
 MiB, peak 1,281 MiB). Here
 
 * ``nnz(K)`` is its structural count, from the mesh: 4 (points + 2 pairs of points sharing an
@@ -92,8 +93,15 @@ STIFFNESS_BYTES = 64
 #: (:func:`vfem.linalg.common.spd_inverse_in_place`; its factor's dense block is in the fill)
 PARDISO_DENSE_BYTES = 12
 #: Bytes per product of two contact surfaces' candidate counts (the paired variant's transfer
-#: and mass matrices and its condensed flexibility).
+#: and mass matrices and its condensed flexibility; fitted while N and T were dense: since
+#: issue 40 they are sparse, and on the dense route the term is an upper bound).
 PAIR_BYTES = 32
+#: The matrix-free route forms no pair matrix, and a pair's N, T and virtual-node weights are
+#: sparse (issue 40): per candidate node of either surface at most this many bytes (16 an
+#: entry, values and indices; at most 32 entries a node over the three matrices: a node's
+#: column of N reaches the nodes of the facets around it, nine on a quadrilateral surface,
+#: T's the nodes of the facets it overlaps, the weights four a row).
+SPARSE_PAIR_BYTES = 16 * 32
 #: Bytes per entry of a large-kinematics body's dense tangent flexibility (ndofs x 2 nc) and its
 #: right-hand sides.
 LARGE_BYTES = 24
@@ -180,7 +188,8 @@ def estimate(surfaces, pairs=(), backend: str | None = None, matrix_free: bool =
         if body.iterates:  # its tangent's factor and flexibility, each iteration
             parts["large"] += LARGE_BYTES * ndofs * 2.0 * s.nc
     for i, j in pairs.keys():
-        parts["pairs"] += PAIR_BYTES * float(surfaces[i].nc) * surfaces[j].nc
+        parts["pairs"] += (SPARSE_PAIR_BYTES * float(surfaces[i].nc + surfaces[j].nc)
+                           if matrix_free else PAIR_BYTES * float(surfaces[i].nc) * surfaces[j].nc)
     parts["total"] = BASE_BYTES + sum(parts.values())
     return parts
 

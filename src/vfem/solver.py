@@ -43,7 +43,7 @@ from .contact.geometry import ContactPairs, exterior_facets
 from .contact.invariants import InvariantCheck, Invariants
 from .contact.search import project_points
 from .contact.settings import ContactSettings
-from .contact.solvers import matrix_free_refusal
+from .contact.solvers import matrix_free_refusal, predicted_seconds
 from .contact.state import ContactState, IterationRecord, SolveResult
 from .errors import (
     ActiveSetNotSettled,
@@ -358,10 +358,12 @@ class Analysis:
 
     def _matrix_free(self, pairs: ContactPairs) -> bool:
         """Whether the contact correction applies the bodies' flexibility instead of forming
-        it (``contact.flexibility``, issue 22): asked for, or ``"auto"`` and the dense blocks
-        would exceed ``contact.dense_limit_mib`` (default half the memory available). The
-        matrix-free route serves the paired variant under small kinematics without friction;
-        asked for elsewhere, it is refused with the reason."""
+        it (``contact.flexibility``, issue 22): asked for, or ``"auto"`` and either the dense
+        blocks would exceed ``contact.dense_limit_mib`` (default half the memory available)
+        or the matrix-free route is predicted to take less time
+        (:func:`~vfem.contact.solvers.routes.predicted_seconds`, issue 40). The matrix-free
+        route serves the paired variant under small kinematics without friction; asked for
+        elsewhere, it is refused with the reason."""
         cfg = self.model.contact
         if cfg.flexibility == "dense" or not any(s.nc for s in self.surfaces):
             return False
@@ -379,11 +381,14 @@ class Analysis:
         else:
             available = available_memory()
             limit = None if available is None else 0.5 * available
+        seconds = predicted_seconds(self.surfaces, len(self.model.load_factors), self.backend)
+        faster = seconds["matrix_free"] < seconds["dense"]
         # one choice for every MPI rank (the memory available differs from rank to rank)
-        chosen = current_ranks().agree(limit is not None and dense > limit)
-        log.info("contact flexibility: %s (dense blocks about %.0f MiB, limit %s)",
-                 "matrix-free" if chosen else "dense", dense / 2**20,
-                 "none" if limit is None else f"{limit / 2**20:.0f} MiB")
+        chosen = current_ranks().agree((limit is not None and dense > limit) or faster)
+        log.info("contact flexibility: %s (dense blocks about %.0f MiB, limit %s; predicted "
+                 "%.3g s dense, %.3g s matrix-free)", "matrix-free" if chosen else "dense",
+                 dense / 2**20, "none" if limit is None else f"{limit / 2**20:.0f} MiB",
+                 seconds["dense"], seconds["matrix_free"])
         return chosen
 
     def _contact(self, pairs: ContactPairs):

@@ -150,7 +150,9 @@ class ContactSettings:
             small zones); ``"matrix_free"`` — applied through each body's factorization, one
             back-substitution per body per iteration of a GMRES solve, nothing dense (large
             contact zones); ``"auto"`` (default) — matrix-free when the dense blocks would take
-            more than ``dense_limit_mib``, else dense. The matrix-free route serves the paired
+            more than ``dense_limit_mib``, or where it is predicted to take less time
+            (:func:`vfem.contact.solvers.routes.predicted_seconds`, issue 40), else dense.
+            The matrix-free route serves the paired
             variant, small kinematics, without friction; ``"auto"`` keeps the others dense.
         dense_limit_mib: the memory (MiB) the dense blocks may take before ``"auto"`` goes
             matrix-free. Default (None): half the memory available when the analysis starts.

@@ -10,8 +10,10 @@ from .complementarity import linear_complementarity
 from .iteration import Check, iterate
 from .matrix_free import PairOperator, matrix_free_refusal
 from .pair_flexibility import force_rows, pair_matrix, platen_rows
+from .routes import predicted_seconds
 
 __all__ = [
+    "predicted_seconds",
     "bordered_matrix",
     "bordered_solve",
     "Check",
