@@ -62,3 +62,41 @@ def test_rays_onto_a_block_top_in_2d(order):
     assert t[0] == pytest.approx(0.25, abs=TOL)
     assert t[1] == pytest.approx(0.4 / 0.8, abs=TOL)
     assert np.all(np.isinf(t[2:]))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_the_nearby_pieces_first_find_what_every_piece_finds(dim, monkeypatch):
+    """``ray_facet`` tests each ray against the pieces near its first ``RAY_REACH`` piece
+    radii first, every piece only for the rays that enter none of those (issue 40): on a
+    finely meshed face (above ``RAY_NEAR_FROM`` pieces), rays from heights of 0 to 30 piece
+    sizes, some through vertices and edges (ties: the lowest piece), the same distances and
+    facets, bit for bit, as every piece against every ray."""
+    from vfem.contact.geometry import pairing
+
+    if dim == 3:
+        mesh = box(0.0, 0.0, 0.0, 1.0, 1.0, 0.2, nx=12, ny=12, nz=1)
+        face, n_facets = "top", 144
+    else:
+        mesh = rectangle(x0=0.0, y0=-0.2, width=1.0, height=0.2, nx=100, ny=1)
+        face, n_facets = "top", 100
+    body = Body("b", mesh, LinearElastic(200.0, 0.3), supports=(Support("bottom"),),
+                contact_boundaries=(face,))
+    s = ContactSurface.build(body, mesh.boundaries[face])
+    assert len(s.facets) == n_facets
+    rng = np.random.default_rng(3)
+    k = 400
+    top = s.X[:, -1].max()
+    xy = rng.uniform(0.0, 1.0, (k, dim - 1))
+    xy[:40] = np.round(xy[:40] * 12) / 12  # over vertices and edges of the mesh
+    h = top + rng.uniform(0.0, 30.0 / 12, k)
+    points = np.column_stack([xy, h])
+    d = np.column_stack([rng.normal(0.0, 0.15, (k, dim - 1)), -np.ones(k)])
+    d[::7] *= -1  # some pointing away
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    near = pairing.ray_facet(s, points, d)
+    monkeypatch.setattr(pairing, "RAY_NEAR_FROM", 10**9)  # every piece against every ray
+    every = pairing.ray_facet(s, points, d)
+    assert np.isfinite(near[0]).sum() > k // 2 and np.isinf(near[0]).sum() > k // 10
+    assert (np.isfinite(near[0]) & (near[0] > pairing.RAY_REACH * 0.08)).any()  # far ones too
+    np.testing.assert_array_equal(near[0], every[0])
+    np.testing.assert_array_equal(near[1], every[1])
