@@ -8,12 +8,13 @@ factorized (seconds on the 2-core machine, PARDISO; the measurements in ``docs/s
 section 1, "Choosing"):
 
 * **dense**: each body's Schur complement on its m_b condensed dofs
-  (``ContactSurface.condensed_dofs``) formed and inverted, W formed and each contact set's
-  block factorized: ``DENSE_CUBE * sum m_b^3 + DENSE_SQUARE * sum m_b^2``, fitted (relative
-  least squares) to the flat plates of ``benchmarks/matrix_free.py`` from 3,939 to 16,371
-  contact dofs (the two routes' total times' difference, where the matrix-free route's own
-  cost is a few percent of it): within 2 % there; 0.16 s predicted against 0.21 s at 2,064,
-  0.018 against 0.043 at 732;
+  (``ContactSurface.condensed_dofs``: the candidates' for the paired variant, which reads no
+  rind, as the solver sets them before it asks) formed and inverted, W formed and each contact
+  set's block factorized: ``DENSE_CUBE * sum m_b^3 + DENSE_SQUARE * sum m_b^2``, fitted
+  (relative least squares) to the flat plates of ``benchmarks/matrix_free.py`` from 3,939 to
+  16,371 contact dofs (the two routes' total times' difference, where the matrix-free route's
+  own cost is a few percent of it): within 2 % there; 0.16 s predicted against 0.21 s at
+  2,064, 0.017 against 0.043 at 732;
 * **matrix-free**: each application of W two back-substitutions through every body's factor,
   ``products * (APPLY * sum nnz(L_b) + APPLY_FIXED * bodies)``
   (:func:`vfem.memory.factor_entries`, the plain factor), ``APPLY`` measured 5.1-5.2e-10 s an
@@ -33,9 +34,9 @@ from __future__ import annotations
 from ...memory import factor_entries
 
 #: seconds per cube of a body's contact dofs: the dense route's condensation and W
-DENSE_CUBE = 1.73e-12
+DENSE_CUBE = 1.39e-11
 #: seconds per square of a body's contact dofs: the dense route's lower-order terms
-DENSE_SQUARE = 1.30e-8
+DENSE_SQUARE = 5.7e-8
 #: seconds per factor entry per application of W on the matrix-free route
 APPLY = 5.2e-10
 #: seconds per body per application of W besides its factor's entries (the operator's own
