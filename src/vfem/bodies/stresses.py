@@ -196,14 +196,22 @@ def strain_beyond(body, u: np.ndarray, limit: float) -> tuple[float, int] | None
         return (strain, element) if strain > limit else None
     if not body.mesh.nelements:
         return None
-    suspect = np.flatnonzero(strain_bound(body, u) * (1 + 1e-9) > limit)
-    if not suspect.size:
-        return None
-    if body.dim == 3 and not (body.order == 1 and body.mesh.t.shape[0] == 4):
-        strain, element = _max_strain_at_quadrature_3d(body, u, suspect)
-    else:  # 2D (one vectorised pass) and linear tetrahedra (one sparse product): cheap whole
-        strain, element = max_strain(body, u)
+    if not _constant_strain(body):  # (linear simplices: the exact strain, one sparse product)
+        suspect = np.flatnonzero(strain_bound(body, u) * (1 + 1e-9) > limit)
+        if not suspect.size:
+            return None
+        if body.dim == 3:
+            strain, element = _max_strain_at_quadrature_3d(body, u, suspect)
+            return (strain, element) if strain > limit else None
+    strain, element = max_strain(body, u)  # 2D: one vectorised pass
     return (strain, element) if strain > limit else None
+
+
+def _constant_strain(body) -> bool:
+    """Whether the body's strain is constant in each element (linear triangles and
+    tetrahedra), read exactly by one sparse product (:func:`average_strain_operator`): cheaper
+    than any screen."""
+    return body.order == 1 and body.mesh.t.shape[0] == body.dim + 1
 
 
 def strain_bound(body, u: np.ndarray) -> np.ndarray:
@@ -214,29 +222,45 @@ def strain_bound(body, u: np.ndarray) -> np.ndarray:
     alone taken out the bound reached 18 % and 5,487 of the 30,724 elements went to the
     eigenvalues (1.5 s a step at 278k dofs); with the linear field taken out too, 2.7 and
     2.9 %, none, 0.03 s (issue 40)."""
-    dim, mesh = body.dim, body.mesh
     u = np.asarray(u, dtype=float)
-    ue = u[body.dof_map.element_dofs].reshape(-1, dim, mesh.nelements)  # (a, comp, e)
+    ue = u[body.dof_map.element_dofs].reshape(-1, body.dim, body.mesh.nelements)  # (a, c, e)
     centre = ue.mean(axis=0)
     d = ue - centre
     # round-off: sum_a grad N_a is zero (and sum_a x_a (x) grad N_a the identity) only to its
     # own rounding, times the rigid motion c (and the fitted field's size times the reach)
     scale = np.sqrt((centre**2).sum(axis=0))
     linear = 0.0
-    if (body.order == 1 and ue.shape[0] == mesh.t.shape[0]
-            and mesh.doflocs.shape == mesh.p.shape):  # nodes and geometry the mesh's corners
-        xe = np.moveaxis(mesh.p[:, mesh.t], 0, 1)  # (node, coordinate, element)
-        centroid = xe.mean(axis=0)
-        X = xe - centroid
-        # G^T = (X^T X)^-1 X^T (u_a - c), each element's least squares over its nodes
-        Gt = np.linalg.solve(np.einsum("aie,aje->eij", X, X),
-                             np.einsum("aie,aje->eij", X, d))
+    fit = _linear_fit(body) if ue.shape[0] == body.mesh.t.shape[0] else None
+    if fit is not None:
+        X, P, reach = fit
+        Gt = np.einsum("aie,aje->eij", P, d)  # G^T, each element's least squares
         d = d - np.einsum("aie,eij->aje", X, Gt)
         linear = np.sqrt((0.25 * (Gt + np.swapaxes(Gt, 1, 2)) ** 2).sum(axis=(1, 2)))
-        reach = np.sqrt((centroid**2).sum(axis=0)) + np.sqrt((X**2).sum(axis=1)).max(axis=0)
         scale = scale + np.sqrt((Gt**2).sum(axis=(1, 2))) * reach
     spread = np.sqrt((d**2).sum(axis=1)).max(axis=0)
     return linear + (spread + 1e-12 * scale) * _gradient_bound(body)
+
+
+def _linear_fit(body):
+    """For linear elements whose nodes and geometry are the mesh's corners, once per mesh:
+    X (node, coordinate, element) the nodes less their centroid, P = X (X^T X)^-1 (the same
+    shape: G^T = sum_a P_a (x) (u_a - c) fits u_a - c by G X_a in least squares), and each
+    element's reach |centroid| + max_a |X_a| (for the round-off); else None."""
+    mesh = body.mesh
+    kept = body.__dict__.get("_linear_fit")
+    if kept is not None and kept[0] is mesh:
+        return kept[1]
+    fit = None
+    if body.order == 1 and mesh.doflocs.shape == mesh.p.shape:
+        xe = np.moveaxis(mesh.p[:, mesh.t], 0, 1)
+        centroid = xe.mean(axis=0)
+        X = xe - centroid
+        inverse = np.linalg.inv(np.einsum("aie,aje->eij", X, X))
+        P = np.einsum("aje,eji->aie", X, inverse)
+        reach = np.sqrt((centroid**2).sum(axis=0)) + np.sqrt((X**2).sum(axis=1)).max(axis=0)
+        fit = (X, P, reach)
+    body.__dict__["_linear_fit"] = (mesh, fit)
+    return fit
 
 
 def _gradient_bound(body) -> np.ndarray:
