@@ -9,7 +9,11 @@ pays), the factorization with its contact candidates' dofs last and their Schur 
 (vfem's route), and the back-substitution route on the plain factor, timed on its first
 ``--columns`` columns (512) and scaled to all of them (said so in its row). Printed per body:
 dofs, contact dofs, seconds and the factor's nonzeros of each route, and each route's cost in
-plain factorizations. Issue 40, item 1.
+plain factorizations. Then, once each: the factor entries of PARDISO's partial solve (its
+sparse right-hand sides, ``iparm[30] = 3``: it orders the marked dofs last as the Schur
+complement does), and the Schur complement with the factors out of core (``iparm[59] = 2``,
+files in ``MKL_PARDISO_OOC_PATH`` or the working folder): its time and PARDISO's own count of the
+memory it keeps, against the in-core one's. Issue 40, item 1.
 
 For the Hertz example's cylinder (the body with all the dofs) and its tracked contact dofs, with
 every installed backend:
@@ -37,6 +41,9 @@ from vfem.linalg.pardiso import PardisoFactorization
 from vfem_examples.hertz import build
 from vfem_tools.bench import hertz_parameters, parse_size
 
+#: the out-of-core route's memory for PARDISO, MB (unless MKL_PARDISO_OOC_MAX_CORE_SIZE is set)
+OOC_CORE_MB = 256
+
 
 class PartialSolve(PardisoFactorization):
     """PARDISO with its sparse right-hand-side, partial-solution solve (iparm[30] = 3)."""
@@ -53,10 +60,41 @@ class PartialSolve(PardisoFactorization):
         self._pt = np.zeros(64, dtype=np.int64)
         self._mtype = 2
         self._iparm = np.zeros(64, dtype=np.int32)
-        self._iparm[[0, 1, 9, 30, 34]] = [1, 2, 8, 3, 1]
+        self._iparm[[0, 1, 9, 17, 30, 34]] = [1, 2, 8, -1, 3, 1]
         self._perm = np.zeros(self.n, dtype=np.int32)
         self._perm[marked] = 1
         self._call(12, np.zeros(self.n), np.zeros(self.n), 1)
+
+
+class OutOfCore(PardisoFactorization):
+    """PARDISO's Schur complement on ``marked`` with its factors out of core (``iparm[59] =
+    2``: kept in files, ``MKL_PARDISO_OOC_PATH``, default the working folder; in memory at
+    most ``MKL_PARDISO_OOC_MAX_CORE_SIZE`` MB, :data:`OOC_CORE_MB` unless set, else MKL's 2,000
+    would hold these factors whole): its own count of the memory it keeps (``factor_bytes``)
+    against the in-core factorization's."""
+
+    def __init__(self, A, marked):
+        import os
+
+        os.environ.setdefault("MKL_PARDISO_OOC_MAX_CORE_SIZE", str(OOC_CORE_MB))
+        import scipy.sparse as sp
+
+        self.shape = A.shape
+        U = sp.triu(A, format="csr")
+        U.sort_indices()
+        self.n = U.shape[0]
+        self._a = np.ascontiguousarray(U.data, dtype=float)
+        self._ia, self._ja = U.indptr.astype(np.int32), U.indices.astype(np.int32)
+        self._pt = np.zeros(64, dtype=np.int64)
+        self._mtype = 2
+        self._iparm = np.zeros(64, dtype=np.int32)
+        self._iparm[[0, 1, 17, 34, 35, 59]] = [1, 2, -1, 1, 2, 2]
+        self._perm = np.zeros(self.n, dtype=np.int32)
+        self._perm[marked] = 1
+        m = len(marked)
+        self._call(12, np.zeros(self.n), np.zeros(max(self.n, m * m)), 1)
+        self.factor_entries = int(self._iparm[17])
+        self.factor_bytes = 1024 * (int(self._iparm[15]) + int(self._iparm[16]))
 
 
 def main(dofs: int, backends: list[str]) -> None:
@@ -117,7 +155,8 @@ def sphere(sizes: list[int], columns: int = 512, repeat: int = 2) -> list[dict]:
     rows = []
     print(f"{'dofs':>9} {'body':>7} {'body dofs':>9} {'contact':>7} {'plain s':>8} "
           f"{'schur s':>8} {'ratio':>6} {'nnz plain':>11} {'nnz schur':>11} "
-          f"{'back-sub s':>11} {'ratio':>6}")
+          f"{'back-sub s':>11} {'ratio':>6} {'nnz partial':>11} {'ooc s':>7} "
+          f"{'MiB kept':>8} {'ooc MiB':>8}")
     for size in sizes:
         model = build_sphere(sphere_parameters(size, None))
         surfaces = model.contact_surfaces()[1]
@@ -149,17 +188,32 @@ def sphere(sizes: list[int], columns: int = 512, repeat: int = 2) -> list[dict]:
                             f.solve(E[:, start:start + 256])
                         back = (time.perf_counter() - t0) * m / max(len(cols), 1)
                     del f
+            # PARDISO's partial solve orders the marked dofs last too (its factor's entries)
+            gc.collect()
+            t0 = time.perf_counter()
+            f = PartialSolve(K, trailing)
+            partial_s, entries["partial"] = time.perf_counter() - t0, int(f._iparm[17])
+            del f
+            in_core = linalg.factorize(K, "pardiso", trailing=trailing).factor_bytes
+            gc.collect()
+            t0 = time.perf_counter()
+            f = OutOfCore(K, trailing)
+            ooc_s, ooc_bytes = time.perf_counter() - t0, f.factor_bytes
+            del f
             row = {"dofs": total, "body": body.name, "body_dofs": K.shape[0],
                    "contact_dofs": m, "plain_s": best["plain"], "schur_s": best["schur"],
                    "nnz_plain": entries["plain"], "nnz_schur": entries["schur"],
                    "back_substitution_s": best["plain"] + back, "sampled_columns":
-                   min(columns, m)}
+                   min(columns, m), "partial_s": partial_s, "nnz_partial": entries["partial"],
+                   "out_of_core_s": ooc_s, "in_core_mib": in_core / 2**20,
+                   "out_of_core_mib": ooc_bytes / 2**20}
             rows.append(row)
             print(f"{total:>9} {body.name:>7} {K.shape[0]:>9} {m:>7} {best['plain']:>8.2f} "
                   f"{best['schur']:>8.2f} {best['schur'] / best['plain']:>6.2f} "
                   f"{entries['plain']:>11,} {entries['schur']:>11,} "
-                  f"{best['plain'] + back:>11.2f} {(best['plain'] + back) / best['plain']:>6.2f}",
-                  flush=True)
+                  f"{best['plain'] + back:>11.2f} {(best['plain'] + back) / best['plain']:>6.2f} "
+                  f"{entries['partial']:>11,} {ooc_s:>7.2f} {in_core / 2**20:>8,.0f} "
+                  f"{ooc_bytes / 2**20:>8,.0f}", flush=True)
         del model, surfaces
         gc.collect()
     return rows
