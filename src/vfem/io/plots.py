@@ -63,6 +63,21 @@ def require_matplotlib():
     return _pyplot()
 
 
+def save(plt, fig, path: Path) -> None:
+    """Lay ``fig`` out tight, write it to ``path`` (PNG, 130 dpi) and close it: every 2D figure
+    ends here. The layout is done once, here: ``tight_layout`` leaves a placeholder layout
+    engine on the figure, and for any engine ``savefig`` draws the whole figure once more
+    before drawing it into the file (matplotlib 3.6+, ``print_figure``). That first pass
+    renders nothing but still walks every artist: little on vfem's figures (0.07 of 0.78 s of
+    savefig on a 100k-dof Hertz run), half of the time where a collection's cells fill the
+    axes (60k random triangles: 1.57 s a pass; issue 40). With the engine dropped the figure is
+    drawn once, into the same pixels (tests/test_figure_drawing.py)."""
+    fig.tight_layout()
+    fig.set_layout_engine(None)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[str, np.ndarray],
                    title: str, method: str = "vfem",
                    xlabel: str = "x / a (undeformed x over Hertz's half-width; dimensionless)",
@@ -85,9 +100,7 @@ def hertz_pressure(path: Path, x_over_a: dict[str, np.ndarray], p_over_p0: dict[
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
 
 
 def _plan_axes(ax, x: np.ndarray, y: np.ndarray, ylabel: str) -> None:
@@ -120,9 +133,7 @@ def pressure_map(path: Path, x: np.ndarray, y: np.ndarray, p: np.ndarray, title:
     ax.plot(np.cos(s), np.sin(s), "w--", lw=1.2)
     _plan_axes(ax, x, y, "y / a (undeformed)")
     ax.set_title(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
 
 
 #: how the stick/slip figures mark a node by its friction status (a VTU's ``friction_status``):
@@ -156,9 +167,7 @@ def stick_map(path: Path, panels: list[tuple[str, np.ndarray, np.ndarray, np.nda
         ax.set_title(label, fontsize=9)
     axes[0][-1].legend(fontsize=8, **OUTSIDE)
     fig.suptitle(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
 
 
 def punch_pressure(path: Path, x: np.ndarray, p: np.ndarray, force: float, a: float,
@@ -183,9 +192,7 @@ def punch_pressure(path: Path, x: np.ndarray, p: np.ndarray, force: float, a: fl
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper center")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
 
 
 def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
@@ -216,9 +223,7 @@ def convergence(path: Path, series: dict[str, list[dict]], title: str) -> None:
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
 
 
 
@@ -250,7 +255,7 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
     ``axes``: the names of the two coordinates drawn ("xz" for a 3D body's plane y = 0).
     """
     plt = require_matplotlib()
-    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.collections import LineCollection
     from matplotlib.colors import to_rgba
 
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
@@ -273,16 +278,16 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
             else:
                 name = label if j == 0 else None
             if mesh_lines:
-                poly = x[t]
+                cells = np.asarray(t)
                 if window is not None:  # only the cells near the window (large meshes)
-                    poly = poly[_near(poly, window)]
+                    poly = x[cells]
+                    near = _near(poly, window)
+                    cells, poly = cells[near], poly[near]
                     fine = _fine(poly, window)  # too small for their edges to show
                     if fine.any():
                         _pixels(ax, window, poly[fine], to_rgba(c))
-                    poly = poly[~fine]
-                ax.add_collection(PolyCollection(poly, facecolors="none", edgecolors=c,
-                                                 linewidths=0.4, linestyles=ls, label=name),
-                                  autolim=False)  # the limits are _frame's
+                    cells = cells[~fine]
+                _mesh_lines(ax, x, cells, c, ls, name)
             else:
                 ax.add_collection(LineCollection(x[_outline(np.asarray(t))], colors=c,
                                                  linewidths=0.9, linestyles=ls, label=name),
@@ -295,18 +300,44 @@ def configurations(path: Path, frames: list[tuple[str, list[tuple[np.ndarray, np
                         4.6)
     ax.set_title(title if magnification is None else magnified(title, scale), fontsize=10)
     ax.legend(fontsize=8, **({"loc": legend_loc} if legend_loc else OUTSIDE))
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
+
+
+def _mesh_lines(ax, x: np.ndarray, cells: np.ndarray, colour, linestyle: str,
+                label: str | None) -> None:
+    """Draw the edges of ``cells`` (m, k) (points ``x`` (n, 2)) as two compound paths: every
+    edge, and again the edges two cells share. Two objects for Agg to stroke, where a
+    PolyCollection of the cells made and transformed a path per cell (0.35 s for the 60k
+    cells of a 100k-dof Hertz close-up, issue 40); drawn twice, a shared edge looks as it did
+    when each of its cells drew it. Added with ``add_artist``: ``add_patch`` would take the
+    limits from every segment in a Python loop (they are the figure's window, :func:`_frame`).
+    """
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as Curve
+
+    edges, _, _, count = (polygon_edges(cells) if len(cells)
+                          else (np.zeros((0, 2), dtype=np.int64),) * 3 + (np.zeros(0),))
+    for chosen, name in ((edges, label), (edges[count >= 2], None)):
+        codes = np.tile(np.array([Curve.MOVETO, Curve.LINETO], dtype=Curve.code_type),
+                        len(chosen))
+        ax.add_artist(PathPatch(Curve(x[chosen].reshape(-1, 2), codes), facecolor="none",
+                                edgecolor=colour, linewidth=0.4, linestyle=linestyle,
+                                label=name))
+
+
+def _window(window, lo: np.ndarray, hi: np.ndarray) -> tuple[float, float, float, float]:
+    """A figure's window: the one given, else the box ``lo``..``hi`` padded by 3 %."""
+    if window is not None:
+        return window
+    pad = 0.03 * (hi - lo).max()
+    return (lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad)
 
 
 def _frame(ax, window, lo: np.ndarray, hi: np.ndarray, axes: str = "xy") -> float:
     """Axes of a configuration figure: ``window`` (xmin, xmax, ymin, ymax; default the box
     ``lo``..``hi`` padded by 3 %), equal scales, coordinate labels. Returns the window's
     width over its height, for the figure's shape."""
-    if window is None:
-        pad = 0.03 * (hi - lo).max()
-        window = (lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad)
+    window = _window(window, lo, hi)
     ax.set_xlim(window[0], window[1])
     ax.set_ylim(window[2], window[3])
     ax.set_aspect("equal")
@@ -323,11 +354,13 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
 
     ``bodies``: (name, points (n, 2), cells (m, k) point numbers around each cell,
     displacement (n, 2), von Mises stress per cell (m,)). Each body's outline is drawn in its
-    own colour and named in the legend. One PolyCollection per body (fast on large meshes).
+    own colour and named in the legend. The cells are filled as one image (:func:`_fill`):
+    fast on large meshes.
     """
     plt = require_matplotlib()
     from matplotlib import colormaps
-    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.collections import LineCollection
     from matplotlib.colors import Normalize
 
     cmap = colormaps["viridis"]
@@ -337,10 +370,14 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
     finite = np.concatenate([v[np.isfinite(v)] for v in values] + [np.zeros(1)])
     norm = Normalize(vmin=float(finite.min()), vmax=float(finite.max()) or 1.0)
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
-    mappable = None
-    for j, ((name, p, t, u, _), v) in enumerate(zip(bodies, values)):
+    deformed = []
+    for (_, p, _, u, _) in bodies:
         x = np.asarray(p)[:, :2] + magnification * np.asarray(u)[:, :2]
         lo, hi = np.minimum(lo, x.min(axis=0)), np.maximum(hi, x.max(axis=0))
+        deformed.append(x)
+    shown = _window(window, lo, hi) if bodies else window
+    filled = []
+    for j, ((name, _, t, _, _), v, x) in enumerate(zip(bodies, values, deformed)):
         poly = x[np.asarray(t)]
         if window is not None:  # only the cells near the window (large meshes)
             near = _near(poly, window)
@@ -349,28 +386,76 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
             if fine.any():
                 _pixels(ax, window, poly[fine], cmap(norm(v[fine])))
             poly, v = poly[~fine], v[~fine]
-        # filled without antialiasing, which leaves no seams between cells to cover with
-        # edges of their own colour (40 % less drawing; the outlines are antialiased)
-        mappable = PolyCollection(poly, array=v, cmap=cmap, norm=norm, edgecolors="none",
-                                  linewidths=0.0, antialiaseds=False)
-        # (autolim=False: the limits are _frame's; matplotlib's extent of every path cost
-        # 1.4 s of a 465k-dof Hertz run's figures)
-        ax.add_collection(mappable, autolim=False)
+        filled.append((poly, cmap(norm(v))))
         ax.add_collection(LineCollection(x[_outline(np.asarray(t))],
                                          colors=colors[j % len(colors)], linewidths=1.0,
                                          label=name), autolim=False)
+    if filled:
+        _fill(ax, shown, filled)
     # a figure shaped like the window (equal axes leave the rest blank)
     ratio = _frame(ax, window, lo, hi)
     fig.set_size_inches(min(12.0, max(5.5, 3.4 * ratio + 2.4)), 4.6)
     ax.set_title(magnified(title, magnification), fontsize=10)
-    if mappable is not None:
-        fig.colorbar(mappable, ax=ax, label=f"von Mises stress ({LENGTH})", shrink=0.8,
-                     pad=0.02)
+    if bodies:
+        fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax,
+                     label=f"von Mises stress ({LENGTH})", shrink=0.8, pad=0.02)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(0.0, -0.15), ncol=4,
               borderaxespad=0.0, title="outlines")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
+
+
+#: pixel centres tested against the cells' triangles at a time (:func:`_fill`): 8 bytes and a
+#: few temporaries each
+FILL_CHUNK = 2_000_000
+
+
+def _fill(ax, window, layers: list[tuple[np.ndarray, np.ndarray]]) -> None:
+    """Fill cells as one image over ``window`` (:func:`_image_shape` pixels): ``layers`` of
+    (polygons (m, k, 2), colours (m, 4)), later layers over earlier ones. A pixel takes the
+    colour of the cell its centre lies in (each polygon a fan of triangles from its first
+    point, each triangle filled row by row between its edges); the rest is transparent. Drawn
+    as the cells' layer (zorder 1, under the outlines), without antialiasing as a
+    PolyCollection filled them before, whose path per cell took 0.33 s to make and draw for
+    the 60k cells of a 100k-dof Hertz figure (issue 40); the cost here is the image's."""
+    nx, ny = _image_shape(window)
+    x0, dx = window[0], (window[1] - window[0]) / nx
+    y0, dy = window[2], (window[3] - window[2]) / ny
+    image = np.zeros((ny, nx, 4))
+    for poly, rgba in layers:
+        if not len(poly):
+            continue
+        k = poly.shape[1]
+        # in pixel units (a pixel's centre at integer + 0.5)
+        tri = (np.concatenate([poly[:, [0, i, i + 1]] for i in range(1, k - 1)])
+               - [x0, y0]) / [dx, dy]  # (t, 3, 2)
+        colour = np.tile(np.asarray(rgba, dtype=float), (k - 2, 1))
+        # the rows whose centres each triangle spans
+        first = np.maximum(np.ceil(tri[:, :, 1].min(axis=1) - 0.5), 0).astype(np.int64)
+        last = np.minimum(np.floor(tri[:, :, 1].max(axis=1) - 0.5), ny - 1).astype(np.int64)
+        n = np.maximum(last - first + 1, 0)
+        which = np.repeat(np.arange(len(tri)), n)
+        row = first[which] + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        y = row + 0.5
+        # where the row's centre line crosses each edge: the span between the crossings
+        left, right = np.full(len(row), np.inf), np.full(len(row), -np.inf)
+        for a, b in ((0, 1), (1, 2), (2, 0)):
+            ya, yb = tri[which, a, 1], tri[which, b, 1]
+            xa, xb = tri[which, a, 0], tri[which, b, 0]
+            crosses = (np.minimum(ya, yb) <= y) & (y <= np.maximum(ya, yb)) & (ya != yb)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                xc = np.where(crosses, xa + (y - ya) * (xb - xa) / (yb - ya), np.nan)
+            left = np.fmin(left, xc)
+            right = np.fmax(right, xc)
+        start = np.maximum(np.ceil(left - 0.5), 0)
+        stop = np.minimum(np.floor(right - 0.5), nx - 1)
+        ok = np.isfinite(start) & np.isfinite(stop) & (stop >= start)
+        start, width = start[ok].astype(np.int64), (stop[ok] - start[ok]).astype(np.int64) + 1
+        run = np.repeat(np.arange(len(start)), width)
+        col = start[run] + np.arange(int(width.sum())) - np.repeat(np.cumsum(width) - width,
+                                                                    width)
+        image[row[ok][run], col] = colour[which[ok][run]]
+    ax.imshow(image, extent=window, origin="lower", interpolation="nearest", aspect="auto",
+              zorder=1)
 
 
 #: in a close-up (a figure with a window), cells narrower than this many of the image's pixels
@@ -494,9 +579,7 @@ def history(path: Path, x: np.ndarray, series: dict[str, np.ndarray], xlabel: st
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
 
 
 def profiles(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray, np.ndarray,
@@ -522,9 +605,7 @@ def _finish_profiles(plt, fig, ax, path: Path, xlabel: str, ylabel: str, title: 
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=legend_size, **OUTSIDE)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
 
 
 def friction_profiles(path: Path, bodies: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
@@ -631,9 +712,7 @@ def history_panels(path: Path, panels: list[tuple[str, dict[str, tuple[np.ndarra
     axes[-1, 0].set_xlabel(xlabel)
     axes[-1, 0].xaxis.set_major_locator(MaxNLocator(integer=True))
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
 
 
 def benchmark_times(path: Path, rows: list[dict], title: str) -> None:
@@ -660,6 +739,4 @@ def benchmark_times(path: Path, rows: list[dict], title: str) -> None:
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save(plt, fig, path)
