@@ -45,10 +45,12 @@ from vfem_tools.bench import hertz_parameters, parse_size
 OOC_CORE_MB = 256
 
 
-class PartialSolve(PardisoFactorization):
-    """PARDISO with its sparse right-hand-side, partial-solution solve (iparm[30] = 3)."""
+class Marked(PardisoFactorization):
+    """PARDISO's positive definite factorization of ``A``, the dofs ``marked`` in ``perm``,
+    with the ``iparm`` entries given besides vfem's own (its values, METIS, the factor's
+    entries counted, zero-based indices): the routes vfem does not take, measured here."""
 
-    def __init__(self, A, marked):
+    def __init__(self, A, marked, settings: dict[int, int]):
         import scipy.sparse as sp
 
         self.shape = A.shape
@@ -60,41 +62,32 @@ class PartialSolve(PardisoFactorization):
         self._pt = np.zeros(64, dtype=np.int64)
         self._mtype = 2
         self._iparm = np.zeros(64, dtype=np.int32)
-        self._iparm[[0, 1, 9, 17, 30, 34]] = [1, 2, 8, -1, 3, 1]
+        self._iparm[[0, 1, 17, 34]] = [1, 2, -1, 1]
+        for k, v in settings.items():
+            self._iparm[k] = v
         self._perm = np.zeros(self.n, dtype=np.int32)
         self._perm[marked] = 1
-        self._call(12, np.zeros(self.n), np.zeros(self.n), 1)
+        m = len(marked) if settings.get(35) else 0
+        self._call(12, np.zeros(self.n), np.zeros(max(self.n, m * m)), 1)
+        self.factor_entries = int(self._iparm[17])
+        self.factor_bytes = 1024 * (int(self._iparm[15]) + int(self._iparm[16]))
 
 
-class OutOfCore(PardisoFactorization):
+def partial_solve(A, marked) -> Marked:
+    """PARDISO with its sparse right-hand-side, partial-solution solve (``iparm[30] = 3``)."""
+    return Marked(A, marked, {9: 8, 30: 3})
+
+
+def out_of_core(A, marked) -> Marked:
     """PARDISO's Schur complement on ``marked`` with its factors out of core (``iparm[59] =
     2``: kept in files, ``MKL_PARDISO_OOC_PATH``, default the working folder; in memory at
     most ``MKL_PARDISO_OOC_MAX_CORE_SIZE`` MB, :data:`OOC_CORE_MB` unless set, else MKL's 2,000
     would hold these factors whole): its own count of the memory it keeps (``factor_bytes``)
     against the in-core factorization's."""
+    import os
 
-    def __init__(self, A, marked):
-        import os
-
-        os.environ.setdefault("MKL_PARDISO_OOC_MAX_CORE_SIZE", str(OOC_CORE_MB))
-        import scipy.sparse as sp
-
-        self.shape = A.shape
-        U = sp.triu(A, format="csr")
-        U.sort_indices()
-        self.n = U.shape[0]
-        self._a = np.ascontiguousarray(U.data, dtype=float)
-        self._ia, self._ja = U.indptr.astype(np.int32), U.indices.astype(np.int32)
-        self._pt = np.zeros(64, dtype=np.int64)
-        self._mtype = 2
-        self._iparm = np.zeros(64, dtype=np.int32)
-        self._iparm[[0, 1, 17, 34, 35, 59]] = [1, 2, -1, 1, 2, 2]
-        self._perm = np.zeros(self.n, dtype=np.int32)
-        self._perm[marked] = 1
-        m = len(marked)
-        self._call(12, np.zeros(self.n), np.zeros(max(self.n, m * m)), 1)
-        self.factor_entries = int(self._iparm[17])
-        self.factor_bytes = 1024 * (int(self._iparm[15]) + int(self._iparm[16]))
+    os.environ.setdefault("MKL_PARDISO_OOC_MAX_CORE_SIZE", str(OOC_CORE_MB))
+    return Marked(A, marked, {35: 2, 59: 2})
 
 
 def main(dofs: int, backends: list[str]) -> None:
@@ -133,7 +126,7 @@ def main(dofs: int, backends: list[str]) -> None:
               f"{np.abs(f.trailing_inverse - reference).max() / scale:>11.1e}", flush=True)
         if name == "pardiso":
             t0 = time.perf_counter()
-            f = PartialSolve(K, dofs_)
+            f = partial_solve(K, dofs_)
             t1 = time.perf_counter()
             E = np.zeros((K.shape[0], m), order="F")
             E[dofs_, np.arange(m)] = 1.0
@@ -191,13 +184,13 @@ def sphere(sizes: list[int], columns: int = 512, repeat: int = 2) -> list[dict]:
             # PARDISO's partial solve orders the marked dofs last too (its factor's entries)
             gc.collect()
             t0 = time.perf_counter()
-            f = PartialSolve(K, trailing)
-            partial_s, entries["partial"] = time.perf_counter() - t0, int(f._iparm[17])
+            f = partial_solve(K, trailing)
+            partial_s, entries["partial"] = time.perf_counter() - t0, f.factor_entries
             del f
             in_core = linalg.factorize(K, "pardiso", trailing=trailing).factor_bytes
             gc.collect()
             t0 = time.perf_counter()
-            f = OutOfCore(K, trailing)
+            f = out_of_core(K, trailing)
             ooc_s, ooc_bytes = time.perf_counter() - t0, f.factor_bytes
             del f
             row = {"dofs": total, "body": body.name, "body_dofs": K.shape[0],
