@@ -332,8 +332,7 @@ def _project_curved(kind: FacetShape, x: np.ndarray, facets: np.ndarray, points:
     triangles' closest point (first on each point's nearest chord triangles, whose distance
     cuts the others); Newton from every basin a lattice over the facet shows
     (:func:`_lattice_starts`: a wavy facet can hold two local minima); then the edges
-    (straight: exact; curved: 1D Newton, only on edges whose chord comes near enough). An
-    affine facet (:data:`AFFINE`) is its chord triangles and skips both Newton stages."""
+    (straight: exact; curved: 1D Newton, only on edges whose chord comes near enough)."""
     m = len(points)
     corners = kind.corners
     dev = chord_deviation(kind, x[facets])
