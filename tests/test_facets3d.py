@@ -141,23 +141,18 @@ def _step(P, inside, di, dj):
 
 # --- geometry ----------------------------------------------------------------------------------
 
-def surface(k, n=3, warp=0.2, seed=0, flat=False):
+def surface(k, n=3, warp=0.2, seed=0):
     """A curved surface of n x n cells over [0, 2]² (conforming, oriented with +z roughly
     outward): quadrilaterals, or each split into two triangles; quadratic facets take their
     midside and centre nodes from the same map; ``warp`` moves every node up or down by up to
     that fraction of a cell (so the quadrilaterals are warped and the quadratic facets
-    wavy). ``flat``: a plane sheared and tilted, every facet affine (parallelograms, their
-    midside nodes at the middle) to the round-off of the coordinates."""
+    wavy)."""
     rng = np.random.default_rng(seed)
     m = 2 * n + 1
     U, V = np.meshgrid(np.linspace(0, 2, m), np.linspace(0, 2, m), indexing="ij")
-    if flat:
-        x = (U[..., None] * np.array([1.0, 0.25, 0.5])
-             + V[..., None] * np.array([-0.25, 1.0, 0.125])).reshape(-1, 3)
-    else:
-        x = np.stack([U + 0.15 * np.sin(2.0 * V), V + 0.1 * np.sin(3.0 * U),
-                      0.5 * np.sin(1.7 * U) * np.cos(1.3 * V)], -1).reshape(-1, 3)
-        x[:, 2] += warp * rng.uniform(-1, 1, len(x)) * (2.0 / n)
+    x = np.stack([U + 0.15 * np.sin(2.0 * V), V + 0.1 * np.sin(3.0 * U),
+                  0.5 * np.sin(1.7 * U) * np.cos(1.3 * V)], -1).reshape(-1, 3)
+    x[:, 2] += warp * rng.uniform(-1, 1, len(x)) * (2.0 / n)
 
     def node(i, j):
         return i * m + j
@@ -296,32 +291,6 @@ def test_closest_points_match_brute_force(k, count):
     reference = brute_force(k, x, facets, points)
     error = res.distance - reference
     assert np.abs(error).max() <= 1e-10, (np.abs(error).max(), points[np.abs(error).argmax()])
-
-
-@pytest.mark.parametrize("k", [4, 6, 9])
-def test_affine_facets_are_read_off_their_chord_triangles(k, monkeypatch):
-    """Facets that are affine maps to round-off (parallelograms, quadratic facets with straight
-    edges and the centre in the middle; their coordinates thirds, so x0 - x1 + x2 - x3 is
-    1e-16, not 0) are their chord triangles: their closest points are taken from those without
-    Newton or the lattice (issue 40), and they are the brute-force reference's, to 1e-10, at
-    points of every sort."""
-    from vfem.contact.geometry.closest3d import AFFINE
-    from vfem.contact.geometry.facets3d import chord_deviation
-
-    x, facets = surface(k, flat=True)
-    size = np.linalg.norm(x[facets[:, 0]] - x[facets[:, 2]], axis=1).max()
-    assert (chord_deviation(facet_shape(facets), x[facets]) <= AFFINE * size).all()
-    points = random_points(k, x, facets, 400, np.random.default_rng(k))
-    from vfem.contact.geometry import closest3d
-
-    newton = []
-    monkeypatch.setattr(closest3d, "_newton", lambda *a: newton.append(1))
-    res = closest_on_facets(points, x, facets)
-    assert not newton
-    assert (res.facet >= 0).all()
-    _check_projection(k, x, facets, points, res)
-    error = res.distance - brute_force(k, x, facets, points)
-    assert np.abs(error).max() <= 1e-10, np.abs(error).max()
 
 
 @pytest.mark.parametrize(("name", "k", "nodes", "box"), [

@@ -80,12 +80,6 @@ _HALVINGS = 30  # step halvings before a Newton iteration gives up
 CHUNK = 65536  # point-facet pairs handled at once (bounds the memory of the kernels)
 
 
-#: a bilinear or quadratic facet whose map is within this fraction of the surface's largest
-#: facet of its chord triangles' (:func:`chord_deviation`) is taken as affine: its closest
-#: points are its chord triangles', exact to that (a parallelogram's corners x0 - x1 + x2 - x3
-#: is zero only to the round-off of its coordinates: 1e-16 of them)
-AFFINE = 1e-14
-
 FEW_PAIRS = 4096  # up to this many pairs the Newton stages on curved facets run as one
 
 
@@ -300,7 +294,7 @@ def _lattice_starts(kind: FacetShape, X: np.ndarray, p: np.ndarray
     if kind.name not in _LATTICES:
         _LATTICES[kind.name] = _lattice(kind)
     xi, nbr, N = _LATTICES[kind.name]
-    rows, starts = [np.zeros(0, dtype=np.int64)], [np.zeros((0, 2))]
+    rows, starts = [], []
     for c in _chunks(len(p), CHUNK // 16):
         P = N[None] @ X[c]  # (n, samples, 3)
         D = _dot(P - p[c][:, None], P - p[c][:, None])
@@ -358,38 +352,29 @@ def _project_curved(kind: FacetShape, x: np.ndarray, facets: np.ndarray, points:
         return (np.concatenate([v for v, _ in parts]).reshape(-1, 2),
                 np.concatenate([v for _, v in parts]))
 
-    # a facet within round-off of its chord triangles (:data:`AFFINE`: a parallelogram, a
-    # quadratic facet with straight edges and its centre in the middle, as a flat structured
-    # mesh's facets are) is its chord triangles: their closest point is the facet's, and
-    # neither Newton nor the lattice has a basin to find (issue 40: 1.4 s of the 4-plate
-    # stack's 16)
-    affine = dev <= AFFINE * tol / TIE
-    f = np.where(affine[fc], 0.5 * d_chord**2, np.inf)
-    curved = np.flatnonzero(np.isinf(f))
-    if len(curved) <= FEW_PAIRS:
+    if len(pt) <= FEW_PAIRS:
         # few pairs: every start of every pair in one Newton call (fewer numpy calls)
-        rows, starts = _lattice_starts(kind, x[facets[fc[curved]]], points[pt[curved]])
-        rows = np.r_[np.arange(len(curved)), rows]
-        xi_s, f_s = newton(curved[rows], np.vstack([xi[curved], starts]))
-        xi[curved], f[curved] = _best_per_row(rows, len(curved), xi_s, f_s)
+        rows, starts = _lattice_starts(kind, x[facets[fc]], points[pt])
+        rows = np.r_[np.arange(len(pt)), rows]
+        xi_s, f_s = newton(rows, np.vstack([xi, starts]))
+        xi, f = _best_per_row(rows, len(pt), xi_s, f_s)
     else:
-        order = curved[np.lexsort((d_chord[curved], pt[curved]))]
+        order = np.lexsort((d_chord, pt))
         first = order[np.r_[0, np.flatnonzero(np.diff(pt[order])) + 1]]
+        f = np.full(len(pt), np.inf)
         xi[first], f[first] = newton(first, xi[first])
         keep = cut(np.sqrt(2 * f), lower)
         keep[first] = True
         pt, fc, xi, f, lower = pt[keep], fc[keep], xi[keep], f[keep], lower[keep]
-        curved = ~affine[fc]
         rest = np.flatnonzero(np.isinf(f))
         xi[rest], f[rest] = newton(rest, xi[rest])
         keep = cut(np.sqrt(2 * f), lower)
-        pt, fc, xi, f, curved = pt[keep], fc[keep], xi[keep], f[keep], curved[keep]
-        c = np.flatnonzero(curved)
-        rows, starts = _lattice_starts(kind, x[facets[fc[c]]], points[pt[c]])
-        xi_s, f_s = newton(c[rows], starts)
-        xi2, f2 = _best_per_row(rows, len(c), xi_s, f_s)
-        better = f2 < f[c]
-        xi[c[better]], f[c[better]] = xi2[better], f2[better]
+        pt, fc, xi, f = pt[keep], fc[keep], xi[keep], f[keep]
+        rows, starts = _lattice_starts(kind, x[facets[fc]], points[pt])
+        xi_s, f_s = newton(rows, starts)
+        xi2, f2 = _best_per_row(rows, len(pt), xi_s, f_s)
+        better = f2 < f
+        xi[better], f[better] = xi2[better], f2[better]
 
     # the edges: a clamped coordinate there is exact (they win ties)
     V = kind.vertices
