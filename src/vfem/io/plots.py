@@ -404,11 +404,6 @@ def von_mises(path: Path, bodies: list[tuple[str, np.ndarray, np.ndarray, np.nda
     save(plt, fig, path)
 
 
-#: pixel centres tested against the cells' triangles at a time (:func:`_fill`): 8 bytes and a
-#: few temporaries each
-FILL_CHUNK = 2_000_000
-
-
 def _fill(ax, window, layers: list[tuple[np.ndarray, np.ndarray]]) -> None:
     """Fill cells as one image over ``window`` (:func:`_image_shape` pixels): ``layers`` of
     (polygons (m, k, 2), colours (m, 4)), later layers over earlier ones. A pixel takes the
@@ -432,9 +427,7 @@ def _fill(ax, window, layers: list[tuple[np.ndarray, np.ndarray]]) -> None:
         # the rows whose centres each triangle spans
         first = np.maximum(np.ceil(tri[:, :, 1].min(axis=1) - 0.5), 0).astype(np.int64)
         last = np.minimum(np.floor(tri[:, :, 1].max(axis=1) - 0.5), ny - 1).astype(np.int64)
-        n = np.maximum(last - first + 1, 0)
-        which = np.repeat(np.arange(len(tri)), n)
-        row = first[which] + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        which, row = _runs(first, np.maximum(last - first + 1, 0))
         y = row + 0.5
         # where the row's centre line crosses each edge: the span between the crossings
         left, right = np.full(len(row), np.inf), np.full(len(row), -np.inf)
@@ -449,13 +442,18 @@ def _fill(ax, window, layers: list[tuple[np.ndarray, np.ndarray]]) -> None:
         start = np.maximum(np.ceil(left - 0.5), 0)
         stop = np.minimum(np.floor(right - 0.5), nx - 1)
         ok = np.isfinite(start) & np.isfinite(stop) & (stop >= start)
-        start, width = start[ok].astype(np.int64), (stop[ok] - start[ok]).astype(np.int64) + 1
-        run = np.repeat(np.arange(len(start)), width)
-        col = start[run] + np.arange(int(width.sum())) - np.repeat(np.cumsum(width) - width,
-                                                                    width)
+        run, col = _runs(start[ok].astype(np.int64), (stop[ok] - start[ok]).astype(np.int64) + 1)
         image[row[ok][run], col] = colour[which[ok][run]]
     ax.imshow(image, extent=window, origin="lower", interpolation="nearest", aspect="auto",
               zorder=1)
+
+
+def _runs(start: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Runs of consecutive integers, run i from ``start[i]``, ``length[i]`` long (>= 0): for
+    each of their integers, its run and the integer."""
+    run = np.repeat(np.arange(len(start)), length)
+    return run, start[run] + np.arange(int(length.sum())) - np.repeat(np.cumsum(length)
+                                                                      - length, length)
 
 
 #: in a close-up (a figure with a window), cells narrower than this many of the image's pixels
