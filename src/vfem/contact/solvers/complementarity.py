@@ -18,7 +18,7 @@ import logging
 import numpy as np
 import scipy.sparse as sp
 
-from .bordered import ReusedFactor, bordered_matrix, bordered_solve
+from .bordered import ReusedFactor, bordered_solve
 
 log = logging.getLogger(__name__)
 
@@ -229,40 +229,19 @@ STAGES = 10
 
 
 class DenseSystem:
-    """W formed (the dense route): its products, and each set's system solved with the LU
-    factors of :class:`ReusedFactor` where given (else least squares for a bordered set,
+    """W formed (the dense route): its products, and each set's system solved with the
+    factors of :class:`ReusedFactor` where given (each new set from those of a set near it:
+    :meth:`ReusedFactor.solve_set`; else least squares for a bordered set,
     ``numpy.linalg.solve`` for a plain one). The matrix-free route's counterpart is
     :class:`~vfem.contact.solvers.matrix_free.PairOperator` (issue 22)."""
 
     def __init__(self, W, factor: ReusedFactor | None = None):
         self.W = W  # dense, or sparse (pairs that share no body: pair_matrix's sparse_ok)
-        self.factor = factor
+        # (a sparse W's sets always through factors: SuperLU's, kept while the call lasts)
+        self.factor = ReusedFactor() if factor is None and sp.issparse(W) else factor
 
     def matvec(self, x: np.ndarray) -> np.ndarray:
         return self.W @ x
-
-    def _solve_sparse(self, a: np.ndarray, rhs: np.ndarray, border=None
-                      ) -> tuple[np.ndarray, float]:
-        """:meth:`solve` with a sparse W: the set's block (bordered by the platen's row and
-        column) factorized sparse, its factors kept while the set recurs; where singular,
-        least squares on the block made dense, as the dense W's."""
-        A = self.W[a][:, a]
-        if border is not None:
-            column, row, corner, extra = border
-            M = sp.bmat([[A, sp.csr_matrix(np.asarray(column)[:, None])],
-                         [sp.csr_matrix(np.asarray(row)[None, :]), sp.csr_matrix([[corner]])]])
-            b = np.concatenate([rhs, [extra]])
-        else:
-            M, b = A, rhs
-        factor = self.factor if self.factor is not None else ReusedFactor()
-        x = factor.solve_sparse((border is not None, a.tobytes()), lambda: M, b)
-        if border is not None:
-            if x is None:  # no node of the platen's body in the set: least squares
-                return bordered_solve(A.toarray(), column, row, corner, rhs, extra)
-            return x[:-1], float(x[-1])
-        if x is None:
-            return np.linalg.solve(A.toarray(), rhs), 0.0  # (singular: LinAlgError, as dense)
-        return x, 0.0
 
     def solve(self, a: np.ndarray, rhs: np.ndarray, border=None, x0=None
               ) -> tuple[np.ndarray, float]:
@@ -270,21 +249,24 @@ class DenseSystem:
         ``border`` = (column, row, corner, extra) the platen's bordered system
         (:func:`~vfem.contact.solvers.bordered.bordered_solve`). ``x0`` (a first guess) is not
         needed."""
-        if sp.issparse(self.W):
-            return self._solve_sparse(a, rhs, border)
         W, factor = self.W, self.factor
         if border is not None:
             column, row, corner, extra = border
             x = None
             if factor is not None:
-                x = factor.solve((True, a.tobytes()), lambda: bordered_matrix(
-                    W[np.ix_(a, a)], column, row, corner), np.concatenate([rhs, [extra]]))
+                x = factor.solve_set(W, a, np.concatenate([rhs, [extra]]),
+                                     (column, row, corner))
             if x is None:  # singular (no node of the platen's body in the set): least squares
-                return bordered_solve(W[np.ix_(a, a)], column, row, corner, rhs, extra)
+                return bordered_solve(_dense(W, a), column, row, corner, rhs, extra)
             return x[:-1], float(x[-1])
-        x = None if factor is None else factor.solve(
-            (False, a.tobytes()), lambda: W[np.ix_(a, a)], rhs)
-        return (np.linalg.solve(W[np.ix_(a, a)], rhs) if x is None else x), 0.0
+        x = None if factor is None else factor.solve_set(W, a, rhs)
+        # (singular: numpy's LinAlgError, for the pivoting to see)
+        return (np.linalg.solve(_dense(W, a), rhs) if x is None else x), 0.0
+
+
+def _dense(W, a: np.ndarray) -> np.ndarray:
+    """W's block over the set ``a``, dense."""
+    return W[a][:, a].toarray() if sp.issparse(W) else W[np.ix_(a, a)]
 
 
 __all__ = ["DenseSystem", "linear_complementarity"]
