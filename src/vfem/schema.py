@@ -40,6 +40,11 @@ def convert(tp, value, where: str, nested=None):
         inner = [a for a in args if a is not type(None)]
         if len(inner) == 1:
             return convert(inner[0], value, where, nested)
+        if isinstance(value, dict) and all(dataclasses.is_dataclass(a) for a in inner):
+            # tables of several kinds (a body's material): the kind whose keys hold the
+            # table's, else the one sharing most keys with it, whose reader then names
+            # what is wrong (an unknown key, with the nearest valid one)
+            return convert(_table_kind(inner, value), value, where, nested)
         for a in inner:
             try:
                 return convert(a, value, where, nested)
@@ -79,6 +84,16 @@ def convert(tp, value, where: str, nested=None):
             raise _Problem(where, f"expected a string, got {_kind(value)}")
         return value
     raise _Problem(where, f"cannot read a value of type {tp!r}")  # a bug in the classes
+
+
+def _table_kind(kinds: list, value: dict):
+    """Of the dataclasses ``kinds``, the first whose fields hold every key of the table
+    ``value``; else the one with most of its keys (the first of equals)."""
+    def known(kind) -> int:
+        names = {f.name for f in dataclasses.fields(kind)}
+        return sum(key in names for key in value)
+    fits = [kind for kind in kinds if known(kind) == len(value)]
+    return fits[0] if fits else max(kinds, key=known)
 
 
 def _reject_unknown(data: dict, valid: list[str], where: str, owner: str = "") -> None:
@@ -131,7 +146,7 @@ def _type_name(tp) -> str:
     origin, args = typing.get_origin(tp), typing.get_args(tp)
     if origin in (typing.Union, types.UnionType):
         inner = [a for a in args if a is not type(None)]
-        return " or ".join(_type_name(a) for a in inner)
+        return " or ".join(dict.fromkeys(_type_name(a) for a in inner))  # (one "table")
     if dataclasses.is_dataclass(tp):
         return "table"
     if origin is tuple and args and args[-1] is not Ellipsis:
