@@ -101,10 +101,10 @@ def test_every_key_has_help_text():
     import vfem.config as config
     from vfem.contact.settings import ContactSettings, PairFriction
     from vfem.io.input import SECTIONS, help_texts
-    from vfem.materials import LinearElastic
+    from vfem.materials import J2Plastic, LinearElastic
 
     classes = {"ContactSettings": ContactSettings, "PairFriction": PairFriction,
-               "LinearElastic": LinearElastic}
+               "LinearElastic": LinearElastic, "J2Plastic": J2Plastic}
     for name in SECTIONS:
         cls = classes.get(name) or getattr(config, name, None) or getattr(bodies, name)
         helps = help_texts(cls)

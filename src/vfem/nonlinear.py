@@ -46,6 +46,12 @@ Both are exact discretisations of the same problem on the same quadrature points
 elements a quadrature point of the moved mesh is the same material point, and ``dV1 = J1 dV0``
 there), so they agree to the Newton tolerance.
 
+A third form, ``"small"``, serves a law with history under small kinematics (J2 plasticity,
+:mod:`vfem.materials.plastic`, issue 41): the strain is the small strain ``sym(grad u)``, the
+stress the Cauchy stress it answers, ``F = I`` and no initial-stress term, so the residual is
+``int B^T sigma`` and the tangent ``int B^T C B`` with the law's consistent tangent ``C``;
+Newton's method then answers the material's nonlinearity alone.
+
 3D bodies (tetrahedra, hexahedra; issue 21, C16) take the same path with 3x3 tensors: the
 dimension is the mesh's (``self.dim``), dofs are ``dim * node + component``, no out-of-plane
 stress is carried, and the left stretch ``V_1`` of the updated form is the square root of
@@ -99,6 +105,9 @@ log = logging.getLogger(__name__)
 
 TOTAL = "total"
 UPDATED = "updated"
+#: small kinematics for a law with history (a plastic one, issue 41): the strain is
+#: sym(grad u), F = I, no geometric stiffness; Newton's method answers the law alone
+SMALL = "small"
 COMPONENTS = {"x": 0, "y": 1, "z": 2}
 
 # linear mesh -> the quadratic-geometry mesh of the same connectivity (for P2/Q2)
@@ -215,6 +224,7 @@ class _State:
     moduli: Callable[[], np.ndarray]  # gives D
     S33: np.ndarray | None  # (ne, nq) out-of-plane S_33 (plane strain); None in 3D
     material_state: State  # what this iterate would commit (materials.protocol)
+    geometric: bool = True  # the initial-stress term (False: small kinematics, F = I)
 
     @functools.cached_property
     def D(self) -> np.ndarray:
@@ -225,7 +235,9 @@ class _State:
         return mul(self.F, self.S)
 
     def tangent_moduli(self) -> np.ndarray:
-        """``A_iJkL = F_iI D_IJKL F_kK + delta_ik S_JL``."""
+        """``A_iJkL = F_iI D_IJKL F_kK + delta_ik S_JL`` (small kinematics: ``D``)."""
+        if not self.geometric:
+            return self.D
         A = np.einsum("iI...,IJKL...,kK...->iJkL...", self.F, self.D, self.F)
         for i in range(A.shape[0]):
             A[i, :, i] += self.S
@@ -304,13 +316,9 @@ class NonlinearBody:
                              f"or a law with the methods of vfem.materials.Material, "
                              f"got {type(material).__name__}")
         material.validate(f"{name}: material")
-        if formulation not in (TOTAL, UPDATED):
-            raise InputError(f"{name}: formulation must be 'total' or 'updated', "
-                             f"got {formulation!r}" + (
-                                 " (a material that carries state under small kinematics "
-                                 "needs a small-strain mode, which is not implemented yet: "
-                                 "give the body kinematics = 'total')"
-                                 if formulation == "small" else ""))
+        if formulation not in (TOTAL, UPDATED, SMALL):
+            raise InputError(f"{name}: formulation must be 'total', 'updated' or 'small', "
+                             f"got {formulation!r}")
         if order not in (1, 2):
             raise InputError(f"{name}: order must be 1 or 2, got {order!r}")
         self.material = material
@@ -461,6 +469,16 @@ class NonlinearBody:
         Updated: gradients on the current mesh ``C_1`` of the increment; strain
         ``11_1 E + E2 + E3`` (eqs. 2.7.31–2.7.36, 2.8.11).
         """
+        if self.formulation == SMALL:  # eps = sym(grad u), F = I (issue 41)
+            arrays = _ElementArrays.of(self.basis0)
+            g = arrays.gradient(self._u_at_current + delta)
+            eps = 0.5 * (g + g.transpose(1, 0, 2, 3))
+            r = self.material.response(eps, self.material_state)
+            F = np.zeros_like(g)
+            for i in range(self.dim):
+                F[i, i] = 1.0
+            return _State(self.basis0, F, r.stress, r.moduli, r.out_of_plane, r.state,
+                          geometric=False)
         if self.formulation == TOTAL:
             basis = self.basis0
             G0 = _ElementArrays.of(basis).gradient(self._u_at_current)
@@ -854,8 +872,12 @@ class NonlinearBody:
         return replace(self.mesh, doflocs=self.deformed_points())
 
     def green_lagrange_strain(self) -> np.ndarray:
-        """(dim, dim, nelems, nqp) Green–Lagrange strain relative to the initial mesh."""
-        return green_lagrange(self.basis0.interpolate(self.displacement).grad)
+        """(dim, dim, nelems, nqp) Green–Lagrange strain relative to the initial mesh (small
+        kinematics: the small strain sym(grad u))."""
+        g = self.basis0.interpolate(self.displacement).grad
+        if self.formulation == SMALL:
+            return 0.5 * (g + np.swapaxes(g, 0, 1))
+        return green_lagrange(g)
 
     def second_piola_kirchhoff(self) -> np.ndarray:
         """(dim, dim, nelems, nqp) 2nd Piola–Kirchhoff stress relative to the initial mesh (the
@@ -872,4 +894,4 @@ class NonlinearBody:
         return self.cauchy_stress_at(self.displacement)[1]
 
 
-__all__ = ["NonlinearBody", "NewtonStep", "TOTAL", "UPDATED"]
+__all__ = ["NonlinearBody", "NewtonStep", "SMALL", "TOTAL", "UPDATED"]

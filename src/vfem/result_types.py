@@ -39,6 +39,9 @@ class StepResult:
     #: per pair ("a/b") whose compatibility side the solver switched in this run by this step
     #: (:meth:`vfem.solver.Analysis._switch_side`), the body that carries it; empty where none
     compatibility_switched: dict[str, str] = field(default_factory=dict)
+    #: per body of a plastic material, its quadrature points with plastic strain once the step
+    #: converged (:func:`vfem.bodies.mechanics.yielded_points`); empty where none is plastic
+    yielded: dict[str, int] = field(default_factory=dict)
 
 
 @dataclass

@@ -37,6 +37,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .bodies import multiplier
+from .bodies.mechanics import yielded_points
 from .bodies.stresses import strain_beyond
 from .contact.formulations import formulation_class
 from .contact.geometry import ContactPairs, exterior_facets
@@ -678,6 +679,8 @@ class Analysis:
                               fixed_point=res.fixed_point, invariants=invariants.record(),
                               compatibility_switched=self._sides())
             step.bodies = fields
+            step.yielded = {b.name: n for b in self.model.bodies
+                            if (n := yielded_points(b.mechanics)) is not None}
             self.warn_large_strain(step)
             steps.append(step)
             log.info("step %d (load factor %.4g) converged in %d iterations", step.step, lf,

@@ -151,6 +151,18 @@ def mechanics_for(body, fixed: dict[int, float]) -> BodyMechanics:
 FALLBACK_COLUMNS = 128
 
 
+def yielded_points(mechanics) -> int | None:
+    """The quadrature points of a body whose material shows a ``yielded`` flag (a plastic one,
+    :mod:`vfem.materials.plastic`) where it is set, in its converged state; None for a body
+    whose material shows none."""
+    nonlinear = getattr(mechanics, "nonlinear", None)
+    shown = getattr(getattr(nonlinear, "material", None), "fields", None)
+    if shown is None:
+        return None
+    flag = shown(nonlinear.material_state).get("yielded")
+    return None if flag is None else int(np.count_nonzero(flag))
+
+
 class LargeMechanics:
     """Large kinematics (see the module docstring)."""
 

@@ -55,6 +55,10 @@ def validate(body) -> None:
         names = " or ".join(repr(name) for name in LAWS)
         raise InputError(f"{where}: law must be {names}, got {body.law!r}")
     section = section_of(body)  # refuses a plane given to a 3D body
+    if body.large and not getattr(body.material, "finite_strain", True):
+        raise InputError(f"{where}: a plastic material takes small kinematics for now "
+                         f"(kinematics = 'small'): its finite-strain form is not implemented "
+                         f"yet, got kinematics = {body.kinematics!r}")
     if body.iterates and not body.large and body.order != 1:  # Newton's mechanics: order 1
         raise InputError(f"{where}: a material that carries state needs linear elements "
                          "(order 1)")

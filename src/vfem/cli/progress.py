@@ -58,9 +58,12 @@ class Progress:
         h = step.history[-1] if step.history else None
         pen = h.max_penetration if h else 0.0
         eq = h.max_equilibrium_error if h else 0.0
+        yielded = getattr(step, "yielded", None)  # (a plastic body's points)
         text = (f"step {step.step:3d}  load factor {step.load_factor:7.4f}  "
                 f"{step.iterations:3d} iterations  penetration {pen:.2e}  "
-                f"equilibrium error {eq:.2e}" + (f"  ({step.cuts} cuts)" if step.cuts else ""))
+                f"equilibrium error {eq:.2e}"
+                + (f"  {sum(yielded.values())} points yielded" if yielded else "")
+                + (f"  ({step.cuts} cuts)" if step.cuts else ""))
         if self.total:
             width = 20
             part = 0.0  # how far a cut step has come towards its scheduled target

@@ -166,6 +166,7 @@ def write(out: Path, model: Model, checkpoint: Checkpoint, model_fingerprint: st
                  "platen_displacement": step.platen_displacement, "cuts": step.cuts,
                  "fixed_point": step.fixed_point, "invariants": step.invariants,
                  "compatibility_switched": step.compatibility_switched,
+                 "yielded": step.yielded,
                  "history": [dataclasses.asdict(h) for h in step.history]},
         "reactions": {b.name: {k: list(v) for k, v in step.bodies[b.name].reactions.items()}
                       for b in model.bodies},

@@ -477,7 +477,8 @@ def step_record(step: StepResult) -> dict:
             "max_equilibrium_error": last.max_equilibrium_error if last else 0.0,
             "invariants": step.invariants, **force_record(step),
             **({"compatibility_switched": step.compatibility_switched}
-               if step.compatibility_switched else {})}
+               if step.compatibility_switched else {}),
+            **({"yielded_points": step.yielded} if step.yielded else {})}
 
 
 def frictional_work(steps: list[StepResult]) -> list[float]:

@@ -8,20 +8,22 @@ A body's ``material`` is one of :data:`MATERIALS`, the tables an input file's
 reference lists each): its elastic constants and ``plane`` (the body's section), its checks
 (``validate``), whether its bodies carry a state (``carries_state``: they then iterate under
 small kinematics too) and the law they evaluate where they iterate (``law(name)``). A material
-with parameters of its own (a yield stress, issue 41) is one more class there.
+with parameters of its own is one more class there: :class:`J2Plastic` (a yield stress and
+hardening, issue 41; :mod:`.plastic`).
 """
 
 from typing import Union
 
 from .elastic import LinearElastic
 from .hyperelastic import LAWS, NeoHookean, SaintVenantKirchhoff
+from .plastic import J2Plastic
 from .protocol import Material, Response, State
 
 #: The material tables a body may be given, in the order an input file's ``[bodies.material]``
 #: is tried against them (:func:`vfem.schema.convert`: the first whose keys fit)
-MATERIALS: tuple[type, ...] = (LinearElastic,)
+MATERIALS: tuple[type, ...] = (LinearElastic, J2Plastic)
 #: The type of a body's ``material`` in an input file: one of :data:`MATERIALS`
 MaterialTable = Union[MATERIALS]  # noqa: UP007 - a union of a tuple built at run time
 
-__all__ = ["LinearElastic", "NeoHookean", "SaintVenantKirchhoff", "LAWS", "MATERIALS",
+__all__ = ["J2Plastic", "LinearElastic", "NeoHookean", "SaintVenantKirchhoff", "LAWS", "MATERIALS",
            "MaterialTable", "Material", "Response", "State"]

@@ -1,0 +1,202 @@
+"""J2 (von Mises) elasto-plasticity in small strain: radial return and its consistent tangent
+(issue 41, item 1; the first material nonlinearity the thesis names, Ch. 1).
+
+The strain splits additively, ``eps = eps_e + eps_p``; the stress is the elastic one of the
+elastic part, ``sigma = K tr(eps) I + 2 mu (dev(eps) - eps_p)`` (the plastic strain is
+deviatoric). The yield function is von Mises' in the stress relative to the back stress
+``beta`` (linear kinematic hardening, Prager), the radius growing with the equivalent plastic
+strain ``alpha`` (linear isotropic hardening):
+
+    f = |xi| - sqrt(2/3) (Y + H_iso alpha),      xi = dev(sigma) - beta,
+    d(eps_p) = dgamma n,  d(alpha) = sqrt(2/3) dgamma,  d(beta) = 2/3 H_kin dgamma n,
+    n = xi / |xi|.
+
+A uniaxial test reads ``sigma = Y + (H_iso + H_kin) eps_p`` while loading: ``H = H_iso + H_kin``
+is the slope of the stress against the plastic strain, and the elasto-plastic tangent
+``E H / (E + H)``.
+
+**Radial return** (Simo & Hughes, *Computational Inelasticity*, 1998, box 3.1): the trial
+state freezes the plastic variables; where ``f_trial > 0`` the closest point projection onto
+the yield surface is along ``n_trial`` and, with linear hardening, closed form:
+``dgamma = f_trial / (2 mu + 2/3 (H_iso + H_kin))``. **Consistent tangent** (their box 3.2):
+
+    C = K I (x) I + 2 mu theta (I_sym - I (x) I / 3) - 2 mu theta_bar n (x) n,
+    theta = 1 - 2 mu dgamma / |xi_trial|,
+    theta_bar = 1 / (1 + (H_iso + H_kin) / (3 mu)) - (1 - theta),
+
+the exact derivative of the returned stress with respect to the total strain, which keeps
+Newton's convergence quadratic past yield.
+
+The tensors are carried in 3D (a plane-strain body's ``eps_zz = 0`` and its plastic strain's
+zz component is not: ``tr eps_p = 0``); a 2D body gets the in-plane stress and tangent and
+``sigma_zz`` beside them. Plane stress (a different return: the zz stress held at zero) is not
+implemented; :meth:`J2Plastic.validate` says so.
+
+The state (:mod:`.protocol`): ``plastic_strain`` and ``back_stress`` (3, 3, ne, nq),
+``equivalent_plastic_strain`` (ne, nq), committed only when a step converges.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from ..errors import InputError
+from .constants import check_elastic_constants
+from .protocol import Response, State
+
+#: a trial state whose yield function is at most this share of the yield radius is elastic:
+#: the stress returned at the last step lies on the surface to round-off, and a step that
+#: holds the strain must not flow by it
+YIELD_TOLERANCE = 1e-12
+
+#: the names of the J2 model in an input file's ``model`` key
+MODELS = ("von_mises",)
+
+
+@dataclass(frozen=True)
+class J2Plastic:
+    """Elasto-plastic material: isotropic elasticity and J2 (von Mises) plasticity with linear
+    isotropic and kinematic hardening, in small strain; a table with a ``yield_stress`` is this
+    one. Its bodies are solved by Newton's method under small kinematics (linear elements; plane
+    strain or 3D).
+
+    (The law: :mod:`vfem.materials.plastic`'s docstring.)
+
+    Attributes:
+        youngs_modulus: E, > 0.
+        poissons_ratio: nu, in (-1, 0.5).
+        yield_stress: Y, > 0: the initial yield stress in uniaxial tension.
+        hardening_modulus: H_iso >= 0: isotropic hardening, the yield stress's growth per unit
+            equivalent plastic strain (0: no isotropic hardening).
+        kinematic_modulus: H_kin >= 0: linear kinematic hardening (Prager), the back stress's
+            growth per unit plastic strain, uniaxially (0: none).
+        model: ``"von_mises"``: the yield criterion.
+        plane: ``"strain"``: the section of a 2D body (plane stress is not implemented).
+    """
+
+    youngs_modulus: float
+    poissons_ratio: float
+    yield_stress: float
+    hardening_modulus: float = 0.0
+    kinematic_modulus: float = 0.0
+    model: str = "von_mises"
+    plane: str = "strain"
+
+    #: a body of this material carries a state from step to step, and so answers its contact
+    #: forces by Newton's method under small kinematics too (:attr:`vfem.bodies.Body.iterates`)
+    carries_state: ClassVar[bool] = True
+    #: whether the law holds under large kinematics: not yet (a small-strain law read in the
+    #: Green-Lagrange strain would not be the model it claims; the body refuses it)
+    finite_strain: ClassVar[bool] = False
+
+    def validate(self, where: str = "material") -> None:
+        """Raise :class:`InputError` naming ``where`` if a parameter is not admissible."""
+        check_elastic_constants(self.youngs_modulus, self.poissons_ratio, where)
+        if self.model not in MODELS:
+            raise InputError(f"{where}: model must be {' or '.join(map(repr, MODELS))}, "
+                             f"got {self.model!r}")
+        for key in ("yield_stress", "hardening_modulus", "kinematic_modulus"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or not math.isfinite(value):
+                raise InputError(f"{where}: {key} must be a finite number, got {value!r}")
+        if self.yield_stress <= 0:
+            raise InputError(f"{where}: yield_stress must be > 0, got {self.yield_stress!r}")
+        for key in ("hardening_modulus", "kinematic_modulus"):
+            if getattr(self, key) < 0:
+                raise InputError(f"{where}: {key} must be >= 0 (softening is not taken), "
+                                 f"got {getattr(self, key)!r}")
+        if self.plane != "strain":
+            raise InputError(f"{where}: plane must be 'strain' for a plastic material "
+                             f"(plane stress is not implemented), got {self.plane!r}")
+
+    def lame(self) -> tuple[float, float]:
+        """Lamé constants (lambda, mu) of the elastic part (plane strain = 3D)."""
+        E, nu = self.youngs_modulus, self.poissons_ratio
+        return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
+
+    def plane_strain_modulus(self) -> float:
+        """E/(1-nu^2) of the elastic part: the modulus in Hertz's E*."""
+        return self.youngs_modulus / (1.0 - self.poissons_ratio ** 2)
+
+    def law(self, name: str) -> J2Plastic:
+        """The law a body of this material evaluates: this one (``name``, the hyperelastic
+        law of a large body, does not apply)."""
+        return self
+
+    # -- the Material protocol (vfem.materials.protocol) ----------------------------------------
+
+    def initial_state(self, dim: int, points: tuple[int, int]) -> State:
+        """No plastic strain, no back stress, no equivalent plastic strain."""
+        return {"plastic_strain": np.zeros((3, 3) + tuple(points)),
+                "back_stress": np.zeros((3, 3) + tuple(points)),
+                "equivalent_plastic_strain": np.zeros(tuple(points))}
+
+    def response(self, E: np.ndarray, state: State) -> Response:
+        """The stress that answers the small strain ``E`` (dim, dim, ne, nq) from the
+        converged ``state``, by radial return; the consistent tangent when asked; the state
+        to commit."""
+        E = np.asarray(E, dtype=float)
+        dim = E.shape[0]
+        lam, mu = self.lame()
+        bulk = lam + 2.0 * mu / 3.0
+        H = self.hardening_modulus + self.kinematic_modulus
+        eps = np.zeros((3, 3) + E.shape[2:])
+        eps[:dim, :dim] = E
+        tr = eps[0, 0] + eps[1, 1] + eps[2, 2]
+        dev = eps.copy()
+        for i in range(3):
+            dev[i, i] -= tr / 3.0
+        ep, beta = state["plastic_strain"], state["back_stress"]
+        alpha = state["equivalent_plastic_strain"]
+        s_trial = 2.0 * mu * (dev - ep)
+        xi = s_trial - beta
+        norm = np.sqrt(np.einsum("ij...,ij...->...", xi, xi))
+        radius = math.sqrt(2.0 / 3.0) * (self.yield_stress + self.hardening_modulus * alpha)
+        f = norm - radius
+        flows = f > YIELD_TOLERANCE * radius
+        dgamma = np.where(flows, f / (2.0 * mu + 2.0 / 3.0 * H), 0.0)
+        n = np.divide(xi, norm, out=np.zeros_like(xi), where=flows)
+        step = dgamma * n
+        sigma = s_trial - 2.0 * mu * step
+        for i in range(3):
+            sigma[i, i] += bulk * tr
+        new = {"plastic_strain": ep + step,
+               "back_stress": beta + 2.0 / 3.0 * self.kinematic_modulus * step,
+               "equivalent_plastic_strain": alpha + math.sqrt(2.0 / 3.0) * dgamma}
+
+        def moduli() -> np.ndarray:
+            theta = 1.0 - 2.0 * mu * np.divide(dgamma, norm, out=np.zeros_like(norm),
+                                               where=flows)
+            theta_bar = np.where(flows, 1.0 / (1.0 + H / (3.0 * mu)) - (1.0 - theta), 0.0)
+            eye = np.eye(dim)
+            shape = (dim, dim, dim, dim) + E.shape[2:]
+            ii = np.einsum("ij,kl->ijkl", eye, eye)
+            sym = 0.5 * (np.einsum("ik,jl->ijkl", eye, eye) + np.einsum("il,jk->ijkl", eye, eye))
+            C = np.broadcast_to((bulk * ii)[..., None, None], shape).copy()
+            C += 2.0 * mu * theta * (sym - ii / 3.0)[..., None, None]
+            nd = n[:dim, :dim]
+            C -= 2.0 * mu * theta_bar * nd[:, :, None, None] * nd[None, None]
+            return C
+
+        return Response(sigma[:dim, :dim].copy(), moduli,
+                        sigma[2, 2].copy() if dim == 2 else None, new)
+
+    def fields(self, state: State) -> dict[str, np.ndarray]:
+        """What a body writes of the state (element averages, :mod:`.protocol`): the
+        equivalent plastic strain, a yielded flag (1 where any plastic strain) and the
+        plastic strain tensor's components."""
+        alpha = state["equivalent_plastic_strain"]
+        ep = state["plastic_strain"]
+        out = {"equivalent_plastic_strain": alpha, "yielded": (alpha > 0.0).astype(float)}
+        for name, (i, j) in (("xx", (0, 0)), ("yy", (1, 1)), ("zz", (2, 2)), ("xy", (0, 1)),
+                             ("yz", (1, 2)), ("xz", (0, 2))):
+            out[f"plastic_strain_{name}"] = ep[i, j]
+        return out
+
+
+__all__ = ["J2Plastic", "MODELS", "YIELD_TOLERANCE"]

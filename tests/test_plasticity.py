@@ -1,0 +1,295 @@
+"""J2 plasticity in small strain (issue 41): the return map's consistent tangent, the
+homogeneous stress-strain curves against their closed forms (uniaxial stress in 3D, uniaxial
+strain in 2D: elastic, yield, hardening, unloading, reverse yield), Newton's convergence past
+yield, a step cut and a saved state restored bit for bit, and the input file's table."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+from skfem import MeshHex, MeshQuad
+
+from vfem.errors import InputError
+from vfem.materials import J2Plastic
+from vfem.nonlinear import NonlinearBody
+
+E, NU, Y, H_ISO, H_KIN = 200e3, 0.3, 250.0, 2000.0, 1000.0
+STEEL = J2Plastic(E, NU, Y, H_ISO, H_KIN)
+
+
+def strain(rng, dim, scale):
+    e = rng.standard_normal((dim, dim, 2, 3)) * scale
+    return 0.5 * (e + e.transpose(1, 0, 2, 3))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("material", [STEEL, J2Plastic(E, NU, Y)], ids=["hardening", "perfect"])
+def test_the_tangent_is_the_derivative_of_the_return_map(dim, material):
+    """Central differences of the returned stress (step h: truncation h^2 |sigma'''|, round-off
+    eps |sigma| / h, both below 1e-9 of |C| here) against the consistent tangent, at points
+    that flow and points that unload, from a state already plastic."""
+    rng = np.random.default_rng(dim)
+    state = material.response(strain(rng, dim, 3e-3), material.initial_state(dim, (2, 3))).state
+    E1 = strain(rng, dim, 3e-3)
+    r = material.response(E1, state)
+    flows = r.state["equivalent_plastic_strain"] > state["equivalent_plastic_strain"]
+    assert flows.any() and (~flows).any() or flows.all()
+    C = r.moduli()
+    h = 1e-8
+    for k in range(dim):
+        for m in range(dim):
+            d = np.zeros_like(E1)
+            d[k, m] += h / 2
+            d[m, k] += h / 2
+            num = (material.response(E1 + d, state).stress
+                   - material.response(E1 - d, state).stress) / (2 * h)
+            assert np.abs(num - C[:, :, k, m]).max() <= 1e-8 * np.abs(C).max()
+
+
+def uniaxial_stress(path):
+    """The closed form of uniaxial stress under a strain path (linear pieces): elastic slope
+    E, flow where |sigma - c| = Y + H_iso alpha (c = H_kin eps_p the back stress's axial
+    reading, alpha the accumulated plastic strain), during which sigma = Y_now + c with
+    d sigma = E H / (E + H) d eps, H = H_iso + H_kin (module docstring of vfem.materials.plastic).
+    Each piece is monotonic, so each reaches its end in one elastic and one plastic part."""
+    H = H_ISO + H_KIN
+    eps_p, alpha, out = 0.0, 0.0, []
+    for eps in path:
+        trial = E * (eps - eps_p)
+        c, radius = H_KIN * eps_p, Y + H_ISO * alpha
+        over = abs(trial - c) - radius
+        if over > 0:
+            dg = over / (E + H)
+            sign = math.copysign(1.0, trial - c)
+            eps_p += sign * dg
+            alpha += dg
+        out.append(E * (eps - eps_p))
+    return out
+
+
+def block(mesh, material, dim):
+    body = NonlinearBody(mesh, material, formulation="small", name="block")
+    for c, face in zip("xyz", ("x0", "y0", "z0")[:dim]):
+        body.prescribe(body.boundary_dofs(face, c))
+    return body
+
+
+def boxes(dim):
+    edges = (np.linspace(0.0, 1.0, 3),) * dim
+    mesh = (MeshHex if dim == 3 else MeshQuad).init_tensor(*edges)
+    faces = {"x0": lambda x: x[0] == 0, "x1": lambda x: x[0] == 1, "y0": lambda x: x[1] == 0,
+             "y1": lambda x: x[1] == 1}
+    if dim == 3:
+        faces.update({"z0": lambda x: x[2] == 0, "z1": lambda x: x[2] == 1})
+    return mesh.with_boundaries(faces)
+
+
+#: the top's displacement (the block's height is 1: the axial strain) at each step: loaded
+#: past yield in compression, unloaded, yielded the other way, reloaded
+PATH = [-1e-3, -3e-3, -6e-3, -4e-3, -2e-3, 0.0, 2e-3, -2e-3]
+
+
+def run(body, top):
+    at = np.r_[0.0, PATH]
+    body.prescribe(top, lambda lf: np.full(len(top), np.interp(lf, np.arange(len(at)), at)))
+    forces, records = [], []
+    for k in range(1, len(at)):
+        records.append(body.equilibrate(float(k), tol=1e-13))
+        body.accept()
+        forces.append(float(body.reactions()[top].sum()))
+    return forces, records
+
+
+def test_uniaxial_stress_in_3d_follows_the_closed_form():
+    """A block on frictionless supports (rollers on three faces), its top moved: the axial
+    stress is the uniaxial closed form at every step to round-off (1e-10 of Y), and each
+    plastic step takes one correction past the elastic predictor (the tangent is exact on a
+    homogeneous field)."""
+    body = block(boxes(3), STEEL, 3)
+    forces, records = run(body, body.boundary_dofs("z1", "z"))
+    expected = uniaxial_stress(PATH)
+    assert max(abs(f - s) for f, s in zip(forces, expected)) <= 1e-10 * Y
+    assert min(expected) < -Y and max(expected) > Y  # both ways past yield
+    assert all(r.iterations <= 2 for r in records)
+    alpha = body.material_state["equivalent_plastic_strain"]
+    assert np.ptp(alpha) <= 1e-12 * alpha.max()  # homogeneous
+
+
+def test_uniaxial_strain_in_plane_strain_follows_the_closed_form():
+    """A plane-strain block held laterally (a die), its top moved: uniaxial strain, a
+    proportional path: q = sigma_yy - sigma_xx = 2 mu eps_yy while elastic, then
+    |q - c| = Y + H_iso alpha (c the back stress's reading); the mean stress K eps_yy
+    throughout, so sigma_yy = K eps_yy + 2/3 q."""
+    body = block(boxes(2), STEEL, 2)
+    body.prescribe(body.boundary_dofs("x1", "x"))  # the die's wall
+    top = body.boundary_dofs("y1", "y")
+    forces, _ = run(body, top)
+    lam, mu = STEEL.lame()
+    bulk = lam + 2 * mu / 3
+    H = H_ISO + H_KIN
+    eps_p = alpha = 0.0  # the axial plastic strain (yy; xx = zz = -eps_p / 2), accumulated
+    for eps, force in zip(PATH, forces):
+        # deviatoric tensors a diag(-1/3, 2/3, -1/3), read by a (norm sqrt(2/3) |a|): the
+        # trial q = 2 mu (eps - 3/2 eps_p), the back stress's c = H_kin eps_p, the radius
+        # Y + H_iso alpha; a flow d eps_p moves them by -3 mu, H_kin and H_iso times it
+        q_trial = 2 * mu * (eps - 1.5 * eps_p)
+        c = H_KIN * eps_p
+        over = abs(q_trial - c) - (Y + H_ISO * alpha)
+        if over > 0:
+            dg = over / (3 * mu + H)
+            eps_p += math.copysign(dg, q_trial - c)
+            alpha += dg
+        q = 2 * mu * (eps - 1.5 * eps_p)
+        sigma_yy = bulk * eps + 2 / 3 * q
+        assert abs(force - sigma_yy) <= 1e-10 * Y
+    assert alpha > 0.0
+
+
+def test_newton_converges_quadratically_past_yield():
+    """A block squeezed by a rigid flat die over part of its top (a heterogeneous plastic
+    zone): the relative residuals fall quadratically (each below a constant times the
+    square of the one before) once near the solution."""
+    body = block(boxes(2).refined(2), J2Plastic(E, NU, Y, H_ISO), 2)
+    mesh = body.mesh
+    die = np.flatnonzero((np.abs(mesh.doflocs[1] - 1) < 1e-12) & (mesh.doflocs[0] <= 0.5))
+    dofs = body.node_dofs(die, "y")
+    body.prescribe(dofs, lambda lf: np.full(len(dofs), -5e-4 * lf))
+    for k in (1.0, 2.0):
+        body.equilibrate(k, tol=1e-12)
+        body.accept()
+    record = body.equilibrate(3.0, tol=1e-12)  # the plastic zone grows under the die's edge
+    before = body.material_state["equivalent_plastic_strain"]
+    after = body._trial_state.material_state["equivalent_plastic_strain"]
+    assert before.max() > 0 and (after > before).sum() > (before > 0).sum()
+    r = record.relative_residuals
+    assert record.iterations >= 3 and r[-1] <= 1e-12
+    ratios = [b / a**2 for a, b in zip(r[1:-1], r[2:]) if a < 1e-3]
+    assert ratios and max(ratios) < 1e3
+
+
+def test_a_cut_step_and_a_saved_state_restore_bit_for_bit():
+    body = block(boxes(3), STEEL, 3)
+    top = body.boundary_dofs("z1", "z")
+    body.prescribe(top, lambda lf: np.full(len(top), -3e-3 * lf))
+    body.equilibrate(1.0, tol=1e-13)
+    body.accept()
+    saved = body.saved_state()
+    first = body.equilibrate(2.0, tol=1e-13)  # a step in plastic flow ...
+    u1, state1 = body.trial_displacement().copy(), body._trial_state.material_state
+    body.discard()  # ... cut
+    assert body.equilibrate(2.0, tol=1e-13).residuals == first.residuals
+    assert np.array_equal(body.trial_displacement(), u1)
+    for k, v in body._trial_state.material_state.items():
+        assert np.array_equal(v, state1[k])
+    body.accept()
+    body.restore_state(saved)  # the state saved (a checkpoint's) put back
+    body.equilibrate(2.0, tol=1e-13)
+    assert np.array_equal(body.trial_displacement(), u1)
+
+
+@pytest.mark.parametrize(("change", "words"), [
+    ({"yield_stress": 0.0}, "yield_stress must be > 0"),
+    ({"hardening_modulus": -1.0}, "hardening_modulus must be >= 0"),
+    ({"model": "tresca"}, "model must be 'von_mises'"),
+    ({"plane": "stress"}, "plane stress is not implemented"),
+])
+def test_bad_parameters_are_named(change, words):
+    values = {"youngs_modulus": E, "poissons_ratio": NU, "yield_stress": Y, **change}
+    with pytest.raises(InputError, match=words):
+        J2Plastic(**values).validate("body 'block', material")
+
+
+PUNCH = """
+name = "plastic punch"
+
+[steps]
+load_factors = [0.25, 0.5, 0.75, 1.0, 0.5, 0.0]
+
+[[bodies]]
+name = "block"
+[bodies.mesh]
+shape = "block"
+x0 = 0.0
+y0 = 0.0
+width = 1.0
+height = 0.5
+h = 0.125
+symmetry = "left"
+[bodies.material]
+youngs_modulus = 200000.0
+poissons_ratio = 0.3
+yield_stress = 250.0
+hardening_modulus = 2000.0
+[[bodies.supports]]
+boundary = "bottom"
+components = ["y"]
+[[bodies.supports]]
+boundary = "symmetry"
+components = ["x"]
+
+[[bodies]]
+name = "punch"
+[bodies.mesh]
+shape = "block"
+x0 = 0.0
+y0 = 0.5
+width = 0.3
+height = 0.3
+h = 0.1
+symmetry = "left"
+[bodies.material]
+youngs_modulus = 400000.0
+poissons_ratio = 0.3
+[[bodies.supports]]
+boundary = "symmetry"
+components = ["x"]
+[[bodies.prescribed]]
+boundary = "top"
+component = "y"
+value = -0.002
+"""
+
+
+def test_a_punch_into_a_plastic_block_leaves_a_dent_and_reads_the_same_either_way():
+    """A flat punch pressed past yield into an elasto-plastic block and taken back out
+    (frictionless contact, Newton's bodies): every step converges with the invariants met;
+    the plastic zone grows while loading and is kept while unloading; at the end the punch
+    has left the block (no contact force) and a dent stays; the bodies listed the other way
+    round give the same answers to the contact tolerances."""
+    import vfem
+    from vfem.io.input import loads
+
+    config = loads(PUNCH, "punch.toml")
+    results = [vfem.solve(config),  # and with the bodies listed the other way round
+               vfem.solve(dataclasses.replace(config, bodies=config.bodies[::-1]))]
+    first, second = results
+    assert first.converged and second.converged
+    assert all(s.invariants["passed"] for s in first.steps + second.steps)
+    force = [float(s.bodies["punch"].contact_force[:, 1].sum()) for s in first.steps]
+    assert force[3] < force[0] * 3.5  # past yield: less than proportional to the push
+    assert abs(force[-1]) <= 1e-9 * abs(force[3])  # lifted off
+    dent = first.steps[-1].bodies["block"].displacement[:, 1].min()
+    assert dent < -1e-4  # a dent of the plastic flow's size stays
+    for a, b in zip(first.steps, second.steps):
+        fa = a.bodies["punch"].contact_force[:, 1].sum()
+        fb = b.bodies["punch"].contact_force[:, 1].sum()
+        assert fb == pytest.approx(fa, rel=1e-8, abs=1e-9 * abs(force[3]))
+
+
+def test_a_plastic_run_killed_and_resumed_ends_as_the_whole_run(tmp_path):
+    """Stopped after the step past yield and resumed from its checkpoint (the plastic
+    strains, back stresses and equivalent plastic strains saved with the body): every later
+    step's contact forces and the points yielded as in the uninterrupted run."""
+    from resume_check import assert_resumed_equals_whole
+    from vfem.io.input import loads
+
+    config = loads(PUNCH, "punch.toml")
+    resumed = assert_resumed_equals_whole(config, tmp_path, stop_after=3)
+    whole = json.loads((tmp_path / "whole" / "summary.json").read_text())
+    points = [s["yielded_points"]["block"] for s in whole["steps"]]
+    assert points == [s["yielded_points"]["block"] for s in resumed["steps"]]
+    assert points[0] < points[3] == points[-1]  # the plastic zone kept on unloading
