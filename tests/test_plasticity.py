@@ -293,3 +293,74 @@ def test_a_plastic_run_killed_and_resumed_ends_as_the_whole_run(tmp_path):
     points = [s["yielded_points"]["block"] for s in whole["steps"]]
     assert points == [s["yielded_points"]["block"] for s in resumed["steps"]]
     assert points[0] < points[3] == points[-1]  # the plastic zone kept on unloading
+
+
+def thick_cylinder(nr: int = 40, nt: int = 12):
+    """A quarter of a plane-strain thick cylinder, a = 1, b = 2, of quadratic triangles (which
+    do not lock under the plastic flow's incompressibility, as bilinear quadrilaterals do:
+    they carried 1.03 times the limit pressure), the rings graded towards the bore; unit
+    pressure on the bore as a load history (small strain: a dead load), symmetry planes."""
+    from skfem import FacetBasis, LinearForm, MeshTri, asm
+    from skfem.helpers import dot
+
+    r = 2.0 ** np.linspace(0.0, 1.0, nr + 1)
+    t = np.linspace(0.0, np.pi / 2, nt + 1)
+    polar = MeshTri.init_tensor(r, t)
+    mesh = MeshTri(np.vstack([polar.p[0] * np.cos(polar.p[1]),
+                              polar.p[0] * np.sin(polar.p[1])]), polar.t).with_boundaries({
+        "bore": lambda x: np.hypot(x[0], x[1]) < 1.0 + 1e-6,
+        "x_axis": lambda x: np.abs(x[1]) < 1e-12, "y_axis": lambda x: np.abs(x[0]) < 1e-12})
+    body = NonlinearBody(mesh, J2Plastic(E, 0.49, Y), formulation="small", order=2,
+                         name="cylinder")
+    body.prescribe(body.boundary_dofs("x_axis", "y"))
+    body.prescribe(body.boundary_dofs("y_axis", "x"))
+    bore = FacetBasis(body.mesh, body.basis0.elem, facets=mesh.boundaries["bore"])
+    unit = asm(LinearForm(lambda v, w: -dot(w.n, v)), bore)  # n points into the bore
+    body.set_load_history(lambda p: p * unit)
+    x = body.basis0.mapping.F(body.basis0.X)
+    return body, np.hypot(x[0], x[1])
+
+
+@pytest.mark.slow
+def test_a_thick_cylinder_yields_and_collapses_as_hill_says():
+    """Hill's elastic-perfectly plastic thick cylinder (The Mathematical Theory of Plasticity,
+    1950, ch. V): plane strain, bore a = 1, outer radius b = 2, nu = 0.49 (Hill's p(c) is
+    exact for nu -> 1/2), k = Y / sqrt(3).
+
+    * first yield at the bore from the elastic (Lame) stresses with nu's sigma_zz: the
+      finite elements' largest von Mises stress at unit pressure gives it within 0.5 %;
+    * with the plastic zone out to c, p = k (1 - c^2/b^2 + 2 ln(c/a)): within 1 % at every
+      pressure (c read as the largest radius of a quadrature point that yielded);
+    * the limit pressure 2 k ln(b/a): carried at 0.995 of it, not at 1.01 (no equilibrium:
+      Newton's method fails there)."""
+    from vfem.errors import AnalysisError
+
+    body, radius = thick_cylinder()
+    a, b, nu, k = 1.0, 2.0, 0.49, Y / math.sqrt(3.0)
+    A = a * a / (b * b - a * a)  # Lame at r = a per unit pressure
+    s_rr, s_tt = -1.0, A * (1.0 + b * b / (a * a))
+    s_zz = nu * (s_rr + s_tt)
+    p_yield = Y / math.sqrt(0.5 * ((s_rr - s_tt) ** 2 + (s_tt - s_zz) ** 2 + (s_zz - s_rr) ** 2))
+    p_limit = 2.0 * k * math.log(b / a)
+
+    body.equilibrate(0.9 * p_yield, tol=1e-10)
+    body.accept()
+    assert not body.material_state["equivalent_plastic_strain"].any()
+    s = body.second_piola_kirchhoff()  # the small-strain stress at the quadrature points
+    zz = nu * (s[0, 0] + s[1, 1])  # elastic plane strain
+    vm = np.sqrt(0.5 * ((s[0, 0] - s[1, 1]) ** 2 + (s[1, 1] - zz) ** 2 + (zz - s[0, 0]) ** 2)
+                 + 3.0 * s[0, 1] ** 2)
+    assert Y / (vm.max() / (0.9 * p_yield)) == pytest.approx(p_yield, rel=5e-3)
+
+    for share in (1.1, 1.3, 1.5, 1.7, 1.8):
+        p = share * p_yield
+        body.equilibrate(p, tol=1e-10, max_iter=40)
+        body.accept()
+        yielded = body.material_state["equivalent_plastic_strain"] > 0
+        c = radius[yielded].max()
+        assert a < c < b
+        assert p == pytest.approx(k * (1 - c * c / (b * b) + 2 * math.log(c / a)), rel=1e-2)
+    body.equilibrate(0.995 * p_limit, tol=1e-10, max_iter=40)
+    body.accept()
+    with pytest.raises(AnalysisError, match="singular|did not converge"):
+        body.equilibrate(1.01 * p_limit, tol=1e-10, max_iter=40)

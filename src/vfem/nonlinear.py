@@ -64,11 +64,13 @@ import functools
 import logging
 import math
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.linalg import MatrixRankWarning
 from skfem import (
     Basis,
     BilinearForm,
@@ -678,7 +680,16 @@ class NonlinearBody:
             if k == max_iter:
                 break
             K = self._tangent(state)
-            correction = solve(*condense(K, -R, D=D, x=pending))
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", MatrixRankWarning)  # singular: below
+                correction = solve(*condense(K, -R, D=D, x=pending))
+            if not np.isfinite(correction).all():
+                self.steps.append(record)
+                self.discard()
+                raise NewtonNotConverged(
+                    f"{self.name}: the tangent stiffness is singular at load factor "
+                    f"{load_factor:g} (iteration {k + 1}): nothing holds the body against "
+                    "the load there (a plastic collapse at its limit load, or a mechanism)")
             # A full Newton correction far from the solution can turn elements inside out (the
             # linearised rotation of a slender part stretches it); halve it until none is. Near
             # the solution the full correction is always taken, so convergence stays quadratic.
