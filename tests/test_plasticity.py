@@ -364,3 +364,43 @@ def test_a_thick_cylinder_yields_and_collapses_as_hill_says():
     body.accept()
     with pytest.raises(AnalysisError, match="singular|did not converge"):
         body.equilibrate(1.01 * p_limit, tol=1e-10, max_iter=40)
+
+
+def test_external_work_is_stored_energy_plus_dissipation():
+    """The block of the uniaxial test loaded past yield and back in 120 steps: the work of the
+    top's force (trapezoids over the steps) equals the elastic energy stored, the hardening
+    energy stored (H_iso alpha^2 / 2 + |beta|^2 / (4/3 H_kin), whose gradients are the
+    hardening forces) and the dissipation, within 1e-3 of the work (the trapezoids' error on
+    the piecewise-linear curve; 1 % is the issue's). The dissipation of a step at a point is
+    the return's xi : d eps_p - H_iso alpha d alpha = Y d alpha (Simo & Hughes 1998, §2.3):
+    never negative."""
+    body = block(boxes(3), STEEL, 3)
+    top = body.boundary_dofs("z1", "z")
+    path = np.r_[np.linspace(0.0, -6e-3, 61), np.linspace(-6e-3, 1e-3, 61)[1:]]
+    body.prescribe(top, lambda lf: np.full(len(top), np.interp(lf, np.arange(len(path)), path)))
+    lam, mu = STEEL.lame()
+    dx = body.basis0.dx
+    work, dissipation, force = 0.0, 0.0, 0.0
+    for k in range(1, len(path)):
+        before = body.material_state["equivalent_plastic_strain"]
+        body.equilibrate(float(k), tol=1e-13)
+        body.accept()
+        step = body.material_state["equivalent_plastic_strain"] - before
+        assert (step >= 0).all()
+        dissipation += float((Y * step * dx).sum())
+        new = float(body.reactions()[top].sum())
+        work += 0.5 * (force + new) * (path[k] - path[k - 1])  # (the area is 1)
+        force = new
+    g = body.basis0.interpolate(body.displacement).grad
+    eps = np.zeros((3, 3) + g.shape[2:])
+    eps[:] = 0.5 * (g + g.transpose(1, 0, 2, 3))
+    elastic = eps - body.material_state["plastic_strain"]
+    tr = elastic[0, 0] + elastic[1, 1] + elastic[2, 2]
+    stored = float(((0.5 * lam * tr**2 + mu * np.einsum("ij...,ij...->...", elastic, elastic))
+                    * dx).sum())
+    alpha, beta = body.material_state["equivalent_plastic_strain"], \
+        body.material_state["back_stress"]
+    hardening = float(((0.5 * H_ISO * alpha**2
+                        + 0.75 / H_KIN * np.einsum("ij...,ij...->...", beta, beta)) * dx).sum())
+    assert dissipation > 0.5 * work > 0
+    assert stored + hardening + dissipation == pytest.approx(work, rel=1e-3)
