@@ -685,6 +685,14 @@ class Analysis:
             steps.append(step)
             log.info("step %d (load factor %.4g) converged in %d iterations", step.step, lf,
                      iterations)
+            if self.model.iterates and len(history) > 1:
+                # Newton's bodies: the order of convergence (quadratic near the solution with
+                # the consistent tangent: r_k+1 / r_k^2 bounded; "-" after a round-off start)
+                r = [h.max_equilibrium_error for h in history]
+                log.info("step %d: relative body residuals %s; r_k+1/r_k^2 %s", step.step,
+                         ", ".join(f"{x:.2e}" for x in r),
+                         ", ".join(f"{b / a**2:.3g}" if a > 1e-10 else "-"
+                                   for a, b in zip(r[:-1], r[1:])))
             if lf == target:
                 self.target += 1
             self.easy = self.easy + 1 if iterations <= easy_limit else 0
