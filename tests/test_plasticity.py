@@ -27,7 +27,11 @@ def strain(rng, dim, scale):
 
 
 @pytest.mark.parametrize("dim", [2, 3])
-@pytest.mark.parametrize("material", [STEEL, J2Plastic(E, NU, Y)], ids=["hardening", "perfect"])
+@pytest.mark.parametrize("material", [
+    STEEL, J2Plastic(E, NU, Y),
+    J2Plastic(E, NU, Y, kinematic_modulus=H_KIN, hardening_curve=((0.0, Y), (2e-3, 400.0),
+                                                                  (6e-3, 450.0)))],
+    ids=["hardening", "perfect", "curve"])
 def test_the_tangent_is_the_derivative_of_the_return_map(dim, material):
     """Central differences of the returned stress (step h: truncation h^2 |sigma'''|, round-off
     eps |sigma| / h, both below 1e-9 of |C| here) against the consistent tangent, at points
@@ -117,6 +121,55 @@ def test_uniaxial_stress_in_3d_follows_the_closed_form():
     assert all(r.iterations <= 2 for r in records)
     alpha = body.material_state["equivalent_plastic_strain"]
     assert np.ptp(alpha) <= 1e-12 * alpha.max()  # homogeneous
+
+
+#: a hardening curve (equivalent plastic strain, yield stress) through two kinks to a plateau
+CURVE = ((0.0, Y), (2e-3, 400.0), (6e-3, 450.0))
+
+
+def test_uniaxial_stress_on_a_hardening_curve_follows_the_closed_form():
+    """The block of the uniaxial test on a piecewise-linear hardening curve (with kinematic
+    hardening beside it), pressed monotonically through both kinks onto the plateau and
+    unloaded a little: while loading |sigma| = sigma_y(eps_p) + H_kin eps_p = E (|eps| - eps_p),
+    solved segment by segment; to 1e-10 of Y at every step."""
+    material = J2Plastic(E, NU, Y, kinematic_modulus=H_KIN, hardening_curve=CURVE)
+    material.validate()
+    path = [-1e-3, -2e-3, -3.5e-3, -6e-3, -9e-3, -1.2e-2, -1.1e-2]
+    body = block(boxes(3), material, 3)
+    top = body.boundary_dofs("z1", "z")
+    at = np.r_[0.0, path]
+    body.prescribe(top, lambda lf: np.full(len(top), np.interp(lf, np.arange(len(at)), at)))
+    start = np.array([a for a, _ in CURVE])
+    level = np.array([v for _, v in CURVE])
+    slope = np.r_[np.diff(level) / np.diff(start), 0.0]
+    eps_p = 0.0
+    for k, eps in enumerate(path, start=1):
+        body.equilibrate(float(k), tol=1e-13)
+        body.accept()
+        force = float(body.reactions()[top].sum())
+        if abs(eps) > abs(path[k - 2]) or k == 1:  # loading: the curve's closed form
+            for j in range(len(start)):  # E (|eps| - e) = level_j + slope_j (e - start_j) + H_kin e
+                e = (E * abs(eps) - level[j] + slope[j] * start[j]) / (E + slope[j] + H_KIN)
+                if j == len(start) - 1 or e <= start[j + 1]:
+                    break
+            eps_p = max(e, 0.0)
+            expected = -E * (abs(eps) - eps_p)
+        else:  # unloading: elastic from the last state
+            expected = -E * (abs(eps) - eps_p)
+        assert abs(force - expected) <= 1e-10 * Y, (k, force, expected)
+    assert body.material_state["equivalent_plastic_strain"].max() > CURVE[-1][0]  # plateau
+
+
+@pytest.mark.parametrize(("curve", "words"), [
+    (((0.0, 200.0), (1e-3, 300.0)), r"must start at \[0, yield_stress\]"),
+    (((0.0, Y), (1e-3, 300.0), (1e-3, 350.0)), "plastic strains must increase"),
+    (((0.0, Y), (1e-3, 240.0)), "must not fall"),
+])
+def test_bad_hardening_curves_are_named(curve, words):
+    with pytest.raises(InputError, match=words):
+        J2Plastic(E, NU, Y, hardening_curve=curve).validate("body 'block', material")
+    with pytest.raises(InputError, match="not both"):
+        J2Plastic(E, NU, Y, 10.0, hardening_curve=CURVE).validate("body 'block', material")
 
 
 def test_uniaxial_strain_in_plane_strain_follows_the_closed_form():

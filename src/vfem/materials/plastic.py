@@ -13,12 +13,18 @@ strain ``alpha`` (linear isotropic hardening):
 
 A uniaxial test reads ``sigma = Y + (H_iso + H_kin) eps_p`` while loading: ``H = H_iso + H_kin``
 is the slope of the stress against the plastic strain, and the elasto-plastic tangent
-``E H / (E + H)``.
+``E H / (E + H)``. In place of ``Y + H_iso alpha`` the yield stress may be a piecewise-linear
+curve of the equivalent plastic strain, ``sigma_y(alpha)`` (``hardening_curve``: pairs
+(alpha, sigma_y) from (0, Y), held at its last value beyond its last point, as Abaqus's
+``*PLASTIC`` table), with ``H_iso`` its slope where ``alpha`` lies.
 
 **Radial return** (Simo & Hughes, *Computational Inelasticity*, 1998, box 3.1): the trial
 state freezes the plastic variables; where ``f_trial > 0`` the closest point projection onto
 the yield surface is along ``n_trial`` and, with linear hardening, closed form:
-``dgamma = f_trial / (2 mu + 2/3 (H_iso + H_kin))``. **Consistent tangent** (their box 3.2):
+``dgamma = f_trial / (2 mu + 2/3 (H_iso + H_kin))``; on a curve the return is the same on the
+segment where the new ``alpha`` lies (the consistency condition is piecewise linear in
+``dgamma``: each segment's root, the next segment's where it falls beyond, exact).
+**Consistent tangent** (their box 3.2, ``H_iso`` the slope at the new ``alpha``):
 
     C = K I (x) I + 2 mu theta (I_sym - I (x) I / 3) - 2 mu theta_bar n (x) n,
     theta = 1 - 2 mu dgamma / |xi_trial|,
@@ -74,6 +80,10 @@ class J2Plastic:
             equivalent plastic strain (0: no isotropic hardening).
         kinematic_modulus: H_kin >= 0: linear kinematic hardening (Prager), the back stress's
             growth per unit plastic strain, uniaxially (0: none).
+        hardening_curve: the yield stress as a piecewise-linear function of the equivalent
+            plastic strain, ``[[0, Y], [alpha_1, sigma_1], ...]``: alpha increasing from 0,
+            sigma_y from ``yield_stress`` never falling, held beyond the last pair; in place of
+            ``hardening_modulus`` (default: none).
         model: ``"von_mises"``: the yield criterion.
         plane: ``"strain"``: the section of a 2D body (plane stress is not implemented).
     """
@@ -83,6 +93,7 @@ class J2Plastic:
     yield_stress: float
     hardening_modulus: float = 0.0
     kinematic_modulus: float = 0.0
+    hardening_curve: tuple[tuple[float, float], ...] = ()
     model: str = "von_mises"
     plane: str = "strain"
 
@@ -110,9 +121,42 @@ class J2Plastic:
             if getattr(self, key) < 0:
                 raise InputError(f"{where}: {key} must be >= 0 (softening is not taken), "
                                  f"got {getattr(self, key)!r}")
+        self._check_curve(where)
         if self.plane != "strain":
             raise InputError(f"{where}: plane must be 'strain' for a plastic material "
                              f"(plane stress is not implemented), got {self.plane!r}")
+
+    def _check_curve(self, where: str) -> None:
+        curve = self.hardening_curve
+        if not curve:
+            return
+        if self.hardening_modulus != 0.0:
+            raise InputError(f"{where}: give hardening_curve or hardening_modulus, not both")
+        if any(len(pair) != 2 or not all(isinstance(v, (int, float)) and math.isfinite(v)
+                                         for v in pair) for pair in curve):
+            raise InputError(f"{where}: hardening_curve must be pairs of finite numbers "
+                             f"[equivalent plastic strain, yield stress], got {curve!r}")
+        alpha = [float(a) for a, _ in curve]
+        stress = [float(v) for _, v in curve]
+        if alpha[0] != 0.0 or stress[0] != float(self.yield_stress):
+            raise InputError(f"{where}: hardening_curve must start at [0, yield_stress] "
+                             f"([0, {self.yield_stress!r}]), got {list(curve[0])!r}")
+        if any(b <= a for a, b in zip(alpha, alpha[1:])):
+            raise InputError(f"{where}: hardening_curve's plastic strains must increase, "
+                             f"got {alpha!r}")
+        if any(b < a for a, b in zip(stress, stress[1:])):
+            raise InputError(f"{where}: hardening_curve's yield stresses must not fall "
+                             f"(softening is not taken), got {stress!r}")
+
+    def _segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The yield stress's segments: their first equivalent plastic strains, yield stresses
+        there and slopes (the last one unbounded: ``H_iso``, or 0 beyond a curve's end)."""
+        if not self.hardening_curve:
+            return (np.zeros(1), np.array([float(self.yield_stress)]),
+                    np.array([float(self.hardening_modulus)]))
+        alpha = np.array([float(a) for a, _ in self.hardening_curve])
+        stress = np.array([float(v) for _, v in self.hardening_curve])
+        return alpha, stress, np.r_[np.diff(stress) / np.diff(alpha), 0.0]
 
     def lame(self) -> tuple[float, float]:
         """Lamé constants (lambda, mu) of the elastic part (plane strain = 3D)."""
@@ -144,7 +188,6 @@ class J2Plastic:
         dim = E.shape[0]
         lam, mu = self.lame()
         bulk = lam + 2.0 * mu / 3.0
-        H = self.hardening_modulus + self.kinematic_modulus
         eps = np.zeros((3, 3) + E.shape[2:])
         eps[:dim, :dim] = E
         tr = eps[0, 0] + eps[1, 1] + eps[2, 2]
@@ -156,10 +199,29 @@ class J2Plastic:
         s_trial = 2.0 * mu * (dev - ep)
         xi = s_trial - beta
         norm = np.sqrt(np.einsum("ij...,ij...->...", xi, xi))
-        radius = math.sqrt(2.0 / 3.0) * (self.yield_stress + self.hardening_modulus * alpha)
+        start, level, slope = self._segments()
+        root = math.sqrt(2.0 / 3.0)
+        j = np.searchsorted(start, alpha, side="right") - 1  # the segment of each point
+        radius = root * (level[j] + slope[j] * (alpha - start[j]))
         f = norm - radius
         flows = f > YIELD_TOLERANCE * radius
-        dgamma = np.where(flows, f / (2.0 * mu + 2.0 / 3.0 * H), 0.0)
+        # the consistency condition, linear on a segment: its root, or the next segment's
+        # where the new alpha falls beyond it (at most a pass per segment)
+        dgamma = np.zeros_like(norm)
+        hardening = slope[j]  # H_iso where the new alpha lies
+        todo = flows.copy()
+        for _ in range(len(start)):
+            if not todo.any():
+                break
+            jt = j[todo]
+            dg = ((norm[todo] - root * (level[jt] + slope[jt] * (alpha[todo] - start[jt])))
+                  / (2.0 * mu + 2.0 / 3.0 * (self.kinematic_modulus + slope[jt])))
+            beyond = (jt + 1 < len(start)) & (
+                alpha[todo] + root * dg > start[np.minimum(jt + 1, len(start) - 1)])
+            dgamma[todo] = dg
+            hardening[todo] = slope[jt]
+            j[todo] = jt + beyond
+            todo[todo] = beyond
         n = np.divide(xi, norm, out=np.zeros_like(xi), where=flows)
         step = dgamma * n
         sigma = s_trial - 2.0 * mu * step
@@ -172,6 +234,7 @@ class J2Plastic:
         def moduli() -> np.ndarray:
             theta = 1.0 - 2.0 * mu * np.divide(dgamma, norm, out=np.zeros_like(norm),
                                                where=flows)
+            H = hardening + self.kinematic_modulus
             theta_bar = np.where(flows, 1.0 / (1.0 + H / (3.0 * mu)) - (1.0 - theta), 0.0)
             eye = np.eye(dim)
             shape = (dim, dim, dim, dim) + E.shape[2:]
