@@ -457,3 +457,54 @@ def test_external_work_is_stored_energy_plus_dissipation():
                         + 0.75 / H_KIN * np.einsum("ij...,ij...->...", beta, beta)) * dx).sum())
     assert dissipation > 0.5 * work > 0
     assert stored + hardening + dissipation == pytest.approx(work, rel=1e-3)
+
+
+@pytest.mark.slow
+def test_yield_starts_under_a_hertz_contact_where_and_when_hertz_says():
+    """The Hertz cylinder (``vfem_examples.hertz``, nu = 0.3) of J2 material, pressed by a
+    force whose Hertz half-width is a = 0.004 R (the elastic half-space's stresses hold to
+    about a / 2R: a disk's own stress from its load, P / pi R, adds 0.4 % of p0 to the von
+    Mises stress here, 2.7 % at the example's a = 0.06 R); yield stress Y = p0 / 1.794 at the
+    force, so that first yield is due at load factor 1 on the axis at 0.704 a (von Mises
+    under McEwen's stresses). The first load factor with a yielded point lies within 2 % of
+    1, and the first yielded points lie, on average, within one element of 0.704 a deep."""
+    from vfem.solver import Analysis
+    from vfem_examples import hertz
+
+    E1, nu = 1.0e6, 0.3
+    probe = hertz.HertzParameters(cylinder_poissons_ratio=nu)
+    e_star = hertz.theory(probe)["e_star"]
+    a = 0.004
+    force = a * a * math.pi * e_star / 8.0  # on the half model
+    p = dataclasses.replace(probe, force=force)
+    theory = hertz.theory(p)
+    assert theory["a_theory"] == pytest.approx(a, rel=1e-12)
+    z = np.linspace(1e-3, 3.0, 300001)  # McEwen's stresses on the axis, per p0, z per a
+    sx = -((1 + 2 * z * z) / np.sqrt(1 + z * z) - 2 * z)
+    sz = -1 / np.sqrt(1 + z * z)
+    sy = nu * (sx + sz)
+    vm = np.sqrt(0.5 * ((sx - sy) ** 2 + (sy - sz) ** 2 + (sz - sx) ** 2))
+    assert 1 / vm.max() == pytest.approx(1.794, abs=5e-4)
+    depth = z[vm.argmax()]
+    Y = theory["p0_theory"] * vm.max()
+    model = hertz.build(p)
+    cylinder = next(b for b in model.bodies if b.name == "cylinder")
+    cylinder.material = J2Plastic(E1, nu, Y)
+    model.load_factors = (0.5, 0.9, 0.96, 0.97, 0.98, 0.99, 1.0, 1.01, 1.02, 1.03)
+    result = Analysis(model).run()
+    assert result.converged
+    first = next(s for s in result.steps if s.yielded["cylinder"] > 0)
+    assert abs(first.load_factor - 1.0) <= 0.02
+    r = first.bodies["cylinder"]
+    nl = cylinder.nonlinear
+    x = nl.basis0.mapping.F(nl.basis0.X)  # quadrature points
+    # the points that yielded in that step, the first to yield (from the virgin state)
+    g = nl.basis0.interpolate(np.ravel(r.displacement)).grad
+    state = nl.material.response(0.5 * (g + np.swapaxes(g, 0, 1)),
+                                 nl.material.initial_state(2, x.shape[1:])).state
+    yielded = state["equivalent_plastic_strain"] > 0
+    bottom = float(nl.mesh.doflocs[1].min())
+    h = a / p.facets_per_half_width  # the elements' size there
+    a_now = a * math.sqrt(first.load_factor)
+    depths = x[1][yielded] - bottom
+    assert abs(depths.mean() - depth * a_now) <= h
