@@ -508,3 +508,18 @@ def test_yield_starts_under_a_hertz_contact_where_and_when_hertz_says():
     a_now = a * math.sqrt(first.load_factor)
     depths = x[1][yielded] - bottom
     assert abs(depths.mean() - depth * a_now) <= h
+
+
+def test_a_plastic_table_is_written_and_read_back_as_it_was():
+    """``vfem export`` / :func:`vfem.io.input.dumps` writes a plastic material's table (its
+    hardening curve as an array of pairs) so that reading it gives the same model."""
+    from vfem.io.input import dumps, loads
+
+    text = PUNCH.replace("hardening_modulus = 2000.0",
+                         "hardening_curve = [[0.0, 250.0], [0.002, 400.0], [0.006, 450.0]]\n"
+                         "kinematic_modulus = 500.0")
+    config = loads(text, "punch.toml")
+    block = next(b for b in config.bodies if b.name == "block")
+    assert isinstance(block.material, J2Plastic)
+    assert block.material.hardening_curve == CURVE[:1] + ((2e-3, 400.0), (6e-3, 450.0))
+    assert loads(dumps(config, "written back"), "again.toml") == config
