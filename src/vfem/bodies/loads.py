@@ -158,21 +158,29 @@ class PrescribedDisplacement:
 
 @dataclass(frozen=True)
 class Traction:
-    """A distributed load on a named boundary.
+    """A distributed load on a named boundary: a traction vector, or a pressure along the
+    boundary's normal.
 
     Attributes:
         boundary: the boundary's name.
         value: the traction (tx, ty), force per unit undeformed length, at load factor 1;
-            (tx, ty, tz), force per unit undeformed area, on a 3D body.
+            (tx, ty, tz), force per unit undeformed area, on a 3D body. Give it or
+            ``pressure``.
         amplitude: a load curve, ``[[load_factor, multiplier], ...]`` points (load factors
             strictly increasing): the traction is ``value`` times the multiplier interpolated
             linearly at the load factor (constant beyond the ends), instead of ``value`` times
             the load factor.
+        pressure: in place of ``value``, a pressure p at load factor 1 (force per unit
+            undeformed length or area), pushing into the body (negative: pulling) along each
+            facet's undeformed outward normal n: the traction -p n (a bore's internal pressure,
+            a seal's fluid). Under large kinematics it stays a dead load on the undeformed
+            normals.
     """
 
     boundary: str
-    value: tuple[float, ...]
+    value: tuple[float, ...] = ()
     amplitude: tuple[tuple[float, float], ...] | None = None
+    pressure: float | None = None
 
 
 @dataclass(frozen=True)
@@ -248,11 +256,23 @@ def load_cases(body, fixed: dict[int, float]) -> list[LoadCase]:
 
 def traction_vector(body, tr: Traction) -> np.ndarray:
     """The nodal forces (ndofs) of a uniform traction on a named boundary: ∫ t·v times the
-    section's measure (:meth:`~vfem.bodies.section.Section.weight`) over its facets."""
+    section's measure (:meth:`~vfem.bodies.section.Section.weight`) over its facets; of a
+    pressure, t = -p n with n the facets' outward normal."""
     fb = FacetBasis(body.mesh, ElementVector(body.element()),
                     facets=body.mesh.boundaries[tr.boundary])
-    t = np.asarray(tr.value, dtype=float)
     section = body.section  # the measure of the body's boundary (:mod:`.section`)
+    if tr.pressure is not None:
+        p = float(tr.pressure)
+
+        @LinearForm
+        def pressed(v, w):
+            out = w.n[0] * v[0] + w.n[1] * v[1]
+            for d in range(2, body.dim):  # 3D: + n_z v_z
+                out = out + w.n[d] * v[d]
+            return -p * out * section.weight(w.x)
+
+        return asm(pressed, fb)
+    t = np.asarray(tr.value, dtype=float)
 
     @LinearForm
     def load(v, w):

@@ -92,11 +92,22 @@ def validate(body) -> None:
                              + ("" if c not in COMPONENTS else
                                 f" (the body's mesh is {body.dim}D)") + f", got {c!r}")
     for tr in body.tractions:
+        if tr.pressure is not None:
+            if len(tr.value):
+                raise InputError(f"{where}: traction on {tr.boundary!r}: give value (a "
+                                 "traction) or pressure, not both")
+            if isinstance(tr.pressure, bool) or not isinstance(tr.pressure, (int, float)) \
+                    or not math.isfinite(tr.pressure):
+                raise InputError(f"{where}: traction on {tr.boundary!r}: pressure must be a "
+                                 f"finite number, got {_shown(tr.pressure)}")
+            continue
         if not isinstance(tr.value, (tuple, list)) or len(tr.value) != body.dim:
             raise InputError(
                 f"{where}: traction on {tr.boundary!r}: value must have {body.dim} "
                 f"components ({', '.join('t' + a for a in allowed)}) on a {body.dim}D "
-                f"body, got {_shown(tr.value)}")
+                f"body, got {_shown(tr.value)}"
+                + (" (or give pressure: a pressure along the boundary's normal)"
+                   if not len(tr.value) else ""))
     for kind, loads in (("prescribed displacement", body.prescribed),
                         ("traction", body.tractions),
                         ("platen", (body.platen,) if body.platen else ())):
