@@ -476,9 +476,7 @@ class NonlinearBody:
             g = arrays.gradient(self._u_at_current + delta)
             eps = 0.5 * (g + g.transpose(1, 0, 2, 3))
             r = self.material.response(eps, self.material_state)
-            F = np.zeros_like(g)
-            for i in range(self.dim):
-                F[i, i] = 1.0
+            F = deformation_gradient(np.zeros_like(g))  # I
             return _State(self.basis0, F, r.stress, r.moduli, r.out_of_plane, r.state,
                           geometric=False)
         if self.formulation == TOTAL:

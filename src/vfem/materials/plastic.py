@@ -52,6 +52,7 @@ import numpy as np
 
 from ..errors import InputError
 from .constants import check_elastic_constants
+from .hyperelastic import _lame
 from .protocol import Response, State
 
 #: a trial state whose yield function is at most this share of the yield radius is elastic:
@@ -160,8 +161,7 @@ class J2Plastic:
 
     def lame(self) -> tuple[float, float]:
         """Lamé constants (lambda, mu) of the elastic part (plane strain = 3D)."""
-        E, nu = self.youngs_modulus, self.poissons_ratio
-        return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
+        return _lame(self.youngs_modulus, self.poissons_ratio)
 
     def plane_strain_modulus(self) -> float:
         """E/(1-nu^2) of the elastic part: the modulus in Hertz's E*."""
@@ -229,7 +229,7 @@ class J2Plastic:
             sigma[i, i] += bulk * tr
         new = {"plastic_strain": ep + step,
                "back_stress": beta + 2.0 / 3.0 * self.kinematic_modulus * step,
-               "equivalent_plastic_strain": alpha + math.sqrt(2.0 / 3.0) * dgamma}
+               "equivalent_plastic_strain": alpha + root * dgamma}
 
         def moduli() -> np.ndarray:
             theta = 1.0 - 2.0 * mu * np.divide(dgamma, norm, out=np.zeros_like(norm),

@@ -80,15 +80,9 @@ class ReusedFactor:
         """The solution of ``matrix() x = b``, ``matrix`` called only when ``key`` is new;
         None when the matrix is singular (an exactly zero pivot)."""
         if key != self.key:
-            A = matrix()
-            with dense_threads(len(A)), warnings.catch_warnings():
-                warnings.simplefilter("ignore", sla.LinAlgWarning)  # singular: None, below
-                lu, piv = sla.lu_factor(A, check_finite=False, overwrite_a=True)
+            self.factors = _factorized(matrix())
             self.key = key
-            self.factors = None if (np.diag(lu) == 0.0).any() else (lu, piv)
-        if self.factors is None:
-            return None
-        return sla.lu_solve(self.factors, b, check_finite=False)
+        return None if self.factors is None else _solve(self.factors, b)
 
     def solve_set(self, W, a: np.ndarray, b: np.ndarray, border=None) -> np.ndarray | None:
         """The solution of ``W[a, a] x = b``, or with ``border`` = (column, row, corner) of
@@ -158,7 +152,7 @@ class ReusedFactor:
         """The set factorized (kept as a base), its bordered system solved from it (or, where
         W over the set is singular, the bordered matrix factorized whole); None where
         singular."""
-        factors = _factorized(_block(W, a, a, dense=False))
+        factors = _factorized(block(W, a, a, dense=False))
         if factors is None:
             return None if border is None else _bordered_whole(W, a, border)
         base = _Base(W, mask, a, factors)
@@ -200,8 +194,9 @@ def _entries(W) -> int:
     return int(W.nnz) if sp.issparse(W) else int(W.size)
 
 
-def _block(W, rows: np.ndarray, cols: np.ndarray, dense: bool = True):
-    """W's block over ``rows`` x ``cols``: dense, or (``dense`` False) as W is."""
+def block(W, rows: np.ndarray, cols: np.ndarray, dense: bool = True):
+    """W's block over ``rows`` x ``cols``, dense W or sparse: dense, or (``dense`` False) as
+    W is."""
     if sp.issparse(W):
         block = W[rows][:, cols]
         return block.toarray() if dense else sp.csc_matrix(block)
@@ -232,7 +227,7 @@ def _solve(factors, b: np.ndarray) -> np.ndarray:
 
 def _set_matrix(W, a: np.ndarray, border):
     """The set's own matrix (bordered where there is a border), dense or sparse as W."""
-    M = _block(W, a, a, dense=False)
+    M = block(W, a, a, dense=False)
     if border is None:
         return M
     column, row, corner = border
@@ -290,9 +285,9 @@ class _Updated:
         H = np.zeros((k, nb))  # their rows over the base
         C = np.zeros((k, k))   # and among themselves
         if ns:
-            G[:, :ns] = _block(W, B, S)
-            H[:ns] = _block(W, S, B)
-            C[:ns, :ns] = _block(W, S, S)
+            G[:, :ns] = block(W, B, S)
+            H[:ns] = block(W, S, B)
+            C[:ns, :ns] = block(W, S, S)
         G[drop, ns + np.arange(nd)] = 1.0
         H[ns + np.arange(nd), drop] = 1.0
         if bordered:

@@ -18,7 +18,7 @@ import logging
 import numpy as np
 import scipy.sparse as sp
 
-from .bordered import ReusedFactor, bordered_solve
+from .bordered import ReusedFactor, block, bordered_solve
 
 log = logging.getLogger(__name__)
 
@@ -257,16 +257,11 @@ class DenseSystem:
                 x = factor.solve_set(W, a, np.concatenate([rhs, [extra]]),
                                      (column, row, corner))
             if x is None:  # singular (no node of the platen's body in the set): least squares
-                return bordered_solve(_dense(W, a), column, row, corner, rhs, extra)
+                return bordered_solve(block(W, a, a), column, row, corner, rhs, extra)
             return x[:-1], float(x[-1])
         x = None if factor is None else factor.solve_set(W, a, rhs)
         # (singular: numpy's LinAlgError, for the pivoting to see)
-        return (np.linalg.solve(_dense(W, a), rhs) if x is None else x), 0.0
-
-
-def _dense(W, a: np.ndarray) -> np.ndarray:
-    """W's block over the set ``a``, dense."""
-    return W[a][:, a].toarray() if sp.issparse(W) else W[np.ix_(a, a)]
+        return (np.linalg.solve(block(W, a, a), rhs) if x is None else x), 0.0
 
 
 __all__ = ["DenseSystem", "linear_complementarity"]
