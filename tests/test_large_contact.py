@@ -48,10 +48,20 @@ def crushed():
 
 
 @pytest.mark.slow
-def test_large_kinematics_gasket_runs_without_cuts(crushed):
+def test_large_kinematics_gasket_is_crushed_and_released(crushed):
+    """Every scheduled load factor reached, loading and unloading; the two gaskets' forces
+    balance; the unloading retraces the loading at the scheduled load factors, and every node
+    is back at its start. (Since the held nodes, issue 41, the first unloading steps of this
+    coarse model are cut, twice at most: at full crush four of the stiff ring's vertices carry
+    the contact, and the tangent prediction of a whole unloading step releases them all, the
+    S-shaped ring then springing 0.46 into the other; without held nodes it took no cut.)"""
+    schedule = np.round(np.concatenate([np.arange(1, 11), np.arange(9, -1, -1)]) / 10, 12)
     for result in crushed.values():
         assert result.converged, result.message
-        assert len(result.steps) == 20 and all(s.cuts == 0 for s in result.steps)
+        assert max(s.cuts for s in result.steps) <= 2
+        lf = np.round([s.load_factor for s in result.steps], 12)
+        at = [int(np.flatnonzero(lf == f)[0 if k < 10 else -1]) for k, f in enumerate(schedule)]
+        assert all(a < b for a, b in zip(at, at[1:]))  # in order: each reached, none skipped
         forces = [np.linalg.norm(s.bodies["soft"].contact_force.sum(axis=0))
                   for s in result.steps]
         assert max(forces) > 1000.0  # the contact carries the whole crushing
@@ -60,7 +70,9 @@ def test_large_kinematics_gasket_runs_without_cuts(crushed):
             total = s.bodies["soft"].contact_force.sum(axis=0)
             assert np.allclose(total, -s.bodies["stiff"].contact_force.sum(axis=0),
                                atol=1e-9 * max(forces))
-        assert np.allclose(forces[:9], forces[-2:-11:-1], rtol=1e-8)
+        loading = [forces[at[k]] for k in range(9)]
+        unloading = [forces[at[18 - k]] for k in range(9)]
+        assert np.allclose(loading, unloading, rtol=1e-8)
         assert max(np.abs(r.displacement).max() for r in result.steps[-1].bodies.values()) < 1e-10
 
 

@@ -53,7 +53,8 @@ The contact forces' turning with the surfaces (follower forces) enters the linea
 derivative of the nodal forces with respect to the positions of the nodes in contact and of the
 opposing nodes around their virtual nodes, at fixed traction values, found by differences of the
 pairing (geometry only: the loaded nodes' normals, :meth:`LargeDeformationContact._normals_at`,
-the coordinates that move disjoint sets of them perturbed together); the transfer is held in it.
+the coordinates that move disjoint sets of them perturbed together); the transfer is held in it
+(a held node's point force moves with its virtual node, :mod:`.large_held`).
 
 The step's increments of the prescribed displacements enter with the first correction, so the
 first iterate of a step is the tangent prediction of the whole step, contact included: the
@@ -78,6 +79,7 @@ from ..geometry import ContactPairs, ContactSurface, overlap, virtual_nodes
 from ..solvers import Check, iterate, linear_complementarity
 from ..state import ContactState, IterationRecord, SolveResult, closing_motion
 from .follower import follower_stiffness
+from .large_held import hold_protruding, pair_held, set_guards
 from .pairset import PairSet
 
 log = logging.getLogger(__name__)
@@ -114,6 +116,9 @@ class LargeDeformationContact(PairSet):
             if s.kind is not None and s.kind.order != 1:
                 raise InputError(f"body {s.body.name!r}: large-displacement contact needs "
                                  "linear elements (order 1)")
+        #: the equilibrium side's nodes held too where they would penetrate (issue 37's held
+        #: nodes, paired anew in every iteration: :meth:`penetrations`); not yet with friction
+        self.both_surfaces = friction is None
         # (its own pairs, built on the undeformed geometry, which side carries compatibility
         # and which nodes decided once; :meth:`penetrations` moves them to the current one)
         super().__init__(surfaces, pairs, settings, backend, sides, executor=executor,
@@ -151,6 +156,9 @@ class LargeDeformationContact(PairSet):
         x = self.positions(state)
         out = []
         for k, pair in enumerate(self.contact_pairs):
+            if pair.point:  # (after the compatibility pairs: their patches are current)
+                out.append(pair_held(self, state, k, x))
+                continue
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
             geo = overlap(sf, sc, x[pair.fine], x[pair.coarse], pair.nodes, pair.zones)
             if geo is None:  # the surfaces no longer face each other anywhere
@@ -182,6 +190,7 @@ class LargeDeformationContact(PairSet):
         """
         cfg = self.settings
         tol = self.penetration_tolerance
+        self._refused = None
 
         def check(it: int) -> Check:
             pens = self.penetrations(state)
@@ -197,11 +206,12 @@ class LargeDeformationContact(PairSet):
             need, _, _ = self._platen_terms(state, lins)
             platen_ok = self._platen_on_force(state, need)
             other_err, other_ok, other_what = self._further_errors(state)
+            protruding = hold_protruding(self, state, pens, traction_values)
             return Check(
                 IterationRecord(it, max(pen_err, other_err), body_err, contact, tension,
                                 platen_error=-need),
                 (pen_err <= tol and tension == 0 and platen_ok and settled
-                 and body_err <= BODY_TOLERANCE and other_ok),
+                 and body_err <= BODY_TOLERANCE and other_ok and not protruding),
                 lambda: self._iteration_sets(state, traction_values),
                 max(pen_err, body_err, other_err),
                 lambda: self.pairings(state, pens),
@@ -274,22 +284,25 @@ class LargeDeformationContact(PairSet):
     def _normals_at(self, state: ContactState, x: list[np.ndarray]) -> list:
         """Per contact pair, the loaded nodes (positions in the pair's nodes, traction nonzero),
         the normals their tractions act along with the bodies' tracked nodes at ``x`` (the
-        opposing surface's normal at the virtual node, wherever that now is) and the facets of
-        the opposing surface their virtual nodes lie on."""
+        opposing surface's normal at the virtual node, wherever that now is), the facets of
+        the opposing surface their virtual nodes lie on, and (held nodes: their point force
+        reaches the other surface at the virtual node, which moves as they slide) the
+        interpolation there, else None."""
         out = []
         for k, pair in enumerate(self.contact_pairs):
             on = np.flatnonzero(self.tractions(state, k) != 0)
             if not len(on):
                 out.append((on, np.zeros((0, self.surfaces[pair.fine].dim)),
-                            np.zeros(0, dtype=int)))
+                            np.zeros(0, dtype=int), None))
                 continue
             sf, sc = self.surfaces[pair.fine], self.surfaces[pair.coarse]
             # (a loaded node is over the other surface; perturbed past its edge, it keeps the
-            # normal there: the one-sided derivative, not a 90-degree turn over the step h)
-            normal, _, _, seg, _ = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse],
-                                                 pair.nodes[on], *pair.patches,
-                                                 beyond_normal=False)
-            out.append((on, normal, seg))
+            # normal there: the one-sided derivative, not a 90-degree turn over the step h;
+            # a held node's force acts along the interpolated normal too, :func:`held_now`)
+            normal, _, interp, seg, _ = virtual_nodes(sf, sc, x[pair.fine], x[pair.coarse],
+                                                      pair.nodes[on], *pair.patches,
+                                                      beyond_normal=False)
+            out.append((on, normal, seg, interp if pair.point else None))
         return out
 
     def _traction_vectors(self, state: ContactState, k: int, on: np.ndarray,
@@ -315,15 +328,17 @@ class LargeDeformationContact(PairSet):
     def _forces_at(self, state: ContactState, x: list[np.ndarray]) -> np.ndarray:
         """All bodies' candidate nodal forces (stacked) of the state's traction values with the
         bodies' tracked nodes at ``x``: the traction acts along the opposing surface's normal at
-        the virtual node, wherever that now is (the transfer held)."""
+        the virtual node, wherever that now is (the transfer held; a held node's point force
+        reaches the other surface where its virtual node now is)."""
         out = [np.zeros((s.nc, s.dim)) for s in self.surfaces]
-        for k, (pair, (on, normal, _)) in enumerate(zip(self.contact_pairs,
-                                                         self._normals_at(state, x))):
+        for k, (pair, (on, normal, _, interp)) in enumerate(zip(self.contact_pairs,
+                                                                 self._normals_at(state, x))):
             if not len(on):
                 continue
             qn = self._traction_vectors(state, k, on, normal)
             out[pair.fine] += pair.mass[:, pair.nodes[on]] @ qn
-            out[pair.coarse] -= pair.transfer[:, pair.nodes[on]] @ qn
+            out[pair.coarse] -= (pair.transfer[:, pair.nodes[on]] if interp is None
+                                 else interp.T) @ qn
         return np.concatenate([F.ravel() for F in out])
 
     def _follower_stiffness(self, state: ContactState, coloured: bool = True
@@ -346,7 +361,7 @@ class LargeDeformationContact(PairSet):
         problem for dq; each body then moves by its own correction plus the response of its full
         mesh to the change of its forces (one more solve with its factorization). With friction
         the unknowns of a node are its normal and tangential traction values
-        (:meth:`directions_now`), and :meth:`_solve_linearised` finds the stick and slip sets
+        (:meth:`directions`), and :meth:`_solve_linearised` finds the stick and slip sets
         too.
         """
         tol = self.penetration_tolerance
@@ -379,7 +394,7 @@ class LargeDeformationContact(PairSet):
             lin_pens.append(p)
             carrying = self.tractions(state, k) != 0
             sets.append(np.flatnonzero(pair.carries & (carrying | (p > -reach))))
-        directions = [self.directions_now(k) for k in range(len(self.contact_pairs))]
+        directions = [self.directions(k) for k in range(len(self.contact_pairs))]
         m = sum(len(s_) * len(dirs) for s_, dirs in zip(sets, directions))
         # force patterns per unit traction value, stacked candidate dofs x m (per pair, the
         # set's normal unknowns, then its tangential ones)
@@ -449,23 +464,32 @@ class LargeDeformationContact(PairSet):
         self._move(state, sets, dq, dplaten, moves,
                    [dF[off[i]:off[i + 1]].reshape(-1, s.dim) for i, s in enumerate(self.surfaces)])
 
-    def directions_now(self, k: int) -> list[np.ndarray]:
-        """The directions of pair k's traction unknowns at its nodes, on the current geometry:
-        the normal, then the friction part's tangents (none without friction)."""
-        tangential = self.friction.tangent_basis(k) if self.friction is not None else []
-        return [self.contact_pairs[k].normal, *tangential]
-
     def _solve_linearised(self, state: ContactState, W: np.ndarray, q0: np.ndarray,
                           p: np.ndarray, tol: float, sets: list[np.ndarray], rate, dR,
                           stiffness: float, need: float) -> tuple[np.ndarray, float]:
         """The traction values of the linearised contact problem (and the platen's motion):
         complementarity on the normal ones
-        (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`); with friction,
-        the part's stick and slip sets too."""
+        (:func:`~vfem.contact.solvers.complementarity.linear_complementarity`), the held nodes
+        joining only where they would penetrate and their guard's nodes do not all touch
+        (:func:`~.large_held.set_guards`; those that find no set with the others are refused, and
+        :meth:`_excused` leaves them to invariant (b), as under small kinematics); with
+        friction, the part's stick and slip sets too."""
         if self.friction is not None:
             return self.friction.solve_linearised(state, W, q0, p, tol, sets, rate, dR,
                                                   stiffness, need)
-        return linear_complementarity(W, q0, p, tol, rate, dR, stiffness, need)
+        reserve, guard = set_guards(self, sets)
+        refused = np.zeros(len(q0), dtype=bool)
+        out = linear_complementarity(W, q0, p, tol, rate, dR, stiffness, need,
+                                     reserve=reserve, guard=guard, refused=refused)
+        offsets = self._unknown_offsets()
+        self._refused = np.zeros(offsets[-1], dtype=bool)
+        starts = np.cumsum([0] + [len(s_) for s_ in sets])
+        for k, s_ in enumerate(sets):
+            self._refused[offsets[k] + s_] = refused[starts[k]:starts[k + 1]]
+        if self._refused.any():
+            log.info("%d held nodes found no contact set with the others: left out",
+                     int(self._refused.sum()))
+        return out
 
     def _motion_along(self, pair, direction: np.ndarray, u: np.ndarray, nodes: np.ndarray
                       ) -> np.ndarray:
@@ -493,9 +517,11 @@ class LargeDeformationContact(PairSet):
             pos += len(s_)
 
     def _normal_motion(self, pair, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-        """Penetration decrease n . (u_fine - u_coarse at the virtual node) of the pair's nodes
-        for stacked candidate motions u (vector or columns)."""
-        return self._motion_along(pair, pair.normal, u, nodes)
+        """Penetration decrease g . (u_fine - u_coarse at the virtual node) of the pair's nodes
+        for stacked candidate motions u (vector or columns), g the direction the gap is read
+        along (:meth:`~vfem.contact.geometry.pairing.ContactPair.reading`: the normal; a held
+        node's, the facet's)."""
+        return self._motion_along(pair, pair.reading(0, pair.normal), u, nodes)
 
     def _move(self, state: ContactState, sets: list[np.ndarray], dq: np.ndarray,
               dplaten: float, moves: list, dF: list[np.ndarray]) -> None:

@@ -19,7 +19,8 @@ from .surface import ContactSurface
 
 def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch: np.ndarray,
                nodes: np.ndarray | None = None, features: bool = False,
-               approach=None) -> tuple[Overlap, np.ndarray, np.ndarray] | None:
+               approach=None, far: bool = False
+               ) -> tuple[Overlap, np.ndarray, np.ndarray] | None:
     """Nodes of ``s`` held against the patch ``opatch`` of ``so`` by point forces (issue 37:
     both surfaces enforced), undeformed: by default every node of ``s``'s patch ``patch``
     (the equilibrium side's), else ``nodes``. Each has its virtual node on the other patch
@@ -32,7 +33,9 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     nor the normal interpolated between the facet's nodal normals: a node held along a direction
     turned from the facet's by an angle a reads the facet's motion d across it as n.d, short
     of the true approach by about |d| sin(a) — the block's corner under a coarse quarter disk
-    faceted at 5 degrees sank 1e-3 (all of the push) through a gap of 0.13); and as transfer a point
+    faceted at 5 degrees sank 1e-3 (all of the push) through a gap of 0.13). ``far``: keep the
+    nodes past the patch at any distance (large kinematics pairs them anew as they slide);
+    else only within two facets of its end. As transfer a point
     force: ``mass`` the identity at the node, ``transfer`` the other side's shape functions at
     the virtual node (so the two forces balance exactly). Returned with each node's guard:
     the nodes of the facet its virtual node lies on (-1 beyond the patch), and that facet's
@@ -54,7 +57,7 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
     normal, gap, interp, seg, past = virtual_nodes(s, so, s.X, so.X, nodes, patch, opatch,
                                                    facet_normal=True)
     reach = 2.0 * (float(s.sizes[patch].max()) + float(so.sizes[opatch].max()))
-    keep = ~past | (np.abs(gap) <= reach)
+    keep = ~past | (np.abs(gap) <= reach) | far
     if not keep.any():
         return None
     nodes, interp, normal, gap, seg, past = (v[keep] for v in (nodes, interp, normal, gap, seg,
@@ -64,8 +67,7 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
             Overlap(nodes, normal, gap, interp, None, past, None, None, None, patch, opatch)))
     # (sparse: the identity at the nodes, and their virtual nodes' weights transposed)
     mass = sp.csr_array((np.ones(len(nodes)), (nodes, nodes)), shape=(s.nc, s.nc))
-    w = sp.coo_array(interp)
-    transfer = sp.csr_array((w.data, (w.col, np.asarray(nodes)[w.row])), shape=(so.nc, s.nc))
+    transfer = point_transfer(interp, nodes, so.nc, s.nc)
     geo = Overlap(nodes, normal, gap, interp, so.rind_depth[seg], past,
                   np.ones(len(nodes), dtype=bool), mass, transfer, patch, opatch)
     guard = np.where(past[:, None], -1, so.facets[seg])
@@ -78,6 +80,37 @@ def held_nodes(s: ContactSurface, so: ContactSurface, patch: np.ndarray, opatch:
         own, other = _own_turning(s, patch, nodes, size), _facet_turning(so, opatch, seg)
         guard[~past & (own > 2.0 * other + FEATURE_TURNING)] = -1
     return geo, guard, size
+
+
+def point_transfer(interp, nodes: np.ndarray, nc_other: int, nc_own: int) -> sp.csr_array:
+    """(nc_other, nc_own) the other surface's nodal forces per unit point force at each of
+    ``nodes``: the shape functions at its virtual node (``interp``'s rows), transposed, so
+    the two forces balance exactly."""
+    w = sp.coo_array(interp)
+    return sp.csr_array((w.data, (w.col, np.asarray(nodes)[w.row])), shape=(nc_other, nc_own))
+
+
+def held_now(s: ContactSurface, so: ContactSurface, x: np.ndarray, xo: np.ndarray,
+             nodes: np.ndarray, patch: np.ndarray, opatch: np.ndarray, feature: np.ndarray
+             ) -> tuple:
+    """Held nodes of ``s`` (:func:`held_nodes`) paired anew at tracked positions ``x``, ``xo``
+    (large kinematics, every iteration:
+    :class:`~vfem.contact.formulations.large.LargeDeformationContact`): (force direction,
+    gap direction, gap, interp, transfer, rind depth, past, guard). Each node's virtual node is
+    its closest point on the other patch ``opatch``; the gap is read along the normal of the
+    facet there (the line the node must not cross, as :func:`held_nodes` reads it) and the
+    force acts along the other surface's normal interpolated there (continuous as the node
+    slides over a vertex, which Newton's method needs: the facet's normal jumps there; the
+    small-kinematics blend with the node's own normal, :func:`held_force_directions`, is for
+    a pairing made once, whose facet turns away as the bodies slide). Beyond the patch, the
+    direction to its end for both. The guard: the nodes of the facet under each node, -1
+    beyond the patch and where ``feature`` (the node a feature of its own, held between
+    compatibility nodes in contact, as :func:`held_nodes` finds at rest)."""
+    gap_normal, gap, interp, seg, past, force = virtual_nodes(
+        s, so, x, xo, nodes, patch, opatch, facet_normal=True, interpolated=True)
+    guard = np.where((past | feature)[:, None], -1, so.facets[seg])
+    return (force, gap_normal, gap, interp, point_transfer(interp, nodes, so.nc, s.nc),
+            so.rind_depth[seg], past, guard)
 
 
 #: degrees: the least angle between the normals of a surface's two facets across an edge (at

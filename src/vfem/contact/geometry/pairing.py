@@ -68,6 +68,10 @@ class ContactPair:
     #: the facets of the ``fine`` and ``coarse`` surfaces on the pair's sides, within which
     #: it is paired again as the bodies move (:class:`~.sides.Side`; None: all)
     zones: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
+    #: (m,) bool, held nodes paired anew as the bodies move (large kinematics): those that are
+    #: features of their own surface at rest (:func:`~.held.held_nodes`' ``features``), held
+    #: whatever the other side's nodes around them do; None: none
+    feature: np.ndarray | None = None
 
     def fine_columns(self) -> np.ndarray:
         """(nc_fine, m) the fine body's nodal force per unit traction value of each unknown."""
@@ -173,7 +177,8 @@ def read_facets(s: ContactSurface, facets: np.ndarray, x: np.ndarray | None,
 
 def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np.ndarray,
                   nodes: np.ndarray, fpatch: np.ndarray, cpatch: np.ndarray,
-                  beyond_normal: bool = True, facet_normal: bool = False):
+                  beyond_normal: bool = True, facet_normal: bool = False,
+                  interpolated: bool = False):
     """The virtual nodes of ``nodes`` of ``sf`` on the patch ``cpatch`` of ``sc`` (positions
     ``xf``, ``xc``): (normal, gap, interp, facet, beyond) — see :func:`overlap`.
     ``beyond_normal=False``: a node beyond the patch keeps the normal interpolated at its
@@ -181,21 +186,30 @@ def virtual_nodes(sf: ContactSurface, sc: ContactSurface, xf: np.ndarray, xc: np
     differences, :meth:`~vfem.contact.formulations.large.LargeDeformationContact._normals_at`: a
     loaded node on the patch's edge that a perturbation moves past it would otherwise turn its
     normal by 90 degrees over the perturbation). ``facet_normal``: the normal of the facet
-    at the virtual node instead of the interpolated one (:func:`~.held.held_nodes`).
+    at the virtual node instead of the interpolated one (:func:`~.held.held_nodes`), and with
+    ``interpolated`` the interpolated one too, at the end (the held nodes of large kinematics:
+    their gap read along the facet's, their force along the interpolated one,
+    :func:`~.held.held_now`).
     """
     pts = xf[nodes]
     seg, t, _, m, tf = sc.closest(pts, xc, cpatch, sf.node_normals(xf, fpatch)[nodes])
     closest, _ = sc.surface_map(seg, t, xc)
     past = sc.beyond(seg, tf, sc.patch_boundary(cpatch))
     interp = sc.interpolation(seg, t)
-    normal = m.copy() if facet_normal else sc.normals_at(seg, t, xc, cpatch)
     d = pts - closest
     dn = np.linalg.norm(d, axis=1)
-    if beyond_normal:
-        normal = np.where((past & (dn > 0))[:, None], d / np.maximum(dn, 1e-300)[:, None],
-                          normal)
-    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
-    return normal, np.einsum("ij,ij->i", d, normal), interp, seg, past
+
+    def unit(normal):
+        if beyond_normal:
+            normal = np.where((past & (dn > 0))[:, None],
+                              d / np.maximum(dn, 1e-300)[:, None], normal)
+        return normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+
+    normal = unit(m.copy() if facet_normal else sc.normals_at(seg, t, xc, cpatch))
+    out = normal, np.einsum("ij,ij->i", d, normal), interp, seg, past
+    if interpolated:
+        return *out, unit(sc.normals_at(seg, t, xc, cpatch))
+    return out
 
 
 def blended_normal(other: np.ndarray, own: np.ndarray, c_own: float, c_other: float
