@@ -523,3 +523,47 @@ def test_a_plastic_table_is_written_and_read_back_as_it_was():
     assert isinstance(block.material, J2Plastic)
     assert block.material.hardening_curve == CURVE[:1] + ((2e-3, 400.0), (6e-3, 450.0))
     assert loads(dumps(config, "written back"), "again.toml") == config
+
+
+def test_the_thick_cylinder_input_file_yields_and_flows_as_hill_says(tmp_path):
+    """``examples/thick_cylinder.toml``, the model above through the input file: quadratic
+    quadrilaterals (order 2, a plastic body that touches no other), the bore's pressure a
+    ``pressure`` traction, one step per pressure. Against Lame and Hill (as above): no point
+    yielded at 0.9 of Lame's first-yield pressure and some at 1.1 of it; at 1.1 to 1.8 of it
+    the pressure within 1 % of k (1 - c^2/b^2 + 2 ln(c/a)), c the largest radius of a yielded
+    quadrature point; 0.995 of the limit pressure carried."""
+    from pathlib import Path
+
+    import vfem
+    from vfem.solver import Analysis
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "thick_cylinder.toml"
+    config = vfem.load(path)
+    analysis = Analysis(config.build(tmp_path))
+    body = analysis.model.bodies[0]
+    a, b, nu = 1.0, 2.0, body.material.poissons_ratio
+    k = body.material.yield_stress / math.sqrt(3.0)
+    A = a * a / (b * b - a * a)
+    s_rr, s_tt = -1.0, A * (1.0 + b * b / (a * a))
+    s_zz = nu * (s_rr + s_tt)
+    p_yield = body.material.yield_stress / math.sqrt(
+        0.5 * ((s_rr - s_tt) ** 2 + (s_tt - s_zz) ** 2 + (s_zz - s_rr) ** 2))
+    p_limit = 2.0 * k * math.log(b / a)
+    seen = []
+
+    def on_step(step):
+        nl = body.mechanics.nonlinear
+        x = nl.basis0.mapping.F(nl.basis0.X)
+        yielded = nl.material_state["equivalent_plastic_strain"] > 0
+        c = float(np.hypot(x[0], x[1])[yielded].max()) if yielded.any() else None
+        seen.append((step.load_factor, c))
+
+    result = analysis.run(on_step)
+    assert result.converged, result.message
+    pressures = [p for p, _ in seen]
+    assert pressures == pytest.approx([s * p_yield for s in (0.9, 1.1, 1.3, 1.5, 1.7, 1.8)]
+                                      + [0.995 * p_limit], rel=2e-4)  # (the file's rounding)
+    assert seen[0][1] is None and seen[1][1] is not None
+    for p, c in seen[1:-1]:
+        assert a < c < b
+        assert p == pytest.approx(k * (1 - c * c / (b * b) + 2 * math.log(c / a)), rel=1e-2)

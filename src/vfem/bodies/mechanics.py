@@ -178,7 +178,7 @@ class LargeMechanics:
         self.body = body
         material = body.material.law(body.law)  # the law its material evaluates
         nl = NonlinearBody(body.mesh, material, formulation=body.kinematics,
-                           name=f"body {body.name!r}")
+                           order=body.order, name=f"body {body.name!r}")
         dofs = np.array(sorted(fixed), dtype=int)
         if len(dofs):
             nl.prescribe(dofs, np.array([fixed[d] for d in dofs.tolist()]))

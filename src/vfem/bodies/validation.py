@@ -59,9 +59,6 @@ def validate(body) -> None:
         raise InputError(f"{where}: a plastic material takes small kinematics for now "
                          f"(kinematics = 'small'): its finite-strain form is not implemented "
                          f"yet, got kinematics = {body.kinematics!r}")
-    if body.iterates and not body.large and body.order != 1:  # Newton's mechanics: order 1
-        raise InputError(f"{where}: a material that carries state needs linear elements "
-                         "(order 1)")
     if body.large and (body.order != 1 or not section.takes_large):
         taken = [s.name for s in SECTIONS.values() if s.takes_large]
         raise InputError(f"{where}: large kinematics ({body.kinematics!r}) needs linear "

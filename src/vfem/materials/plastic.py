@@ -68,8 +68,8 @@ MODELS = ("von_mises",)
 class J2Plastic:
     """Elasto-plastic material: isotropic elasticity and J2 (von Mises) plasticity with linear
     isotropic and kinematic hardening, in small strain; a table with a ``yield_stress`` is this
-    one. Its bodies are solved by Newton's method under small kinematics (linear elements; plane
-    strain or 3D).
+    one. Its bodies are solved by Newton's method under small kinematics (plane strain or 3D;
+    linear elements where it touches another body, quadratic too where it touches none).
 
     (The law: :mod:`vfem.materials.plastic`'s docstring.)
 

@@ -153,10 +153,15 @@ def check_capabilities(model) -> None:
                              "([[bodies.prescribed]]), or use small kinematics")
     touching = bodies_that_may_touch(model)
     for b in model.bodies:
-        if b.order not in caps.orders:
+        # (a body that touches no other takes any element: under large kinematics too, where
+        # the Newton formulation needs linear facets of the bodies it pairs)
+        if b.order not in caps.orders and not (large and b.name not in touching):
             if large:
-                raise InputError(f"model {model.name!r}, body {b.name!r}: contact with a "
-                                 f"large-kinematics body needs {_orders(caps)} on every body")
+                what = ("a large-kinematics body" if any(o.large for o in model.bodies) else
+                        "a body of a material that carries state (Newton's method)")
+                raise InputError(f"model {model.name!r}, body {b.name!r}: contact with "
+                                 f"{what} needs {_orders(caps)} on every body that touches "
+                                 "another")
             raise InputError(f"model {model.name!r}, body {b.name!r}: the {caps.name} variant "
                              f"supports {_orders(caps).replace(' (', ' only (', 1)}; use the "
                              "paired variant for quadratic elements")

@@ -110,10 +110,11 @@ class LargeDeformationContact(PairSet):
     def __init__(self, surfaces: list[ContactSurface], pairs: ContactPairs, settings,
                  backend: str | None = None, sides: dict | None = None, executor=None,
                  friction: type | None = None):
-        for s in surfaces:
+        for i, s in enumerate(surfaces):
             # (the facet kind's order: ``s.order`` counts a 2D facet's nodes; a 3D body that
-            # touches nothing has no kind and no candidate)
-            if s.kind is not None and s.kind.order != 1:
+            # touches nothing has no kind and no candidate; a body paired with none may be
+            # quadratic: a plastic thick cylinder)
+            if s.kind is not None and s.kind.order != 1 and pairs.opponents(i):
                 raise InputError(f"body {s.body.name!r}: large-displacement contact needs "
                                  "linear elements (order 1)")
         #: the equilibrium side's nodes held too where they would penetrate (issue 37's held
