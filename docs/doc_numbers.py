@@ -653,6 +653,22 @@ def examples_stack() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_indentation() -> str:
+    """docs/examples.md, Indentation: ``vfem run indentation`` (defaults)."""
+    s = _summary("indentation")
+    m = s["indentation"]
+    rows = ["| dofs | onset force | Y | no yield at | first yield at | its depth / a (Hertz) "
+            "| peak force | points yielded | residual approach | verification |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+    passed = sum(r["passed"] for r in s["verification"])
+    rows.append(f"| {s['dofs']} | {m['onset_force']:.4g} | {m['yield_stress']:.4g} | "
+                f"{m['last_elastic_force']:.2f} | {m['first_yield_force']:.2f} | "
+                f"{m['first_yield_depth_over_a']:.3f} ({m['depth_over_a']:.3f}) | "
+                f"{m['peak_contact_force']:.4g} | {max(m['yielded_points'])} | "
+                f"{m['residual_approach']:.3g} | {passed} of {len(s['verification'])} passed |")
+    return "\n".join(rows) + "\n"
+
+
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
     "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
@@ -671,6 +687,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-cattaneo3d-study": ("docs/examples.md", examples_cattaneo3d_study, False),
     "examples-circular-punch": ("docs/examples.md", examples_circular_punch, False),
     "examples-stack": ("docs/examples.md", examples_stack, False),
+    "examples-indentation": ("docs/examples.md", examples_indentation, False),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
     "patch-thesis": ("docs/examples.md", patch_thesis, False),

@@ -60,7 +60,8 @@ FILES = sorted(EXAMPLES_DIR.rglob("*.toml"))
 #: Cases that take more than about a second (relative path under examples/, or
 #: "builtin:NAME[KEY]"): the slow set's (issue 39's two-minute suite)
 SLOW = {"sliding.toml", "cattaneo3d.toml", "circular_punch.toml", "friction/slide3d.toml",
-        "flange.toml", "sphere.toml", "stack.toml", "gasket.toml", "press_fit.toml"}
+        "flange.toml", "sphere.toml", "stack.toml", "gasket.toml", "press_fit.toml",
+        "indentation.toml"}
 
 #: Cases known to break an invariant at some converged step, with what was measured (issue 16):
 #: relative path -> reason (an ``xfail(strict=True)``). None now. At commit 32435f5 (before the

@@ -13,7 +13,8 @@ import importlib
 from vfem.io import replot
 
 EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
-            "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack")
+            "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack",
+            "indentation")
 
 
 def load(name: str):
