@@ -15,7 +15,7 @@ import logging
 
 import numpy as np
 
-from ..geometry import held_now
+from ..geometry import corner_spread, held_now
 from ..state import ContactState
 
 log = logging.getLogger(__name__)
@@ -84,7 +84,6 @@ def set_guards(form, sets: list[np.ndarray]
     return reserve, guard
 
 
-
 def hold_protruding(form, state: ContactState, pens: list[np.ndarray],
                     traction_values: list[np.ndarray]) -> int:
     """Hold, for the rest of the step (as
@@ -108,29 +107,18 @@ def hold_protruding(form, state: ContactState, pens: list[np.ndarray],
     tol = form.penetration_tolerance
     offsets = form._unknown_offsets()
     for k, pair in enumerate(form.contact_pairs):
-        forward = form._guarding_pair(pair) if pair.point else None
-        if forward is None or pair.patches is None or not len(pair.nodes):
+        guarded = form._guard_touching(pair, traction_values)
+        if guarded is None or pair.patches is None or not len(pair.nodes):
             continue
-        q, p = traction_values[k], pens[k]
-        so = form.surfaces[pair.coarse]
-        touching = np.zeros(so.nc + 1, dtype=bool)
-        touching[form.contact_pairs[forward].nodes] = traction_values[forward] > 0
         free = ~form._forced_of(offsets[k], len(pair.nodes))
-        excused = touching[pair.guard].all(axis=1) & (pair.guard >= 0).any(axis=1)
-        ask = np.flatnonzero(excused & free & (q <= 0) & (p > tol))
+        ask = np.flatnonzero(guarded & free & (traction_values[k] <= 0) & (pens[k] > tol))
         if not len(ask):
             continue
+        so = form.surfaces[pair.coarse]
         corners = pair.guard[ask][:, : so.kind.corners]
-        xc = x[pair.coarse][corners]  # (m, c, dim)
-        nn = so.node_normals(x[pair.coarse], pair.patches[1])[corners]
-        size = np.zeros(len(ask))
-        turn = np.zeros(len(ask))
-        for a in range(corners.shape[1]):
-            for b in range(a + 1, corners.shape[1]):
-                size = np.maximum(size, np.linalg.norm(xc[:, a] - xc[:, b], axis=1))
-                cos = np.clip(np.einsum("ij,ij->i", nn[:, a], nn[:, b]), -1.0, 1.0)
-                turn = np.maximum(turn, np.arccos(cos))
-        deep = ask[p[ask] > tol + 0.5 * size * np.tan(0.5 * np.minimum(turn, 0.5 * np.pi))]
+        size, turn = corner_spread(x[pair.coarse][corners],
+                                   so.node_normals(x[pair.coarse], pair.patches[1])[corners])
+        deep = ask[pens[k][ask] > tol + 0.5 * size * np.tan(0.5 * np.minimum(turn, 0.5 * np.pi))]
         if not len(deep):
             continue
         if form._forced is None:

@@ -266,16 +266,25 @@ class PairSet:
             if self._refused is not None:
                 e = self._refused[pos:pos + len(q)].copy()
             pos += len(q)
-            if pair.point and pair.guard is not None and len(q):
-                forward = self._guarding_pair(pair)
-                if forward is not None:
-                    touching = np.zeros(self.surfaces[pair.coarse].nc + 1, dtype=bool)
-                    touching[self.contact_pairs[forward].nodes] = traction_values[forward] > 0
-                    # (-1, beyond the other patch, reads the last entry: never touching)
-                    free = ~self._forced_of(pos - len(q), len(q))
-                    e |= (q[: len(pair.nodes)] <= 0) & touching[pair.guard].all(axis=1) & free
+            guarded = self._guard_touching(pair, traction_values)
+            if guarded is not None and len(q):
+                free = ~self._forced_of(pos - len(q), len(q))
+                e |= (q[: len(pair.nodes)] <= 0) & guarded & free
             out.append(e)
         return out
+
+    def _guard_touching(self, pair: ContactPair, traction_values: list[np.ndarray]
+                        ) -> np.ndarray | None:
+        """(m,) for a held pair (``point``), whether every node of each held node's guard
+        (the compatibility nodes of the facet under it) carries force; None for a pair that
+        is not held or has no compatibility pair."""
+        forward = self._guarding_pair(pair) if pair.point and pair.guard is not None else None
+        if forward is None:
+            return None
+        touching = np.zeros(self.surfaces[pair.coarse].nc + 1, dtype=bool)
+        touching[self.contact_pairs[forward].nodes] = traction_values[forward] > 0
+        # (-1, beyond the other patch, reads the last entry: never touching)
+        return touching[pair.guard].all(axis=1)
 
     def _guarding_pair(self, held: ContactPair) -> int | None:
         """The index of the compatibility pair of the same two bodies as the ``point`` pair

@@ -10,7 +10,7 @@ The public face of this stage: code outside it imports these names from here
 from .bodymesh import exterior_facets, symmetry_planes
 from .closest3d import closest_on_facets
 from .facets import FACET_READINGS, kind_of
-from .held import held_edges, held_force_directions, held_nodes, held_now
+from .held import corner_spread, held_edges, held_force_directions, held_nodes, held_now
 from .pairing import (
     EDGE_RATIO,
     FACING,
@@ -43,6 +43,7 @@ __all__ = [
     "FACET_READINGS",
     "FACING",
     "facing",
+    "corner_spread",
     "held_edges",
     "held_force_directions",
     "held_nodes",

@@ -505,14 +505,22 @@ def _own_turning(s: ContactSurface, patch: np.ndarray, nodes: np.ndarray, length
 def _facet_turning(s: ContactSurface, patch: np.ndarray, facet: np.ndarray) -> np.ndarray:
     """(m,) how far the surface ``s`` turns across each of its facets ``facet``: the largest
     angle between the nodal normals (over the patch ``patch``) at its corners."""
-    nn = s.node_normals(None, patch)
     c = s.facets[facet][:, : s.kind.corners]
-    out = np.zeros(len(facet))
-    for a in range(c.shape[1]):
-        for b in range(a + 1, c.shape[1]):
-            cos = np.clip(np.einsum("ij,ij->i", nn[c[:, a]], nn[c[:, b]]), -1.0, 1.0)
-            out = np.maximum(out, np.arccos(cos))
-    return out
+    return corner_spread(s.X[c], s.node_normals(None, patch)[c])[1]
+
+
+def corner_spread(x: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Of facets given by their corners' positions ``x`` and nodal normals ``normals`` (both
+    (m, corners, dim)): (m,) the largest distance between two corners and (m,) the largest
+    angle between two corners' normals, how far the surface turns across the facet."""
+    size = np.zeros(len(x))
+    turn = np.zeros(len(x))
+    for a in range(x.shape[1]):
+        for b in range(a + 1, x.shape[1]):
+            size = np.maximum(size, np.linalg.norm(x[:, a] - x[:, b], axis=1))
+            cos = np.clip(np.einsum("ij,ij->i", normals[:, a], normals[:, b]), -1.0, 1.0)
+            turn = np.maximum(turn, np.arccos(cos))
+    return size, turn
 
 
 def held_force_directions(s: ContactSurface, patch: np.ndarray, held: Overlap, c_own: float,
