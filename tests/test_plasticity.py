@@ -172,20 +172,17 @@ def test_bad_hardening_curves_are_named(curve, words):
         J2Plastic(E, NU, Y, 10.0, hardening_curve=CURVE).validate("body 'block', material")
 
 
-def test_uniaxial_strain_in_plane_strain_follows_the_closed_form():
-    """A plane-strain block held laterally (a die), its top moved: uniaxial strain, a
-    proportional path: q = sigma_yy - sigma_xx = 2 mu eps_yy while elastic, then
+def uniaxial_strain(path):
+    """The closed form of uniaxial strain (a plane-strain block in a die) under a strain path:
+    a proportional path, q = sigma_yy - sigma_xx = 2 mu eps_yy while elastic, then
     |q - c| = Y + H_iso alpha (c the back stress's reading); the mean stress K eps_yy
-    throughout, so sigma_yy = K eps_yy + 2/3 q."""
-    body = block(boxes(2), STEEL, 2)
-    body.prescribe(body.boundary_dofs("x1", "x"))  # the die's wall
-    top = body.boundary_dofs("y1", "y")
-    forces, _ = run(body, top)
+    throughout, so sigma_yy = K eps_yy + 2/3 q. The axial stress at each step."""
     lam, mu = STEEL.lame()
     bulk = lam + 2 * mu / 3
     H = H_ISO + H_KIN
     eps_p = alpha = 0.0  # the axial plastic strain (yy; xx = zz = -eps_p / 2), accumulated
-    for eps, force in zip(PATH, forces):
+    out = []
+    for eps in path:
         # deviatoric tensors a diag(-1/3, 2/3, -1/3), read by a (norm sqrt(2/3) |a|): the
         # trial q = 2 mu (eps - 3/2 eps_p), the back stress's c = H_kin eps_p, the radius
         # Y + H_iso alpha; a flow d eps_p moves them by -3 mu, H_kin and H_iso times it
@@ -196,10 +193,20 @@ def test_uniaxial_strain_in_plane_strain_follows_the_closed_form():
             dg = over / (3 * mu + H)
             eps_p += math.copysign(dg, q_trial - c)
             alpha += dg
-        q = 2 * mu * (eps - 1.5 * eps_p)
-        sigma_yy = bulk * eps + 2 / 3 * q
-        assert abs(force - sigma_yy) <= 1e-10 * Y
+        out.append(bulk * eps + 2 / 3 * 2 * mu * (eps - 1.5 * eps_p))
     assert alpha > 0.0
+    return out
+
+
+def test_uniaxial_strain_in_plane_strain_follows_the_closed_form():
+    """A plane-strain block held laterally (a die), its top moved: uniaxial strain's closed
+    form (:func:`uniaxial_strain`) to 1e-10 Y."""
+    body = block(boxes(2), STEEL, 2)
+    body.prescribe(body.boundary_dofs("x1", "x"))  # the die's wall
+    top = body.boundary_dofs("y1", "y")
+    forces, _ = run(body, top)
+    for force, sigma_yy in zip(forces, uniaxial_strain(PATH)):
+        assert abs(force - sigma_yy) <= 1e-10 * Y
 
 
 def test_newton_converges_quadratically_past_yield():

@@ -350,12 +350,6 @@ class NonlinearBody:
         self._reset_updated_state()
         # the material's converged state at the quadrature points (materials.protocol)
         self.material_state = material.initial_state(dim, self.pseudo_strain.shape[2:])
-        if formulation == UPDATED and self.material_state:
-            # the updated form carries the strain in C_1 and stands V_1 = b_1^(1/2) for F_1
-            # (_pushed_material): exact for an isotropic law without history only
-            raise InputError(f"{name}: the updated Lagrangian formulation takes a material "
-                             "without history; use formulation 'total' for "
-                             f"{type(material).__name__}")
 
     # -- set-up ---------------------------------------------------------------------------------
 
@@ -504,12 +498,22 @@ class NonlinearBody:
         With ``F_1`` the deformation gradient of ``C_1`` the material sees the Green–Lagrange
         strain ``E = F_1^T E_pseudo F_1`` (eq. 2.8.9 read backwards) and the conjugate stress in
         ``C_1`` is ``J_1^-1 F_1 S F_1^T``, the tangent ``J_1^-1 F_1 F_1 F_1 F_1 : D``. Isotropy lets
-        ``V_1 = b_1^(1/2)``, ``b_1 = (I - 2 11_1E)^-1``, stand for ``F_1``.
+        ``V_1 = b_1^(1/2)``, ``b_1 = (I - 2 11_1E)^-1``, stand for ``F_1`` for a law without
+        history. A law with history (a plastic one, issue 41) keeps its state in the frame of
+        the reference configuration, which a rotation of ``C_1`` turns: it is given ``F_1``
+        itself, from the converged displacement's gradient on the initial mesh (the same
+        material point: the elements are isoparametric), and sees exactly the total form's
+        strain.
         """
-        V, J1 = self._left_stretch()
-        E = mul(V, mul(E_pseudo, V))
+        if self.material_state:  # F_1 itself: E = F_1^T E_pseudo F_1, S_c = F_1 S F_1^T / J_1
+            V, J1 = self._configuration()
+            Vt = np.ascontiguousarray(np.swapaxes(V, 0, 1))
+        else:  # V_1, symmetric
+            V, J1 = self._left_stretch()
+            Vt = V
+        E = mul(Vt, mul(E_pseudo, V))
         r = self.material.response(E, self.material_state)
-        S_c = mul(V, mul(r.stress, V)) / J1
+        S_c = mul(V, mul(r.stress, Vt)) / J1
 
         def D_c() -> np.ndarray:
             D = r.moduli()
@@ -541,6 +545,14 @@ class NonlinearBody:
         V /= np.sqrt(b[0, 0] + b[1, 1] + 2.0 * s)
         self._stretch_cache = (V, s)
         return V, s
+
+    def _configuration(self) -> tuple[np.ndarray, np.ndarray]:
+        """``F_1`` and ``J_1 = det F_1`` of the converged configuration ``C_1``, by the
+        displacement's gradient on the initial mesh (kept for the step)."""
+        if self._stretch_cache is None:
+            F1 = deformation_gradient(_ElementArrays.of(self.basis0).gradient(self._u_at_current))
+            self._stretch_cache = (F1, determinant(F1))
+        return self._stretch_cache
 
     def _left_stretch_3d(self) -> tuple[np.ndarray, np.ndarray]:
         """``V_1`` and ``J_1`` of a 3D body: ``b_1^-1 = I - 2 11_1E = Q diag(m) Q^T`` (symmetric

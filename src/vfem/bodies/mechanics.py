@@ -176,7 +176,7 @@ class LargeMechanics:
         starts from.
         """
         self.body = body
-        material = body.material.law(body.law)  # the law its material evaluates
+        material = body.material.law(body.law, body.kinematics)  # the law it evaluates
         nl = NonlinearBody(body.mesh, material, formulation=body.kinematics,
                            order=body.order, name=f"body {body.name!r}")
         dofs = np.array(sorted(fixed), dtype=int)

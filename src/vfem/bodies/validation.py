@@ -55,10 +55,6 @@ def validate(body) -> None:
         names = " or ".join(repr(name) for name in LAWS)
         raise InputError(f"{where}: law must be {names}, got {body.law!r}")
     section = section_of(body)  # refuses a plane given to a 3D body
-    if body.large and not getattr(body.material, "finite_strain", True):
-        raise InputError(f"{where}: a plastic material takes small kinematics for now "
-                         f"(kinematics = 'small'): its finite-strain form is not implemented "
-                         f"yet, got kinematics = {body.kinematics!r}")
     if body.large and (body.order != 1 or not section.takes_large):
         taken = [s.name for s in SECTIONS.values() if s.takes_large]
         raise InputError(f"{where}: large kinematics ({body.kinematics!r}) needs linear "

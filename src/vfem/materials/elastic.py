@@ -41,12 +41,12 @@ class LinearElastic:
         (:func:`vfem.bodies.section.section_of`)."""
         check_elastic_constants(self.youngs_modulus, self.poissons_ratio, where)
 
-    def law(self, name: str) -> Material:
+    def law(self, name: str, kinematics: str = "total") -> Material:
         """The constitutive law (:class:`~vfem.materials.protocol.Material`) a body of this
         material evaluates where it iterates (:mod:`vfem.nonlinear`): the hyperelastic law
         ``name`` (the body's ``law``, :data:`~vfem.materials.hyperelastic.LAWS`) whose
-        small-strain constants are the material's. A material with its own law (and state)
-        answers with it."""
+        small-strain constants are the material's, whatever the large ``kinematics``. A
+        material with its own law (and state) answers with it."""
         return LAWS[name](self.youngs_modulus, self.poissons_ratio)
 
     def lame(self) -> tuple[float, float]:

@@ -53,6 +53,7 @@ import numpy as np
 from ..errors import InputError
 from .constants import check_elastic_constants
 from .hyperelastic import _lame
+from .logstrain import LogarithmicStrain
 from .protocol import Response, State
 
 #: a trial state whose yield function is at most this share of the yield radius is elastic:
@@ -101,9 +102,6 @@ class J2Plastic:
     #: a body of this material carries a state from step to step, and so answers its contact
     #: forces by Newton's method under small kinematics too (:attr:`vfem.bodies.Body.iterates`)
     carries_state: ClassVar[bool] = True
-    #: whether the law holds under large kinematics: not yet (a small-strain law read in the
-    #: Green-Lagrange strain would not be the model it claims; the body refuses it)
-    finite_strain: ClassVar[bool] = False
 
     def validate(self, where: str = "material") -> None:
         """Raise :class:`InputError` naming ``where`` if a parameter is not admissible."""
@@ -167,10 +165,12 @@ class J2Plastic:
         """E/(1-nu^2) of the elastic part: the modulus in Hertz's E*."""
         return self.youngs_modulus / (1.0 - self.poissons_ratio ** 2)
 
-    def law(self, name: str) -> J2Plastic:
-        """The law a body of this material evaluates: this one (``name``, the hyperelastic
-        law of a large body, does not apply)."""
-        return self
+    def law(self, name: str, kinematics: str = "small") -> J2Plastic | LogarithmicStrain:
+        """The law a body of this material evaluates (``name``, the hyperelastic law of a
+        large body, does not apply): this one under small kinematics; under ``total`` or
+        ``updated`` kinematics this one read in the logarithmic strain
+        (:class:`~vfem.materials.logstrain.LogarithmicStrain`: finite-strain plasticity)."""
+        return self if kinematics == "small" else LogarithmicStrain(self)
 
     # -- the Material protocol (vfem.materials.protocol) ----------------------------------------
 
