@@ -181,11 +181,13 @@ class BodyConfig:
         platen: a rigid, force-controlled platen on a named boundary.
         contact_boundaries: the boundaries that may touch other bodies. Default: every
             exterior facet on which no displacement is prescribed.
-        kinematics: ``"small"`` (small displacements, linear elasticity), or large
-            displacements and strains by the ``"total"`` or ``"updated"`` Lagrangian
-            formulation (plane strain or 3D, linear elements).
+        kinematics: ``"small"`` (small displacements, linear elasticity or small-strain
+            plasticity), or large displacements and strains by the ``"total"`` or
+            ``"updated"`` Lagrangian formulation (plane strain or 3D, linear elements; a
+            plastic material at finite strain).
         law: under large kinematics, the hyperelastic law whose small-strain constants are the
-            material's: ``"saint-venant-kirchhoff"`` or ``"neo-hookean"``.
+            material's: ``"saint-venant-kirchhoff"`` or ``"neo-hookean"`` (a plastic material
+            has its own law: Hencky elasticity in the logarithmic strain).
     """
 
     name: str

@@ -42,11 +42,13 @@ class Body:
         order: 1 for linear elements (3-node triangles, 4-node quadrilaterals; 4-node
             tetrahedra, 8-node hexahedra), 2 for quadratic ones (6-node triangles, 9-node
             quadrilaterals; 10-node tetrahedra, 27-node hexahedra) on the same mesh.
-        kinematics: ``"small"`` (default: small displacements and strains, linear elasticity)
-            or large displacements and strains, by the ``"total"`` or ``"updated"`` Lagrangian
-            formulation (thesis Chapters 2-3; plane strain or 3D, linear elements).
+        kinematics: ``"small"`` (default: small displacements and strains, linear elasticity
+            or small-strain plasticity) or large displacements and strains, by the ``"total"``
+            or ``"updated"`` Lagrangian formulation (thesis Chapters 2-3; plane strain or 3D,
+            linear elements; a plastic material at finite strain).
         law: under large kinematics, the hyperelastic law whose small-strain constants are the
-            material's: ``"saint-venant-kirchhoff"`` (default) or ``"neo-hookean"``.
+            material's: ``"saint-venant-kirchhoff"`` (default) or ``"neo-hookean"`` (a plastic
+            material has its own law: Hencky elasticity in the logarithmic strain).
 
     Points: the nodes of the elements. For linear elements they are the mesh vertices; quadratic
     elements add one point at the middle of each facet (numbered after the vertices, in facet

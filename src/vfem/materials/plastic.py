@@ -1,5 +1,6 @@
 """J2 (von Mises) elasto-plasticity in small strain: radial return and its consistent tangent
-(issue 41, item 1; the first material nonlinearity the thesis names, Ch. 1).
+(issue 41, item 1; the first material nonlinearity the thesis names, Ch. 1). Read in the
+logarithmic strain, the same law serves finite strain (:mod:`.logstrain`).
 
 The strain splits additively, ``eps = eps_e + eps_p``; the stress is the elastic one of the
 elastic part, ``sigma = K tr(eps) I + 2 mu (dev(eps) - eps_p)`` (the plastic strain is
@@ -68,9 +69,11 @@ MODELS = ("von_mises",)
 @dataclass(frozen=True)
 class J2Plastic:
     """Elasto-plastic material: isotropic elasticity and J2 (von Mises) plasticity with linear
-    isotropic and kinematic hardening, in small strain; a table with a ``yield_stress`` is this
-    one. Its bodies are solved by Newton's method under small kinematics (plane strain or 3D;
-    linear elements where it touches another body, quadratic too where it touches none).
+    isotropic and kinematic hardening; a table with a ``yield_stress`` is this one. Its bodies
+    are solved by Newton's method (plane strain or 3D): in small strain under small
+    kinematics (linear elements where it touches another body, quadratic too where it touches
+    none), at finite strain under ``total`` or ``updated`` kinematics (the same law in the
+    logarithmic strain, :mod:`vfem.materials.logstrain`; linear elements).
 
     (The law: :mod:`vfem.materials.plastic`'s docstring.)
 
