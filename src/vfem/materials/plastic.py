@@ -36,8 +36,9 @@ Newton's convergence quadratic past yield.
 
 The tensors are carried in 3D (a plane-strain body's ``eps_zz = 0`` and its plastic strain's
 zz component is not: ``tr eps_p = 0``); a 2D body gets the in-plane stress and tangent and
-``sigma_zz`` beside them. Plane stress (a different return: the zz stress held at zero) is not
-implemented; :meth:`J2Plastic.validate` says so.
+``sigma_zz`` beside them. In plane stress ``eps_zz`` is the unknown that makes the returned
+``sigma_zz`` vanish at each point (a scalar Newton iteration on the 3D return), and the
+in-plane tangent the 3D one condensed by ``sigma_zz = 0``.
 
 The state (:mod:`.protocol`): ``plastic_strain`` and ``back_stress`` (3, 3, ne, nq),
 ``equivalent_plastic_strain`` (ne, nq), committed only when a step converges.
@@ -61,6 +62,9 @@ from .protocol import Response, State
 #: the stress returned at the last step lies on the surface to round-off, and a step that
 #: holds the strain must not flow by it
 YIELD_TOLERANCE = 1e-12
+
+#: Newton iterations of the plane-stress return's sigma_zz = 0 at most (it takes 2 to 6)
+_PLANE_STRESS_ITERATIONS = 60
 
 #: the names of the J2 model in an input file's ``model`` key
 MODELS = ("von_mises",)
@@ -90,7 +94,8 @@ class J2Plastic:
             sigma_y from ``yield_stress`` never falling, held beyond the last pair; in place of
             ``hardening_modulus`` (default: none).
         model: ``"von_mises"``: the yield criterion.
-        plane: ``"strain"``: the section of a 2D body (plane stress is not implemented).
+        plane: ``"strain"`` or ``"stress"``: the section of a 2D body (plane stress under
+            small kinematics).
     """
 
     youngs_modulus: float
@@ -124,9 +129,6 @@ class J2Plastic:
                 raise InputError(f"{where}: {key} must be >= 0 (softening is not taken), "
                                  f"got {getattr(self, key)!r}")
         self._check_curve(where)
-        if self.plane != "strain":
-            raise InputError(f"{where}: plane must be 'strain' for a plastic material "
-                             f"(plane stress is not implemented), got {self.plane!r}")
 
     def _check_curve(self, where: str) -> None:
         curve = self.hardening_curve
@@ -161,11 +163,22 @@ class J2Plastic:
         return alpha, stress, np.r_[np.diff(stress) / np.diff(alpha), 0.0]
 
     def lame(self) -> tuple[float, float]:
-        """Lamé constants (lambda, mu) of the elastic part (plane strain = 3D)."""
+        """Lamé constants (lambda, mu) of the elastic part as a body's section reads them
+        (lambda modified in plane stress, as :meth:`LinearElastic.lame
+        <vfem.materials.LinearElastic.lame>`): the stiffness at rest."""
+        lam, mu = self._lame3d()
+        if self.plane == "stress":
+            lam = 2.0 * lam * mu / (lam + 2.0 * mu)
+        return lam, mu
+
+    def _lame3d(self) -> tuple[float, float]:
+        """The 3D Lamé constants (lambda, mu), which the return map reads."""
         return _lame(self.youngs_modulus, self.poissons_ratio)
 
     def plane_strain_modulus(self) -> float:
-        """E/(1-nu^2) of the elastic part: the modulus in Hertz's E*."""
+        """E/(1-nu^2) of the elastic part (E in plane stress): the modulus in Hertz's E*."""
+        if self.plane == "stress":
+            return self.youngs_modulus
         return self.youngs_modulus / (1.0 - self.poissons_ratio ** 2)
 
     def law(self, name: str, kinematics: str = "small") -> J2Plastic | LogarithmicStrain:
@@ -186,13 +199,75 @@ class J2Plastic:
     def response(self, E: np.ndarray, state: State) -> Response:
         """The stress that answers the small strain ``E`` (dim, dim, ne, nq) from the
         converged ``state``, by radial return; the consistent tangent when asked; the state
-        to commit."""
+        to commit. A plane-strain body's ``eps_zz`` is 0 and its ``sigma_zz`` comes beside the
+        in-plane stress; a plane-stress body's ``eps_zz`` is the one that makes ``sigma_zz``
+        vanish (:meth:`_plane_stress`)."""
         E = np.asarray(E, dtype=float)
         dim = E.shape[0]
-        lam, mu = self.lame()
-        bulk = lam + 2.0 * mu / 3.0
+        if dim == 3:
+            sigma, moduli, new = self._return(E, state)
+            return Response(sigma, moduli, None, new)
         eps = np.zeros((3, 3) + E.shape[2:])
-        eps[:dim, :dim] = E
+        eps[:2, :2] = E
+        if self.plane == "stress":
+            return self._plane_stress(eps, state)
+        sigma, moduli, new = self._return(eps, state, dim=2)
+        return Response(sigma[:2, :2].copy(), moduli, sigma[2, 2].copy(), new)
+
+    def _plane_stress(self, eps: np.ndarray, state: State) -> Response:
+        """Plane stress: ``eps_zz`` at each point such that the returned ``sigma_zz`` is 0,
+        by Newton's method on that one equation with the 3D return and its tangent
+        ``C_zzzz`` (at least the bulk modulus: ``sigma_zz`` rises monotonically with
+        ``eps_zz``), kept inside the bracket its signs have shown (bisection where a step
+        leaves it); then the in-plane tangent condensed, ``C_abcd - C_abzz C_zzcd / C_zzzz``,
+        the exact derivative of the plane-stress return (its ``eps_zz`` follows the in-plane
+        strain through ``sigma_zz = 0``). Converged where ``|sigma_zz|`` is within 1e-14 of
+        the stress's scale, or the step within round-off of ``eps_zz``."""
+        lam, mu = self._lame3d()
+        ep = state["plastic_strain"]
+        # the elastic guess: sigma_zz = lam tr(eps) + 2 mu (eps_zz - ep_zz) = 0
+        eps[2, 2] = (2.0 * mu * ep[2, 2] - lam * (eps[0, 0] + eps[1, 1])) / (lam + 2.0 * mu)
+        lo = np.full(eps.shape[2:], -np.inf)
+        hi = np.full(eps.shape[2:], np.inf)
+        for _ in range(_PLANE_STRESS_ITERATIONS):
+            sigma, moduli, new = self._return(eps, state)
+            s33 = sigma[2, 2]
+            scale = self.yield_stress + np.abs(sigma[:2, :2]).max(axis=(0, 1))
+            if np.all(np.abs(s33) <= 1e-14 * scale):
+                break
+            C = moduli()
+            hi = np.where(s33 > 0.0, np.minimum(hi, eps[2, 2]), hi)
+            lo = np.where(s33 < 0.0, np.maximum(lo, eps[2, 2]), lo)
+            step = -s33 / C[2, 2, 2, 2]
+            trial = eps[2, 2] + step
+            outside = (trial <= lo) | (trial >= hi)
+            bisect = outside & np.isfinite(lo) & np.isfinite(hi)
+            middle = 0.5 * (np.where(bisect, lo, 0.0) + np.where(bisect, hi, 0.0))
+            trial = np.where(bisect, middle, trial)
+            if np.all(np.abs(trial - eps[2, 2]) <= 4.0 * np.finfo(float).eps
+                      * np.maximum(np.abs(eps[2, 2]), np.abs(eps[:2, :2]).max(axis=(0, 1)))):
+                eps[2, 2] = trial
+                sigma, moduli, new = self._return(eps, state)
+                break
+            eps[2, 2] = trial
+        else:
+            raise ArithmeticError(f"plane-stress return: sigma_zz not zero after "
+                                  f"{_PLANE_STRESS_ITERATIONS} iterations")
+
+        def condensed() -> np.ndarray:
+            C = moduli()
+            return (C[:2, :2, :2, :2]
+                    - C[:2, :2, 2, 2][:, :, None, None] * C[2, 2, :2, :2][None, None]
+                    / C[2, 2, 2, 2])
+
+        return Response(sigma[:2, :2].copy(), condensed, np.zeros_like(sigma[2, 2]), new)
+
+    def _return(self, eps: np.ndarray, state: State, dim: int = 3):
+        """The radial return at the 3D small strain ``eps`` (3, 3, ...): the stress (3, 3,
+        ...), its consistent tangent as a function (its first ``dim`` components in each
+        index: (dim, dim, dim, dim, ...)) and the state to commit."""
+        lam, mu = self._lame3d()
+        bulk = lam + 2.0 * mu / 3.0
         tr = eps[0, 0] + eps[1, 1] + eps[2, 2]
         dev = eps.copy()
         for i in range(3):
@@ -240,7 +315,7 @@ class J2Plastic:
             H = hardening + self.kinematic_modulus
             theta_bar = np.where(flows, 1.0 / (1.0 + H / (3.0 * mu)) - (1.0 - theta), 0.0)
             eye = np.eye(dim)
-            shape = (dim, dim, dim, dim) + E.shape[2:]
+            shape = (dim, dim, dim, dim) + eps.shape[2:]
             ii = np.einsum("ij,kl->ijkl", eye, eye)
             sym = 0.5 * (np.einsum("ik,jl->ijkl", eye, eye) + np.einsum("il,jk->ijkl", eye, eye))
             C = np.broadcast_to((bulk * ii)[..., None, None], shape).copy()
@@ -249,8 +324,7 @@ class J2Plastic:
             C -= 2.0 * mu * theta_bar * nd[:, :, None, None] * nd[None, None]
             return C
 
-        return Response(sigma[:dim, :dim].copy(), moduli,
-                        sigma[2, 2].copy() if dim == 2 else None, new)
+        return sigma, moduli, new
 
     def fields(self, state: State) -> dict[str, np.ndarray]:
         """What a body writes of the state (element averages, :mod:`.protocol`): the
