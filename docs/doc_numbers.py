@@ -669,6 +669,26 @@ def examples_indentation() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_thick_cylinder() -> str:
+    """docs/examples.md, Thick cylinder: ``vfem run thick_cylinder`` (defaults)."""
+    s = _summary("thick_cylinder")
+    m = s["thick_cylinder"]
+    rows = ["| pressure p | plastic to c | Hill's p at c | p / Hill − 1 |", "|---:|---:|---:|---:|"]
+    for p, c, h in zip(m["pressure"], m["plastic_radius"], m["hill_pressure"]):
+        if c is None:
+            rows.append(f"| {p:.5g} | elastic | | |")
+        else:
+            rows.append(f"| {p:.5g} | {c:.4f} | {h:.5g} | {_percent(p / h - 1, 2, sign=True)} |")
+    passed = sum(r["passed"] for r in s["verification"])
+    rows.append("")
+    first = m["run_first_yield_pressure"] / m["first_yield_pressure"] - 1
+    rows.append(f"{s['dofs']} dofs; first yield at p = {m['run_first_yield_pressure']:.5g} "
+                f"(Lamé {m['first_yield_pressure']:.5g}, {_percent(first, 2, sign=True)}); "
+                f"Hill's limit {m['limit_pressure']:.5g}; verification {passed} of "
+                f"{len(s['verification'])} passed.")
+    return "\n".join(rows) + "\n"
+
+
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
     "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
@@ -688,6 +708,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-circular-punch": ("docs/examples.md", examples_circular_punch, False),
     "examples-stack": ("docs/examples.md", examples_stack, False),
     "examples-indentation": ("docs/examples.md", examples_indentation, False),
+    "examples-thick-cylinder": ("docs/examples.md", examples_thick_cylinder, False),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
     "patch-thesis": ("docs/examples.md", patch_thesis, False),

@@ -14,7 +14,7 @@ from vfem.io import replot
 
 EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
             "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack",
-            "indentation")
+            "indentation", "thick_cylinder")
 
 
 def load(name: str):
