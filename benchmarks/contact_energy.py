@@ -34,9 +34,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
-from test_plasticity import PUNCH  # noqa: E402
-
 import vfem  # noqa: E402
+from test_plasticity import PUNCH  # noqa: E402
 from vfem.io.input import loads  # noqa: E402
 
 
