@@ -740,6 +740,18 @@ class NonlinearBody:
         self.steps.append(record)
         return record
 
+    def adopt(self, delta: np.ndarray, load_factor: float, record: NewtonStep) -> None:
+        """Take the trial state that :meth:`equilibrate` reached elsewhere (the body's owner
+        over MPI ranks, :mod:`vfem.parallel`): the displacement ``delta`` since the converged
+        state at ``load_factor``, and its record. The state at the quadrature points is
+        computed here from ``delta``, as the last iterate there computed it, so every rank
+        holds the same numbers."""
+        self._delta = np.array(delta, dtype=float)
+        self._trial_state = self._state(self._delta)
+        self._trial_load_factor = load_factor
+        self._trial_converged = True
+        self.steps.append(record)
+
     def accept(self) -> None:
         """Make the last trial state (see :meth:`equilibrate`) the converged state."""
         if not self._trial_converged:

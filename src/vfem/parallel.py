@@ -16,6 +16,17 @@ invariants, the end); the work is spread (issue 40):
 * on every rank alike: the contact problem on W (its complementarity solves) and the rest of
   the invariants.
 
+A body that Newton's method corrects (large kinematics, or a plastic material: the contact
+formulation of ``vfem.contact.formulations.large``) is kept on every rank: its trial and
+converged displacements and its material's state (which the pairing on the current geometry
+reads on every rank), each computed alike from the same numbers. Its owner alone factorizes
+its tangent and solves with it (:meth:`vfem.bodies.mechanics.LargeMechanics._shared_system`:
+the correction, the tangent flexibility on the contact dofs and the platen's terms sent to
+every rank, every body's owner at once, :func:`vfem.bodies.mechanics.prefetch`), and
+equilibrates it at the end of a step, the others taking its trial state
+(:meth:`vfem.nonlinear.NonlinearBody.adopt`). A model with such a body reads the linear
+bodies' flexibility on every rank too (as the thesis variant does).
+
 What each rank computed comes to the others (:meth:`Ranks.map`, :meth:`Ranks.share`), so every
 rank holds the same numbers, and the answers are the serial run's to round-off (W's parts are
 summed rank by rank; tests/test_mpi.py: 1e-10, 3e-14 measured). :meth:`Ranks.own` times each
@@ -31,7 +42,10 @@ What crosses between ranks:
 * per contact iteration on the matrix-free route, each body's motion under its contact forces
   at its condensed dofs (:meth:`Ranks.map`: every owner solves its own bodies at once, then they
   are exchanged);
-* per converged step, each body's fields and reactions from its owner.
+* per converged step, each body's fields and reactions from its owner;
+* per Newton iteration of a model with a body that Newton's method corrects, each such body's
+  correction (ndofs), tangent flexibility (condensed x candidate dofs) and platen terms from
+  its owner, and its response to the change of its contact forces (ndofs).
 
 Rank 0 writes the results and prints; the others write nothing. Serial runs never import
 mpi4py (:func:`current` is a one-rank :class:`Ranks` unless the process was started by an MPI
@@ -251,11 +265,12 @@ def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None],
     also its dense flexibility on its contact dofs (a formulation that reads it on every
     rank: the thesis variant); the paired variant reads it on the owner only
     (:meth:`Ranks.map`)."""
-    from .bodies.mechanics import LinearMechanics
+    from .bodies.mechanics import LinearMechanics, mechanics_for
 
     ranks.place([b.dim * b.npoints for b in bodies])
     log.info("MPI: %d ranks; rank %d sets up %s", ranks.size, ranks.rank,
              ", ".join(repr(b.name) for i, b in enumerate(bodies) if ranks.mine(i)) or "nothing")
+    fixed = {}
     for i, b in enumerate(bodies):
         if ranks.mine(i):
             try:
@@ -263,7 +278,7 @@ def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None],
             except Exception as e:  # noqa: BLE001 - raised on every rank by share, below
                 b._setup_error = e
         else:
-            b.assemble(stiffness=False)
+            fixed[i] = b.assemble(stiffness=False)
     for i, b in enumerate(bodies):
         def payload(b=b):
             error = b.__dict__.pop("_setup_error", None)
@@ -279,6 +294,8 @@ def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None],
         data = ranks.share(i, payload)
         if ranks.mine(i):
             b.factor = SharedFactor(b.factor, ranks, i)
+            if b.iterates:  # its state on every rank, its tangent's algebra on its owner
+                b.mechanics.ranks, b.mechanics.index = ranks, i
             continue
         for case, (u, reaction) in zip(b.load_cases, data["cases"], strict=True):
             case.displacement, case.platen_reaction = u, reaction
@@ -290,7 +307,11 @@ def set_up_bodies(ranks: Ranks, bodies, setup: Callable[[int], None],
         b.condensed_flexibility = data["condensed_flexibility"]
         b.timings = data["timings"]
         b.factor = SharedFactor(None, ranks, i)
-        b.mechanics = LinearMechanics(b)
+        if b.iterates:  # Newton's body: its state kept on every rank (LargeMechanics)
+            b.mechanics = mechanics_for(b, fixed[i])
+            b.mechanics.ranks, b.mechanics.index = ranks, i
+        else:
+            b.mechanics = LinearMechanics(b)
 
 
 _current = Ranks()

@@ -317,17 +317,13 @@ class Analysis:
         check_memory(self.surfaces, pairs, self.backend, matrix_free=self.matrix_free)
         with memory_guard("factorizing the bodies and computing their flexibility"):
             ranks = current_ranks()
-            # the thesis variant reads every body's flexibility on every rank; the paired
-            # variant on its owner only (vfem.parallel)
-            shared = self.model.contact.variant != "paired"
+            # the thesis variant reads every body's flexibility on every rank, and so does
+            # the Newton formulation (a model with a body that iterates: the linear bodies'
+            # beside the others' tangent ones, vfem.contact.formulations.large); the paired
+            # variant of small kinematics on its owner only (vfem.parallel)
+            shared = (self.model.contact.variant != "paired"
+                      or any(b.iterates for b in bodies))
             if ranks.parallel:  # each body on its own rank (vfem.parallel, issue 22)
-                b = next((b for b in bodies if b.iterates), None)
-                if b is not None:
-                    raise InputError("a run over MPI ranks serves small kinematics; body "
-                                     f"{b.name!r} "
-                                     + ("has large kinematics" if b.large else
-                                        "carries a material state (Newton's method)")
-                                     + ": run it in one process")
                 set_up_bodies(ranks, bodies, lambda i: bodies[i].setup(
                     self.backend, condensed_dofs=None if self.matrix_free
                     else self.surfaces[i].condensed_dofs), shared)

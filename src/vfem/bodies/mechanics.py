@@ -196,18 +196,40 @@ class LargeMechanics:
             nl.set_load_history(body.applied_load)
         self.nonlinear = nl
         self._equilibrated: tuple | None = None
+        #: over MPI ranks (:func:`vfem.parallel.set_up_bodies`): the ranks and this body's
+        #: index. Every rank keeps the body's state (its trial and converged displacements
+        #: and material state, which the contact iteration reads on every rank); its owner
+        #: alone factorizes its tangent and solves with it, and hands the others what comes
+        #: of that (:meth:`_shared_system`, :meth:`equilibrate`)
+        self.ranks = None
+        self.index = -1
+
+    def _parallel(self) -> bool:
+        return self.ranks is not None and self.ranks.parallel
 
     def equilibrate(self, load_factor: float, platen_displacement: float,
                     contact_force: np.ndarray) -> np.ndarray:
         """The equilibrium displacement (ndofs) under the loads at
         ``load_factor``, the platen at ``platen_displacement`` and the nodal ``contact_force``
         (a trial state of the step, see :meth:`commit_step`). Repeated calls with the same
-        arguments cost nothing."""
+        arguments cost nothing. Over MPI ranks its owner solves and the others take its trial
+        state (:meth:`~vfem.nonlinear.NonlinearBody.adopt`)."""
         f = np.asarray(contact_force, dtype=float)
         key = (float(load_factor), float(platen_displacement), f.tobytes())
         if self._equilibrated != key:
             self._platen_value = float(platen_displacement)
-            self.nonlinear.equilibrate(load_factor, f)
+            if self._parallel():
+                nl = self.nonlinear
+
+                def solve() -> tuple:
+                    record = nl.equilibrate(load_factor, f)
+                    return nl.trial_displacement() - nl.displacement, record
+
+                delta, record = self.ranks.share(self.index, solve)
+                if not self.ranks.mine(self.index):
+                    nl.adopt(delta, load_factor, record)
+            else:
+                self.nonlinear.equilibrate(load_factor, f)
             self._equilibrated = key
         return self.nonlinear.trial_displacement()
 
@@ -279,7 +301,32 @@ class LargeMechanics:
                     "platen_motion": platen_motion, "platen_stiffness": stiffness,
                     "platen_reaction": reaction, "solve": solve}
 
+        if self._parallel():
+            system = self._shared_system(system)
         return Linearization(float(np.linalg.norm(R[free])), ref, met, system)
+
+    def _shared_system(self, system: Callable[[], dict]) -> Callable[[], dict]:
+        """Over MPI ranks: ``system`` (the tangent factorized, the correction, the
+        flexibility) computed on the body's owner alone, its arrays sent to every rank, and a
+        ``solve`` that solves on the owner (every rank asks it the same at the same point of
+        the same iteration, as :class:`~vfem.parallel.SharedFactor`'s)."""
+        ranks, index = self.ranks, self.index
+        kept: dict = {}
+
+        def arrays() -> dict:
+            out = system()
+            kept["solve"] = out.pop("solve")
+            return out
+
+        def shared() -> dict:
+            out = kept.pop("arrays") if "arrays" in kept else ranks.share(index, arrays)
+            owner_solve = kept.get("solve")
+            out["solve"] = lambda f: ranks.share(index, lambda: owner_solve(f))
+            return out
+
+        # (every body's owner at once: :func:`prefetch`)
+        shared.index, shared.owner_arrays, shared.kept = index, arrays, kept
+        return shared
 
     def _free_block(self, K: sp.csr_matrix, free: np.ndarray) -> sp.csc_matrix:
         """``K[free][:, free]`` as CSC. The tangent's pattern and the free dofs stay from one
@@ -388,6 +435,23 @@ class Linearization:
         raise AttributeError(name)
 
 
+def prefetch(ranks, linearizations: list) -> None:
+    """Over MPI ranks, the linearisations (:class:`Linearization`, of bodies whose tangent
+    is factorized on their owner, :meth:`LargeMechanics._shared_system`) not yet computed,
+    each on its owner, all owners at once (:meth:`~vfem.parallel.Ranks.map`), and every rank
+    given their arrays: what reading them one by one would do with the owners in turn."""
+    pending = {}
+    for lin in linearizations:
+        system = None if lin is None else lin.__dict__.get("_system")
+        if system is not None and hasattr(system, "owner_arrays"):
+            pending[system.index] = system
+    if not pending or not getattr(ranks, "parallel", False):
+        return
+    got = ranks.map(sorted(pending), lambda i: pending[i].owner_arrays())
+    for i, system in pending.items():
+        system.kept["arrays"] = got[i]
+
+
 def _tangent_factorization(K_ff, trailing: np.ndarray, groups: np.ndarray, rhs: np.ndarray,
                            backend: str | None, name: str, analysis=None):
     """A large body's tangent on its free dofs, factorized once per linearisation.
@@ -435,4 +499,4 @@ def _ramp(pd, n: int):
     return lambda load_factor: np.full(n, pd.at(load_factor))
 
 
-__all__ = ["BodyMechanics", "LargeMechanics", "LinearMechanics", "Linearization"]
+__all__ = ["BodyMechanics", "LargeMechanics", "LinearMechanics", "Linearization", "prefetch"]

@@ -73,6 +73,7 @@ import logging
 import numpy as np
 import scipy.sparse as sp
 
+from ...bodies.mechanics import prefetch
 from ...errors import AnalysisError, InputError
 from ..capabilities import Capabilities
 from ..geometry import ContactPairs, ContactSurface, overlap, virtual_nodes
@@ -368,6 +369,9 @@ class LargeDeformationContact(PairSet):
         tol = self.penetration_tolerance
         off = self._offsets
         nt = off[-1]
+        # over MPI ranks every body's tangent on its owner, all owners at once
+        # (vfem.bodies.mechanics.prefetch; nothing in serial)
+        prefetch(self.executor, lins)
         C = [lin.flexibility[: s.dim * s.nc] if lin is not None else s.C
              for s, lin in zip(self.surfaces, lins)]
         a = np.concatenate([lin.correction[s.candidate_dofs] if lin is not None
