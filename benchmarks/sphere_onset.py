@@ -1,0 +1,120 @@
+"""Yield onset under Hertz's sphere (issue 41's acceptance: "sphere on a flat: p0 = 1.613 Y at
+depth 0.481 a — the load at first yield within 2 % and the depth within one element").
+
+The sphere example (``vfem_examples.sphere``: a quarter sphere-ended cylinder on a block, both
+E = 200e3, nu = 0.3, meshes graded to the contact) with the flat of J2 material, elastic-
+perfectly plastic, Y = p0 / (p0/Y at onset) at the full force, so that Hertz's onset is at load
+factor 1; the force is the one whose Hertz radius is ``a_over_r`` R (the half-space's stresses
+hold for a << R: the sphere's own stress adds to them as a / R grows), the flat's elements at
+the contact ``a / facets`` (the sphere's finer by the example's ``flat_size_ratio``). The load
+factors step by 1 % around the onset. Printed per run: the dofs, the last load factor with no
+yielded point and the first with one (Hertz's onset: 1), the mean depth of the first yielded
+points per a at that load against Huber's, the element size per a, the seconds.
+
+The onset itself (:func:`onset`): von Mises on the axis under Hertz's pressure (Johnson,
+*Contact Mechanics*, 1985, eq. 3.45: sigma_r = sigma_theta = p0 (-(1 + nu)(1 - (z/a)
+arctan(a/z)) + (1/2)(1 + z^2/a^2)^-1), sigma_z = -p0 (1 + z^2/a^2)^-1), its largest value and
+where.
+
+    python3 benchmarks/sphere_onset.py                      # a = 0.1 R and 0.02 R, a/12
+    python3 benchmarks/sphere_onset.py --a-over-r 0.02 --facets 16
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import time
+
+import numpy as np
+
+from vfem.config import Steps
+from vfem.materials import J2Plastic
+from vfem.solver import Analysis
+from vfem_examples import sphere
+
+#: the load factors (per Hertz's onset force)
+LOAD_FACTORS = (0.5, 0.9, 0.94, 0.96, 0.97, 0.98, 0.99, 1.0, 1.01, 1.02, 1.03)
+
+
+def onset(nu: float) -> tuple[float, float]:
+    """(p0 / Y at first yield, its depth per a) under Hertz's sphere (module docstring)."""
+    z = np.linspace(1e-4, 3.0, 300001)
+    sr = -(1 + nu) * (1 - z * np.arctan(1 / z)) + 0.5 / (1 + z * z)
+    sz = -1 / (1 + z * z)
+    vm = np.abs(sz - sr)
+    k = int(vm.argmax())
+    return 1.0 / float(vm[k]), float(z[k])
+
+
+def run(a_over_r: float, facets: int, flat_size_ratio: float) -> dict:
+    base = sphere.SphereParameters()
+    E_star = sphere.theory(base)["e_star"]
+    a = a_over_r * base.radius
+    force = 4.0 * E_star * a ** 3 / (3.0 * base.radius)
+    p = dataclasses.replace(base, force=force, facets_per_radius=facets,
+                            flat_size_ratio=flat_size_ratio)
+    th = sphere.theory(p)
+    ratio, depth = onset(p.flat_poissons_ratio)
+    Y = th["p0_theory"] / ratio
+    cfg = sphere.config(p)
+    bodies = tuple(dataclasses.replace(b, material=J2Plastic(
+        p.flat_youngs_modulus, p.flat_poissons_ratio, Y)) if b.name == "flat" else b
+        for b in cfg.bodies)
+    cfg = dataclasses.replace(cfg, bodies=bodies, steps=Steps(load_factors=LOAD_FACTORS))
+    model = cfg.build()
+    t0 = time.perf_counter()
+    result = Analysis(model).run()
+    seconds = time.perf_counter() - t0
+    out = {"a_over_r": a_over_r, "facets": facets, "dofs": sum(b.ndofs for b in model.bodies),
+           "seconds": seconds, "converged": result.converged, "onset_ratio": ratio,
+           "onset_depth": depth, "element_over_a": flat_size_ratio / facets}
+    if not result.converged:
+        out["message"] = result.message
+        return out
+    steps = result.steps
+    first = next((s for s in steps if s.yielded.get("flat", 0) > 0), None)
+    if first is None:
+        return out
+    k = steps.index(first)
+    out["first_yield"] = first.load_factor
+    out["last_elastic"] = steps[k - 1].load_factor if k else 0.0
+    flat = next(b for b in model.bodies if b.name == "flat")
+    nl = flat.mechanics.nonlinear
+    x = nl.basis0.mapping.F(nl.basis0.X)
+    g = nl.basis0.interpolate(np.ravel(first.bodies["flat"].displacement)).grad
+    state = nl.material.response(0.5 * (g + np.swapaxes(g, 0, 1)),
+                                 nl.material.initial_state(3, x.shape[1:])).state
+    yielded = state["equivalent_plastic_strain"] > 0
+    a_now = th["a_theory"] * first.load_factor ** (1.0 / 3.0)
+    out["depth"] = float(-x[2][yielded].mean() / a_now)
+    out["points"] = int(yielded.sum())
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--a-over-r", type=float, nargs="+", default=[0.1, 0.02])
+    ap.add_argument("--facets", type=int, default=12, help="the flat's elements over a")
+    ap.add_argument("--flat-size-ratio", type=float, default=1.0,
+                    help="the flat's elements at the contact per the sphere's")
+    args = ap.parse_args(argv)
+    ratio, depth = onset(0.3)
+    print(f"Hertz's onset (nu = 0.3): p0 = {ratio:.4f} Y at {depth:.4f} a")
+    print(f"{'a/R':>6} {'dofs':>7} {'no yield at':>11} {'yield at':>9} {'depth/a':>8} "
+          f"{'Huber':>6} {'element/a':>9} {'points':>6} {'s':>6}")
+    for a_over_r in args.a_over_r:
+        # the flat's elements a/facets: the sphere's a/(facets * flat_size_ratio)
+        r = run(a_over_r, round(args.facets * args.flat_size_ratio), args.flat_size_ratio)
+        if "first_yield" not in r:
+            print(f"{a_over_r:>6g} {r['dofs']:>7} no yield: {r.get('message', '')}")
+            continue
+        print(f"{a_over_r:>6g} {r['dofs']:>7} {r['last_elastic']:>11.2f} {r['first_yield']:>9.2f} "
+              f"{r['depth']:>8.3f} {r['onset_depth']:>6.3f} {r['element_over_a']:>9.3f} "
+              f"{r['points']:>6} {r['seconds']:>6.0f}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
