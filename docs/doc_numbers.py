@@ -669,6 +669,22 @@ def examples_indentation() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_block_indentation() -> str:
+    """docs/examples.md, Block indentation: ``vfem run block_indentation`` (defaults)."""
+    s = _summary("block_indentation")
+    m = s["block_indentation"]
+    rows = ["| dofs | onset force | Y | no yield at | first yield at | its depth / a (Hertz) "
+            "| peak force | depression at the peak | dent | verification |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+    passed = sum(r["passed"] for r in s["verification"])
+    rows.append(f"| {s['dofs']} | {m['onset_force']:.4g} | {m['yield_stress']:.4g} | "
+                f"{m['last_elastic_force']:.2f} | {m['first_yield_force']:.2f} | "
+                f"{m['first_yield_depth_over_a']:.3f} ({m['depth_over_a']:.3f}) | "
+                f"{m['peak_contact_force']:.4g} | {m['depression_at_peak']:.3g} | "
+                f"{m['dent']:.3g} | {passed} of {len(s['verification'])} passed |")
+    return "\n".join(rows) + "\n"
+
+
 def examples_thick_cylinder() -> str:
     """docs/examples.md, Thick cylinder: ``vfem run thick_cylinder`` (defaults)."""
     s = _summary("thick_cylinder")
@@ -709,6 +725,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-stack": ("docs/examples.md", examples_stack, False),
     "examples-indentation": ("docs/examples.md", examples_indentation, False),
     "examples-thick-cylinder": ("docs/examples.md", examples_thick_cylinder, False),
+    "examples-block-indentation": ("docs/examples.md", examples_block_indentation, False),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
     "patch-thesis": ("docs/examples.md", patch_thesis, False),

@@ -14,7 +14,7 @@ from vfem.io import replot
 
 EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
             "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack",
-            "indentation", "thick_cylinder")
+            "indentation", "thick_cylinder", "block_indentation")
 
 
 def load(name: str):

@@ -342,14 +342,15 @@ def graded_nodes(a: float, b: float, h: Callable[[np.ndarray], np.ndarray]) -> n
 def block(x0: float, y0: float, width: float, height: float, h: float, *,
           h_fine: float | None = None, growth: float = 0.2, fine_x: Sequence[float] = (),
           fine_y: Sequence[float] = (), symmetry: str | None = None,
-          triangles: bool = False) -> MeshQuad | MeshTri:
+          triangles: bool = False, plateau: float = 0.0) -> MeshQuad | MeshTri:
     """The rectangle ``[x0, x0 + width] x [y0, y0 + height]`` as a tensor grid of elements.
 
     Uniform with spacing at most ``h``, or, given ``h_fine``, graded: the column widths are
     ``h_fine`` at the lines x = ``fine_x`` (for instance the other block's corners) and grow
     with ``growth`` per unit distance up to ``h``; the row heights likewise towards
-    y = ``fine_y`` (for instance the contact face). Lines of ``fine_x``/``fine_y`` inside the
-    rectangle are grid lines. Quadrilaterals unless ``triangles`` (each split in two).
+    y = ``fine_y`` (for instance the contact face), ``h_fine`` within ``plateau`` of them (a
+    contact zone's width: default 0). Lines of ``fine_x``/``fine_y`` inside the rectangle are
+    grid lines. Quadrilaterals unless ``triangles`` (each split in two).
 
     Named boundaries: ``top``, ``bottom``, ``left`` and ``right``; with ``symmetry`` = "left"
     or "right" that side is named ``symmetry`` instead (half model about a vertical plane).
@@ -359,8 +360,8 @@ def block(x0: float, y0: float, width: float, height: float, h: float, *,
         raise ValueError("width and height must be positive")
     if symmetry not in (None, "left", "right"):
         raise ValueError(f"symmetry must be None, 'left' or 'right', got {symmetry!r}")
-    x = _grid_line(x0, x1, h, h_fine, growth, fine_x)
-    y = _grid_line(y0, y1, h, h_fine, growth, fine_y)
+    x = _grid_line(x0, x1, h, h_fine, growth, fine_x, plateau)
+    y = _grid_line(y0, y1, h, h_fine, growth, fine_y, plateau)
     check_count(float(len(x)) * len(y), "block")
     grid = (MeshTri if triangles else MeshQuad).init_tensor(x, y)
     t = _counter_clockwise(grid.p, grid.t)  # init_tensor's quadrilaterals are clockwise
