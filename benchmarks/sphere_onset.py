@@ -32,6 +32,7 @@ from vfem.config import Steps
 from vfem.materials import J2Plastic
 from vfem.solver import Analysis
 from vfem_examples import sphere
+from vfem_examples.indentation import first_yielded
 
 #: the load factors (per Hertz's onset force)
 LOAD_FACTORS = (0.5, 0.9, 0.94, 0.96, 0.97, 0.98, 0.99, 1.0, 1.01, 1.02, 1.03)
@@ -80,12 +81,7 @@ def run(a_over_r: float, facets: int, flat_size_ratio: float) -> dict:
     out["first_yield"] = first.load_factor
     out["last_elastic"] = steps[k - 1].load_factor if k else 0.0
     flat = next(b for b in model.bodies if b.name == "flat")
-    nl = flat.mechanics.nonlinear
-    x = nl.basis0.mapping.F(nl.basis0.X)
-    g = nl.basis0.interpolate(np.ravel(first.bodies["flat"].displacement)).grad
-    state = nl.material.response(0.5 * (g + np.swapaxes(g, 0, 1)),
-                                 nl.material.initial_state(3, x.shape[1:])).state
-    yielded = state["equivalent_plastic_strain"] > 0
+    x, yielded = first_yielded(flat.mechanics.nonlinear, first.bodies["flat"].displacement)
     a_now = th["a_theory"] * first.load_factor ** (1.0 / 3.0)
     out["depth"] = float(-x[2][yielded].mean() / a_now)
     out["points"] = int(yielded.sum())

@@ -105,9 +105,9 @@ def test_the_ranks_launcher_runs_the_same_command(tmp_path):
 
 
 @pytest.mark.slow
-def test_resume_after_a_kill_under_mpi_is_the_uninterrupted_run(tmp_path):
-    args = ["stack", "--set", "divisions=14", "--set", "steps=8", "--set",
-            "flexibility=matrix_free", "--no-figures"]
+def killed_and_resumed(tmp_path: Path, args: list[str], steps: int) -> tuple[Path, Path]:
+    """``vfem run ARGS`` whole in one process, and over two ranks killed (SIGKILL) after its
+    third checkpoint of ``steps`` and resumed over two ranks: the two results folders."""
     whole = tmp_path / "whole"
     assert vfem(["run", *args, "--out", str(whole)]).returncode == 0
     out = tmp_path / "killed"
@@ -124,9 +124,16 @@ def test_resume_after_a_kill_under_mpi_is_the_uninterrupted_run(tmp_path):
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     steps_before = len(list(out.glob("**/checkpoint/step*.npz")))
-    assert 1 <= steps_before < 8
+    assert 1 <= steps_before < steps
     done = vfem(["run", *args, "--resume", str(out)], ranks=2)
     assert done.returncode == 0, done.stderr + done.stdout
+    return whole, out
+
+
+def test_resume_after_a_kill_under_mpi_is_the_uninterrupted_run(tmp_path):
+    args = ["stack", "--set", "divisions=14", "--set", "steps=8", "--set",
+            "flexibility=matrix_free", "--no-figures"]
+    whole, out = killed_and_resumed(tmp_path, args, 8)
     same_results(whole, out)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["converged"] and len(summary["steps"]) == 8
@@ -240,24 +247,5 @@ def test_a_plastic_run_killed_under_mpi_resumes_as_the_uninterrupted_run(tmp_pat
     """The indentation example (a plastic cylinder, 20 steps) over two ranks, killed after
     three checkpoints and resumed over two ranks: the whole run's answers (the plastic
     strains saved with the body, on the owner's and the other rank's copy alike)."""
-    args = ["indentation", "--no-figures"]
-    whole = tmp_path / "whole"
-    assert vfem(["run", *args, "--out", str(whole)]).returncode == 0
-    out = tmp_path / "killed"
-    command, env = parallel.launch_command(
-        MPIEXEC, 2, [sys.executable, "-m", "vfem", "run", *args, "--out", str(out)])
-    proc = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, start_new_session=True)
-    deadline = time.time() + 300
-    while time.time() < deadline and proc.poll() is None:
-        if len(list(out.glob("**/checkpoint/step*.npz"))) >= 3:
-            break
-        time.sleep(0.05)
-    assert proc.poll() is None, "the run ended before it could be killed: make it longer"
-    os.killpg(proc.pid, signal.SIGKILL)
-    proc.wait()
-    steps_before = len(list(out.glob("**/checkpoint/step*.npz")))
-    done = vfem(["run", *args, "--resume", str(out)], ranks=2)
-    assert done.returncode == 0, done.stderr + done.stdout
-    assert 1 <= steps_before < 20
+    whole, out = killed_and_resumed(tmp_path, ["indentation", "--no-figures"], 20)
     assert_serial_answers(whole, out)

@@ -46,7 +46,14 @@ from vfem.materials import J2Plastic, LinearElastic
 from vfem.solver import AnalysisResult, Model
 
 from . import hertz
-from .indentation import LOADING, MAX_OVERLOAD, UNLOADING, onset
+from .indentation import (
+    check_loading,
+    first_yielded,
+    load_factors,
+    loop_and_onset,
+    onset,
+    verification,
+)
 
 #: the most elements the block may have (a few minutes of run)
 MAX_ELEMENTS = 60000
@@ -96,29 +103,12 @@ def theory(p: BlockIndentationParameters) -> dict[str, float]:
 
 def validate(p: BlockIndentationParameters) -> None:
     """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
-    for name in ("onset_half_width", "overload", "radius", "block_size", "growth"):
-        value = getattr(p, name)
-        if isinstance(value, bool) or not (isinstance(value, (int, float))
-                                           and 0 < value < math.inf):
-            raise InputError(f"{name} must be a finite number > 0, got {value!r}")
-    if p.overload <= LOADING[-3]:
-        raise InputError(f"overload must exceed {LOADING[-3]} (the steps around the onset "
-                         f"reach {LOADING[-3]} of its force), got {p.overload!r}")
-    if p.overload > MAX_OVERLOAD:
-        raise InputError(f"overload must be at most {MAX_OVERLOAD:g} (the loading steps are half "
-                         f"the onset force apart up to it), got {p.overload!r}")
-    if p.onset_half_width > 0.05:
-        raise InputError("onset_half_width must be at most 0.05 (Hertz's half-space holds to "
-                         f"about a / 2R), got {p.onset_half_width!r}")
+    check_loading(p, ("onset_half_width", "overload", "radius", "block_size", "growth"))
     if p.block_size < 20 * p.onset_half_width * math.sqrt(p.overload):
         raise InputError(f"block_size must be at least 20 times the peak's half-width per "
                          f"radius ({20 * p.onset_half_width * math.sqrt(p.overload):.4g}: "
                          f"Hertz's half-space), got {p.block_size!r}")
     hertz.check_resolution("facets_per_half_width", p.facets_per_half_width, "half-width", 0)
-    if isinstance(p.hardening_modulus, bool) or not (
-            isinstance(p.hardening_modulus, (int, float)) and 0 <= p.hardening_modulus < math.inf):
-        raise InputError(f"hardening_modulus must be a finite number >= 0, got "
-                         f"{p.hardening_modulus!r}")
     if p.kinematics not in ("small", "total"):
         raise InputError(f"kinematics must be 'small' or 'total', got {p.kinematics!r}")
     model = build(p)
@@ -162,60 +152,31 @@ def config(p: BlockIndentationParameters | None = None) -> ModelConfig:
         contact_boundaries=("top",),
         kinematics=p.kinematics,
     )
-    loading = [s for s in LOADING if s < p.overload] + [
-        float(s) for s in np.arange(1.5, p.overload - 1e-9, 0.5)]
-    factors = tuple(s / p.overload for s in loading) + (1.0,) + tuple(
-        2.0 - s / p.overload for s in UNLOADING)
     return ModelConfig("block_indentation", (cylinder, block), ContactSettings(),
-                       Steps(load_factors=factors))
+                       Steps(load_factors=load_factors(p.overload)))
 
 
 def build(p: BlockIndentationParameters | None = None) -> Model:
     return config(p).build()
 
 
-def _force(result_step, p: BlockIndentationParameters) -> float:
-    """The platen's force per onset force at a step's load factor (the curve of :func:`config`)."""
-    lf = result_step.load_factor
-    return p.overload * (lf if lf <= 1.0 else 2.0 - lf)
-
-
 def evaluate(result: AnalysisResult, p: BlockIndentationParameters) -> dict:
     """The onset, the loop and the dent from a run."""
     th = theory(p)
+    out, first = loop_and_onset(result, p.overload, th, "block")
     steps = result.steps
-    first = next((s for s in steps if s.yielded.get("block", 0) > 0), None)
-    out = dict(th)
-    out["force_over_onset"] = [_force(s, p) for s in steps]
-    out["contact_force"] = [float(s.bodies["cylinder"].contact_force[:, 1].sum()) for s in steps]
-    out["travel"] = [float(-s.platen_displacement) for s in steps]
-    out["yielded_points"] = [int(s.yielded.get("block", 0)) for s in steps]
     block = next(b for b in result.model.bodies if b.name == "block")
     X = block.mesh.p
     axis = int(np.argmin(np.hypot(X[0], X[1])))  # the top's point on the axis
     out["dent"] = float(-steps[-1].bodies["block"].displacement[axis, 1])
     out["depression_at_peak"] = float(max(-s.bodies["block"].displacement[axis, 1]
                                           for s in steps))
-    out["peak_contact_force"] = max(out["contact_force"])
-    out["peak_applied_force"] = p.overload * th["onset_force"]
     if first is None:
         return out
-    k = steps.index(first)
-    out["first_yield_step"] = first.step
-    out["first_yield_force"] = _force(first, p)
-    out["last_elastic_force"] = _force(steps[k - 1], p) if k else 0.0
     # the points that yield first: those the step's displacement takes past yield from the
     # virgin state (the block's own law at its strain: small, or the log strain at finite)
-    nl = block.mechanics.nonlinear
-    x = nl.basis0.mapping.F(nl.basis0.X)
-    u = np.ravel(first.bodies["block"].displacement)
-    g = nl.basis0.interpolate(u).grad
-    if p.kinematics == "small":
-        strain = 0.5 * (g + np.swapaxes(g, 0, 1))
-    else:
-        strain = 0.5 * (g + np.swapaxes(g, 0, 1) + np.einsum("ki...,kj...->ij...", g, g))
-    state = nl.material.response(strain, nl.material.initial_state(2, x.shape[1:])).state
-    yielded = state["equivalent_plastic_strain"] > 0
+    x, yielded = first_yielded(block.mechanics.nonlinear, first.bodies["block"].displacement,
+                               finite=p.kinematics != "small")
     a_now = th["a_onset"] * math.sqrt(out["first_yield_force"])
     out["first_yield_depth_over_a"] = float(
         (-x[1][yielded]).mean() / a_now) if yielded.any() else float("nan")
@@ -242,28 +203,6 @@ def summarize(result: AnalysisResult, p: BlockIndentationParameters) -> dict:
         summary["block_indentation"] = m = evaluate(result, p)
         summary["verification"] = verification(m, result.model.contact)
     return summary
-
-
-def verification(m: dict, settings) -> list[dict]:
-    """The load at first yield against Hertz's onset, the depth of the first yielded points
-    against McEwen's, the platen's force at the peak."""
-    from vfem.io.verification import check, platen
-
-    source = (f"Hertz, McEwen's stresses in plane strain: p0 = {m['p0_over_Y']:.3f} Y at "
-              f"{m['depth_over_a']:.3f} a")
-    records = []
-    if "first_yield_force" in m:
-        records.append(check(
-            "force at first yield / Hertz's onset", m["first_yield_force"], 1.0, source, 0.02,
-            "issue 41's bound (the steps bracket it: no yield at "
-            f"{m['last_elastic_force']:.2f}, yield at {m['first_yield_force']:.2f})"))
-        records.append(check(
-            "depth of the first yielded points / a", m["first_yield_depth_over_a"],
-            m["depth_over_a"], source, m["element_over_a"],
-            "one element under the contact (the points' mean depth)", measure="absolute"))
-    records.append(platen("contact force at the peak", m["peak_contact_force"],
-                          m["peak_applied_force"], settings))
-    return records
 
 
 def run(p: BlockIndentationParameters, out, on_step=None, figures: bool = True,

@@ -107,11 +107,15 @@ def theory(p: IndentationParameters) -> dict[str, float]:
             "p0_over_Y": ratio, "depth_over_a": depth, "e_star": e_star}
 
 
-def validate(p: IndentationParameters) -> None:
-    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
-    for name in ("onset_half_width", "overload", "radius"):
+def check_loading(p, positive: tuple[str, ...] = ("onset_half_width", "overload", "radius")
+                  ) -> None:
+    """Raise :class:`~vfem.errors.InputError` unless the parameters ``positive`` are finite and
+    positive and the onset and the overload make a schedule (:func:`load_factors`): the checks
+    this example and :mod:`.block_indentation` share."""
+    for name in positive:
         value = getattr(p, name)
-        if not (isinstance(value, (int, float)) and 0 < value < math.inf):
+        if isinstance(value, bool) or not (isinstance(value, (int, float))
+                                           and 0 < value < math.inf):
             raise InputError(f"{name} must be a finite number > 0, got {value!r}")
     if p.overload <= LOADING[-3]:
         raise InputError(f"overload must exceed {LOADING[-3]} (the steps around the onset "
@@ -122,11 +126,50 @@ def validate(p: IndentationParameters) -> None:
     if p.onset_half_width > 0.05:
         raise InputError("onset_half_width must be at most 0.05 (Hertz's half-space holds to "
                          f"about a / 2R), got {p.onset_half_width!r}")
-    hertz.check_resolution("facets_per_half_width", p.facets_per_half_width, "half-width",
-                           p.refinement)
-    if not (isinstance(p.hardening_modulus, (int, float)) and 0 <= p.hardening_modulus < math.inf):
+    if isinstance(p.hardening_modulus, bool) or not (
+            isinstance(p.hardening_modulus, (int, float)) and 0 <= p.hardening_modulus < math.inf):
         raise InputError(f"hardening_modulus must be a finite number >= 0, got "
                          f"{p.hardening_modulus!r}")
+
+
+def load_factors(overload: float) -> tuple[float, ...]:
+    """The steps' load factors for a peak of ``overload`` onset forces over load factors 0 to
+    1 and back over 1 to 2 (:data:`LOADING`, :data:`UNLOADING`)."""
+    loading = [s for s in LOADING if s < overload] + [
+        float(s) for s in np.arange(1.5, overload - 1e-9, 0.5)]
+    return tuple(s / overload for s in loading) + (1.0,) + tuple(
+        2.0 - s / overload for s in UNLOADING)
+
+
+def force_at(step, overload: float) -> float:
+    """The platen's force per onset force at a step's load factor (up to the peak over 0 to
+    1, down over 1 to 2)."""
+    lf = step.load_factor
+    return overload * (lf if lf <= 1.0 else 2.0 - lf)
+
+
+def first_yielded(nl, displacement: np.ndarray, finite: bool = False
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The quadrature points' positions (dim, ne, nq) of a Newton body ``nl``
+    (:class:`vfem.nonlinear.NonlinearBody`) and which of them the ``displacement`` (its
+    points', (n, dim)) takes past yield from the virgin state: the return map of its strain
+    as the body's law reads it (the small strain, or with ``finite`` the Green-Lagrange
+    one)."""
+    x = nl.basis0.mapping.F(nl.basis0.X)
+    g = nl.basis0.interpolate(np.ravel(displacement)).grad
+    strain = 0.5 * (g + np.swapaxes(g, 0, 1))
+    if finite:
+        strain = strain + 0.5 * np.einsum("ki...,kj...->ij...", g, g)
+    state = nl.material.response(strain, nl.material.initial_state(x.shape[0],
+                                                                    x.shape[1:])).state
+    return x, state["equivalent_plastic_strain"] > 0
+
+
+def validate(p: IndentationParameters) -> None:
+    """Raise :class:`~vfem.errors.InputError` if the parameters make no valid model."""
+    check_loading(p)
+    hertz.check_resolution("facets_per_half_width", p.facets_per_half_width, "half-width",
+                           p.refinement)
     build(p).validate()
 
 
@@ -148,34 +191,43 @@ def config(p: IndentationParameters | None = None) -> ModelConfig:
                                                       p.cylinder_poissons_ratio,
                                                       th["yield_stress"],
                                                       hardening_modulus=p.hardening_modulus))
-    loading = [s for s in LOADING if s < p.overload] + [
-        float(s) for s in np.arange(1.5, p.overload - 1e-9, 0.5)]
-    factors = tuple(s / p.overload for s in loading) + (1.0,) + tuple(
-        2.0 - s / p.overload for s in UNLOADING)
     return ModelConfig("indentation", (cylinder, flat), base.contact,
-                       Steps(load_factors=factors))
+                       Steps(load_factors=load_factors(p.overload)))
 
 
 def build(p: IndentationParameters | None = None) -> Model:
     return config(p).build()
 
 
-def _force(result_step, p: IndentationParameters) -> float:
-    """The platen's force per onset force at a step's load factor (the curve of :func:`config`)."""
-    lf = result_step.load_factor
-    return p.overload * (lf if lf <= 1.0 else 2.0 - lf)
+def loop_and_onset(result: AnalysisResult, overload: float, th: dict, plastic: str
+                   ) -> tuple[dict, object]:
+    """What this example and :mod:`.block_indentation` read alike from a run: the theory
+    ``th``, the platen's force per onset force, the contact force and the platen's travel at
+    each step, the points of body ``plastic`` yielded, the peak forces, the first step with a
+    yielded point and the forces either side of the onset; and that first step (None where
+    none yielded)."""
+    steps = result.steps
+    first = next((s for s in steps if s.yielded.get(plastic, 0) > 0), None)
+    out = dict(th)
+    out["force_over_onset"] = [force_at(s, overload) for s in steps]
+    out["contact_force"] = [float(s.bodies["cylinder"].contact_force[:, 1].sum()) for s in steps]
+    out["travel"] = [float(-s.platen_displacement) for s in steps]
+    out["yielded_points"] = [int(s.yielded.get(plastic, 0)) for s in steps]
+    out["peak_contact_force"] = max(out["contact_force"])
+    out["peak_applied_force"] = overload * th["onset_force"]
+    if first is not None:
+        k = steps.index(first)
+        out["first_yield_step"] = first.step
+        out["first_yield_force"] = force_at(first, overload)
+        out["last_elastic_force"] = force_at(steps[k - 1], overload) if k else 0.0
+    return out, first
 
 
 def evaluate(result: AnalysisResult, p: IndentationParameters) -> dict:
     """The onset, the loop and the dent from a run."""
     th = theory(p)
+    out, first = loop_and_onset(result, p.overload, th, "cylinder")
     steps = result.steps
-    first = next((s for s in steps if s.yielded.get("cylinder", 0) > 0), None)
-    out = dict(th)
-    out["force_over_onset"] = [_force(s, p) for s in steps]
-    out["contact_force"] = [float(s.bodies["cylinder"].contact_force[:, 1].sum()) for s in steps]
-    out["travel"] = [float(-s.platen_displacement) for s in steps]
-    out["yielded_points"] = [int(s.yielded.get("cylinder", 0)) for s in steps]
     cylinder = next(b for b in result.model.bodies if b.name == "cylinder")
     X = cylinder.mesh.p
     tip = int(np.argmin(np.hypot(X[0], X[1] - X[1].min())))  # the lowest point, on the axis
@@ -184,22 +236,12 @@ def evaluate(result: AnalysisResult, p: IndentationParameters) -> dict:
     # travel is about half of it)
     out["residual_approach"] = float(steps[-1].bodies["cylinder"].displacement[tip, 1]
                                      - steps[-1].platen_displacement)
-    out["peak_contact_force"] = max(out["contact_force"])
-    out["peak_applied_force"] = p.overload * th["onset_force"]
     if first is None:
         return out
-    k = steps.index(first)
-    out["first_yield_step"] = first.step
-    out["first_yield_force"] = _force(first, p)
-    out["last_elastic_force"] = _force(steps[k - 1], p) if k else 0.0
     # the points that yield first: those the step's displacement takes past yield from the
     # virgin state (the return map of the step's strain, as the cylinder's law reads it)
-    nl = cylinder.mechanics.nonlinear
-    x = nl.basis0.mapping.F(nl.basis0.X)
-    g = nl.basis0.interpolate(np.ravel(first.bodies["cylinder"].displacement)).grad
-    state = nl.material.response(0.5 * (g + np.swapaxes(g, 0, 1)),
-                                 nl.material.initial_state(2, x.shape[1:])).state
-    yielded = state["equivalent_plastic_strain"] > 0
+    x, yielded = first_yielded(cylinder.mechanics.nonlinear,
+                               first.bodies["cylinder"].displacement)
     a_now = th["a_onset"] * math.sqrt(out["first_yield_force"])
     out["first_yield_depth_over_a"] = float(
         (x[1][yielded] - X[1].min()).mean() / a_now) if yielded.any() else float("nan")
