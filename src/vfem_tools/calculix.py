@@ -10,7 +10,8 @@ CalculiX*):
   body; supports and prescribed displacements as ``*BOUNDARY``; a force-controlled platen as
   ``*EQUATION`` ties of its nodes' platen component to one reference node that carries the
   ``*CLOAD``; frictionless surface-to-surface penalty contact (``*CONTACT PAIR, TYPE=SURFACE TO
-  SURFACE``) between the bodies' contact candidate facets, the softer body the slave. With
+  SURFACE``) between the bodies' contact candidate facets, the softer body the slave; a J2
+  plastic material (:class:`vfem.materials.J2Plastic`, isotropic hardening) as ``*PLASTIC``. With
   ``friction``, Coulomb friction (``*FRICTION``: mu and ccx's stick slope); with
   ``steps="curves"``, loads on load curves (prescribed displacements and a platen force with
   amplitudes: the Cattaneo example's press, then shear) as one ccx step per stretch of linear
@@ -129,6 +130,27 @@ def _check_supported(model, curves: bool = False) -> None:
         if b.platen is not None and b.platen.amplitude is not None:
             raise InputError(f"CalculiX deck: body {b.name!r} has a platen force with an "
                              "amplitude, which the writer does not translate")
+
+
+def _plastic(body) -> list[str]:
+    """``*PLASTIC`` of a J2 material (:class:`vfem.materials.J2Plastic`; none for an elastic
+    one): ccx's isotropic hardening table, von Mises stress against equivalent plastic strain
+    (its hardening curve, or Y and, with a hardening modulus H, Y + H at a plastic strain of 1;
+    perfectly plastic: Y alone)."""
+    m = body.material
+    if getattr(m, "yield_stress", None) is None:
+        return []
+    if m.kinematic_modulus:
+        raise InputError(f"CalculiX deck: body {body.name!r} has kinematic hardening, which the "
+                         "writer does not translate (ccx's *PLASTIC here is isotropic)")
+    if m.hardening_curve:
+        table = [(float(v), float(a)) for a, v in m.hardening_curve]
+    elif m.hardening_modulus:
+        table = [(float(m.yield_stress), 0.0),
+                 (float(m.yield_stress + m.hardening_modulus), 1.0)]
+    else:
+        table = [(float(m.yield_stress), 0.0)]
+    return ["*PLASTIC", *(f"{_num(v)}, {_num(a)}" for v, a in table)]
 
 
 def _counter_clockwise(mesh) -> tuple[np.ndarray, int]:
@@ -357,6 +379,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
                 for e, k in (_faces3d if solid else _faces)(mesh, t, s.facet_ids)]
         out += [f"*MATERIAL, NAME=M_{tag}", "*ELASTIC",
                 f"{_num(b.material.youngs_modulus)}, {_num(b.material.poissons_ratio)}",
+                *_plastic(b),
                 f"*SOLID SECTION, ELSET=E_{tag}, MATERIAL=M_{tag}", *([] if solid else ["1."])]
         decks.append(BodyDeck(b.name, node_off, elem_off, kind, np.asarray(s.facet_ids),
                               flipped))
@@ -696,8 +719,10 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
     (CSHEAR1, CSHEAR2: along the master surface's tangent nearest to global x, and along z),
     ``copen`` and ``cslip`` (CSLIP1, CSLIP2; the total relative tangential displacement,
     written with friction only), ``force_nodal`` (the contact forces ``K u`` of
-    :func:`nodal_reading`, where the .dat file has the slave's displacements at that time) and
-    ``tributary`` (each node's undeformed tributary length), ``reactions`` (set -> the total
+    :func:`nodal_reading`, where the .dat file has the slave's displacements at that time),
+    ``tributary`` (each node's undeformed tributary length) and ``u`` (the slave's
+    displacements, (npoints, dim)), ``platen_displacement`` (the platen's reference node's,
+    along its component), ``reactions`` (set -> the total
     (fx, fy) of ``*NODE PRINT, TOTALS=ONLY``, ``steps="curves"``) and ``contact_force`` (ccx's
     total surface force (fx, fy) on the slave), ``contact_normal_force`` and
     ``contact_shear_force`` (its size) from ``*CONTACT PRINT, CF``."""
@@ -711,6 +736,14 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
     statistics = _contact_statistics_by_time(dat)
     displacements = _dat_timed_blocks(dat, f"displacements (vx,vy,vz) for set "
                                            f"N_{_tag(deck.slave)}")
+    # the platen's reference node (the body that carries it: the slave's or the master's set)
+    platen_blocks = []
+    if deck.reference_node is not None:
+        carrier = next(b.name for b in deck.model.bodies if b.platen is not None)
+        platen_blocks = _dat_timed_blocks(dat, f"displacements (vx,vy,vz) for set "
+                                               f"N_{_tag(carrier)}")
+        component = DOF[next(b for b in deck.model.bodies if b.platen is not None)
+                        .platen.component] - 1
     stiffness = _stiffness(body) if displacements else None
     out = []
     for total, values in contact:
@@ -728,6 +761,12 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
             order = [where[int(n)] for n in nodes]
             row["force_nodal"] = reading["force"][order]
             row["tributary"] = reading["tributary"][order]
+            row["u"] = u
+        rows = _at(platen_blocks, total)
+        if rows is not None:
+            hit = rows[rows[:, 0].astype(int) == deck.reference_node]
+            if len(hit):
+                row["platen_displacement"] = float(hit[0, 1 + component])
         row["reactions"] = {}
         for name, blocks in reactions.items():
             r = _at(blocks, total)
