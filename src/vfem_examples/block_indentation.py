@@ -52,7 +52,7 @@ from .indentation import (
     load_factors,
     loop_and_onset,
     onset,
-    verification,
+    summary_of,
 )
 
 #: the most elements the block may have (a few minutes of run)
@@ -186,23 +186,7 @@ def evaluate(result: AnalysisResult, p: BlockIndentationParameters) -> dict:
 
 def summarize(result: AnalysisResult, p: BlockIndentationParameters) -> dict:
     """The ``summary.json`` dictionary of a run."""
-    from vfem.io.results import step_record
-
-    summary = {
-        "example": "block_indentation",
-        "converged": result.converged,
-        "message": result.message,
-        "steps": [{**step_record(s), "platen_displacement": s.platen_displacement}
-                  for s in result.steps],
-        "dofs": int(sum(s.body.ndofs for s in result.surfaces)),
-        "parameters": dataclasses.asdict(p),
-        "timings": result.timings,
-        "linear_solver": result.backend,
-    }
-    if result.converged:
-        summary["block_indentation"] = m = evaluate(result, p)
-        summary["verification"] = verification(m, result.model.contact)
-    return summary
+    return summary_of("block_indentation", result, p, evaluate)
 
 
 def run(p: BlockIndentationParameters, out, on_step=None, figures: bool = True,

@@ -252,10 +252,17 @@ def evaluate(result: AnalysisResult, p: IndentationParameters) -> dict:
 
 def summarize(result: AnalysisResult, p: IndentationParameters) -> dict:
     """The ``summary.json`` dictionary of a run."""
+    return summary_of("indentation", result, p, evaluate)
+
+
+def summary_of(example: str, result: AnalysisResult, p, evaluate) -> dict:
+    """The ``summary.json`` dictionary of a run of ``example`` (this one or
+    :mod:`.block_indentation`): the steps with the platen's displacement, and where the run
+    converged ``evaluate(result, p)`` under the example's name and its verification."""
     from vfem.io.results import step_record
 
     summary = {
-        "example": "indentation",
+        "example": example,
         "converged": result.converged,
         "message": result.message,
         "steps": [{**step_record(s), "platen_displacement": s.platen_displacement}
@@ -266,7 +273,7 @@ def summarize(result: AnalysisResult, p: IndentationParameters) -> dict:
         "linear_solver": result.backend,
     }
     if result.converged:
-        summary["indentation"] = m = evaluate(result, p)
+        summary[example] = m = evaluate(result, p)
         summary["verification"] = verification(m, result.model.contact)
     return summary
 
