@@ -4,20 +4,20 @@ depth 0.481 a — the load at first yield within 2 % and the depth within one el
 The sphere example (``vfem_examples.sphere``: a quarter sphere-ended cylinder on a block, both
 E = 200e3, nu = 0.3, meshes graded to the contact) with the flat of J2 material, elastic-
 perfectly plastic, Y = p0 / (p0/Y at onset) at the full force, so that Hertz's onset is at load
-factor 1; the force is the one whose Hertz radius is ``a_over_r`` R (the half-space's stresses
-hold for a << R: the sphere's own stress adds to them as a / R grows), the flat's elements at
-the contact ``a / facets`` (the sphere's finer by the example's ``flat_size_ratio``). The load
+factor 1; the force is the one whose Hertz radius is ``a_over_r`` R (Hertz's paraboloid and
+half-space hold for a << R), the sphere's elements at the contact ``a / facets`` and the flat's
+``flat_size_ratio`` times larger (the example's defaults: 6 and 1.3). The load
 factors step by 1 % around the onset. Printed per run: the dofs, the last load factor with no
 yielded point and the first with one (Hertz's onset: 1), the mean depth of the first yielded
 points per a at that load against Huber's, the element size per a, the seconds.
 
-The onset itself (:func:`onset`): von Mises on the axis under Hertz's pressure (Johnson,
-*Contact Mechanics*, 1985, eq. 3.45: sigma_r = sigma_theta = p0 (-(1 + nu)(1 - (z/a)
-arctan(a/z)) + (1/2)(1 + z^2/a^2)^-1), sigma_z = -p0 (1 + z^2/a^2)^-1), its largest value and
-where.
+The onset itself: :func:`vfem_examples.sphere_indentation.onset` (von Mises on the axis under
+Hertz's pressure, Johnson, *Contact Mechanics*, 1985, eq. 3.45), its largest value and where.
+The built-in example ``sphere_indentation`` is this model with a = 0.05 R at the onset on the
+sphere example's default mesh, loaded past yield and lifted off.
 
     python3 benchmarks/sphere_onset.py                      # a = 0.1 R and 0.02 R, a/12
-    python3 benchmarks/sphere_onset.py --a-over-r 0.02 --facets 16
+    python3 benchmarks/sphere_onset.py --a-over-r 0.1 0.05 0.02 --facets 6 --flat-size-ratio 1.3
 """
 
 from __future__ import annotations
@@ -26,26 +26,15 @@ import argparse
 import dataclasses
 import time
 
-import numpy as np
-
 from vfem.config import Steps
 from vfem.materials import J2Plastic
 from vfem.solver import Analysis
 from vfem_examples import sphere
 from vfem_examples.indentation import first_yielded
+from vfem_examples.sphere_indentation import onset
 
 #: the load factors (per Hertz's onset force)
 LOAD_FACTORS = (0.5, 0.9, 0.94, 0.96, 0.97, 0.98, 0.99, 1.0, 1.01, 1.02, 1.03)
-
-
-def onset(nu: float) -> tuple[float, float]:
-    """(p0 / Y at first yield, its depth per a) under Hertz's sphere (module docstring)."""
-    z = np.linspace(1e-4, 3.0, 300001)
-    sr = -(1 + nu) * (1 - z * np.arctan(1 / z)) + 0.5 / (1 + z * z)
-    sz = -1 / (1 + z * z)
-    vm = np.abs(sz - sr)
-    k = int(vm.argmax())
-    return 1.0 / float(vm[k]), float(z[k])
 
 
 def run(a_over_r: float, facets: int, flat_size_ratio: float) -> dict:
@@ -91,17 +80,17 @@ def run(a_over_r: float, facets: int, flat_size_ratio: float) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--a-over-r", type=float, nargs="+", default=[0.1, 0.02])
-    ap.add_argument("--facets", type=int, default=12, help="the flat's elements over a")
+    ap.add_argument("--facets", type=int, default=12, help="the sphere's elements over a")
     ap.add_argument("--flat-size-ratio", type=float, default=1.0,
-                    help="the flat's elements at the contact per the sphere's")
+                    help="the flat's elements at the contact per the sphere's (1.0)")
     args = ap.parse_args(argv)
     ratio, depth = onset(0.3)
     print(f"Hertz's onset (nu = 0.3): p0 = {ratio:.4f} Y at {depth:.4f} a")
     print(f"{'a/R':>6} {'dofs':>7} {'no yield at':>11} {'yield at':>9} {'depth/a':>8} "
           f"{'Huber':>6} {'element/a':>9} {'points':>6} {'s':>6}")
     for a_over_r in args.a_over_r:
-        # the flat's elements a/facets: the sphere's a/(facets * flat_size_ratio)
-        r = run(a_over_r, round(args.facets * args.flat_size_ratio), args.flat_size_ratio)
+        # the sphere's elements a/facets, the flat's flat_size_ratio times larger
+        r = run(a_over_r, args.facets, args.flat_size_ratio)
         if "first_yield" not in r:
             print(f"{a_over_r:>6g} {r['dofs']:>7} no yield: {r.get('message', '')}")
             continue

@@ -669,10 +669,11 @@ def examples_indentation() -> str:
     return "\n".join(rows) + "\n"
 
 
-def examples_block_indentation() -> str:
-    """docs/examples.md, Block indentation: ``vfem run block_indentation`` (defaults)."""
-    s = _summary("block_indentation")
-    m = s["block_indentation"]
+def _plastic_indentation(example: str) -> str:
+    """The numbers row of ``vfem run EXAMPLE`` (defaults) for the plastic indentations into a
+    block or a flat (:mod:`vfem_examples.block_indentation`, ``sphere_indentation``)."""
+    s = _summary(example)
+    m = s[example]
     rows = ["| dofs | onset force | Y | no yield at | first yield at | its depth / a (Hertz) "
             "| peak force | depression at the peak | dent | verification |",
             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
@@ -683,6 +684,16 @@ def examples_block_indentation() -> str:
                 f"{m['peak_contact_force']:.4g} | {m['depression_at_peak']:.3g} | "
                 f"{m['dent']:.3g} | {passed} of {len(s['verification'])} passed |")
     return "\n".join(rows) + "\n"
+
+
+def examples_block_indentation() -> str:
+    """docs/examples.md, Block indentation: ``vfem run block_indentation`` (defaults)."""
+    return _plastic_indentation("block_indentation")
+
+
+def examples_sphere_indentation() -> str:
+    """docs/examples.md, Sphere indentation: ``vfem run sphere_indentation`` (defaults)."""
+    return _plastic_indentation("sphere_indentation")
 
 
 def examples_thick_cylinder() -> str:
@@ -726,6 +737,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-indentation": ("docs/examples.md", examples_indentation, False),
     "examples-thick-cylinder": ("docs/examples.md", examples_thick_cylinder, False),
     "examples-block-indentation": ("docs/examples.md", examples_block_indentation, False),
+    "examples-sphere-indentation": ("docs/examples.md", examples_sphere_indentation, False),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
     "patch-thesis": ("docs/examples.md", patch_thesis, False),

@@ -14,7 +14,8 @@ from vfem.io import replot
 
 EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
             "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack",
-            "indentation", "thick_cylinder", "block_indentation")
+            "indentation", "thick_cylinder", "block_indentation",
+            "sphere_indentation")
 
 
 def load(name: str):

@@ -51,7 +51,9 @@ from .indentation import (
     first_yielded,
     load_factors,
     loop_and_onset,
+    loop_figure,
     onset,
+    report_lines,
     summary_of,
 )
 
@@ -200,40 +202,19 @@ def run(p: BlockIndentationParameters, out, on_step=None, figures: bool = True,
 def figures(folder) -> list[Path]:
     """``loop.png``: the contact force against the platen's travel, loading and unloading;
     ``von_mises.png`` at the peak, the block's plastic zone under the contact."""
-    from vfem.io import plots, replot
+    from vfem.io import replot
 
-    s = folder.summary
-    m = s.get("block_indentation")
-    if not folder.has_steps or m is None:
+    drawn = loop_figure(folder, "block_indentation", "block indentation")
+    if drawn is None:
         return []
-    out = folder.directory
-    travel = np.array(m["travel"])
-    force = np.array(m["contact_force"]) / m["onset_force"]
-    plots.history(out / "loop.png", travel, {"contact force / onset force": force},
-                  "platen travel (approach)", "force / onset force",
-                  f"block indentation: loaded to {s['parameters']['overload']:g} times the "
-                  f"onset force and lifted off; dent {m['dent']:.3g}")
-    peak = int(np.argmax(force))
-    a = m["a_peak"]
-    step = folder.steps[min(peak, len(folder.steps) - 1)]
+    step, a = drawn
     vm = replot.von_mises(folder, step, "von_mises.png",
                           "block indentation: von Mises stress at the peak force",
                           window=(0.0, 3.0 * a, -3.0 * a, 0.5 * a))
-    return [out / "loop.png", vm]
+    return [folder.directory / "loop.png", vm]
 
 
 def report(s: dict) -> list[str]:
     """What the CLI prints after the run."""
     m = s.get("block_indentation")
-    if m is None:
-        return []
-    lines = [f"  block indentation: onset force {m['onset_force']:.4g} (Hertz: a = "
-             f"{m['a_onset']:.4g}, p0 = {m['p0_onset']:.4g}, Y = {m['yield_stress']:.4g})"]
-    if "first_yield_force" in m:
-        lines.append(f"  first yield at {m['first_yield_force']:.2f} of it (none at "
-                     f"{m['last_elastic_force']:.2f}), {m['first_yield_depth_over_a']:.3f} a deep "
-                     f"(Hertz: {m['depth_over_a']:.3f} a)")
-    lines.append(f"  peak force {m['peak_contact_force']:.4g}, {max(m['yielded_points'])} points "
-                 f"yielded; depression on the axis {m['depression_at_peak']:.4g} at the peak, "
-                 f"dent {m['dent']:.4g} lifted off to a hundredth of the onset force")
-    return lines
+    return [] if m is None else report_lines(m, "block indentation: onset force")

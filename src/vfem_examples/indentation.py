@@ -123,7 +123,7 @@ def check_loading(p, positive: tuple[str, ...] = ("onset_half_width", "overload"
     if p.overload > MAX_OVERLOAD:
         raise InputError(f"overload must be at most {MAX_OVERLOAD:g} (the loading steps are half "
                          f"the onset force apart up to it), got {p.overload!r}")
-    if p.onset_half_width > 0.05:
+    if getattr(p, "onset_half_width", 0.0) > 0.05:  # (the plane examples')
         raise InputError("onset_half_width must be at most 0.05 (Hertz's half-space holds to "
                          f"about a / 2R), got {p.onset_half_width!r}")
     if isinstance(p.hardening_modulus, bool) or not (
@@ -199,18 +199,20 @@ def build(p: IndentationParameters | None = None) -> Model:
     return config(p).build()
 
 
-def loop_and_onset(result: AnalysisResult, overload: float, th: dict, plastic: str
-                   ) -> tuple[dict, object]:
-    """What this example and :mod:`.block_indentation` read alike from a run: the theory
-    ``th``, the platen's force per onset force, the contact force and the platen's travel at
-    each step, the points of body ``plastic`` yielded, the peak forces, the first step with a
+def loop_and_onset(result: AnalysisResult, overload: float, th: dict, plastic: str,
+                   indenter: str = "cylinder", axis: int = 1) -> tuple[dict, object]:
+    """What this example, :mod:`.block_indentation` and :mod:`.sphere_indentation` read alike
+    from a run: the theory ``th``, the platen's force per onset force, the contact force on
+    the ``indenter`` (its component ``axis``, the platen's) and the platen's travel at each
+    step, the points of body ``plastic`` yielded, the peak forces, the first step with a
     yielded point and the forces either side of the onset; and that first step (None where
     none yielded)."""
     steps = result.steps
     first = next((s for s in steps if s.yielded.get(plastic, 0) > 0), None)
     out = dict(th)
     out["force_over_onset"] = [force_at(s, overload) for s in steps]
-    out["contact_force"] = [float(s.bodies["cylinder"].contact_force[:, 1].sum()) for s in steps]
+    out["contact_force"] = [float(s.bodies[indenter].contact_force[:, axis].sum())
+                            for s in steps]
     out["travel"] = [float(-s.platen_displacement) for s in steps]
     out["yielded_points"] = [int(s.yielded.get(plastic, 0)) for s in steps]
     out["peak_contact_force"] = max(out["contact_force"])
@@ -255,10 +257,12 @@ def summarize(result: AnalysisResult, p: IndentationParameters) -> dict:
     return summary_of("indentation", result, p, evaluate)
 
 
-def summary_of(example: str, result: AnalysisResult, p, evaluate) -> dict:
-    """The ``summary.json`` dictionary of a run of ``example`` (this one or
-    :mod:`.block_indentation`): the steps with the platen's displacement, and where the run
-    converged ``evaluate(result, p)`` under the example's name and its verification."""
+def summary_of(example: str, result: AnalysisResult, p, evaluate,
+               stresses: str = "McEwen's stresses in plane strain") -> dict:
+    """The ``summary.json`` dictionary of a run of ``example`` (this one,
+    :mod:`.block_indentation` or :mod:`.sphere_indentation`): the steps with the platen's
+    displacement, and where the run converged ``evaluate(result, p)`` under the example's name
+    and its verification (:func:`verification` with ``stresses``)."""
     from vfem.io.results import step_record
 
     summary = {
@@ -274,17 +278,18 @@ def summary_of(example: str, result: AnalysisResult, p, evaluate) -> dict:
     }
     if result.converged:
         summary[example] = m = evaluate(result, p)
-        summary["verification"] = verification(m, result.model.contact)
+        summary["verification"] = verification(m, result.model.contact, stresses)
     return summary
 
 
-def verification(m: dict, settings) -> list[dict]:
+def verification(m: dict, settings, stresses: str = "McEwen's stresses in plane strain"
+                 ) -> list[dict]:
     """The indentation's checks (``summary.json``'s ``verification``): the load at first yield
-    against Hertz's onset, the depth of the first yielded points against McEwen's, the
-    platen's force at the peak."""
+    against Hertz's onset, the depth of the first yielded points against the onset's depth
+    under Hertz's pressure (``stresses``: whose), the platen's force at the peak."""
     from vfem.io.verification import check, platen
 
-    source = (f"Hertz, McEwen's stresses in plane strain: p0 = {m['p0_over_Y']:.3f} Y at "
+    source = (f"Hertz, {stresses}: p0 = {m['p0_over_Y']:.3f} Y at "
               f"{m['depth_over_a']:.3f} a")
     records = []
     if "first_yield_force" in m:
@@ -351,4 +356,39 @@ def report(s: dict) -> list[str]:
     lines.append(f"  peak force {m['peak_contact_force']:.4g}, {max(m['yielded_points'])} points "
                  f"yielded; lifted off to a hundredth of the onset force: residual approach "
                  f"{m['residual_approach']:.4g}")
+    return lines
+
+
+def loop_figure(folder, example: str, label: str):
+    """``loop.png`` of a plastic indentation's results folder (this example's,
+    :mod:`.block_indentation`'s, :mod:`.sphere_indentation`'s): the contact force per onset
+    force against the platen's travel, loading and unloading. Returns the peak step's frames
+    and the peak's contact radius, or None where the run left no steps or no summary of it."""
+    from vfem.io import plots
+
+    s = folder.summary
+    m = s.get(example)
+    if not folder.has_steps or m is None:
+        return None
+    travel = np.array(m["travel"])
+    force = np.array(m["contact_force"]) / m["onset_force"]
+    plots.history(folder.directory / "loop.png", travel, {"contact force / onset force": force},
+                  "platen travel (approach)", "force / onset force",
+                  f"{label}: loaded to {s['parameters']['overload']:g} times the "
+                  f"onset force and lifted off; dent {m['dent']:.3g}")
+    return folder.steps[min(int(np.argmax(force)), len(folder.steps) - 1)], m["a_peak"]
+
+
+def report_lines(m: dict, label: str, reference: str = "Hertz") -> list[str]:
+    """What the CLI prints after a plastic indentation into a block or a flat (``label`` its
+    first words, ``reference`` whose onset depth)."""
+    lines = [f"  {label} {m['onset_force']:.4g} (Hertz: a = {m['a_onset']:.4g}, "
+             f"p0 = {m['p0_onset']:.4g}, Y = {m['yield_stress']:.4g})"]
+    if "first_yield_force" in m:
+        lines.append(f"  first yield at {m['first_yield_force']:.2f} of it (none at "
+                     f"{m['last_elastic_force']:.2f}), {m['first_yield_depth_over_a']:.3f} a deep "
+                     f"({reference}: {m['depth_over_a']:.3f} a)")
+    lines.append(f"  peak force {m['peak_contact_force']:.4g}, {max(m['yielded_points'])} points "
+                 f"yielded; depression on the axis {m['depression_at_peak']:.4g} at the peak, "
+                 f"dent {m['dent']:.4g} lifted off to a hundredth of the onset force")
     return lines

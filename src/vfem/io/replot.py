@@ -604,26 +604,34 @@ def _cell_field(frame: BodyFrame, name: str) -> np.ndarray:
     return np.asarray(frame.cell_data[name], dtype=float)
 
 
-def plane_section(frame: BodyFrame, axis: int, at: float
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def plane_section(frame: BodyFrame, axis: int, at: float, cell_field: str | None = None
+                  ) -> tuple:
     """A 3D body's faces that lie in the plane ``x[axis] = at`` (a symmetry plane of its
     model), for drawing as a 2D mesh: (points (n, 2), faces (m, k), displacement (n, 2)), the
-    two other coordinates in order (y = 0: x and z). Linear cells (tetrahedra, hexahedra)."""
+    two other coordinates in order (y = 0: x and z). Linear cells (tetrahedra, hexahedra).
+    With ``cell_field``, a fourth: that cell field of the VTU at each face's cell (m,)."""
     cells = np.asarray(frame.polygons)
     faces = figures3d.CELL_FACES.get(cells.shape[1])  # VTK's faces of the linear cells
     keep = [a for a in range(3) if a != axis]
     if faces is None or not len(cells):
-        return np.zeros((0, 2)), np.zeros((0, 3), dtype=int), np.zeros((0, 2))
+        empty = np.zeros((0, 2)), np.zeros((0, 3), dtype=int), np.zeros((0, 2))
+        return empty if cell_field is None else (*empty, np.zeros(0))
     x = frame.points
     tol = 1e-9 * max(float(np.ptp(x, axis=0).max()), 1e-300)
     on = np.abs(x[:, axis] - at) <= tol
-    found = []
+    found, owner = [], []
     for face in faces:
         f = cells[:, face]
-        found.append(f[on[f].all(axis=1)])
-    chosen = np.unique(np.sort(np.vstack(found), axis=1), axis=0, return_index=True)[1]
-    f = np.vstack(found)[np.sort(chosen)]
-    return x[:, keep], f, frame.displacement[:, keep]
+        inside = on[f].all(axis=1)
+        found.append(f[inside])
+        owner.append(np.flatnonzero(inside))
+    chosen = np.sort(np.unique(np.sort(np.vstack(found), axis=1), axis=0,
+                               return_index=True)[1])
+    f = np.vstack(found)[chosen]
+    out = x[:, keep], f, frame.displacement[:, keep]
+    if cell_field is None:
+        return out
+    return *out, _cell_field(frame, cell_field)[np.concatenate(owner)[chosen]]
 
 
 def magnification_for(steps: list[Step]) -> float:
