@@ -347,16 +347,10 @@ def report(s: dict) -> list[str]:
     m = s.get("indentation")
     if m is None:
         return []
-    lines = [f"  indentation: onset force {m['onset_force']:.4g} (Hertz: a = "
-             f"{m['a_onset']:.4g}, p0 = {m['p0_onset']:.4g}, Y = {m['yield_stress']:.4g})"]
-    if "first_yield_force" in m:
-        lines.append(f"  first yield at {m['first_yield_force']:.2f} of it (none at "
-                     f"{m['last_elastic_force']:.2f}), {m['first_yield_depth_over_a']:.3f} a deep "
-                     f"(Hertz: {m['depth_over_a']:.3f} a)")
-    lines.append(f"  peak force {m['peak_contact_force']:.4g}, {max(m['yielded_points'])} points "
-                 f"yielded; lifted off to a hundredth of the onset force: residual approach "
-                 f"{m['residual_approach']:.4g}")
-    return lines
+    return report_lines(m, "indentation: onset force", closing=(
+        f"  peak force {m['peak_contact_force']:.4g}, {max(m['yielded_points'])} points "
+        f"yielded; lifted off to a hundredth of the onset force: residual approach "
+        f"{m['residual_approach']:.4g}"))
 
 
 def loop_figure(folder, example: str, label: str):
@@ -379,16 +373,19 @@ def loop_figure(folder, example: str, label: str):
     return folder.steps[min(int(np.argmax(force)), len(folder.steps) - 1)], m["a_peak"]
 
 
-def report_lines(m: dict, label: str, reference: str = "Hertz") -> list[str]:
-    """What the CLI prints after a plastic indentation into a block or a flat (``label`` its
-    first words, ``reference`` whose onset depth)."""
+def report_lines(m: dict, label: str, reference: str = "Hertz", closing: str | None = None
+                 ) -> list[str]:
+    """What the CLI prints after a plastic indentation (``label`` its first words,
+    ``reference`` whose onset depth; ``closing`` the last line, by default the peak and the
+    dent into a block or a flat)."""
     lines = [f"  {label} {m['onset_force']:.4g} (Hertz: a = {m['a_onset']:.4g}, "
              f"p0 = {m['p0_onset']:.4g}, Y = {m['yield_stress']:.4g})"]
     if "first_yield_force" in m:
         lines.append(f"  first yield at {m['first_yield_force']:.2f} of it (none at "
                      f"{m['last_elastic_force']:.2f}), {m['first_yield_depth_over_a']:.3f} a deep "
                      f"({reference}: {m['depth_over_a']:.3f} a)")
-    lines.append(f"  peak force {m['peak_contact_force']:.4g}, {max(m['yielded_points'])} points "
-                 f"yielded; depression on the axis {m['depression_at_peak']:.4g} at the peak, "
-                 f"dent {m['dent']:.4g} lifted off to a hundredth of the onset force")
+    lines.append(closing or (
+        f"  peak force {m['peak_contact_force']:.4g}, {max(m['yielded_points'])} points "
+        f"yielded; depression on the axis {m['depression_at_peak']:.4g} at the peak, "
+        f"dent {m['dent']:.4g} lifted off to a hundredth of the onset force"))
     return lines
