@@ -14,9 +14,10 @@ first point yields when p0 = 1.613 Y. The yield stress is set so that this happe
 whose Hertz radius is ``onset_contact_radius`` R (the *onset force*; the mesh's a is that
 force's); the platen's force rises to it in steps of 1 % of it near it, on to ``overload`` times
 it (whose contact radius the fine zone still covers: overload^(1/3) < 1.2), and falls back to
-a hundredth of it. Why a = 0.05 R: Hertz's half-space holds for a << R, and the sphere's onset
-measured on this mesh (``benchmarks/sphere_onset.py``, the flat's elements 0.217 a) came at
-0.94-0.96 of Hertz's with a = 0.1 R, 0.97-0.98 with 0.05 R, 0.96-0.97 with 0.02 R.
+a hundredth of it. Why a = 0.05 R: Hertz's half-space holds for a << R; the sphere's onset
+measured on this mesh (``benchmarks/sphere_onset.py``, the flat's elements 0.217 a, its state
+at their Gauss points: :func:`vfem.nonlinear.gauss_rule`) came at 0.99-1.00 of Hertz's with
+a = 0.1 R and 1.00-1.01 with 0.05 R.
 
 **Verification** (``summary.json``, the screen): the first step with a yielded point against
 Hertz's onset (within 2 %, issue 41's bound; the steps 1 % apart bracket it); the mean depth of

@@ -174,17 +174,15 @@ def _plastic_radii(result: AnalysisResult) -> list[float | None]:
     return out
 
 
-def _first_yield(result: AnalysisResult) -> float:
-    """The first-yield pressure from the first (elastic) step: its pressure times Y over the
-    elastic solution's largest von Mises stress (with sigma_zz), read at the quadrature points
-    of the wall and of its boundary (the peak is on the bore, which the wall's Gauss points,
-    a ninth of an element inside, read about 2 h/9a low: 0.8 % with h = a/24)."""
+def peak_von_mises(nl, displacement: np.ndarray) -> float:
+    """The largest von Mises stress (with sigma_zz) of a plane-strain Newton body ``nl``'s law
+    answering ``displacement`` from the virgin state, read at its Gauss points and at its
+    boundary's (the elastic solution's peak may be on the boundary, as on the bore, which the
+    nearest Gauss points, a ninth of an element inside, read about 2 h / 9a low: 0.8 % with
+    h = a/24)."""
     from skfem import ElementVector, FacetBasis
 
-    body = result.model.bodies[0]
-    nl = body.mechanics.nonlinear
-    step = result.steps[0]
-    u = np.ravel(step.bodies[body.name].displacement)
+    u = np.ravel(displacement)
     peak = 0.0
     for basis in (nl.basis0, FacetBasis(nl.mesh, ElementVector(nl.mesh.elem()))):
         g = basis.interpolate(u).grad
@@ -194,7 +192,17 @@ def _first_yield(result: AnalysisResult) -> float:
         vm = np.sqrt(0.5 * ((s[0, 0] - s[1, 1]) ** 2 + (s[1, 1] - szz) ** 2
                             + (szz - s[0, 0]) ** 2) + 3.0 * s[0, 1] ** 2)
         peak = max(peak, float(vm.max()))
-    return step.load_factor * nl.material.yield_stress / peak
+    return peak
+
+
+def _first_yield(result: AnalysisResult) -> float:
+    """The first-yield pressure from the first (elastic) step: its pressure times Y over the
+    elastic solution's largest von Mises stress (:func:`peak_von_mises`)."""
+    body = result.model.bodies[0]
+    nl = body.mechanics.nonlinear
+    step = result.steps[0]
+    return step.load_factor * nl.material.yield_stress / peak_von_mises(
+        nl, step.bodies[body.name].displacement)
 
 
 def evaluate(result: AnalysisResult, p: ThickCylinderParameters) -> dict:
