@@ -429,6 +429,30 @@ def examples_wedge_coarse() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_sliding() -> str:
+    """docs/examples.md, Sliding: the frictionless slide (``vfem run sliding``)."""
+    s = _summary("sliding", "--no-figures")
+    e = s["sliding"]
+    steps = s["steps"]
+    mean = abs(e["normal_reaction_mean"])
+    return "\n".join([
+        "| quantity | value |", "|---|---|",
+        f"| steps converged | {sum(x['converged'] for x in steps)} of {len(steps)}, "
+        f"{sum(x['iterations'] for x in steps)} contact iterations, "
+        f"{sum(x['cuts'] for x in steps)} step cuts |",
+        f"| normal reaction, mean over the steady slide ({e['steady_steps']} steps) | "
+        f"{mean:.3f} |",
+        f"| its largest deviation from the mean | "
+        f"{100 * e['normal_reaction_max_deviation']:.3f} % (acceptance: 2 %) |",
+        f"| tangential reaction, largest | {e['tangential_reaction_max']:.1e} "
+        f"({e['tangential_reaction_max'] / mean:.1e} of the normal one) |",
+        f"| largest residual penetration of the block's nodes | "
+        f"{e['largest_residual_penetration']:.1e} (tolerance {e['penetration_tolerance']:.1e}) |",
+        f"| largest penetration of any node of either body, deformed surfaces | "
+        f"{e['largest_penetration_any_node']:.1e} |",
+    ]) + "\n"
+
+
 def examples_sliding_friction() -> str:
     """docs/examples.md, Sliding: the slide with friction (``vfem run sliding --set
     friction=0.3``)."""
@@ -727,6 +751,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-cattaneo": ("docs/examples.md", examples_cattaneo, False),
     "examples-wedge": ("docs/examples.md", examples_wedge, False),
     "examples-wedge-coarse": ("docs/examples.md", examples_wedge_coarse, True),
+    "examples-sliding": ("docs/examples.md", examples_sliding, False),
     "examples-sliding-friction": ("docs/examples.md", examples_sliding_friction, False),
     "examples-sphere": ("docs/examples.md", examples_sphere, False),
     "examples-sphere-study": ("docs/examples.md", examples_sphere_study, False),
