@@ -359,7 +359,8 @@ def test_a_2d_file_in_a_3d_model(tmp_path, capsys):
         '[[bodies]]\nname = "box"\n[bodies.mesh]\nshape = "box"\nz0 = 1.5\n'
         '[bodies.material]\nyoungs_modulus = 1.0\npoissons_ratio = 0.3\n'
         '[[bodies.supports]]\nboundary = "top"\n'))
-    refused(capsys, model, "bodies must all be 2D or all 3D", "'block' 2D", "'box' 3D")
+    refused(capsys, model, "bodies must all be plane strain or all plane stress or all "
+            "axisymmetric or all 3D", "'block' plane strain", "'box' 3D")
 
 
 def test_read_mesh_names_file_group_and_type(tmp_path):

@@ -310,8 +310,9 @@ def test_a_model_of_2d_and_3d_bodies_is_refused():
                 supports=(Support("bottom"),))
     solid = Body("solid", box(0.0, 0.0, 0.0, 1.0, 1.0, 1.0), LinearElastic(E, NU),
                  supports=(Support("bottom"),))
-    with pytest.raises(InputError, match=r"its bodies must all be 2D or all 3D, got 'flat' "
-                                         r"2D, 'solid' 3D"):
+    with pytest.raises(InputError, match=r"its bodies must all be plane strain or all plane "
+                                         r"stress or all axisymmetric or all 3D, got 'flat' "
+                                         r"plane strain, 'solid' 3D"):
         Model("mixed", [flat, solid], contact_pairs=()).validate()
 
 

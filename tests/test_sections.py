@@ -137,7 +137,7 @@ def test_a_body_is_given_its_section_by_its_plane_and_its_mesh(deep):
 def test_a_plane_that_names_no_section_is_refused_naming_the_sections():
     text = pushed().replace("poissons_ratio = 0.3", 'poissons_ratio = 0.3\nplane = "deep"', 1)
     with pytest.raises(InputError, match=r"body 'lower', material: plane must be 'strain' or "
-                                         r"'stress', got 'deep'"):
+                                         r"'stress' or 'axisymmetric', got 'deep'"):
         built(text)
 
 

@@ -41,6 +41,10 @@ class BodyStepResult:
     #: (:meth:`Body.boundary_reactions`: a shared corner dof counts in each boundary constraining
     #: it; the body's total, ``reaction.sum(axis=0)``, counts it once)
     reactions: dict[str, tuple[float, ...]] = field(default_factory=dict)
+    #: the components of the forces whose sums are the body's resultants (its section's
+    #: :attr:`~vfem.bodies.section.Section.resultant`; None: all): what ``reaction_imbalance``
+    #: reads (a body of revolution's radial forces cancel round the ring)
+    resultant_components: tuple[int, ...] | None = None
     #: (dim,) resultant (x, y[, z]) of the body's applied loads (its tractions) at the step's
     #: load factor
     applied_load: np.ndarray | None = None
@@ -87,4 +91,5 @@ def add_reactions(body: Body, r: BodyStepResult, load_factor: float) -> BodyStep
     r.reaction = nodal.reshape(-1, dim)
     r.reactions = body.boundary_reactions(nodal)
     r.applied_load = body.applied_load(load_factor).reshape(-1, dim).sum(axis=0)
+    r.resultant_components = body.section.resultant
     return r

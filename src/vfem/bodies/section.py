@@ -42,6 +42,9 @@ from skfem.models.elasticity import linear_elasticity
 from ..errors import InputError
 from .assembly import elasticity_stiffness
 from .stresses import (
+    axisymmetric_average_strain_operator,
+    axisymmetric_max_strain,
+    axisymmetric_small_strain_stress,
     plane_average_strain_operator,
     plane_max_strain,
     plane_small_strain_stress,
@@ -61,10 +64,16 @@ class Section(Protocol):
 
     #: ``"plane strain"``, ``"plane stress"``, ``"3D"``: in messages
     name: str
-    #: the bodies of one model share it: ``"2D"`` or ``"3D"``
+    #: the bodies of one model share it (issue 42: all plane strain, all plane stress, all
+    #: axisymmetric or all 3D): ``"plane strain"``, ``"plane stress"``, ``"axisymmetric"``,
+    #: ``"3D"``
     space: str
     #: whether large kinematics (:mod:`vfem.nonlinear`) has this section
     takes_large: bool
+    #: the force components whose sum over a body's nodes is a resultant the body must balance
+    #: (None: all; a body of revolution's axial one alone, its radial forces cancelling round
+    #: the ring)
+    resultant: tuple[int, ...] | None
     #: whether its small strain is sym(∇u) alone (a body of revolution's also has u_r / r):
     #: what the strain warning's screen bounds (:func:`~.stresses.strain_beyond`)
     strain_is_gradient: bool
@@ -77,6 +86,11 @@ class Section(Protocol):
     def facet_mass(self, x: np.ndarray, facets: np.ndarray) -> np.ndarray:
         """(nf, k, k): ∫φφᵀ times the weight over each straight facet of ``k`` nodes of a 2D
         boundary (positions ``x`` (n, 2))."""
+        ...
+
+    def not_surface(self, mesh, facets: np.ndarray) -> np.ndarray:
+        """(len(facets),) which of the mesh's boundary ``facets`` are not the body's surface,
+        and so can touch nothing (a body of revolution's axis); none elsewhere."""
         ...
 
     def basis(self, body) -> Basis | None:
@@ -112,7 +126,8 @@ class Section(Protocol):
 class _Plane:
     """A 2D section of measure 1 (plane strain or plane stress): what they share."""
 
-    space = "2D"
+    resultant = None
+
     strain_is_gradient = True
 
     def __repr__(self) -> str:
@@ -120,6 +135,9 @@ class _Plane:
 
     def weight(self, x):
         return 1.0
+
+    def not_surface(self, mesh, facets):
+        return np.zeros(len(facets), dtype=bool)
 
     def facet_mass(self, x, facets):
         L = np.linalg.norm(x[facets[:, 1]] - x[facets[:, 0]], axis=1)
@@ -152,6 +170,7 @@ class PlaneStrain(_Plane):
 
     name = "plane strain"
     plane = "strain"
+    space = "plane strain"
     takes_large = True
 
     @staticmethod
@@ -168,6 +187,7 @@ class PlaneStress(_Plane):
 
     name = "plane stress"
     plane = "stress"
+    space = "plane stress"
     takes_large = False
 
     @staticmethod
@@ -183,6 +203,7 @@ class Solid:
 
     name = "3D"
     space = "3D"
+    resultant = None
     takes_large = True
     strain_is_gradient = True
 
@@ -191,6 +212,9 @@ class Solid:
 
     def weight(self, x):
         return 1.0
+
+    def not_surface(self, mesh, facets):
+        return np.zeros(len(facets), dtype=bool)
 
     def facet_mass(self, x, facets):
         raise NotImplementedError("a 3D body's boundary is a surface: no facet mass of lines")
@@ -233,8 +257,92 @@ class Solid:
         return material.plane_strain_modulus()  # E / (1 - nu^2)
 
 
+class Axisymmetric(_Plane):
+    """A body of revolution about the y axis (issue 42): its mesh is the r-z half-plane,
+    x = r >= 0 and y = z, every field independent of the angle and without twist. The strain
+    has the hoop component u_r / r beside sym(grad u), and every integral the measure 2 pi r
+    (the weight: per **full circle**, as Abaqus's and CalculiX's axisymmetric elements read
+    their concentrated loads: a platen's force, a reaction, a contact force is the ring's
+    whole force). Stresses: sxx = s_rr, syy = s_zz, sxy = s_rz and szz the hoop stress
+    s_tt (the third direction's, as plane strain's szz is). The only rigid motion is along the
+    axis; the material's Lamé constants are its 3D ones, and Hertz's modulus E / (1 - nu^2)."""
+
+    name = "axisymmetric"
+    plane = "axisymmetric"
+    space = "axisymmetric"
+    resultant = (1,)  # along the axis: the radial forces of a ring cancel round it
+    takes_large = False
+    strain_is_gradient = False  # the hoop strain u_r / r too
+
+    def weight(self, x):
+        return 2.0 * np.pi * np.asarray(x)[0]
+
+    def not_surface(self, mesh, facets):
+        # a facet on the axis (both ends at r = 0, to round-off of the mesh's size) bounds the
+        # r-z section but not the body: it has no area (2 pi r = 0) and touches nothing
+        span = float(np.ptp(mesh.p, axis=1).max())
+        return np.all(np.abs(mesh.p[0, mesh.facets[:, facets]]) <= 1e-12 * span, axis=0)
+
+    def facet_mass(self, x, facets):
+        # ∫ φ_a φ_b 2πr ds over each straight facet: r is linear along it, so three Gauss
+        # points are exact for the 2-node (cubic) and the 3-node (quintic) facets
+        t, wt = np.polynomial.legendre.leggauss(3)
+        t, wt = 0.5 * (t + 1.0), 0.5 * wt
+        if facets.shape[1] == 2:
+            phi = np.stack([1.0 - t, t])
+        else:
+            phi = np.stack([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])
+        ends = x[facets[:, :2]]  # (nf, 2, 2)
+        L = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+        r = ends[:, 0, 0][:, None] * (1 - t)[None] + ends[:, 1, 0][:, None] * t[None]
+        w = 2.0 * np.pi * r * wt[None] * L[:, None]  # (nf, q)
+        return np.einsum("aq,bq,fq->fab", phi, phi, w)
+
+    def stiffness(self, body, lam, mu):
+        return asm(_axisymmetric_elasticity(lam, mu), body.basis).tocsr()
+
+    def average_strain_operator(self, body):
+        return axisymmetric_average_strain_operator(body)
+
+    def stress(self, body, u):
+        return axisymmetric_small_strain_stress(body, u)
+
+    def max_strain(self, body, u):
+        return axisymmetric_max_strain(body, u)
+
+    def rigid_modes(self, points):
+        x, y = points
+        return {"translation along the axis (y)": np.column_stack([0 * x, np.ones_like(y)])}
+
+    def contact_modulus(self, material):
+        E, nu = material.youngs_modulus, material.poissons_ratio
+        return E / (1.0 - nu**2)
+
+
+def _axisymmetric_elasticity(lam: float, mu: float):
+    """The bilinear form of isotropic linear elasticity on a body of revolution: ∫ (lam
+    tr e(u) tr e(v) + 2 mu e(u) : e(v)) 2 pi r dA, e = (du_r/dr, du_z/dz, u_r / r and the
+    shear (du_r/dz + du_z/dr) / 2, which counts twice in e : e)."""
+    from skfem import BilinearForm
+
+    def strains(f, r):
+        g = f.grad
+        return g[0, 0], g[1, 1], f[0] / r, 0.5 * (g[0, 1] + g[1, 0])
+
+    @BilinearForm
+    def form(u, v, w):
+        r = w.x[0]
+        a, b = strains(u, r), strains(v, r)
+        tra, trb = a[0] + a[1] + a[2], b[0] + b[1] + b[2]
+        return 2.0 * np.pi * r * (lam * tra * trb + 2.0 * mu * (
+            a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + 2.0 * a[3] * b[3]))
+
+    return form
+
+
 #: The 2D sections by the material's ``plane`` name
-SECTIONS: dict[str, Section] = {s.plane: s for s in (PlaneStrain(), PlaneStress())}
+SECTIONS: dict[str, Section] = {s.plane: s for s in (PlaneStrain(), PlaneStress(),
+                                                      Axisymmetric())}
 #: A 3D body's section
 SOLID: Section = Solid()
 #: The spaces a model's bodies may share, in the order messages name them
@@ -264,5 +372,5 @@ def section_of(body) -> Section:
     return SECTIONS[plane]
 
 
-__all__ = ["SECTIONS", "SOLID", "SPACES", "PlaneStrain", "PlaneStress", "Section", "Solid",
-           "check_plane", "section_of"]
+__all__ = ["SECTIONS", "SOLID", "SPACES", "Axisymmetric", "PlaneStrain", "PlaneStress",
+           "Section", "Solid", "check_plane", "section_of"]

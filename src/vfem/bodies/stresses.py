@@ -145,6 +145,69 @@ def solid_average_strain_operator(body):
     return op
 
 
+def axisymmetric_average_strain_operator(body):
+    """:func:`average_strain_operator` of a body of revolution (4 nelems x ndofs): exx (e_rr),
+    eyy (e_zz), exy (e_rz) and the hoop strain e_tt = u_r / r, each element's average over its
+    volume (the weight 2 pi r)."""
+    cached = body.__dict__.get("_average_strain")
+    if cached is not None and cached[0] is body.basis:
+        return cached[1]
+    import scipy.sparse as sp
+
+    basis = body.basis
+    r = basis.mapping.F(basis.X)[0]  # (element, quadrature point)
+    w = basis.dx * r
+    total = w.sum(axis=1)
+    nel = basis.nelems
+    rows, cols, vals = [], [], []
+    elements = np.arange(nel)
+    for i in range(basis.Nbfun):
+        c = i % 2  # ElementVector: shape function i moves component i % 2
+        f = basis.basis[i][0]
+        avg = (f.grad[c] * w[None]).sum(axis=2) / total[None]  # (derivative, element)
+        dofs = basis.element_dofs[i]
+        rows += [c * nel + elements, 2 * nel + elements]
+        cols += [dofs, dofs]
+        vals += [avg[c], 0.5 * avg[1 - c]]
+        if c == 0:  # the hoop strain u_r / r
+            rows.append(3 * nel + elements)
+            cols.append(dofs)
+            vals.append((np.asarray(f)[0] / r * w).sum(axis=1) / total)
+    op = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                       shape=(4 * nel, basis.N))
+    body.__dict__["_average_strain"] = (basis, op)
+    return op
+
+
+def axisymmetric_small_strain_stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`plane_small_strain_stress` of a body of revolution: sxx (s_rr), syy (s_zz),
+    sxy (s_rz) and szz the hoop stress s_tt, from the elements' average strains."""
+    lam, mu = body.material.lame()
+    nel = body.mesh.nelements
+    e = axisymmetric_average_strain_operator(body) @ np.asarray(u, dtype=float)
+    err, ezz, erz, ett = e.reshape(4, nel)
+    tr = err + ezz + ett
+    avg = {"sxx": 2 * mu * err + lam * tr, "syy": 2 * mu * ezz + lam * tr, "sxy": 2 * mu * erz,
+           "szz": 2 * mu * ett + lam * tr}
+    return _with_von_mises(avg)
+
+
+def axisymmetric_max_strain(body, u: np.ndarray) -> tuple[float, int]:
+    """:func:`max_strain` of a body of revolution: the largest absolute principal strain of
+    the in-plane tensor and the hoop strain u_r / r at every quadrature point."""
+    basis = body.basis
+    f = basis.interpolate(np.asarray(u, dtype=float))
+    g = f.grad
+    r = basis.mapping.F(basis.X)[0]
+    exx, eyy, exy = g[0, 0], g[1, 1], 0.5 * (g[0, 1] + g[1, 0])
+    in_plane = np.abs(0.5 * (exx + eyy)) + np.sqrt((0.5 * (exx - eyy)) ** 2 + exy**2)
+    per_element = np.maximum(in_plane, np.abs(np.asarray(f)[0] / r)).max(axis=1)
+    if not per_element.size:
+        return 0.0, 0
+    element = int(np.argmax(per_element))
+    return float(per_element[element]), element
+
+
 def max_strain(body, u: np.ndarray) -> tuple[float, int]:
     """The largest strain of displacement ``u`` (ndofs) as small kinematics reads it: the
     largest absolute principal value of the in-plane small-strain tensor sym(grad u)
@@ -392,6 +455,8 @@ def _with_von_mises(avg: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return avg
 
 
-__all__ = ["cauchy_stress", "max_strain", "plane_average_strain_operator", "plane_max_strain",
+__all__ = ["axisymmetric_average_strain_operator", "axisymmetric_max_strain",
+           "axisymmetric_small_strain_stress", "cauchy_stress", "max_strain",
+           "plane_average_strain_operator", "plane_max_strain",
            "plane_small_strain_stress", "small_strain_stress", "solid_average_strain_operator",
            "solid_max_strain", "solid_small_strain_stress", "stress"]

@@ -14,7 +14,7 @@ from ..materials import LAWS
 from ..mesh.checks import check_mesh
 from .discretisation import COMPONENTS, MESHES
 from .loads import _shown, check_amplitude, constraints
-from .section import SECTIONS, check_plane, section_of
+from .section import SECTIONS, SOLID, check_plane, section_of
 
 
 def _named_first(null: np.ndarray) -> np.ndarray:
@@ -59,7 +59,9 @@ def validate(body) -> None:
         taken = [s.name for s in SECTIONS.values() if s.takes_large]
         raise InputError(f"{where}: large kinematics ({body.kinematics!r}) needs linear "
                          "elements (order 1)"
-                         + ("" if section.space != "2D" else f" and {' or '.join(taken)}"))
+                         + ("" if section is SOLID else f" and {' or '.join(taken)}"))
+    if section.name == "axisymmetric":
+        check_axisymmetric(body, where)
     names = set((body.mesh.boundaries or {}).keys())
     for bc in (*body.supports, *body.prescribed, *body.tractions,
                *((body.platen,) if body.platen else ()), *(body.contact_boundaries or ())):
@@ -119,6 +121,22 @@ def check_supports(body) -> None:
     validate(body)
     constraints(body)
     check_supported(body)
+
+
+def check_axisymmetric(body, where: str) -> None:
+    """What a body of revolution needs (issue 42): its mesh in the r-z half-plane (x = r >= 0,
+    to round-off of its size) and small kinematics with a material without state (the
+    Newton bodies, plastic or large, are plane strain or 3D as yet)."""
+    x = body.mesh.p[0]
+    span = float(np.ptp(body.mesh.p, axis=1).max()) if x.size else 0.0
+    if x.size and x.min() < -1e-12 * span:
+        node = int(np.argmin(x))
+        raise InputError(f"{where}: an axisymmetric body's mesh lies in the r-z half-plane, "
+                         f"x = r >= 0 (the axis is x = 0), but node {node} is at x = "
+                         f"{x[node]:.6g}")
+    if body.material.carries_state:
+        raise InputError(f"{where}: axisymmetric bodies are linear elastic as yet; a plastic "
+                         "material needs plane strain, plane stress or 3D")
 
 
 def rigid_modes(body) -> dict[str, np.ndarray]:

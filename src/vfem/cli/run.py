@@ -213,6 +213,9 @@ def run_input_file(args) -> int:
     if not args.quiet:
         print(f"vfem: {config.name} ({args.example}), {len(factors)} "
               f"step{'s' if len(factors) > 1 else ''}, results in {out}/", flush=True)
+        if any(b.section.name == "axisymmetric" for b in model.bodies):
+            print("vfem: axisymmetric bodies (x = r, y = z): forces, reactions and contact "
+                  "forces are per full circle (the ring's whole force, 2 pi r ds)", flush=True)
     progress = Progress(factors, not args.quiet)
     return _solve_and_report(
         lambda: runner.run(config, out, model=model, on_step=progress, source=args.example,

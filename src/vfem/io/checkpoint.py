@@ -38,7 +38,8 @@ from ..solver import BodyStepResult, Checkpoint, Model, StepResult
 FOLDER = "checkpoint"
 #: the array fields of a body's step results (the per-boundary reaction totals, a dict, go into
 #: the JSON text)
-_FIELDS = [f.name for f in dataclasses.fields(BodyStepResult) if f.name != "reactions"]
+_FIELDS = [f.name for f in dataclasses.fields(BodyStepResult)
+           if f.name not in ("reactions", "resultant_components")]
 
 
 def fingerprint(model: Model) -> str:
@@ -273,7 +274,8 @@ def _step(meta: dict, arrays: dict[str, np.ndarray], model: Model,
     step.bodies = {b.name: BodyStepResult(**{f: arrays[f"field_{i}_{f}"] for f in _FIELDS
                                                 if f"field_{i}_{f}" in arrays},
                                           reactions={k: tuple(v) for k, v in
-                                                     reactions.get(b.name, {}).items()})
+                                                     reactions.get(b.name, {}).items()},
+                                          resultant_components=b.section.resultant)
                    for i, b in enumerate(model.bodies)}
     return step
 

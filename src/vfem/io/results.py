@@ -534,12 +534,16 @@ def total(force: np.ndarray) -> list[float]:
     return [float(force[:, c].sum()) for c in range(force.shape[1])]
 
 
-def imbalance(contact: list[float], reaction: list[float], applied: list[float]) -> float:
-    """``|contact + reaction + applied| / |contact|`` for a body's resultant forces (x, y): 0
-    when the body is in equilibrium. Without contact force, relative to the larger of the
-    other two (0 when all three are zero)."""
+def imbalance(contact: list[float], reaction: list[float], applied: list[float],
+              components: tuple[int, ...] | None = None) -> float:
+    """``|contact + reaction + applied| / |contact|`` for a body's resultant forces (x, y), of
+    ``components`` alone if given (a body of revolution's axial one): 0 when the body is in
+    equilibrium. Without contact force, relative to the larger of the other two (0 when all
+    three are zero)."""
     c, r, a = (np.asarray(v, dtype=float) for v in (contact, reaction, applied))
     scale = float(np.linalg.norm(c)) or max(float(np.linalg.norm(r)), float(np.linalg.norm(a)))
+    if components is not None:  # (the scale: every component, the forces the body carries)
+        c, r, a = (v[list(components)] for v in (c, r, a))
     return float(np.linalg.norm(c + r + a)) / scale if scale > 0 else 0.0
 
 
@@ -555,7 +559,10 @@ def force_record(step: StepResult) -> dict:
     dof once, each boundary sums the dofs its own conditions constrain, see
     :attr:`vfem.bodies.results.BodyStepResult.reactions`); ``applied_load`` the resultant of its
     tractions at the step's load factor; ``reaction_imbalance``: :func:`imbalance` of the three,
-    which balance (0 up to the solver's residual). The last three leave out a body whose
+    which balance (0 up to the solver's residual); ``resultant_components``, for the bodies
+    whose sums of some components are no resultants (a body of revolution's radial forces
+    cancel round the ring), the components that are (absent otherwise). The last three
+    leave out a body whose
     reactions were not computed (a step read back from an older checkpoint)."""
     out: dict = {"contact_force": {name: total(r.contact_force)
                                    for name, r in step.bodies.items()},
@@ -570,7 +577,10 @@ def force_record(step: StepResult) -> dict:
                                   "boundaries": {k: [float(v) for v in xy]
                                                  for k, xy in r.reactions.items()}}
         out["applied_load"][name] = applied
-        out["reaction_imbalance"][name] = imbalance(contact, reaction, applied)
+        out["reaction_imbalance"][name] = imbalance(contact, reaction, applied,
+                                                    r.resultant_components)
+        if r.resultant_components is not None:  # a body of revolution: its axial force alone
+            out.setdefault("resultant_components", {})[name] = list(r.resultant_components)
     return out
 
 

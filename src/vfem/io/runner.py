@@ -188,6 +188,9 @@ def balance_line(steps: list[dict]) -> str:
             c = np.asarray((x.get("contact_force") or {}).get(name, none), dtype=float)
             a = np.asarray((x.get("applied_load") or {}).get(name, none), dtype=float)
             scale[name] = max(scale.get(name, 0.0), *(float(np.linalg.norm(v)) for v in (c, t, a)))
+            only = (x.get("resultant_components") or {}).get(name)
+            if only is not None:  # a body of revolution: its axial force alone balances
+                c, t, a = (v[only] for v in (c, t, a))
             rows.append((float(np.linalg.norm(c + t + a)), name, x["step"]))
     if not rows:
         return ""

@@ -1,4 +1,4 @@
-"""Isotropic linear elasticity in plane strain or plane stress."""
+"""Isotropic linear elasticity in plane strain, plane stress, axisymmetry or 3D."""
 
 from __future__ import annotations
 
@@ -22,8 +22,10 @@ class LinearElastic:
     Attributes:
         youngs_modulus: E, > 0.
         poissons_ratio: nu, in (-1, 0.5).
-        plane: ``"strain"`` (default) or ``"stress"``; the out-of-plane assumption of a 2D body
-            (its section).
+        plane: ``"strain"`` (default), ``"stress"`` or ``"axisymmetric"``; the out-of-plane
+            assumption of a 2D body (its section): a slice of a long body, a thin plate, or a
+            body of revolution about the y axis (x = r >= 0, y = z; forces per full circle;
+            small kinematics; a model's bodies share it).
     """
 
     youngs_modulus: float

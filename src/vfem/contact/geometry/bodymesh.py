@@ -28,16 +28,18 @@ def exterior_facets(body: Body) -> np.ndarray:
     """Facets of the body that may take part in contact (indices into ``mesh.facets``)."""
     mesh = body.mesh
     if body.contact_boundaries is not None:
-        return np.unique(np.concatenate([np.zeros(0, dtype=np.int64)] + [
+        bnd = np.unique(np.concatenate([np.zeros(0, dtype=np.int64)] + [
             mesh.boundaries[b] for b in body.contact_boundaries])).astype(np.int64)
-    bnd = mesh.boundary_facets()
-    excluded = [mesh.boundaries[s.boundary] for s in body.supports]
-    excluded += [mesh.boundaries[p.boundary] for p in body.prescribed]
-    if body.platen is not None:
-        excluded.append(mesh.boundaries[body.platen.boundary])
-    if excluded:
-        bnd = np.setdiff1d(bnd, np.concatenate(excluded))
-    return bnd
+    else:
+        bnd = mesh.boundary_facets()
+        excluded = [mesh.boundaries[s.boundary] for s in body.supports]
+        excluded += [mesh.boundaries[p.boundary] for p in body.prescribed]
+        if body.platen is not None:
+            excluded.append(mesh.boundaries[body.platen.boundary])
+        if excluded:
+            bnd = np.setdiff1d(bnd, np.concatenate(excluded))
+    # a body of revolution's axis bounds its section, not the body (Section.not_surface)
+    return bnd[~body.section.not_surface(mesh, bnd)]
 
 
 def _most_distorted(mesh, facet_ids: np.ndarray) -> str:
