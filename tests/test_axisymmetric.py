@@ -270,6 +270,41 @@ def test_the_axis_is_no_contact_surface():
     assert on_axis.sum() == 5  # the block's left side, 0.5 high in elements of 0.1
 
 
+PUSH_OUT = (PRESS_FIT
+            .replace("y0 = 0.0\nwidth = 1.001\nheight = 0.5",
+                     "y0 = -0.2\nwidth = 1.001\nheight = 0.9")
+            .replace('[[bodies.supports]]\nboundary = "bottom"\ncomponents = ["y"]\n'
+                     '[[bodies.supports]]\nboundary = "top"\ncomponents = ["y"]\n\n[[bodies]]',
+                     '[[bodies.prescribed]]\nboundary = "bottom"\ncomponent = "y"\nvalue = 0.01\n'
+                     'amplitude = [[0.0, 0.0], [1.0, 0.0], [2.0, 1.0]]\n\n[[bodies]]')
+            .replace('[[bodies.supports]]\nboundary = "bottom"\ncomponents = ["y"]\n'
+                     '[[bodies.supports]]\nboundary = "top"\ncomponents = ["y"]\n\n[steps]\n'
+                     'load_factors = [1.0]',
+                     '[[bodies.supports]]\nboundary = "top"\ncomponents = ["y"]\n\n[contact]\n'
+                     'friction = 0.2\n\n[steps]\nload_factors = [1.0, 1.25, 1.5, 1.75, 2.0]'))
+
+
+def test_a_shaft_pushed_out_of_its_hub_slips_at_coulombs_force():
+    """Friction in the r-z plane: the press fit's shaft, longer than the hub (z from -0.2 to
+    0.7), pushed 0.01 along the axis at its lower end after the fit, mu = 0.2, the hub held
+    at its top. Once every node of the fit slips, the shaft's axial contact force is mu times
+    the ring's normal force (Coulomb's law summed round the ring: the radial forces'
+    magnitudes are the normal ones) to 1e-8, and within 1 % of mu p 2 pi b L with Lame's p
+    (the fit's length L = 0.5); each body balances along the axis."""
+    assert PUSH_OUT.count("friction = 0.2") == 1 and PUSH_OUT.count("prescribed") == 1
+    assert "height = 0.9" in PUSH_OUT
+    result = solve(PUSH_OUT)
+    b, c, delta, length = 1.0, 2.0, 1e-3, 0.5
+    lame = E * delta * (c * c - b * b) / (2 * b * c * c * (1 - NU * NU))
+    f = result.steps[-1].bodies["shaft"].contact_force
+    normal = np.abs(f[:, 0]).sum()
+    assert abs(f[:, 1].sum()) == pytest.approx(0.2 * normal, rel=1e-8)
+    assert abs(f[:, 1].sum()) == pytest.approx(0.2 * lame * 2 * math.pi * b * length, rel=1e-2)
+    from vfem.io.results import force_record
+
+    assert max(force_record(result.steps[-1])["reaction_imbalance"].values()) <= 1e-10
+
+
 def hertz_sphere(refinement: int, order: int, a_over_r: float = 0.0306):
     """The Hertz example's model (``vfem_examples.hertz``: a half disk of radius R = 1 on a
     flat 3000 times stiffer, its mesh graded to the half-width a of its force) read as a body
