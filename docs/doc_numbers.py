@@ -740,6 +740,29 @@ def examples_thick_cylinder() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_axisymmetric_sphere() -> str:
+    """docs/examples.md, Axisymmetric sphere: ``vfem run axisymmetric_sphere`` at its default
+    mesh (quadratic, a/6), refined (a/12) and with linear elements."""
+    rows = ["| elements | facets over a | dofs | sphere's p_max / p0 − 1 | flat's | contact "
+            "radius / a | verification |", "|---|---:|---:|---:|---:|---:|---|"]
+    for label, sets in (("quadratic", ()), ("quadratic", ("facets_per_radius=12",)),
+                        ("linear", ("order=1",)), ("linear", ("order=1",
+                                                              "facets_per_radius=12"))):
+        argv = ["axisymmetric_sphere", "--no-figures"]
+        for s in sets:
+            argv += ["--set", s]
+        s = _summary(*argv)
+        m = s["axisymmetric_sphere"]
+        passed = sum(r["passed"] for r in s["verification"])
+        facets = s["parameters"]["facets_per_radius"]
+        rows.append(f"| {label} | {facets} | {_thousands(s['dofs'], 0)} | "
+                    f"{_percent(m['sphere_p_max'] / m['p0_theory'] - 1, 2, sign=True)} | "
+                    f"{_percent(m['flat_p_max'] / m['p0_theory'] - 1, 2, sign=True)} | "
+                    f"{m['edge'] / m['a_theory']:.3f} | {passed} of "
+                    f"{len(s['verification'])} passed |")
+    return "\n".join(rows) + "\n"
+
+
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
     "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
@@ -763,6 +786,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-thick-cylinder": ("docs/examples.md", examples_thick_cylinder, False),
     "examples-block-indentation": ("docs/examples.md", examples_block_indentation, False),
     "examples-sphere-indentation": ("docs/examples.md", examples_sphere_indentation, False),
+    "examples-axisymmetric-sphere": ("docs/examples.md", examples_axisymmetric_sphere, False),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
     "patch-thesis": ("docs/examples.md", patch_thesis, False),

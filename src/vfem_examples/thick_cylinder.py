@@ -244,8 +244,8 @@ def verification(m: dict) -> list[dict]:
 
     records = [check("first-yield pressure", m["run_first_yield_pressure"],
                      m["first_yield_pressure"], "Lamé's elastic stresses at the bore, von Mises",
-                     0.005, "issue 41's bound (the quadrature points nearest the bore lie a "
-                     "fraction of an element from it)")]
+                     0.005, "issue 41's bound (the elastic solution's peak, read at the Gauss "
+                     "points and on the bore)")]
     hill_source = "Hill (1950, ch. V): p = k (1 - c^2/b^2 + 2 ln(c/a)), exact as nu -> 1/2"
     for p, c, ref in zip(m["pressure"][1:-1], m["plastic_radius"][1:-1],
                          m["hill_pressure"][1:-1]):
@@ -253,8 +253,8 @@ def verification(m: dict) -> list[dict]:
             continue
         records.append(check(f"pressure with the wall plastic to c = {c:.3f}", p, ref,
                              hill_source, 0.01,
-                             "issue 41's bound (c: the outermost yielded quadrature point, "
-                             "within an element of the zone's edge)"))
+                             "issue 41's bound (c: midway between the outermost yielded Gauss "
+                             "point and the next elastic one)"))
     records.append(check("pressure carried / Hill's limit 2k ln(b/a)",
                          m["pressure"][-1] / m["limit_pressure"], 1.0,
                          "Hill's limit pressure (1950, ch. V)", 0.01,
