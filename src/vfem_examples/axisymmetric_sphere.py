@@ -61,11 +61,21 @@ Parameters = AxisymmetricSphereParameters
 VERIFY_SLOW = ("facets_per_radius=12",)
 
 
+def _disk(p: AxisymmetricSphereParameters, force: float = 1.0) -> hertz.HertzParameters:
+    """The Hertz example's parameters of the same bodies (R = 1), ``force`` on its half model."""
+    facets = p.facets_per_radius
+    return hertz.HertzParameters(
+        radius=1.0, cylinder_youngs_modulus=p.sphere_youngs_modulus,
+        cylinder_poissons_ratio=p.sphere_poissons_ratio,
+        flat_youngs_modulus=p.flat_youngs_modulus, flat_poissons_ratio=p.flat_poissons_ratio,
+        force=force, steps=1, order=p.order if p.order in (1, 2) else 1,
+        facets_per_half_width=facets if isinstance(facets, int) and facets >= 1 else 1)
+
+
 def theory(p: AxisymmetricSphereParameters) -> dict[str, float]:
-    """Hertz's force for the contact radius (per full circle), a, p0 and E*."""
-    e1 = LinearElastic(p.sphere_youngs_modulus, p.sphere_poissons_ratio)
-    e2 = LinearElastic(p.flat_youngs_modulus, p.flat_poissons_ratio)
-    e_star = 1.0 / (1.0 / e1.plane_strain_modulus() + 1.0 / e2.plane_strain_modulus())
+    """Hertz's force for the contact radius (per full circle), a, p0 and E* (the Hertz
+    example's, of the same two materials)."""
+    e_star = hertz.theory(_disk(p))["e_star"]
     a = p.contact_radius
     force = 4.0 * e_star * a ** 3 / 3.0
     return {"force": force, "a_theory": a, "p0_theory": 3.0 * force / (2.0 * math.pi * a * a),
@@ -106,14 +116,7 @@ def config(p: AxisymmetricSphereParameters | None = None) -> ModelConfig:
         h = a
     # the Hertz example's quarter disk (its mesh graded to the half-width of a 2D force: the
     # force whose half-width is a, a^2 pi E* / 8R on its half model), the sphere's force on it
-    disk = hertz.config(hertz.HertzParameters(
-        radius=1.0, cylinder_youngs_modulus=p.sphere_youngs_modulus,
-        cylinder_poissons_ratio=p.sphere_poissons_ratio,
-        flat_youngs_modulus=p.flat_youngs_modulus, flat_poissons_ratio=p.flat_poissons_ratio,
-        force=a * a * math.pi * th.get("e_star", 1.0) / 8.0,
-        facets_per_half_width=p.facets_per_radius if isinstance(p.facets_per_radius, int)
-        and p.facets_per_radius >= 1 else 1, steps=1, order=p.order if p.order in (1, 2)
-        else 1))
+    disk = hertz.config(_disk(p, a * a * math.pi * th.get("e_star", 1.0) / 8.0))
     ball = next(b for b in disk.bodies if b.name == "cylinder")
     ball = dataclasses.replace(
         ball, name="sphere",
