@@ -84,28 +84,39 @@ def average_strain_operator(body):
 
 def plane_average_strain_operator(body):
     """:func:`average_strain_operator` of a 2D body (3 nelems x ndofs)."""
+    return _average_strain_2d(body, hoop=False)
+
+
+def _average_strain_2d(body, hoop: bool):
+    """The element-average strain operator of a 2D body, cached on it: exx, eyy, exy averaged
+    over the element's area, or with ``hoop`` (a body of revolution) over its volume (the
+    weight r) with the hoop strain u_r / r as a fourth block."""
     cached = body.__dict__.get("_average_strain")
     if cached is not None and cached[0] is body.basis:
         return cached[1]
     import scipy.sparse as sp
 
     basis = body.basis
-    w = basis.dx  # (element, quadrature point)
+    r = basis.mapping.F(basis.X)[0] if hoop else None  # (element, quadrature point)
+    w = basis.dx * r if hoop else basis.dx
     total = w.sum(axis=1)
     nel = basis.nelems
     rows, cols, vals = [], [], []
     elements = np.arange(nel)
     for i in range(basis.Nbfun):
         c = i % 2  # ElementVector: shape function i moves component i % 2
-        g = basis.basis[i][0].grad[c]  # (derivative, element, quadrature point)
-        avg = (g * w[None]).sum(axis=2) / total[None]  # (derivative, element)
+        f = basis.basis[i][0]
+        avg = (f.grad[c] * w[None]).sum(axis=2) / total[None]  # (derivative, element)
         dofs = basis.element_dofs[i]
-        normal = (0 if c == 0 else 1) * nel + elements  # exx from d/dx of u_x, eyy of u_y
-        rows += [normal, 2 * nel + elements]
+        rows += [c * nel + elements, 2 * nel + elements]  # exx from d/dx of u_x, eyy of u_y
         cols += [dofs, dofs]
         vals += [avg[c], 0.5 * avg[1 - c]]  # exy: half of d(u_x)/dy + d(u_y)/dx
+        if hoop and c == 0:  # the hoop strain u_r / r
+            rows.append(3 * nel + elements)
+            cols.append(dofs)
+            vals.append((np.asarray(f)[0] / r * w).sum(axis=1) / total)
     op = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                       shape=(3 * nel, basis.N))
+                       shape=((4 if hoop else 3) * nel, basis.N))
     body.__dict__["_average_strain"] = (basis, op)
     return op
 
@@ -149,34 +160,7 @@ def axisymmetric_average_strain_operator(body):
     """:func:`average_strain_operator` of a body of revolution (4 nelems x ndofs): exx (e_rr),
     eyy (e_zz), exy (e_rz) and the hoop strain e_tt = u_r / r, each element's average over its
     volume (the weight 2 pi r)."""
-    cached = body.__dict__.get("_average_strain")
-    if cached is not None and cached[0] is body.basis:
-        return cached[1]
-    import scipy.sparse as sp
-
-    basis = body.basis
-    r = basis.mapping.F(basis.X)[0]  # (element, quadrature point)
-    w = basis.dx * r
-    total = w.sum(axis=1)
-    nel = basis.nelems
-    rows, cols, vals = [], [], []
-    elements = np.arange(nel)
-    for i in range(basis.Nbfun):
-        c = i % 2  # ElementVector: shape function i moves component i % 2
-        f = basis.basis[i][0]
-        avg = (f.grad[c] * w[None]).sum(axis=2) / total[None]  # (derivative, element)
-        dofs = basis.element_dofs[i]
-        rows += [c * nel + elements, 2 * nel + elements]
-        cols += [dofs, dofs]
-        vals += [avg[c], 0.5 * avg[1 - c]]
-        if c == 0:  # the hoop strain u_r / r
-            rows.append(3 * nel + elements)
-            cols.append(dofs)
-            vals.append((np.asarray(f)[0] / r * w).sum(axis=1) / total)
-    op = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                       shape=(4 * nel, basis.N))
-    body.__dict__["_average_strain"] = (basis, op)
-    return op
+    return _average_strain_2d(body, hoop=True)
 
 
 def axisymmetric_small_strain_stress(body, u: np.ndarray) -> dict[str, np.ndarray]:
