@@ -350,3 +350,14 @@ def test_hertzs_sphere_as_a_body_of_revolution():
         errors.append(p.max() / p0 - 1)
         assert abs(x[:, 0].max() - a) <= h / 2 ** refinement
     assert errors[0] < errors[1] < 0 and abs(errors[1]) <= 5e-3 and abs(errors[2]) <= 5e-3
+
+
+def test_a_plane_strain_body_beside_a_plane_stress_one_is_refused():
+    """Issue 42: a model is all plane strain, all plane stress, all axisymmetric or all 3D: a
+    slice of a long body and a thin plate cannot touch either (both 2D, refused since the
+    sections became the model's space)."""
+    text = PRESS_FIT.replace('plane = "axisymmetric"', 'plane = "strain"', 1).replace(
+        'plane = "axisymmetric"', 'plane = "stress"', 1)
+    assert 'plane = "strain"' in text and 'plane = "stress"' in text
+    with pytest.raises(InputError, match=r"got 'shaft' plane strain, 'hub' plane stress"):
+        loads(text, "model.toml").build().validate()
