@@ -305,6 +305,41 @@ def test_a_shaft_pushed_out_of_its_hub_slips_at_coulombs_force():
     assert max(force_record(result.steps[-1])["reaction_imbalance"].values()) <= 1e-10
 
 
+END_PUSH = (PRESS_FIT
+            .replace('[[bodies.supports]]\nboundary = "bottom"\ncomponents = ["y"]\n'
+                     '[[bodies.supports]]\nboundary = "top"\ncomponents = ["y"]\n\n[[bodies]]',
+                     '[[bodies.prescribed]]\nboundary = "top"\ncomponent = "y"\nvalue = 0.01\n'
+                     'amplitude = [[0.0, 0.0], [1.0, 0.0], [2.0, 1.0]]\n\n[[bodies]]')
+            .replace('[steps]\nload_factors = [1.0]',
+                     '[contact]\nfriction = 0.2\n\n[steps]\n'
+                     'load_factors = [1.0, 1.25, 1.5, 1.75, 2.0]'))
+
+
+@pytest.mark.parametrize("plane", ["axisymmetric", "strain"])
+def test_a_shaft_pushed_by_an_end_face_that_meets_the_fit(plane):
+    """The press fit's shaft pushed 0.01 along the axis by its upper end face, which meets
+    the fit, the hub held at both ends: at the fit's upper corner a node of each body is held
+    along the surface and the two move apart by the push, so that node must slip by it (its
+    traction friction's, mu q; the 3D press fit's pushed end faces, ``friction.py``'s
+    *driven* nodes, in 2D too). Before, its slip stayed in the stick error and no push step
+    converged, in plane strain as in r-z. Now every step converges with the invariants met
+    and, at full slip, the shaft's axial force is mu times its normal force to 1e-8. (In
+    plane strain the bodies are slabs held across: rollers at the shaft's axis side and the
+    hub's outer side.)"""
+    text = END_PUSH
+    assert text.count("prescribed") == 1 and "friction = 0.2" in text
+    if plane == "strain":
+        text = text.replace('plane = "axisymmetric"', 'plane = "strain"').replace(
+            '[[bodies.prescribed]]', '[[bodies.supports]]\nboundary = "left"\ncomponents = '
+            '["x"]\n[[bodies.prescribed]]', 1).replace(
+            'h = 0.04\n', 'h = 0.04\n[[bodies.supports]]\nboundary = "right"\n'
+            'components = ["x"]\n', 1)  # (the hub's: after its mesh table)
+        assert text.count('boundary = "left"') == 1 and text.count('boundary = "right"') == 1
+    result = solve(text)
+    f = result.steps[-1].bodies["shaft"].contact_force
+    assert abs(f[:, 1].sum()) == pytest.approx(0.2 * np.abs(f[:, 0]).sum(), rel=1e-8)
+
+
 def hertz_sphere(refinement: int, order: int, a_over_r: float = 0.0306):
     """The Hertz example's model (``vfem_examples.hertz``: a half disk of radius R = 1 on a
     flat 3000 times stiffer, its mesh graded to the half-width a of its force) read as a body

@@ -374,10 +374,10 @@ class SmallFriction(FrictionHistory):
             # there, but not alike: the press fit's shaft end faces pushed past the hub's held
             # ones) slips by that motion, known: its traction there is friction's, -mu q along
             # the slip, a tie like any slipping node's, carried by the supports
-            driven = np.zeros(n, dtype=bool)
-            if ntan > 1:
-                driven = contact & (magnitudes(np.where(held, slip, 0.0)) > tol) & acts
-                slip[held & ~driven[:, None]] = 0.0  # (round-off: the supports hold it)
+            # (2D too: a block's end face pushed along the interface past the other body's
+            # held one; issue 42's push-out, in plane strain and in r-z alike)
+            driven = contact & (magnitudes(np.where(held, slip, 0.0)) > tol) & acts
+            slip[held & ~driven[:, None]] = 0.0  # (round-off: the supports hold it)
             # a node on the cone keeps slipping unless its slip has turned back: the static cone
             # for a node at rest, the dynamic one for a node that slips (the same for Coulomb);
             # sigma, its slip direction, is the one its traction opposes (2D: -sign(s))

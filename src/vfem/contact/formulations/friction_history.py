@@ -151,8 +151,8 @@ class FrictionHistory:
         round-off) or before the first correction has set up the pair matrix. A sticking node's slip
         along a held tangent is the supports' (a prescribed motion, as the press fit's pushed end
         faces), not an error the iteration could correct."""
-        if getattr(self, "_ntan", 1) == 1 or getattr(self.form, "_full", None) is None:
-            return None  # (2D; or the large-kinematics part, which reads none)
+        if getattr(self.form, "_full", None) is None or not hasattr(self, "_held"):
+            return None  # (before the first correction; or the large-kinematics part)
         n, base = len(self.form.contact_pairs[k].nodes), self.form._full[3][k]
         return self._held[base + n: base + (1 + self._ntan) * n].reshape(self._ntan, n).T
 
