@@ -294,8 +294,8 @@ class Axisymmetric(_Plane):
             phi = np.stack([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])
         ends = x[facets[:, :2]]  # (nf, 2, 2)
         L = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
-        r = ends[:, 0, 0][:, None] * (1 - t)[None] + ends[:, 1, 0][:, None] * t[None]
-        w = 2.0 * np.pi * r * wt[None] * L[:, None]  # (nf, q)
+        at = ends[:, 0, :, None] * (1 - t) + ends[:, 1, :, None] * t  # (nf, 2, q)
+        w = self.weight(np.moveaxis(at, 1, 0)) * wt[None] * L[:, None]  # (nf, q)
         return np.einsum("aq,bq,fq->fab", phi, phi, w)
 
     def stiffness(self, body, lam, mu):
@@ -315,8 +315,7 @@ class Axisymmetric(_Plane):
         return {"translation along the axis (y)": np.column_stack([0 * x, np.ones_like(y)])}
 
     def contact_modulus(self, material):
-        E, nu = material.youngs_modulus, material.poissons_ratio
-        return E / (1.0 - nu**2)
+        return material.plane_strain_modulus()  # E / (1 - nu^2)
 
 
 def _axisymmetric_elasticity(lam: float, mu: float):

@@ -61,6 +61,7 @@ class LinearElastic:
         return lam, mu
 
     def plane_strain_modulus(self) -> float:
-        """E/(1-nu^2) in plane strain, E in plane stress: the modulus in Hertz's E*."""
+        """E/(1-nu^2), E in plane stress: the modulus in Hertz's E* (a slice in plane strain, a
+        body of revolution and a 3D body alike)."""
         E, nu = self.youngs_modulus, self.poissons_ratio
-        return E / (1.0 - nu**2) if self.plane == PLANE_STRAIN else E
+        return E if self.plane == PLANE_STRESS else E / (1.0 - nu**2)

@@ -48,15 +48,14 @@ def consistent_pressure(s, force: np.ndarray) -> np.ndarray:
     integrate to zero (a uniform pressure puts no force on them), the consistent pressure
     instead, the nodal values p with N p = force (N the surface's mass matrix, ∫ phi phi^T):
     exact for any pressure the facets can represent (the 3D patch test's to round-off). So too
-    where a node's tributary vanishes otherwise: a body of revolution's node on the axis at
-    the end of a quadratic facet (∫ phi 2 pi r ds = 0 on a straight one, of the order of the
-    facet's curvature on a curved one: 6e-10 of the largest tributary on the Hertz sphere's
-    axis; issue 42), where force over tributary is no reading: any node's under 1e-6 of the
-    largest."""
+    wherever a node's tributary (nearly) vanishes, under 1e-6 of the largest, and force over
+    tributary is no reading: a body of revolution's node on the axis at the end of a quadratic
+    facet (∫ phi 2 pi r ds = 0 on a straight one, of the order of the facet's curvature on a
+    curved one: 6e-10 of the largest tributary on the Hertz sphere's axis; issue 42)."""
     trib = s.tributary
-    on_axis = (s.body.section.name == "axisymmetric" and len(s.facets) > 0 and trib.size > 0
-               and bool((trib <= 1e-6 * np.abs(trib).max()).any()))
-    if weightless_corners(s) or on_axis:
+    weightless = len(s.facets) > 0 and trib.size > 0 and bool(
+        (trib <= 1e-6 * np.abs(trib).max()).any())
+    if weightless_corners(s) or weightless:
         from scipy.sparse.linalg import spsolve
 
         N = s.mass_matrix(np.ones(len(s.facets))).tocsc()
