@@ -52,6 +52,13 @@ stress the Cauchy stress it answers, ``F = I`` and no initial-stress term, so th
 ``int B^T sigma`` and the tangent ``int B^T C B`` with the law's consistent tangent ``C``;
 Newton's method then answers the material's nonlinearity alone.
 
+Bodies of revolution (``axisymmetric=True``, issue 42) take the 3D path on their 2D mesh: the
+displacement gradient about the axis is 3x3, its (3, 3) slot the hoop ``u_r / r`` (and of a
+virtual displacement ``v_r / r``), so ``F``, ``E``, ``S`` and ``A`` are the 3D ones with no
+out-of-plane assumption, and every integral carries ``2 pi r`` (of the reference mesh in the
+total form, of ``C_1`` in the updated one: ``dV = 2 pi r dA`` of the configuration the gradients
+are taken on).
+
 3D bodies (tetrahedra, hexahedra; issue 21, C16) take the same path with 3x3 tensors: the
 dimension is the mesh's (``self.dim``), dofs are ``dim * node + component``, no out-of-plane
 stress is carried, and the left stretch ``V_1`` of the updated form is the square root of
@@ -158,13 +165,26 @@ class _ElementArrays:
     matrix to 4e-16.
     """
 
-    def __init__(self, basis: Basis):
-        nb, dim = basis.Nbfun, basis.mesh.dim()
+    def __init__(self, basis: Basis, axisymmetric: bool = False):
+        nb = basis.Nbfun
         ne, nq = basis.nelems, basis.X.shape[-1]
         G = np.array([np.asarray(basis.basis[j][0].grad) for j in range(nb)])
-        #: B[e, q, (c, J), i]: d(v_i)_c / dX_J
-        self.B = np.ascontiguousarray(G.transpose(3, 4, 1, 2, 0).reshape(ne, nq, dim * dim, nb))
         self.dx = basis.dx
+        if axisymmetric:
+            # a body of revolution (issue 42): the gradient of (u_r, u_z) about the y axis is
+            # the 3x3 [[du_r/dr, du_r/dz, 0], [du_z/dr, du_z/dz, 0], [0, 0, u_r / r]] (the hoop
+            # stretch r'/r = 1 + u_r / r, no twist), and every integral has the measure 2 pi r:
+            # the 3D forms of the module's docstring with 3x3 tensors, per full circle
+            V = np.array([np.asarray(basis.basis[j][0]) for j in range(nb)])
+            r = np.asarray(basis.global_coordinates())[0]  # (ne, nq), > 0 inside
+            G3 = np.zeros((nb, 3, 3, ne, nq))
+            G3[:, :2, :2] = G
+            G3[:, 2, 2] = V[:, 0] / r
+            G = G3
+            self.dx = basis.dx * 2.0 * np.pi * r
+        dim = G.shape[1]  # the tensors': the mesh's, or 3 about an axis
+        #: B[e, q, (c, J), i]: d(v_i)_c / dX_J (and v_r / r in the hoop slot (2, 2))
+        self.B = np.ascontiguousarray(G.transpose(3, 4, 1, 2, 0).reshape(ne, nq, dim * dim, nb))
         self.shape = (ne, nq, dim * dim)
         dofs = basis.element_dofs  # (nb, ne)
         self.element_dofs = np.ascontiguousarray(dofs.T)
@@ -176,16 +196,19 @@ class _ElementArrays:
         self.N = basis.N
 
     @classmethod
-    def of(cls, basis: Basis) -> _ElementArrays:
+    def of(cls, basis: Basis, axisymmetric: bool = False) -> _ElementArrays:
         """The assembly for ``basis``, made once and kept on it (a total-Lagrangian body's
         reference basis lives as long as the body, an updated one's basis for its step)."""
-        found = getattr(basis, "_vfem_tangent_assembly", None)
+        key = "_vfem_tangent_assembly_rz" if axisymmetric else "_vfem_tangent_assembly"
+        found = getattr(basis, key, None)
         if found is None:
-            found = basis._vfem_tangent_assembly = cls(basis)
+            found = cls(basis, axisymmetric)
+            setattr(basis, key, found)
         return found
 
     def gradient(self, u: np.ndarray) -> np.ndarray:
-        """``basis.interpolate(u).grad`` (dim, dim, ne, nq) by the same gradients, to
+        """``basis.interpolate(u).grad`` (dim, dim, ne, nq) by the same gradients (3x3 with
+        the hoop component about an axis), to
         round-off: one batched product instead of scikit-fem's sum over the basis functions
         (a third of the time of a large body's state in the sliding example)."""
         ne, nq, m = self.shape
@@ -331,6 +354,11 @@ class NonlinearBody:
             move the midside nodes with the displacement.
         formulation: ``"total"`` or ``"updated"`` Lagrangian.
         name: used in messages.
+        axisymmetric: a body of revolution about the y axis (issue 42): its 2D mesh is the
+            r-z half-plane (x = r >= 0), its tensors 3x3 with the hoop stretch 1 + u_r / r
+            (thesis eqs. 2.7.19–2.7.21 and 2.8.11 as in 3D, the gradient's (3, 3) slot u_r / r
+            and the others out of the plane zero) and every integral the measure 2 pi r: forces
+            per full circle, as the linear :class:`~vfem.bodies.section.Axisymmetric` body's.
 
     Dofs are scikit-fem's ``ElementVector`` numbering on :attr:`basis0` (x and y, and z in 3D, of
     each node interleaved: ``dim * node + component``). Prescribe with :meth:`prescribe` and load
@@ -338,7 +366,7 @@ class NonlinearBody:
     """
 
     def __init__(self, mesh: Mesh, material: Material, *, order: int = 1,
-                 formulation: str = TOTAL, name: str = "body"):
+                 formulation: str = TOTAL, name: str = "body", axisymmetric: bool = False):
         self.name = name
         if not isinstance(material, Material):
             raise InputError(f"{name}: material must be SaintVenantKirchhoff or NeoHookean, "
@@ -359,6 +387,12 @@ class NonlinearBody:
                             quadrature=gauss_rule(self.mesh.elem()))
         self.ndofs = self.basis0.N
         self.dim = dim = self.mesh.dim()
+        if axisymmetric and dim != 2:
+            raise InputError(f"{name}: a body of revolution has a 2D (r-z) mesh, got a {dim}D one")
+        self.axisymmetric = bool(axisymmetric)
+        #: the dimension of its tensors: the mesh's, or 3 for a body of revolution (its hoop
+        #: components; its dofs stay the mesh's two a node)
+        self.tensor_dim = 3 if axisymmetric else dim
         # the node of each dof, as positions in mesh.doflocs: isoparametric elements have their
         # nodes at the mesh's doflocs, x and y (and z) interleaved
         if not all(np.allclose(self.basis0.doflocs[:, c::dim], self.mesh.doflocs)
@@ -377,7 +411,8 @@ class NonlinearBody:
         # updated Lagrangian state: the current configuration C_1 and the pseudo-strain 11_1 E
         self._reset_updated_state()
         # the material's converged state at the quadrature points (materials.protocol)
-        self.material_state = material.initial_state(dim, self.pseudo_strain.shape[2:])
+        self.material_state = material.initial_state(self.tensor_dim,
+                                                     self.pseudo_strain.shape[2:])
 
     # -- set-up ---------------------------------------------------------------------------------
 
@@ -402,7 +437,8 @@ class NonlinearBody:
         self.current_mesh = self.mesh
         self.current_basis = self.basis0
         nq = self.basis0.X.shape[-1]
-        self.pseudo_strain = np.zeros((self.dim, self.dim, self.mesh.nelements, nq))
+        self.pseudo_strain = np.zeros((self.tensor_dim, self.tensor_dim, self.mesh.nelements,
+                                       nq))
         self._u_at_current = np.zeros(self.ndofs)
         self._stretch_cache: tuple[np.ndarray, np.ndarray] | None = None
         self._delta = np.zeros(self.ndofs)  # trial displacement since the converged state
@@ -494,7 +530,7 @@ class NonlinearBody:
         ``11_1 E + E2 + E3`` (eqs. 2.7.31–2.7.36, 2.8.11).
         """
         if self.formulation == SMALL:  # eps = sym(grad u), F = I (issue 41)
-            arrays = _ElementArrays.of(self.basis0)
+            arrays = self._arrays(self.basis0)
             g = arrays.gradient(self._u_at_current + delta)
             eps = 0.5 * (g + g.transpose(1, 0, 2, 3))
             r = self.material.response(eps, self.material_state)
@@ -503,15 +539,15 @@ class NonlinearBody:
                           geometric=False)
         if self.formulation == TOTAL:
             basis = self.basis0
-            G0 = _ElementArrays.of(basis).gradient(self._u_at_current)
-            g = _ElementArrays.of(basis).gradient(delta)
+            G0 = self._arrays(basis).gradient(self._u_at_current)
+            g = self._arrays(basis).gradient(delta)
             F = deformation_gradient(G0 + g)
             self._check_orientation(F)
             E = strain_increment(G0, g).total
             r = self.material.response(E, self.material_state)
             return _State(basis, F, r.stress, r.moduli, r.out_of_plane, r.state)
         basis = self.current_basis
-        h = _ElementArrays.of(basis).gradient(delta)
+        h = self._arrays(basis).gradient(delta)
         f = deformation_gradient(h)
         self._check_orientation(f)
         E_pseudo = updated_strain_increment(h, self.pseudo_strain).total
@@ -559,7 +595,7 @@ class NonlinearBody:
         """
         if self._stretch_cache is not None:
             return self._stretch_cache
-        if self.dim == 3:
+        if self.tensor_dim == 3:
             self._stretch_cache = self._left_stretch_3d()
             return self._stretch_cache
         b_inv = -2.0 * self.pseudo_strain
@@ -578,7 +614,7 @@ class NonlinearBody:
         """``F_1`` and ``J_1 = det F_1`` of the converged configuration ``C_1``, by the
         displacement's gradient on the initial mesh (kept for the step)."""
         if self._stretch_cache is None:
-            F1 = deformation_gradient(_ElementArrays.of(self.basis0).gradient(self._u_at_current))
+            F1 = deformation_gradient(self._arrays(self.basis0).gradient(self._u_at_current))
             self._stretch_cache = (F1, determinant(F1))
         return self._stretch_cache
 
@@ -595,6 +631,10 @@ class NonlinearBody:
         V = np.einsum("...ik,...k,...jk->...ij", Q, 1.0 / np.sqrt(m), Q)
         return np.ascontiguousarray(np.moveaxis(V, (-2, -1), (0, 1))), 1.0 / np.sqrt(m.prod(-1))
 
+    def _arrays(self, basis: Basis) -> _ElementArrays:
+        """The element arrays of ``basis`` (about the axis for a body of revolution)."""
+        return _ElementArrays.of(basis, self.axisymmetric)
+
     def _check_orientation(self, F: np.ndarray) -> None:
         J = determinant(F)
         if np.any(J <= 0.0):
@@ -604,10 +644,10 @@ class NonlinearBody:
     # -- assembled quantities ---------------------------------------------------------------------
 
     def _internal(self, state: _State) -> np.ndarray:
-        return _ElementArrays.of(state.basis).internal_force(state.first_piola())
+        return self._arrays(state.basis).internal_force(state.first_piola())
 
     def _tangent(self, state: _State):
-        return _ElementArrays.of(state.basis).assemble(state.tangent_moduli())
+        return self._arrays(state.basis).assemble(state.tangent_moduli())
 
     def internal_force(self) -> np.ndarray:
         """Internal nodal forces ``int grad(v) : P`` at the current state (ndofs)."""
@@ -885,7 +925,7 @@ class NonlinearBody:
         by name, (nelems,) each)."""
         state = self._state(np.asarray(u, dtype=float) - self._u_at_current)
         J = determinant(state.F)
-        w = state.basis.dx * J
+        w = self._arrays(state.basis).dx * J
         shown = getattr(self.material, "fields", None)  # optional (materials.protocol)
         fields = {} if shown is None else {
             name: (v * w).sum(axis=-1) / w.sum(axis=-1)
@@ -906,7 +946,7 @@ class NonlinearBody:
         ``F = I + h`` (eq. 2.8.15), and the mesh nodes move by the increment.
         """
         if self.formulation == UPDATED:
-            h = self.current_basis.interpolate(delta).grad
+            h = self._arrays(self.current_basis).gradient(delta)
             E_pseudo = updated_strain_increment(h, self.pseudo_strain).total
             self.pseudo_strain = change_reference(E_pseudo, h)
             self._stretch_cache = None
@@ -935,7 +975,7 @@ class NonlinearBody:
     def green_lagrange_strain(self) -> np.ndarray:
         """(dim, dim, nelems, nqp) Green–Lagrange strain relative to the initial mesh (small
         kinematics: the small strain sym(grad u))."""
-        g = self.basis0.interpolate(self.displacement).grad
+        g = self._arrays(self.basis0).gradient(self.displacement)
         if self.formulation == SMALL:
             return 0.5 * (g + np.swapaxes(g, 0, 1))
         return green_lagrange(g)

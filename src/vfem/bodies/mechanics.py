@@ -178,7 +178,8 @@ class LargeMechanics:
         self.body = body
         material = body.material.law(body.law, body.kinematics)  # the law it evaluates
         nl = NonlinearBody(body.mesh, material, formulation=body.kinematics,
-                           order=body.order, name=f"body {body.name!r}")
+                           order=body.order, name=f"body {body.name!r}",
+                           axisymmetric=body.section.space == "axisymmetric")
         dofs = np.array(sorted(fixed), dtype=int)
         if len(dofs):
             nl.prescribe(dofs, np.array([fixed[d] for d in dofs.tolist()]))

@@ -2,11 +2,11 @@
 
 A 2D body stands for a 3D one by an assumption about the third direction: a slice of a long
 body (plane strain: no strain across it), a thin plate (plane stress: no stress across it), or
-— the next one (issue 42) — a body of revolution (axisymmetric: the hoop strain u_r / r, and a
+a body of revolution (issue 42) (axisymmetric: the hoop strain u_r / r, and a
 measure 2πr). A 3D body has none. Every integral of a small-kinematics body reads its section
 rather than the material's ``plane`` or the mesh's dimension (the plane-stress λ is the
-material's :meth:`~vfem.materials.LinearElastic.lame`; the large-kinematics integrals of
-:mod:`vfem.nonlinear`, plane strain or 3D, do not read it yet):
+material's :meth:`~vfem.materials.LinearElastic.lame`; a Newton body of :mod:`vfem.nonlinear`
+(large kinematics, or a law with state) is told only whether it turns about an axis):
 
 * :meth:`Section.weight` — the measure per unit of the mesh's own length, area or volume at given
   points: 1 here (2πr, or r per radian, for a body of revolution). The body's tractions
@@ -271,7 +271,7 @@ class Axisymmetric(_Plane):
     plane = "axisymmetric"
     space = "axisymmetric"
     resultant = (1,)  # along the axis: the radial forces of a ring cancel round it
-    takes_large = False
+    takes_large = True  # (vfem.nonlinear's 3x3 tensors about the axis)
     strain_is_gradient = False  # the hoop strain u_r / r too
 
     def weight(self, x):

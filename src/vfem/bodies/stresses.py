@@ -26,7 +26,7 @@ def cauchy_stress(nonlinear, u: np.ndarray) -> dict[str, np.ndarray]:
     """Element-average Cauchy stresses of a :class:`~vfem.nonlinear.NonlinearBody` at ``u``,
     and the fields its material shows of its state (an equivalent plastic strain: issue 41)."""
     sig, szz, fields = nonlinear.cauchy_stress_at(u)
-    if sig.shape[1] == 3:
+    if sig.shape[1] == 3 and not nonlinear.axisymmetric:  # (about an axis: szz the hoop)
         avg = {"sxx": sig[:, 0, 0], "syy": sig[:, 1, 1], "szz": sig[:, 2, 2],
                "syz": sig[:, 1, 2], "sxz": sig[:, 0, 2], "sxy": sig[:, 0, 1]}
     else:

@@ -125,8 +125,7 @@ def check_supports(body) -> None:
 
 def check_axisymmetric(body, where: str) -> None:
     """What a body of revolution needs (issue 42): its mesh in the r-z half-plane (x = r >= 0,
-    to round-off of its size) and small kinematics with a material without state (the
-    Newton bodies, plastic or large, are plane strain or 3D as yet)."""
+    to round-off of its size)."""
     x = body.mesh.p[0]
     span = float(np.ptp(body.mesh.p, axis=1).max()) if x.size else 0.0
     if x.size and x.min() < -1e-12 * span:
@@ -134,9 +133,6 @@ def check_axisymmetric(body, where: str) -> None:
         raise InputError(f"{where}: an axisymmetric body's mesh lies in the r-z half-plane, "
                          f"x = r >= 0 (the axis is x = 0), but node {node} is at x = "
                          f"{x[node]:.6g}")
-    if body.material.carries_state:
-        raise InputError(f"{where}: axisymmetric bodies are linear elastic as yet; a plastic "
-                         "material needs plane strain, plane stress or 3D")
 
 
 def rigid_modes(body) -> dict[str, np.ndarray]:
