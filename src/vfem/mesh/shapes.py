@@ -754,26 +754,32 @@ def disk_map(u: np.ndarray, v: np.ndarray, R: float, blend_from: float = 0.5,
     return x, y
 
 
-def disk(radius: float = 1.0, h: float = 0.1, *, quarter: bool = True,
+def disk(radius: float = 1.0, h: float = 0.1, *, quarter: bool = True, half: bool = False,
          blend_from: float = 0.5) -> MeshQuad:
-    """The disk of ``radius`` about the origin (with ``quarter``, its part x >= 0, y >= 0) in
+    """The disk of ``radius`` about the origin (with ``quarter``, its part x >= 0, y >= 0; with
+    ``half``, its part y >= 0: the cross-section of an O-ring above its plane of symmetry) in
     quadrilaterals: a square grid of spacing about ``h`` mapped onto it as the plan of
     :func:`vfem.mesh.solids.cylinder` (:func:`disk_map`): its rim's nodes at
     equal angles, 2 n per quarter turn for n divisions across, so an :func:`annulus` with as
     many facets per quarter turn has its bore's nodes at the same angles.
 
-    Named boundaries: ``rim`` and, with ``quarter``, ``left`` (x = 0) and ``bottom`` (y = 0).
+    Named boundaries: ``rim`` and, with ``quarter``, ``left`` (x = 0) and ``bottom`` (y = 0);
+    with ``half``, ``bottom`` (y = 0).
     """
     if not (radius > 0 and h > 0):
         raise ValueError(f"radius and h must be positive, got {radius} and {h}")
+    if half and quarter:
+        raise ValueError("give quarter or half, not both (quarter = false with half = true)")
     n = max(1, int(np.ceil(radius / h - 1e-9)))
     check_count((2.0 * n + 1.0) ** 2, "disk")
     line = np.linspace(0.0 if quarter else -1.0, 1.0, n + 1 if quarter else 2 * n + 1)
-    mesh = MeshQuad.init_tensor(line, line)
+    mesh = MeshQuad.init_tensor(line, np.linspace(0.0, 1.0, n + 1) if half else line)
     tol = 1e-9
     tests = {"rim": lambda p: np.maximum(np.abs(p[0]), np.abs(p[1])) > 1 - tol}
     if quarter:
         tests.update(left=lambda p: p[0] < tol, bottom=lambda p: p[1] < tol)
+    if half:
+        tests.update(bottom=lambda p: p[1] < tol)
     mesh = named_boundaries(mesh, tests)
     x, y = disk_map(mesh.p[0], mesh.p[1], radius, blend_from)
     return share_topology(mesh, replace(mesh, doflocs=np.vstack([x, y])))
