@@ -763,6 +763,50 @@ def examples_axisymmetric_sphere() -> str:
     return "\n".join(rows) + "\n"
 
 
+def _signed_percent(x: float) -> str:
+    """:func:`_percent` to three decimals with its sign, or in two figures where that would
+    read 0.000 % (quadratic elements leave errors of 1e-8, whose sign is theirs)."""
+    return _percent(x, 3, sign=True) if abs(x) >= 5e-6 else \
+        f"{'−' if x < 0 else '+'}{abs(100 * x):.1e} %"
+
+
+def examples_axisymmetric_press_fit() -> str:
+    """docs/examples.md, Axisymmetric press fit: ``vfem run axisymmetric_press_fit`` at its
+    default mesh, coarser, finer, on quadratic elements and with an aluminium hub."""
+    rows = ["| run | dofs | hub's p / Lamé − 1 | shaft's (on b + δ) | spread along the fit "
+            "| u_r hub | u_r shaft | hoop stress at the bore | push-out / μp·2πbL − 1 "
+            "| verification |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+    for label, sets in (("defaults (elements 0.05 / 0.04)", ()),
+                        ("coarser (0.1 / 0.08)", ("shaft_element_size=0.1",
+                                                  "hub_element_size=0.08")),
+                        ("finer (0.025 / 0.02)", ("shaft_element_size=0.025",
+                                                  "hub_element_size=0.02")),
+                        ("quadratic", ("order=2",)),
+                        ("aluminium hub", ("hub_youngs_modulus=70000",
+                                           "hub_poissons_ratio=0.33"))):
+        argv = ["axisymmetric_press_fit", "--no-figures"]
+        for x in sets:
+            argv += ["--set", x]
+        s = _summary(*argv)
+        m = s["axisymmetric_press_fit"]
+        p = m["lame_pressure"]
+        spread = max(m["hub"]["pressure_spread"], m["shaft"]["pressure_spread"]) / p
+        last = m["push"][-1]["axial_force"]
+        passed = sum(r["passed"] for r in s["verification"])
+        pc = _signed_percent
+        rows.append(
+            f"| {label} | {_thousands(s['dofs'], 0)} | "
+            f"{pc(m['hub']['mean_pressure'] / p - 1)} | "
+            f"{pc(m['shaft']['mean_pressure'] / m['lame_shaft_pressure'] - 1)}"
+            f" | {'< 1e-12' if spread < 1e-12 else f'{spread:.1e}'} | "
+            f"{pc(m['hub']['u_r_worst'] / m['lame_u_hub'] - 1)} | "
+            f"{pc(m['shaft']['u_r_worst'] / m['lame_u_shaft'] - 1)} | "
+            f"{pc(m['hoop']['worst_error'])} | "
+            f"{pc(last / m['push_out_force_theory'] - 1)} | "
+            f"{passed} of {len(s['verification'])} passed |")
+    return "\n".join(rows) + "\n"
+
+
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
     "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
@@ -787,6 +831,8 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-block-indentation": ("docs/examples.md", examples_block_indentation, False),
     "examples-sphere-indentation": ("docs/examples.md", examples_sphere_indentation, False),
     "examples-axisymmetric-sphere": ("docs/examples.md", examples_axisymmetric_sphere, False),
+    "examples-axisymmetric-press-fit": ("docs/examples.md", examples_axisymmetric_press_fit,
+                                        True),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
     "patch-thesis": ("docs/examples.md", patch_thesis, False),

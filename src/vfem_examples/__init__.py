@@ -15,7 +15,8 @@ from vfem.io import replot
 EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", "punch",
             "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack",
             "indentation", "thick_cylinder", "block_indentation",
-            "sphere_indentation", "axisymmetric_sphere", "oring")
+            "sphere_indentation", "axisymmetric_sphere", "axisymmetric_press_fit",
+            "oring")
 
 
 def load(name: str):

@@ -71,10 +71,37 @@ VERIFY_SLOW = ("around=48", "radial=16", "interference=0.005")
 PRESSURE_TOLERANCE = 0.01
 
 
+def lame_fit(b: float, c: float, delta: float, shaft: tuple[float, float],
+             hub: tuple[float, float]) -> dict[str, float]:
+    """Lame's interference fit in plane strain: a solid shaft (Young's modulus and Poisson's
+    ratio ``shaft``) of radius b + delta in a hub (``hub``) of bore b and outer radius c.
+
+    Under a pressure p on its bore the hub's bore moves out by u_hub = p b (1 + nu_h)
+    ((1 - 2 nu_h) b^2 + c^2) / (E_h (c^2 - b^2)); the solid shaft's surface moves by
+    u_shaft = -p_s (b + delta) (1 + nu_s)(1 - 2 nu_s) / E_s under its own pressure p_s, which
+    carries the same force over the radius b + delta, p_s = p b / (b + delta), so u_shaft =
+    -p b (1 + nu_s)(1 - 2 nu_s) / E_s (exactly, in small strain). They meet when u_hub -
+    u_shaft = delta:
+
+        p = delta / (b (1 + nu_h)((1 - 2 nu_h) b^2 + c^2) / (E_h (c^2 - b^2))
+                     + b (1 + nu_s)(1 - 2 nu_s) / E_s),
+
+    one material: p = E delta (c^2 - b^2) / (2 b c^2 (1 - nu^2)). Returns ``pressure`` (p,
+    on the bore), ``shaft_pressure`` (p_s), ``u_hub``, ``u_shaft`` (radial displacements at
+    the fit) and ``hoop_bore`` (the hub's hoop stress at its bore, p (c^2 + b^2) / (c^2 -
+    b^2)); the hub's hoop stress at radius r is p b^2 (1 + c^2 / r^2) / (c^2 - b^2)."""
+    (Es, nus), (Eh, nuh) = shaft, hub
+    hub_per_p = b * (1 + nuh) * ((1 - 2 * nuh) * b * b + c * c) / (Eh * (c * c - b * b))
+    shaft_per_p = b * (1 + nus) * (1 - 2 * nus) / Es
+    p = delta / (hub_per_p + shaft_per_p)
+    return {"pressure": p, "shaft_pressure": p * b / (b + delta), "u_hub": p * hub_per_p,
+            "u_shaft": -p * shaft_per_p, "hoop_bore": p * (c * c + b * b) / (c * c - b * b)}
+
+
 def lame(p: PressFitParameters) -> float:
-    """Lame's contact pressure of the fit, plane strain, one material."""
-    b, c, E, nu = p.bore_radius, p.hub_radius, p.youngs_modulus, p.poissons_ratio
-    return E * p.interference * (c * c - b * b) / (2 * b * c * c * (1 - nu * nu))
+    """Lame's contact pressure of the fit, plane strain, one material (:func:`lame_fit`)."""
+    material = (p.youngs_modulus, p.poissons_ratio)
+    return lame_fit(p.bore_radius, p.hub_radius, p.interference, material, material)["pressure"]
 
 
 def push_out_force(p: PressFitParameters) -> float:
