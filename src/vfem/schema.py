@@ -110,7 +110,9 @@ NOT_YET = {"friction": "friction is set for a model's contact: contact.friction 
                        "coefficient, or [[contact.pairs]], in an input file (the paired "
                        "variant; of the built-in examples cattaneo and sliding have a friction "
                        "parameter: --set friction=0.3)",
-           "self_contact": "contact of a body with itself is not available yet"}
+           "self_contact": "a body's contact with itself is between two of its boundaries, "
+                           "named as a pair's two sides: contact_pairs = [['ring:upper', "
+                           "'ring:lower']] (2D and r-z)"}
 
 
 def _suggest(key: str, valid: list[str]) -> str:

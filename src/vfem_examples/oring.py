@@ -129,28 +129,31 @@ def config(p: ORingParameters | None = None) -> ModelConfig:
     except (TypeError, ZeroDivisionError):
         h, squeeze = d / 10, 0.1 * d  # validate() names what is wrong
     plane = SECTIONS.get(p.section, "axisymmetric")
+    # a straight cord is symmetric about its vertical diameter too: its quarter, held along x
+    # there (a ring of revolution is not: its inner and outer sides differ)
+    cord = plane != "axisymmetric"
     ring = BodyConfig(
         name="ring",
         mesh=MeshSpec(shape="disk", translate=(rc, 0.0), parameters=as_parameters(
-            radius=0.5 * d, h=h, quarter=False, half=True)),
+            radius=0.5 * d, h=h, quarter=cord, half=not cord)),
         material=LinearElastic(p.youngs_modulus, p.poissons_ratio, plane=plane),
-        supports=(Support("bottom", ("y",)),),  # the plane of symmetry
+        # the plane of symmetry (and the cord's vertical one)
+        supports=(Support("bottom", ("y",)), *((Support("left", ("x",)),) if cord else ())),
         contact_boundaries=("rim",), kinematics="total", law="neo-hookean")
     # the lid spans the groove and a little more; the walls stop short of the lid's lowest
     # position (a twentieth of d below it), so that steel never meets steel
-    lid = _steel("lid", rc - 0.75 * w, 0.5 * d, 1.5 * w, 0.25 * d, h, "bottom",
-                 (Support("top", ("x",)),), plane,
+    lid = _steel("lid", rc - (0.0 if cord else 0.75 * w), 0.5 * d, (0.75 if cord else 1.5) * w,
+                 0.25 * d, h, "bottom", (Support("top", ("x",)),), plane,
                  prescribed=(PrescribedDisplacement("top", "y", -squeeze),))
     wall_height = 0.5 * d - squeeze - 0.05 * d
     inner = _steel("inner wall", rc - 0.5 * w - 0.25 * d, 0.0, 0.25 * d, wall_height, h,
                    "right", (Support("left", ("x", "y")),), plane)
     outer = _steel("outer wall", rc + 0.5 * w, 0.0, 0.25 * d, wall_height, h, "left",
                    (Support("right", ("x", "y")),), plane)
-    pairs = tuple(PairFriction(("ring", other), p.friction)
-                  for other in ("lid", "inner wall", "outer wall"))
+    bodies = (ring, lid, outer) if cord else (ring, lid, inner, outer)
+    pairs = tuple(PairFriction(("ring", b.name), p.friction) for b in bodies[1:])
     steps = p.steps if isinstance(p.steps, int) and p.steps >= 1 else 1
-    return ModelConfig("oring", (ring, lid, inner, outer), ContactSettings(pairs=pairs),
-                       Steps(count=steps))
+    return ModelConfig("oring", bodies, ContactSettings(pairs=pairs), Steps(count=steps))
 
 
 def build(p: ORingParameters | None = None) -> Model:
@@ -176,8 +179,10 @@ def evaluate(result: AnalysisResult, p: ORingParameters) -> dict:
     Lindley's, the contact width and peak pressure on the lid, the walls' contact; Coulomb's
     cone's largest share; the floor's force."""
     d = p.cross_section
-    # per unit of circumference (a straight cord's forces are per unit length already)
-    circumference = math.pi * p.mean_diameter if p.section == "axisymmetric" else 1.0
+    # per unit of circumference (a straight cord's forces are per unit length already, of
+    # its quarter model: half the cord's); a quarter's contact width is half the cord's
+    cord = p.section != "axisymmetric"
+    circumference = 0.5 if cord else math.pi * p.mean_diameter
     rows = []
     cone = 0.0
     for step in result.steps:
@@ -191,20 +196,21 @@ def evaluate(result: AnalysisResult, p: ORingParameters) -> dict:
         floor = float(ring.reaction_total[1])
         walls = {}
         for name in ("inner wall", "outer wall"):
-            _, wr = _contact_nodes(result, step, name)
-            walls[name] = float(np.asarray(wr.contact_force)[:, 1].sum())
+            if name in step.bodies:  # (a straight cord's quarter has the outer alone)
+                _, wr = _contact_nodes(result, step, name)
+                walls[name] = float(np.asarray(wr.contact_force)[:, 1].sum())
         # the ring's nodes against the lid: at the lid's height (the lid barely moves but
         # by its travel); the contact width between the outermost two
         top = 0.5 * d * (1.0 - c)
         on = (ring.contact_status > 0) & (ring_x[:, 1] > top - 0.25 * d / p.elements_across)
-        width = float(np.ptp(ring_x[on, 0])) if on.sum() > 1 else 0.0
+        width = (2.0 if cord else 1.0) * float(np.ptp(ring_x[on, 0])) if on.sum() > 1 else 0.0
         p_max = float(np.asarray(ring.contact_pressure)[on].max()) if on.any() else 0.0
         side = (ring.contact_status > 0) & ~on
         rows.append({
             "load_factor": float(step.load_factor), "compression": c,
             "lid_force": lid_force, "force_per_length": lid_force / circumference,
             "lindley": lindley(p, c), "contact_width": width, "peak_pressure": p_max,
-            "floor_force": floor, "wall_axial_force": walls["inner wall"] + walls["outer wall"],
+            "floor_force": floor, "wall_axial_force": sum(walls.values()),
             "wall_nodes": int(side.sum()),
         })
         # Coulomb's cone on the pair's traction field (at the nodes that carry it: friction

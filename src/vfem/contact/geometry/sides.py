@@ -16,9 +16,11 @@ the nodes a side keeps (:mod:`vfem.contact.formulations.pairmaking`: :meth:`Cont
 What reads bodies only (the memory estimate, the unreachable pairs' note, the thesis variant
 and the baselines, which refuse named sides) reads :meth:`ContactPairs.keys` and
 :meth:`ContactPairs.opponents`. A pair of two sides of one body (self-contact, issue 42) is a
-pair like any other to those that read sides; what it adds is the split of one boundary into
-two sides (each node's own neighbourhood left out), which is not built yet
-(:meth:`ContactPairs.parse` refuses a body named twice).
+pair like any other to those that read sides: its two sides are two named boundaries of the
+body that share no facet (:func:`_check_own_sides`), so a node never meets its own facets; the
+invariants check the body against itself (:meth:`vfem.contact.invariants.check.InvariantCheck
+._own_sides_apart`). In 2D and r-z; a whole boundary that finds its own sides (single-surface
+contact) and 3D are not built yet.
 """
 
 from __future__ import annotations
@@ -118,8 +120,7 @@ class ContactPairs:
                                  "['punch', 'block:top']")
             sides = [_side(text, names, bodies, entry, where) for text in entry]
             if sides[0].body == sides[1].body:
-                raise InputError(f"{where} {list(entry)!r} names one body twice: contact of "
-                                 "a body with itself is not supported")
+                _check_own_sides(sides, bodies, entry, where)
             key = tuple(sorted((sides[0].body, sides[1].body)))
             if key in made:
                 first = made[key]
@@ -204,6 +205,31 @@ def zone_mask(surface, facets: np.ndarray | None) -> np.ndarray:
     mask = np.zeros(surface.nc, dtype=bool)
     mask[zone_nodes(surface, facets)] = True
     return mask
+
+
+def _check_own_sides(sides: list[Side], bodies, entry, where: str) -> None:
+    """Two sides of one body (self-contact, issue 42): each must name its boundaries, and
+    they must share no facet. A node never meets its own facets then, nor the surface next to
+    it along the boundary but across the line where the two sides meet (the other side's
+    facets that share a node with its own are left out of its candidates: the sides' common
+    corner is no contact, :func:`~.pairing.facing`)."""
+    body = bodies[sides[0].body]
+    if body.dim == 3:
+        raise InputError(f"{where} {list(entry)!r} names one body twice ({body.name!r}): a "
+                         "body's contact with itself is taken in 2D and in r-z as yet, not in "
+                         "3D")
+    if any(s.boundaries is None for s in sides):
+        raise InputError(f"{where} {list(entry)!r} names one body twice ({body.name!r}) "
+                         "without its boundaries: a body's contact with itself is between two "
+                         "of its boundaries, named as the pair's sides (e.g. "
+                         f"['{body.name}{SEPARATOR}upper', '{body.name}{SEPARATOR}lower'])")
+    a, b = (set(s.mesh_facets(body).tolist()) for s in sides)
+    if a & b:
+        shared = sorted(set(sides[0].boundaries) & set(sides[1].boundaries))
+        raise InputError(f"{where} {list(entry)!r}: the two sides of body {body.name!r} share "
+                         f"{len(a & b)} facets" + (f" (boundary {shared[0]!r} is named on both)"
+                                                   if shared else "")
+                         + "; a body's two sides in contact with each other must be apart")
 
 
 def _side(text, names: dict, bodies, entry, where: str) -> Side:

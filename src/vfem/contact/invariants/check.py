@@ -73,6 +73,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...executor import SERIAL
+from ..search import project_points
 from .check3d import SOLID
 from .kind import SurfaceKind
 from .measures import (
@@ -141,10 +142,17 @@ class InvariantCheck:
                  tension_tolerance: float = TENSION_TOLERANCE,
                  quadratic_tension_tolerance: float = QUADRATIC_TENSION_TOLERANCE,
                  tension_measure: str = "nodal"):
+        #: a body's two sides that may touch each other (self-contact, issue 42): (body,
+        #: mesh facets of one side, of the other), from the model's pairs
+        self.own_sides: list[tuple[int, np.ndarray, np.ndarray]] = []
         if hasattr(bodies, "bodies"):  # a model
+            model_pairs = bodies.pairs()
             if pairs is None:  # its pairs' bodies (a side's boundaries do not matter here)
-                pairs = bodies.pairs().keys()
+                pairs = model_pairs.keys()
             bodies = bodies.bodies
+            self.own_sides = [(p.a.body, p.a.mesh_facets(bodies[p.a.body]),
+                               p.b.mesh_facets(bodies[p.b.body]))
+                              for p in model_pairs if p.a.body == p.b.body]
         self.bodies = list(bodies)
         names = [b.name for b in self.bodies]
         if pairs is None:
@@ -217,7 +225,8 @@ class InvariantCheck:
             out.enforced = tuple(enforced)
         F = [np.asarray(fields[b.name].contact_force, dtype=float) for b in self.bodies]
         self._force_balance(F, out)
-        if kind.skips_untouched and not self.pairs and not any(np.any(f) for f in F):
+        if kind.skips_untouched and not self.pairs and not self.own_sides and \
+                not any(np.any(f) for f in F):
             # nothing may touch and no force acts: (a) balances, (b) and (c) hold
             out.allowed = self.penetration_tolerance + extra_allowance
             out.tension_tolerance = min((self._tolerance(b) for b in self.bodies),
@@ -235,6 +244,8 @@ class InvariantCheck:
         cur = [r if not np.any(ui) else kind.surface(r.b, r.x + ui) for r, ui in zip(ref, u)]
         Fb = [f[g.nodes] for f, g in zip(F, self.boundaries)]
         self._interpenetration(cur, out, extra_allowance, Fb, ref)
+        if self.own_sides:
+            self._own_sides_apart(cur, out, extra_allowance, Fb)
         # (c)'s normals: the deformed ones under large kinematics, the undeformed ones (linear
         # theory's) under small
         own = [c if b.large else r for b, c, r in zip(self.bodies, cur, ref)]
@@ -253,6 +264,11 @@ class InvariantCheck:
         resultant = totals.sum(axis=0)
         out.resultant = tuple(float(v) for v in resultant)
         scale = float(np.linalg.norm(totals, axis=1).max(initial=0.0))
+        # a body touching itself carries equal and opposite forces on its two sides, which its
+        # own total does not show: each side's total counts as a body's would
+        for i, facets, _ in self.own_sides:
+            nodes = np.unique(self.bodies[i].facet_points(facets))
+            scale = max(scale, float(np.linalg.norm(F[i][nodes].sum(axis=0))))
         out.force_balance = float(np.linalg.norm(resultant)) / scale if scale > 0 else 0.0
 
     # -- (b) ------------------------------------------------------------------------------------
@@ -341,6 +357,75 @@ class InvariantCheck:
                      "into": self.bodies[j].name,
                      **{c: float(v) for c, v in zip(("x", "y", "z"), pos)},
                      "deformed_depth": deformed, "linearised_depth": linearised}
+
+    def _own_sides_apart(self, cur: list, out: Invariants, extra: float,
+                         forces: list[np.ndarray]) -> None:
+        """(b) between the two sides of a body in contact with itself (issue 42): no node of
+        one side behind the other side's deformed facets deeper than the tolerance and the
+        faceting allowance, as between two bodies. A body's own polygon cannot say it (a
+        node lies on its own boundary, so on it, "inside"); so a node of side A is read
+        against side B's facets alone: behind them (along B's outward normal at its closest
+        point, or at a vertex between two of B's facets the sum of their normals), over B (a
+        node beyond B's ends is not: there the boundary turns away from B, to A or
+        elsewhere), and not a node of B itself (the sides' common corner). Every node of both
+        sides is asked, both ways: O(side) a step. Under small kinematics too the deformed
+        reading alone is judged (the linearised one of two bodies reads the other's
+        undeformed polygon, which here holds the node)."""
+        if self.kind is not PLANE:
+            raise NotImplementedError("a body's contact with itself is checked in 2D only")
+        tol = self.penetration_tolerance + extra
+        for i, facets_a, facets_b in self.own_sides:
+            g = cur[i]
+            segments = g.b.segments
+            boundary = self.bodies[i].mesh.boundary_facets()
+            per = len(segments) // max(len(boundary), 1)  # 2: a quadratic facet's two chords
+            touched = _loaded_or_next(segments, forces[i])
+            for own, other in ((facets_a, facets_b), (facets_b, facets_a)):
+                mine = np.tile(np.isin(boundary, own), per)
+                theirs = segments[np.tile(np.isin(boundary, other), per)]
+                if not len(theirs) or not mine.any():
+                    continue
+                nodes = np.setdiff1d(np.unique(segments[mine]), theirs)
+                a, b = g.x[theirs[:, 0]], g.x[theirs[:, 1]]
+                seg, t, dist, free = project_points(g.x[nodes], a, b, free=True)
+                d = b - a
+                length = np.maximum(np.linalg.norm(d, axis=1), 1e-300)
+                normal = np.column_stack([d[:, 1], -d[:, 0]]) / length[:, None]
+                # a vertex of B: the sum of its B facets' normals; an end of B: one facet
+                count = np.zeros(len(g.x))
+                vertex = np.zeros((len(g.x), 2))
+                for col in (0, 1):
+                    np.add.at(count, theirs[:, col], 1.0)
+                    np.add.at(vertex, theirs[:, col], normal)
+                at = np.where(t <= 0, theirs[seg, 0], theirs[seg, 1])
+                end = (t <= 0) | (t >= 1)
+                c = a[seg] + t[:, None] * d[seg]
+                inner = count[at] > 1  # a vertex between two of B's facets
+                direction = np.where((end & inner)[:, None], vertex[at], normal[seg])
+                behind = np.einsum("ij,ij->i", g.x[nodes] - c, direction) < 0
+                # over B: over a facet, at a vertex between two, or at B's end no further
+                # than its line's foot (to round-off)
+                over = ~end | inner | (np.abs(free - t) <= 1e-9)
+                hit = behind & over
+                if not hit.any():
+                    continue
+                node, depth = nodes[hit], dist[hit]
+                L = np.where(touched[theirs[seg[hit]]].any(axis=1), length[seg[hit]], 0.0)
+                alpha = np.minimum(g.turning_within(node, L), 0.5 * np.pi)
+                allowed = tol + np.minimum(0.5 * L * np.tan(0.5 * alpha),
+                                           np.maximum(g.adjacent[node], 0.5 * L))
+                out.max_penetration = max(out.max_penetration, float(depth.max()))
+                k = int(np.argmax(depth - allowed))
+                excess = float(depth[k] - allowed[k])
+                recorded = (None if out.where is None else out.penetration - out.allowed)
+                if recorded is None or (excess > 0 and excess > recorded) or (
+                        recorded <= 0 and excess <= 0 and depth[k] > out.penetration):
+                    out.penetration, out.allowed = float(depth[k]), float(allowed[k])
+                    pos = g.x[node[k]]
+                    out.where = {"body": self.bodies[i].name, "node": int(g.b.nodes[node[k]]),
+                                 "into": self.bodies[i].name + " (its other side)",
+                                 **{c_: float(v) for c_, v in zip(("x", "y"), pos)},
+                                 "deformed_depth": float(depth[k]), "linearised_depth": None}
 
     def _may_enter(self, i: int, j: int, near: np.ndarray, cur: list, ref: list
                    ) -> np.ndarray:
