@@ -3,7 +3,7 @@
 For comparing vfem with a general-purpose code on the *same mesh* (docs/benchmarks.md, *Hertz in
 CalculiX*):
 
-* :func:`write_deck` writes a two-body, linear-element, small-kinematics :class:`~vfem.model.Model`
+* :func:`write_deck` writes a two-body, linear-element :class:`~vfem.model.Model`
   (the Hertz example's, or any like it) as a CalculiX deck: the same nodes and elements (3-node
   triangles as CPE3, 4-node quadrilaterals as CPE4; CPS3/CPS4 for plane stress), each counter-
   clockwise in the x-y plane as ccx requires, unit thickness; one linear elastic material per
@@ -19,7 +19,15 @@ CalculiX*):
   model): 8-node hexahedra as C3D8 (scikit-fem's corners in ccx's order,
   :data:`C3D8_FROM_SKFEM`) and 4-node tetrahedra as C3D4, each of positive volume (a mirrored
   element's node order reversed), supports on x, y and z, the platen's ties on its component,
-  the contact surfaces as the elements' faces S1-S6 (S1-S4).
+  the contact surfaces as the elements' faces S1-S6 (S1-S4). A body of revolution (material
+  ``plane = "axisymmetric"``) as CAX4 (CAX3): ccx expands them into a wedge of 2 degrees and
+  reports its forces (RF, CF) on the wedge, which the readers multiply by 180
+  (``Deck.force_scale``) to give vfem's, per full circle (its loads, like vfem's, are per full
+  circle: ccx's manual, *Eight-node axisymmetric element*). A large-kinematics body (``kinematics
+  = "total"`` or ``"updated"``) puts NLGEOM on every step; its law ``"neo-hookean"`` is
+  written as ``*HYPERELASTIC, NEO HOOKE`` with the same small-strain constants (not the same
+  law at finite strain: :func:`_elastic`), Saint Venant-Kirchhoff as ``*ELASTIC`` (ccx's
+  under NLGEOM); the held boundaries' total reactions are then written at every increment.
 * :func:`run` runs ``ccx`` in a temporary folder, times it, and reads the results: ccx's own
   nodal contact pressure on the slave surface (CPRESS of ``*CONTACT FILE, CSTR``: "raw"), the
   total contact force ccx reports, and the slave body's nodal contact forces recomputed as
@@ -99,6 +107,10 @@ class Deck:
     increments: list[list[float]] = field(default_factory=list)
     # boundary node sets whose total reaction is printed per increment: set -> (body, boundary)
     reaction_sets: dict[str, tuple[str, str]] = field(default_factory=dict)
+    #: what ccx's forces (RF, CF) are multiplied by to be vfem's: 1, or 180 for an
+    #: axisymmetric model (ccx expands CAX elements into a wedge of 2 degrees and reports the
+    #: forces on it; vfem's, like the loads of both, are per full circle)
+    force_scale: float = 1.0
 
     def body(self, name: str) -> BodyDeck:
         return next(b for b in self.bodies if b.name == name)
@@ -115,10 +127,13 @@ def _check_supported(model, curves: bool = False) -> None:
         raise InputError(f"CalculiX deck: the writer handles two bodies in contact, model "
                          f"{model.name!r} has {len(model.bodies)}")
     for b in model.bodies:
-        if b.order != 1 or b.large:
+        if b.order != 1:
             raise InputError(f"CalculiX deck: body {b.name!r} must have linear elements (order "
-                             f"1) and small kinematics, got order {b.order} and kinematics "
-                             f"{b.kinematics!r}")
+                             f"1), got order {b.order}")
+        if b.large and b.material.carries_state:
+            raise InputError(f"CalculiX deck: body {b.name!r} is plastic under large kinematics "
+                             f"({b.kinematics!r}), which the writer does not translate (ccx's "
+                             "finite-strain plasticity is not vfem's Hencky law)")
         if b.tractions:
             raise InputError(f"CalculiX deck: body {b.name!r} has tractions, which the writer "
                              "does not translate")
@@ -151,6 +166,29 @@ def _plastic(body) -> list[str]:
     else:
         table = [(float(m.yield_stress), 0.0)]
     return ["*PLASTIC", *(f"{_num(v)}, {_num(a)}" for v, a in table)]
+
+
+def _elastic(body) -> list[str]:
+    """The elastic law of a body's ``*MATERIAL``: ``*ELASTIC`` (E, nu), which under ``NLGEOM``
+    ccx reads in the Green-Lagrange strain, i.e. Saint Venant-Kirchhoff, vfem's default law of a
+    large body; a large body with ``law = "neo-hookean"`` (:class:`vfem.materials.NeoHookean`)
+    as ``*HYPERELASTIC, NEO HOOKE`` with the same small-strain constants, ``C10 = mu / 2`` and
+    ``D1 = 2 / K`` (K = lambda + 2 mu / 3). The two neo-Hookean laws are not the same at finite
+    strain: vfem's is Ciarlet-Simo's, ``W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2``, ccx's
+    the split ``W = C10 (I1bar - 3) + (J - 1)^2 / D1`` (I1bar = J^(-2/3) I1); no form of ccx's
+    ``*HYPERELASTIC`` or ``*HYPERFOAM`` equals vfem's (benchmarks/oring_calculix.py measures the
+    difference at a material point)."""
+    m = body.material
+    if body.large and body.law == "neo-hookean":
+        lam, mu = _lame3d(m.youngs_modulus, m.poissons_ratio)
+        bulk = lam + 2.0 * mu / 3.0
+        return ["*HYPERELASTIC, NEO HOOKE", f"{_num(mu / 2.0)}, {_num(2.0 / bulk)}"]
+    return ["*ELASTIC", f"{_num(m.youngs_modulus)}, {_num(m.poissons_ratio)}"]
+
+
+def _lame3d(E: float, nu: float) -> tuple[float, float]:
+    """The 3D (= plane-strain, axisymmetric) Lamé constants (lambda, mu)."""
+    return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
 
 
 def _counter_clockwise(mesh) -> tuple[np.ndarray, int]:
@@ -283,7 +321,8 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     """Write ``model`` as a CalculiX input deck at ``path`` (see the module docstring).
 
     Args:
-        model: a two-body :class:`~vfem.model.Model` with linear elements, small kinematics,
+        model: a two-body :class:`~vfem.model.Model` with linear elements (plane, axisymmetric
+            or 3D; elastic bodies under small or large kinematics, plastic ones under small),
             supports, prescribed displacements and at most one platen (with amplitudes, i.e.
             load curves, only with ``steps="curves"``).
         path: the ``.inp`` file to write.
@@ -346,6 +385,10 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     tags = {n: _tag(n) for n in names}
     _, surfaces = model.contact_surfaces()
     size = max(float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in model.bodies)
+    # large kinematics: every step NLGEOM (ccx's applies to the whole model; a small body in
+    # it is then Saint Venant-Kirchhoff, which its small strains cannot tell from linear)
+    large = any(b.large for b in model.bodies)
+    axisymmetric = model.bodies[0].section.space == "axisymmetric"
 
     out = ["*HEADING", f"vfem model {model.name!r} written by vfem_tools.calculix"]
     decks: list[BodyDeck] = []
@@ -358,8 +401,9 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
             kind = "C3D8" if t.shape[0] == 8 else "C3D4"
         else:
             t, flipped = _counter_clockwise(mesh)
-            kind = (("CPE" if b.material.plane == "strain" else "CPS")
-                    + ("3" if isinstance(mesh, MeshTri) else "4"))
+            family = {"plane strain": "CPE", "plane stress": "CPS",
+                      "axisymmetric": "CAX"}[b.section.space]
+            kind = family + ("3" if isinstance(mesh, MeshTri) else "4")
         out.append(f"** body {b.name}: nodes {node_off + 1}-{node_off + mesh.p.shape[1]}, "
                    f"elements {elem_off + 1}-{elem_off + t.shape[1]} ({kind})")
         out.append(f"*NODE, NSET=N_{tag}")
@@ -377,10 +421,11 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
         out.append(f"*SURFACE, NAME=S_{tag}, TYPE=ELEMENT")
         out += [f"{elem_off + e + 1}, S{k}"
                 for e, k in (_faces3d if solid else _faces)(mesh, t, s.facet_ids)]
-        out += [f"*MATERIAL, NAME=M_{tag}", "*ELASTIC",
-                f"{_num(b.material.youngs_modulus)}, {_num(b.material.poissons_ratio)}",
-                *_plastic(b),
-                f"*SOLID SECTION, ELSET=E_{tag}, MATERIAL=M_{tag}", *([] if solid else ["1."])]
+        # a plane element's thickness, 1 (an axisymmetric one's is ccx's 2 degrees, whatever
+        # the line says: none is written)
+        out += [f"*MATERIAL, NAME=M_{tag}", *_elastic(b), *_plastic(b),
+                f"*SOLID SECTION, ELSET=E_{tag}, MATERIAL=M_{tag}",
+                *([] if solid or kind.startswith("CAX") else ["1."])]
         decks.append(BodyDeck(b.name, node_off, elem_off, kind, np.asarray(s.facet_ids),
                               flipped))
         node_off += mesh.p.shape[1]
@@ -431,7 +476,8 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
             approach = max(gap, 0.0) + 1e-6 * size
         towards = float(np.sign(pl.force)) or 1.0
         out += ["** step 1: the platen pushed under displacement control until contact holds "
-                "the body", "*STEP, INC=100", "*STATIC", "1., 1., 1e-5, 1.", "*BOUNDARY",
+                "the body", f"*STEP, {'NLGEOM, ' if large else ''}INC=100", "*STATIC",
+                "1., 1., 1e-5, 1.", "*BOUNDARY",
                 f"{ref}, {dof}, {dof}, {_num(towards * approach)}",
                 *(prescribed(0.0) if curves else []), "*END STEP"]
     rising = all(np.diff(np.r_[0.0, factors]) > 0)
@@ -442,15 +488,17 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     else:
         plan = [(f, f) for f in factors]
     reaction_sets = {}
-    if curves:
+    if curves or large:
         for b in model.bodies:
             for x in (*b.supports, *b.prescribed):
                 reaction_sets[f"B_{tags[b.name]}_{_tag(x.boundary)}"] = (b.name, x.boundary)
 
     def output(k: int) -> list[str]:
-        if not curves:
+        if not curves:  # (a large body's forces: its held boundaries' reactions, not K u)
             return [f"*NODE PRINT, NSET=N_{tags[slave]}", "U",
                     f"*NODE PRINT, NSET=N_{tags[master]}", "U",
+                    *(line for name in reaction_sets
+                      for line in (f"*NODE PRINT, NSET={name}, TOTALS=ONLY", "RF")),
                     f"*CONTACT PRINT, SLAVE=S_{tags[slave]}, MASTER=S_{tags[master]}", "CF",
                     "*CONTACT FILE", "CSTR"]
         # every increment (ccx's default frequency): *TIME POINTS would pin the increments to
@@ -474,7 +522,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
             # 4e-17): ccx lands on each of them
             largest = round(float(np.abs(np.diff([previous, *stretches[k]])).max()), 12)
             initial, span = round(initial, 12), round(span, 12)
-        out += [f"*STEP, INC={max_increments}", "*STATIC",
+        out += [f"*STEP, {'NLGEOM, ' if large else ''}INC={max_increments}", "*STATIC",
                 f"{_num(initial)}, {_num(span)}, {_num(1e-5 * span)}, {_num(largest)}"]
         if ref is not None:
             # OP=NEW releases the platen's reference node: force control from here on
@@ -488,7 +536,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     path.write_text("\n".join(out) + "\n", encoding="ascii")
     return Deck(path, model, decks, slave, master, ref, penalty, tension, approach,
                 [f for _, f in plan], friction, stick_slope if friction is not None else None,
-                [list(s) for s in stretches], reaction_sets)
+                [list(s) for s in stretches], reaction_sets, 180.0 if axisymmetric else 1.0)
 
 
 def _stretches(model) -> list[list[float]]:
@@ -655,6 +703,23 @@ def _constrained(body) -> np.ndarray:
     return np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, dtype=int)
 
 
+def _reads_k_u(body) -> bool:
+    """Whether ``K u`` (:func:`nodal_reading`: the body's linear plane stiffness times ccx's
+    displacements) is the body's nodal force: not for a large body (its law is not linear) nor
+    for a body of revolution (its stiffness is not the plane one)."""
+    return not body.large and body.section.space != "axisymmetric"
+
+
+def _unread(body, facets: np.ndarray) -> dict:
+    """:func:`nodal_reading`'s keys, not a number, for a body whose ``K u`` is no reading
+    (:func:`_reads_k_u`)."""
+    nodes = np.unique(body.mesh.facets[:, facets])
+    d = body.mesh.p.shape[0]
+    return {"nodes": nodes, "force": np.full((len(nodes), d), np.nan),
+            "pressure": np.full(len(nodes), np.nan), "tributary": np.full(len(nodes), np.nan),
+            "total_force": np.full(d, np.nan), "residual": float("nan")}
+
+
 def nodal_reading(body, facets: np.ndarray, u: np.ndarray, stiffness=None) -> dict:
     """The body's nodal contact forces ``K u`` on the nodes of ``facets`` and the nominal pressure.
 
@@ -715,17 +780,20 @@ def _at(blocks: list[tuple[float, np.ndarray]], total: float) -> np.ndarray | No
 def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
     """Per increment with contact output (each CONTACT block of the .frd file), on the slave
     body's contact candidate nodes (sorted by x): ``time`` (ccx's total time),
-    ``load_factor``, ``x`` (undeformed coordinates), ccx's nodal ``cpress``, ``cshear``
+    ``load_factor``, ``nodes`` (the body's point numbers), ``x`` (their undeformed
+    coordinates), ccx's nodal ``cpress``, ``cshear``
     (CSHEAR1, CSHEAR2: along the master surface's tangent nearest to global x, and along z),
     ``copen`` and ``cslip`` (CSLIP1, CSLIP2; the total relative tangential displacement,
-    written with friction only), ``force_nodal`` (the contact forces ``K u`` of
-    :func:`nodal_reading`, where the .dat file has the slave's displacements at that time),
-    ``tributary`` (each node's undeformed tributary length) and ``u`` (the slave's
-    displacements, (npoints, dim)), ``platen_displacement`` (the platen's reference node's,
-    along its component), ``reactions`` (set -> the total
-    (fx, fy) of ``*NODE PRINT, TOTALS=ONLY``, ``steps="curves"``) and ``contact_force`` (ccx's
-    total surface force (fx, fy) on the slave), ``contact_normal_force`` and
-    ``contact_shear_force`` (its size) from ``*CONTACT PRINT, CF``."""
+    written with friction only), ``u`` (the slave's displacements, (npoints, dim)) and, where
+    ``K u`` reads the slave's forces (:func:`_reads_k_u`: small kinematics, plane or 3D),
+    ``force_nodal`` (the contact forces ``K u`` of :func:`nodal_reading`) and ``tributary``
+    (each node's undeformed tributary length), where the .dat file has the slave's
+    displacements at that time; ``platen_displacement`` (the platen's reference node's,
+    along its component), ``reactions`` (set -> the total (fx, fy) of ``*NODE PRINT,
+    TOTALS=ONLY``, ``steps="curves"`` or a large body) and ``contact_force`` (ccx's total
+    surface force (fx, fy) on the slave), ``contact_normal_force`` and
+    ``contact_shear_force`` (its size) from ``*CONTACT PRINT, CF``; the forces of an
+    axisymmetric model per full circle (``Deck.force_scale``)."""
     body = next(b for b in deck.model.bodies if b.name == deck.slave)
     bd = deck.body(deck.slave)
     nodes = np.unique(body.mesh.facets[:, bd.contact_facets])
@@ -744,11 +812,12 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
                                                f"N_{_tag(carrier)}")
         component = DOF[next(b for b in deck.model.bodies if b.platen is not None)
                         .platen.component] - 1
-    stiffness = _stiffness(body) if displacements else None
+    stiffness = _stiffness(body) if displacements and _reads_k_u(body) else None
+    scale = deck.force_scale
     out = []
     for total, values in contact:
         v = np.array([values.get(int(i), np.zeros(6)) for i in ids]).reshape(-1, 6)
-        row = {"time": total, "load_factor": _load_factor(deck, total),
+        row = {"time": total, "load_factor": _load_factor(deck, total), "nodes": nodes,
                "x": body.mesh.p[:, nodes].T.copy(), "copen": v[:, 0], "cslip": v[:, 1:3],
                "cpress": v[:, 3], "cshear": v[:, 4:6]}
         rows = _at(displacements, total)
@@ -756,12 +825,13 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
             d = body.mesh.p.shape[0]
             u = np.zeros((body.npoints, d))
             u[rows[:, 0].astype(int) - bd.node_offset - 1] = rows[:, 1:1 + d]
-            reading = nodal_reading(body, bd.contact_facets, u, stiffness)
-            where = {int(n): k for k, n in enumerate(reading["nodes"])}
-            order = [where[int(n)] for n in nodes]
-            row["force_nodal"] = reading["force"][order]
-            row["tributary"] = reading["tributary"][order]
             row["u"] = u
+            if stiffness is not None:
+                reading = nodal_reading(body, bd.contact_facets, u, stiffness)
+                where = {int(n): k for k, n in enumerate(reading["nodes"])}
+                order = [where[int(n)] for n in nodes]
+                row["force_nodal"] = reading["force"][order]
+                row["tributary"] = reading["tributary"][order]
         rows = _at(platen_blocks, total)
         if rows is not None:
             hit = rows[rows[:, 0].astype(int) == deck.reference_node]
@@ -771,14 +841,14 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
         for name, blocks in reactions.items():
             r = _at(blocks, total)
             if r is not None:
-                row["reactions"][name] = r[0, :body.mesh.p.shape[0]].copy()
+                row["reactions"][name] = scale * r[0, :body.mesh.p.shape[0]]
         stats = next((st for t, st in statistics
                       if abs(t - total) <= 1e-6 * max(1.0, abs(total))), {})
         if stats:
-            row["contact_force"] = np.asarray(
+            row["contact_force"] = scale * np.asarray(
                 stats.get("force", [np.nan] * 3)[:body.mesh.p.shape[0]])
-            row["contact_normal_force"] = abs(stats.get("normal_force", np.nan))
-            row["contact_shear_force"] = stats.get("shear_force", np.nan)
+            row["contact_normal_force"] = scale * abs(stats.get("normal_force", np.nan))
+            row["contact_shear_force"] = scale * stats.get("shear_force", np.nan)
         out.append(row)
     return out
 
@@ -882,7 +952,8 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
         d = body.mesh.p.shape[0]
         u = np.zeros((body.npoints, d))
         u[rows[:, 0].astype(int) - bd.node_offset - 1] = rows[:, 1:1 + d]
-        readings[name] = nodal_reading(body, bd.contact_facets, u)
+        readings[name] = (nodal_reading(body, bd.contact_facets, u) if _reads_k_u(body)
+                          else _unread(body, bd.contact_facets))
     s = readings[deck.slave]
     bd = deck.body(deck.slave)
     raw = np.array([cpress.get(int(n) + bd.node_offset + 1, 0.0) for n in s["nodes"]])
@@ -908,8 +979,9 @@ def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
         "p_max_raw": float(raw.max()),
         "p_max_nodal": float(s["pressure"].max()),
         "p_max_master_nodal": float(readings[deck.master]["pressure"].max()),
-        "total_contact_force": stats.get("force", [float("nan")] * 3)[:body.mesh.p.shape[0]],
-        "contact_normal_force": abs(stats.get("normal_force", float("nan"))),
+        "total_contact_force": [deck.force_scale * v for v in
+                                stats.get("force", [float("nan")] * 3)[:body.mesh.p.shape[0]]],
+        "contact_normal_force": deck.force_scale * abs(stats.get("normal_force", float("nan"))),
         "total_contact_force_nodal": [float(v) for v in s["total_force"]],
         "nodal_residual": s["residual"],
         "slave": {"x": body.mesh.p[:, s["nodes"]].T, "pressure_raw": raw,
