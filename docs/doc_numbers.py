@@ -807,6 +807,29 @@ def examples_axisymmetric_press_fit() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_oring() -> str:
+    """docs/examples.md, O-ring: ``vfem run oring`` at its defaults, each step's lid force per
+    unit circumference beside Lindley's, the contact width and peak pressure."""
+    s = _summary("oring", "--no-figures")
+    m = s["oring"]
+    d = s["parameters"]["cross_section"]
+    E = s["parameters"]["youngs_modulus"]
+    rows = ["| compression | lid force per unit circumference | Lindley's | ratio | contact "
+            "width / d | peak pressure / E |", "|---:|---:|---:|---:|---:|---:|"]
+    for r in m["steps"]:
+        rows.append(f"| {_percent(r['compression'], 0)} | {r['force_per_length']:.4f} | "
+                    f"{r['lindley']:.4f} | {r['force_per_length'] / r['lindley']:.2f} | "
+                    f"{r['contact_width'] / d:.3f} | {r['peak_pressure'] / E:.3f} |")
+    passed = sum(r["passed"] for r in s["verification"])
+    touched = m["walls_touched_at"]
+    rows.append("")
+    rows.append(f"{_thousands(s['dofs'], 0)} dofs; the walls "
+                + ("are not touched" if touched is None else
+                   f"touched from {_percent(touched, 0)} compression")
+                + f"; verification {passed} of {len(s['verification'])} passed.")
+    return "\n".join(rows) + "\n"
+
+
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
     "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
@@ -833,6 +856,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-axisymmetric-sphere": ("docs/examples.md", examples_axisymmetric_sphere, False),
     "examples-axisymmetric-press-fit": ("docs/examples.md", examples_axisymmetric_press_fit,
                                         True),
+    "examples-oring": ("docs/examples.md", examples_oring, False),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
     "patch-thesis": ("docs/examples.md", patch_thesis, False),

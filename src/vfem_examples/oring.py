@@ -38,7 +38,7 @@ import numpy as np
 
 from vfem.bodies import PrescribedDisplacement, Support
 from vfem.config import BodyConfig, MeshSpec, ModelConfig, Steps, as_parameters
-from vfem.contact.settings import ContactSettings, PairFriction
+from vfem.contact.settings import ContactSettings
 from vfem.errors import InputError
 from vfem.materials import LinearElastic
 from vfem.solver import AnalysisResult, Model
@@ -69,6 +69,10 @@ class ORingParameters:
     #: "axisymmetric" (the ring) or "plane strain" (a straight cord, Lindley's setting: forces
     #: per unit length)
     section: str = "axisymmetric"
+    #: the groove's walls as bodies (false: the ring and the lid alone, between two flat
+    #: plates: Lindley's setting, and the two-body model ``benchmarks/oring_calculix.py``
+    #: writes for CalculiX)
+    walls: bool = True
 
 
 Parameters = ORingParameters
@@ -95,6 +99,8 @@ def validate(p: ORingParameters) -> None:
     if p.groove_width <= p.cross_section:
         raise InputError(f"oring: groove_width must exceed cross_section ({p.cross_section!r}) "
                          f"for the ring to go in, got {p.groove_width!r}")
+    if not isinstance(p.walls, bool):
+        raise InputError(f"oring: walls must be true or false, got {p.walls!r}")
     if p.section not in SECTIONS:
         raise InputError(f"oring: section must be {' or '.join(map(repr, SECTIONS))}, got "
                          f"{p.section!r}")
@@ -150,10 +156,12 @@ def config(p: ORingParameters | None = None) -> ModelConfig:
                    "right", (Support("left", ("x", "y")),), plane)
     outer = _steel("outer wall", rc + 0.5 * w, 0.0, 0.25 * d, wall_height, h, "left",
                    (Support("right", ("x", "y")),), plane)
-    bodies = (ring, lid, outer) if cord else (ring, lid, inner, outer)
-    pairs = tuple(PairFriction(("ring", b.name), p.friction) for b in bodies[1:])
+    bodies = (ring, lid) + (() if not p.walls else (outer,) if cord else (inner, outer))
+    # the ring may touch each of the others; steel never meets steel
+    pairs = tuple(("ring", b.name) for b in bodies[1:])
     steps = p.steps if isinstance(p.steps, int) and p.steps >= 1 else 1
-    return ModelConfig("oring", bodies, ContactSettings(pairs=pairs), Steps(count=steps))
+    return ModelConfig("oring", bodies, ContactSettings(friction=p.friction), Steps(count=steps),
+                       contact_pairs=pairs)
 
 
 def build(p: ORingParameters | None = None) -> Model:

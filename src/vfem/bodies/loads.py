@@ -19,6 +19,7 @@ import numpy as np
 from skfem import ElementVector, FacetBasis, LinearForm, asm
 
 from ..errors import InputError
+from ..mesh.topology import centred
 from .discretisation import COMPONENTS
 
 
@@ -258,8 +259,12 @@ def traction_vector(body, tr: Traction) -> np.ndarray:
     """The nodal forces (ndofs) of a uniform traction on a named boundary: ∫ t·v times the
     section's measure (:meth:`~vfem.bodies.section.Section.weight`) over its facets; of a
     pressure, t = -p n with n the facets' outward normal."""
-    fb = FacetBasis(body.mesh, ElementVector(body.element()),
+    # (on the mesh moved to its centre, :func:`~vfem.mesh.topology.centred`: the measure
+    # reads the points where they are; the normals do not move)
+    moved, centre = centred(body.mesh)
+    fb = FacetBasis(moved, ElementVector(body.element()),
                     facets=body.mesh.boundaries[tr.boundary])
+    at = centre.reshape(-1, 1, 1)
     section = body.section  # the measure of the body's boundary (:mod:`.section`)
     if tr.pressure is not None:
         p = float(tr.pressure)
@@ -269,7 +274,7 @@ def traction_vector(body, tr: Traction) -> np.ndarray:
             out = w.n[0] * v[0] + w.n[1] * v[1]
             for d in range(2, body.dim):  # 3D: + n_z v_z
                 out = out + w.n[d] * v[d]
-            return -p * out * section.weight(w.x)
+            return -p * out * section.weight(np.asarray(w.x) + at)
 
         return asm(pressed, fb)
     t = np.asarray(tr.value, dtype=float)
@@ -279,7 +284,7 @@ def traction_vector(body, tr: Traction) -> np.ndarray:
         out = t[0] * v[0] + t[1] * v[1]
         for d in range(2, len(t)):  # 3D: + t[2] * v[2]
             out = out + t[d] * v[d]
-        return out * section.weight(w.x)
+        return out * section.weight(np.asarray(w.x) + at)
 
     return asm(load, fb)
 

@@ -17,6 +17,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
 from ...errors import InputError
+from ...mesh.topology import centred
 from .bodymesh import _most_distorted
 
 
@@ -39,8 +40,11 @@ def virtual_quadrature(surface, order: int) -> tuple[np.ndarray, np.ndarray, np.
 def facet_mass_entries(surface):
     """(facet, row, col, value) of every nonzero of every candidate facet's mass matrix
     ∫φφᵀ (times the section's weight) on the undeformed facet, by scikit-fem."""
+    # on the mesh moved to its own centre (:func:`~vfem.mesh.topology.centred`); the weight
+    # reads the points where they are
+    moved, centre = centred(surface.body.mesh)
     try:
-        fb = FacetBasis(surface.body.mesh, surface.body.element(), facets=surface.facet_ids)
+        fb = FacetBasis(moved, surface.body.element(), facets=surface.facet_ids)
     except Exception as exc:  # noqa: BLE001 - scikit-fem raises a bare Exception here
         # its map of the facets' quadrature points into their quadrilaterals (Newton's
         # iteration on the isoparametric map) failed: an element along the surface so
@@ -55,7 +59,7 @@ def facet_mass_entries(surface):
 
     @BilinearForm
     def mass(u, v, w):
-        return w["tag"] * u * v * section.weight(w.x)
+        return w["tag"] * u * v * section.weight(np.asarray(w.x) + centre.reshape(-1, 1, 1))
 
     nq = fb.X.shape[1]
     # scikit-fem's unsummed (per facet) entries; the tag tells which facet each came from
