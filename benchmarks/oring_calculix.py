@@ -2,12 +2,13 @@
 "O-ring: ... against CalculiX (axisymmetric CAX4 or CAX8, ``*HYPERELASTIC, NEO HOOKE``, the
 same mesh) within 3 %; time ratio beside it").
 
-The model (``--model``: default ``examples/oring.toml`` where it exists, else
-``/tmp/or/half.toml``): the upper half of an O-ring's cross-section (a half disk of radius 1
-about r = 10, bilinear quadrilaterals, ``kinematics = "total"``, ``law = "neo-hookean"``,
-E = 6, nu = 0.49, ``plane = "axisymmetric"``), its flat side on the plane of symmetry (held in
-y), pressed by a stiff elastic lid (E = 2e5) moved down 0.3 (30 % compression of the section) in
-10 steps, Coulomb friction 0.2 between lid and ring. vfem solves it (``vfem.solve``); ccx solves
+The model (default: the ``oring`` example, ``vfem_examples.oring``, without the groove's walls,
+which it does not touch; ``--model`` an input file of a ring and a lid): the upper half of an
+O-ring's cross-section (a half disk of radius 1 about r = 10, bilinear quadrilaterals,
+``kinematics = "total"``, ``law = "neo-hookean"``, E = 6, nu = 0.49, ``plane =
+"axisymmetric"``), its flat side on the plane of symmetry (held in y), pressed by a stiff
+elastic lid (E = 2e5) moved down 0.3 (30 % compression of the section) in six steps, Coulomb
+friction 0.2 between lid and ring. vfem solves it (``vfem.solve``); ccx solves
 the deck :func:`vfem_tools.calculix.write_deck` makes of it (``steps="model"``: one ccx step
 per load factor): the same nodes and elements as CAX4, the ring ``*HYPERELASTIC, NEO HOOKE``,
 NLGEOM, surface-to-surface penalty contact (the ring the slave) with ccx's penalty friction.
@@ -47,19 +48,17 @@ pressure, 1e-4 of the smallest step's travel), the stick slope 1e4 (elastic slip
 many cutbacks in the first step) at penalties of 3e4, 1e5 and 1e6; a slope of 3e4 instead of
 1e4 changes the force by under 0.01 %.
 
-Measured (ccx 2.20, the half model, 231 + 246 nodes, h = 0.1; 2 shared cores): the force
-differences (vfem - ccx)/ccx at 3, 6, ..., 30 % compression +2.9 (three nodes in contact: the
-two contact discretisations differ most), +1.4, +0.5, -0.1, +0.6, -0.1, -0.6, -0.3, -0.9 and
--0.7 %; the same nodes in contact (the width alike to 0.001 at 9 of the 10 steps); the peak
-pressure within 1 % from 9 % compression on, but where ccx's extrapolation swings (-4.7 % at 15
-%, -2.2 % at 24 %; at 3 %, three nodes in contact, ccx's middle one reads 0.34 against vfem's
-0.70); penalty 1e5 against 1e6 within 0.04 %; vfem 3.5 s, ccx 26 s (ratio 7). At h = 0.05 (3,504
-dofs) the first step's difference falls to +0.4 % and the rest run from +0.1 % to -1.3 % at 30 %
-(the law's share growing with the strain; both codes' forces 3-4 % below h = 0.1's: bilinear
-elements lock at nu = 0.49), ccx 103 s.
+Measured on the example's defaults without its walls (ccx 2.20, 3,460 dofs, h = d/40, six
+steps; 2 shared cores, 2026-12-03): the force differences (vfem - ccx)/ccx at 5, 10, ..., 30 %
+compression +0.48, -0.02, -0.30, -0.64, -0.93 and -1.28 % (ccx's law the stiffer, by 0.2 to
+1.8 % at a point: below); the contact width alike to 0.001 but at 15 % and 30 % (one node more
+in ccx's contact); the peak pressure -2.3 % at 5 %, then -0.5 to -1.6 %; penalty 1e5 against 1e6
+within 0.015 %; vfem 4.1 s, ccx 38.4 s (ratio 9.4). Earlier, on the coarser half model of the
+issue's first try (231 + 246 nodes, h = 0.1, ten steps): +2.9 % at 3 % (three nodes in
+contact), then within -0.9 ... +1.4 %, ccx 7 times vfem's time.
 
     python3 benchmarks/oring_calculix.py
-    python3 benchmarks/oring_calculix.py --model examples/oring.toml --keep /tmp/ccx_oring
+    python3 benchmarks/oring_calculix.py --model ring_and_lid.toml --keep /tmp/ccx_oring
 
 Needs ``ccx`` (Debian: calculix-ccx); prints a note without it.
 """
