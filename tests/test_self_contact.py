@@ -56,24 +56,40 @@ def u_mesh(half: bool = False) -> MeshQuad:
     })
 
 
-def closing_u(kinematics: str = "small") -> Model:
+#: a U of revolution (``plane = "axisymmetric"``): moved out to r = 1 ... 5, a groove round a
+#: disk's rim closing (a bellows' convolution)
+AXIS = {"plane": "axisymmetric"}
+
+
+def material(section: dict) -> LinearElastic:
+    return LinearElastic(E, NU, **section)
+
+
+def moved(mesh, section: dict):
+    return mesh.translated((1.0, 0.0)) if section else mesh
+
+
+def closing_u(kinematics: str = "small", section: dict | None = None) -> Model:
     """The U's arms pressed together by equal and opposite tractions on their ends: they meet
     at their tips, on the plane of symmetry y = H/2."""
-    u = Body("u", u_mesh(), LinearElastic(E, NU), supports=[Support("back")],
+    section = section or {}
+    u = Body("u", moved(u_mesh(), section), material(section), supports=[Support("back")],
              tractions=[Traction("upper_end", (0.0, -P)), Traction("lower_end", (0.0, P))],
              contact_boundaries=["slot_top", "slot_bottom"], kinematics=kinematics)
     return Model("u", [u], load_factors=STEPS, contact_pairs=(("u:slot_top", "u:slot_bottom"),))
 
 
-def halved_u(kinematics: str = "small") -> Model:
+def halved_u(kinematics: str = "small", section: dict | None = None) -> Model:
     """The same, halved by its symmetry: the lower arm against a plane a million times
     stiffer on y = H/2 (the upper arm's mirror image), the cut held along y."""
-    half = Body("u", u_mesh(half=True), LinearElastic(E, NU),
+    section = section or {}
+    half = Body("u", moved(u_mesh(half=True), section), material(section),
                 supports=[Support("back"), Support("mid", ("y",))],
                 tractions=[Traction("lower_end", (0.0, P))], contact_boundaries=["slot_bottom"],
                 kinematics=kinematics)
-    plane = Body("plane", block(BACK, 0.5 * H, L - BACK, 0.1, SIZE), LinearElastic(1e6 * E, NU),
-                 supports=[Support("top")], contact_boundaries=["bottom"])
+    plane = Body("plane", moved(block(BACK, 0.5 * H, L - BACK, 0.1, SIZE), section),
+                 LinearElastic(1e6 * E, NU, **section), supports=[Support("top")],
+                 contact_boundaries=["bottom"])
     return Model("half", [half, plane], load_factors=STEPS)
 
 
@@ -81,12 +97,16 @@ def by_load_factor(result) -> dict:
     return {round(s.load_factor, 9): s for s in result.steps}
 
 
-def test_a_u_closing_on_itself_is_its_half_against_the_plane_of_symmetry():
+@pytest.mark.parametrize("section", [{}, AXIS], ids=["plane strain", "axisymmetric"])
+def test_a_u_closing_on_itself_is_its_half_against_the_plane_of_symmetry(section):
     """Small kinematics: the U's arms meeting tip to tip (self-contact) carry, at every node
     of the lower arm and at every step both runs reach, the contact forces and displacements of
     the halved model against a stiff plane to 1e-6 of the largest (the plane's compliance, a
-    millionth of the arm's, is the one difference); the invariants pass at every step."""
-    whole, half = Analysis(closing_u()).run(), Analysis(halved_u()).run()
+    millionth of the arm's, is the one difference); the invariants pass at every step. In
+    plane strain, and as a body of revolution (the U moved out to r = 1 ... 5: a groove round a
+    disk's rim, its two faces closing on each other, forces per full circle)."""
+    whole, half = Analysis(closing_u(section=section)).run(), \
+        Analysis(halved_u(section=section)).run()
     assert whole.converged, whole.message
     assert half.converged, half.message
     assert all(s.invariants["passed"] for s in whole.steps)
