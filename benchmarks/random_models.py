@@ -169,6 +169,7 @@ import numpy as np  # noqa: E402
 from scipy.spatial import cKDTree  # noqa: E402
 from skfem import (  # noqa: E402
     Basis,
+    BilinearForm,
     ElementHex1,
     ElementQuad1,
     ElementQuad2,
@@ -258,6 +259,20 @@ def large(p: dict) -> dict:
     q = dict(p)
     q["order"], q["curved"] = 1, False
     q["kinematics"] = "total"
+    return q
+
+
+def axisymmetric(p: dict) -> dict:
+    """Model ``p`` (2D) as bodies of revolution (``--axisymmetric``, issue 42): both materials'
+    ``plane = "axisymmetric"``, the model moved out from the axis by WIDTH times 1 plus a
+    log-uniform share in [0.02, 10] (the upper body's left edge then 0.05 WIDTH to 10 WIDTH
+    from it: an annular punch on an annular block, the measure 2 pi r varying across the
+    contact by up to a factor of 40), drawn from ``[seed, dim, k, 42]``. The checks read the
+    axisymmetric stiffness (:class:`BodyCheck`); the rest is the plane-strain model's."""
+    q = dict(p)
+    k = int(p["id"].partition("d-")[2])
+    rng = np.random.default_rng([p["seed"], p["dim"], k, 42])
+    q["axis_offset"] = WIDTH * (1.0 + _log_uniform(rng, 0.02, 10.0))
     return q
 
 
@@ -653,9 +668,12 @@ def build(p: dict, folder: Path) -> tuple[ModelConfig, dict]:
     h_min = min(p["h_lower"], p["h_upper"])
     gap = p["gap_facets"] * h_min
     shift = np.append(plan, gap - lowest)
-    translate = tuple(float(v) for v in shift)
+    off_axis = np.zeros(dim)
+    off_axis[0] = p.get("axis_offset", 0.0)  # --axisymmetric: the whole model moved out
+    placed = shift + off_axis
+    translate = tuple(float(v) for v in placed)
     if arc is not None and p.get("curved"):
-        curve = Curve(arc[0], tuple(float(c + s) for c, s in zip(arc[1], shift)), arc[2])
+        curve = Curve(arc[0], tuple(float(c + s) for c, s in zip(arc[1], placed)), arc[2])
     upper_spec = dataclasses.replace(upper_spec, translate=translate, curve=curve)
 
     # the push: a contact strain of p["strain"]
@@ -676,6 +694,8 @@ def build(p: dict, folder: Path) -> tuple[ModelConfig, dict]:
         a = min(R * eps, 0.4 * WIDTH)
         push = a * a / R
         force = min(4.0 / 3.0 * Ep * math.sqrt(R) * push ** 1.5, flat_force)
+    if "axis_offset" in p:  # per full circle: round the upper body's centre line
+        force *= 2.0 * math.pi * (p["axis_offset"] + p["centre"][0])
     comps = ("x", "y", "z")[:dim]
     vertical = comps[-1]
     held = vfem.Support(top, comps[:-1])
@@ -683,15 +703,20 @@ def build(p: dict, folder: Path) -> tuple[ModelConfig, dict]:
         motion = {"platen": vfem.Platen(top, vertical, -force)}
     else:
         motion = {"prescribed": (vfem.PrescribedDisplacement(top, vertical, -(gap + push)),)}
-    upper = BodyConfig("upper", upper_spec, vfem.LinearElastic(p["E_upper"], p["nu_upper"]),
+    section = {"plane": "axisymmetric"} if "axis_offset" in p else {}
+    upper = BodyConfig("upper", upper_spec, vfem.LinearElastic(p["E_upper"], p["nu_upper"],
+                                                               **section),
                        order=order, supports=(held,), **motion)
-    material = vfem.LinearElastic(p["E_lower"], p["nu_lower"])
+    material = vfem.LinearElastic(p["E_lower"], p["nu_lower"], **section)
     if "yield_ratio" in p:  # --plastic: the block elasto-plastic, yielding at a share of the
         # contact stress's scale E* eps
         Y = p["yield_ratio"] * Ep * eps
         material = J2Plastic(p["E_lower"], p["nu_lower"], Y,
                              hardening_modulus=p["hardening_ratio"] * p["E_lower"])
-    lower = BodyConfig("block", _lower_spec(p), material,
+    lower_spec = _lower_spec(p)
+    if "axis_offset" in p:
+        lower_spec = dataclasses.replace(lower_spec, translate=tuple(float(v) for v in off_axis))
+    lower = BodyConfig("block", lower_spec, material,
                        order=order, supports=(vfem.Support("bottom", comps),))
     if "kinematics" in p:  # --large
         upper, lower = (dataclasses.replace(b, kinematics=p["kinematics"])
@@ -723,7 +748,9 @@ class BodyCheck:
         if not all(np.allclose(vb.doflocs[:, c::d], self.geo.X) for c in range(d)):
             raise AssertionError("scikit-fem's vector dofs are not interleaved by point")
         E, nu = body.material.youngs_modulus, body.material.poissons_ratio
-        self.K = asm(linear_elasticity(*_lame(E, nu)), vb).tocsr()
+        form = (_axisymmetric_elasticity if body.material.plane == "axisymmetric"
+                else linear_elasticity)
+        self.K = asm(form(*_lame(E, nu)), vb).tocsr()
         self.ndofs = self.K.shape[0]
         self.support, self.prescribed, self.platen = [], [], None
         for kind, boundary, comps, value in bcs:
@@ -742,6 +769,27 @@ class BodyCheck:
         interior = np.setdiff1d(np.arange(self.geo.npoints), self.geo.bnodes)
         self.interior_dofs = (interior[:, None] * d + np.arange(d)).ravel()
         self.vb = vb
+
+
+def _axisymmetric_elasticity(lam: float, mu: float) -> BilinearForm:
+    """Isotropic elasticity on a body of revolution about the y axis, written here from the
+    strains (e_rr, e_zz, e_tt = u_r / r, e_rz) and the measure 2 pi r dA, not read from vfem
+    (its own is :class:`vfem.bodies.section.Axisymmetric`'s): ``--axisymmetric``'s K u = f."""
+
+    @BilinearForm
+    def form(u, v, w):
+        r = w.x[0]
+
+        def strain(f):
+            g = f.grad
+            return (g[0, 0], g[1, 1], f[0] / r, 0.5 * (g[0, 1] + g[1, 0]))
+
+        a, b = strain(u), strain(v)
+        ta, tb = a[0] + a[1] + a[2], b[0] + b[1] + b[2]
+        inner = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + 2.0 * a[3] * b[3]
+        return 2.0 * np.pi * r * (lam * ta * tb + 2.0 * mu * inner)
+
+    return form
 
 
 def _inside_2d(pts: np.ndarray, segs: np.ndarray) -> np.ndarray:
@@ -1439,6 +1487,9 @@ def main(argv=None) -> int:
     ap.add_argument("--large", action="store_true",
                     help="the same models under large kinematics (total Lagrangian, linear "
                          "elements), solved by the Newton contact formulation")
+    ap.add_argument("--axisymmetric", action="store_true",
+                    help="the 2D models as bodies of revolution, moved out from the axis "
+                         "(issue 42); no 3D models")
     ap.add_argument("--plastic", action="store_true",
                     help="the same models with the block elasto-plastic (issue 41)")
     ap.add_argument("--remedies", action="store_true",
@@ -1462,6 +1513,8 @@ def main(argv=None) -> int:
     else:
         models = ([draw(args.seed, 2, k) for k in range(args.count_2d)]
                   + [draw(args.seed, 3, k) for k in range(args.count_3d)])
+    if args.axisymmetric:
+        models = [axisymmetric(p) for p in models if p["dim"] == 2]
     if args.plastic:
         models = [plastic(p) for p in models]
     if args.large:
@@ -1496,7 +1549,8 @@ def main(argv=None) -> int:
                "summary": text, "counts": counts,
                "models": [{"parameters": p, **results[p["id"]]} for p in models]}
         Path(args.json).write_text(json.dumps(out, indent=1, default=_json_default))
-    print(("plastic block (--plastic): " if args.plastic else "")
+    print(("bodies of revolution (--axisymmetric): " if args.axisymmetric else "")
+          + ("plastic block (--plastic): " if args.plastic else "")
           + ("large kinematics (--large): " if args.large else "") + text)
     if args.remedies:
         stopped = [p["id"] for p in models if results[p["id"]]["vfem"]["status"] == "stopped"]

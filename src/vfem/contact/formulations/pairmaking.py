@@ -94,7 +94,7 @@ def make_pair_sided(form, sides: SurfacePair, density_i: tuple[float, bool],
     a, b = sides.a, sides.b
     si, sj = form.surfaces[a.body], form.surfaces[b.body]
     (ci, ei), (cj, ej) = density_i, density_j
-    if ci == 0.0 and cj == 0.0:
+    if ci == 0.0 and cj == 0.0 and not (form.keep_all_nodes and _face(form, a, b)):
         return None, [], -1  # no facet of either faces the other
     if ei != ej and (ci if ei else cj) * EDGE_RATIO >= max(ci, cj):
         # the contact zone ends at an edge of one surface (a corner over the other): that
@@ -286,6 +286,17 @@ def relative_motion(form, own: int, other: int, read, read_other,
     sense = -np.sign(np.einsum("ij,ij->i", platen, normal))[:, None]
     none = np.linalg.norm(out, axis=1) <= 1e-12 * max(float(np.abs(s.X).max()), 1e-300)
     return np.where(none[:, None], sense * platen, out)
+
+
+def _face(form, a: Side, b: Side) -> bool:
+    """Whether facets of each side face the other (:func:`~vfem.contact.geometry.pairing.facing`)
+    though none lies over it: under large kinematics such a pair is made all the same, its
+    nodes re-paired on the current geometry at every iteration, so that two sides that will
+    meet only after a large deformation are paired when they do (a bore's two halves, each
+    over nothing of the other at rest: their closest points are the other's end)."""
+    s, so = form.surfaces[a.body], form.surfaces[b.body]
+    return bool(len(facing(s, s.X, so, so.X, a.facets, b.facets))
+                and len(facing(so, so.X, s, s.X, b.facets, a.facets)))
 
 
 def compliance_density(form, side: Side, other: Side) -> tuple[float, bool]:
