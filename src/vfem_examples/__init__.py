@@ -16,7 +16,7 @@ EXAMPLES = ("springs", "hertz", "patch", "wedge", "block", "gasket", "sliding", 
             "cattaneo", "sphere", "press_fit", "cattaneo3d", "circular_punch", "stack",
             "indentation", "thick_cylinder", "block_indentation",
             "sphere_indentation", "axisymmetric_sphere", "axisymmetric_press_fit",
-            "oring")
+            "oring", "ring_crush")
 
 
 def load(name: str):

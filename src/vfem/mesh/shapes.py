@@ -786,11 +786,19 @@ def disk(radius: float = 1.0, h: float = 0.1, *, quarter: bool = True, half: boo
 
 
 def annulus(inner_radius: float = 1.0, outer_radius: float = 2.0, *, around: int = 16,
-            radial: int = 4) -> MeshQuad:
+            radial: int = 4, half: bool = False, split: float = 60.0) -> MeshQuad:
     """The quarter annulus x >= 0, y >= 0 between two circles about the origin in
     quadrilaterals: ``around`` divisions per quarter turn (nodes at equal angles), ``radial``
     through the wall. Named boundaries: ``inner``, ``outer``, ``left`` (x = 0) and ``bottom``
-    (y = 0)."""
+    (y = 0).
+
+    With ``half``: the half annulus x >= 0 (a ring's section halved by its vertical plane of
+    symmetry: a ring crushed between two plates), ``around`` divisions per quarter turn. Named
+    boundaries: ``inner`` and ``outer``; ``top`` and ``bottom`` (the cuts at x = 0, y > 0 and
+    y < 0); ``inner_upper`` and ``inner_lower`` (the bore's parts more than ``split`` degrees
+    above and below the horizontal: the two sides of the bore that meet when the ring is
+    crushed flat, apart from each other, for a self-contact pair); ``foot`` (the outer facet at
+    the bottom: a point support that holds the ring's vertical motion)."""
     if not 0 < inner_radius < outer_radius:
         raise ValueError(f"need 0 < inner_radius < outer_radius, got {inner_radius} and "
                          f"{outer_radius}")
@@ -798,6 +806,25 @@ def annulus(inner_radius: float = 1.0, outer_radius: float = 2.0, *, around: int
             and around >= 1 and radial >= 1):
         raise ValueError(f"around and radial must be whole numbers >= 1, got {around} and "
                          f"{radial}")
+    if half:
+        if not 0.0 < split < 90.0:
+            raise ValueError(f"split must lie in (0, 90) degrees, got {split}")
+        check_count((2.0 * around + 1.0) * (radial + 1.0), "annulus")
+        mesh = MeshQuad.init_tensor(np.linspace(inner_radius, outer_radius, radial + 1),
+                                    np.linspace(-0.5 * np.pi, 0.5 * np.pi, 2 * around + 1))
+        tol = 1e-9 * outer_radius
+        cut, step = np.radians(split), 0.5 * np.pi / around
+        mesh = named_boundaries(mesh, {
+            "inner": lambda p: p[0] < inner_radius + tol,
+            "inner_upper": lambda p: (p[0] < inner_radius + tol) & (p[1] > cut),
+            "inner_lower": lambda p: (p[0] < inner_radius + tol) & (p[1] < -cut),
+            "outer": lambda p: p[0] > outer_radius - tol,
+            "foot": lambda p: (p[0] > outer_radius - tol) & (p[1] < -0.5 * np.pi + step),
+            "top": lambda p: p[1] > 0.5 * np.pi - 1e-9,
+            "bottom": lambda p: p[1] < -0.5 * np.pi + 1e-9})
+        r, t = mesh.p
+        return share_topology(mesh, replace(mesh, doflocs=np.vstack([r * np.cos(t),
+                                                                     r * np.sin(t)])))
     check_count((around + 1.0) * (radial + 1.0), "annulus")
     mesh = MeshQuad.init_tensor(np.linspace(inner_radius, outer_radius, radial + 1),
                                 np.linspace(0.0, 0.5 * np.pi, around + 1))
