@@ -830,6 +830,30 @@ def examples_oring() -> str:
     return "\n".join(rows) + "\n"
 
 
+def examples_ring_crush() -> str:
+    """docs/examples.md, Ring crush: ``vfem run ring_crush`` at its defaults, every fourth step
+    and each step from the bore's closing on: the plate's travel and force, the bore's
+    opening, the self-contact force."""
+    s = _summary("ring_crush", "--no-figures")
+    m = s["ring_crush"]
+    rows = ["| travel | plate's force | bore's opening | self-contact force | nodes in "
+            "self-contact |", "|---:|---:|---:|---:|---:|"]
+    for k, r in enumerate(m["steps"]):
+        if k % 4 == 3 or r["self_contact_force"] > 0:
+            opening = r["bore_opening"] if abs(r["bore_opening"]) > 1e-6 else 0.0
+            rows.append(f"| {r['travel']:.3f} | {r['force']:.4g} | {opening:.4f} | "
+                        f"{r['self_contact_force']:.4g} | {r['self_contact_nodes']} |")
+    passed = sum(r["passed"] for r in s["verification"])
+    first = m["steps"][0]
+    rows.append("")
+    rows.append(f"{_thousands(s['dofs'], 0)} dofs; the bore closes at a travel of "
+                f"{m['closed_at_travel']:.3f}; the first step's stiffness "
+                f"{first['force'] / first['travel']:.4g} (a thin ring's "
+                f"{m['thin_ring_stiffness']:.4g}); verification {passed} of "
+                f"{len(s['verification'])} passed.")
+    return "\n".join(rows) + "\n"
+
+
 BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "readme-hertz": ("README.md", readme_hertz, True),
     "accuracy-hertz-study": ("docs/accuracy.md", accuracy_hertz_study, False),
@@ -857,6 +881,7 @@ BLOCKS: dict[str, tuple[str, Callable[[], str], bool]] = {
     "examples-axisymmetric-press-fit": ("docs/examples.md", examples_axisymmetric_press_fit,
                                         True),
     "examples-oring": ("docs/examples.md", examples_oring, False),
+    "examples-ring-crush": ("docs/examples.md", examples_ring_crush, False),
     "examples-block": ("docs/examples.md", examples_block, True),
     "gasket-linear": ("docs/examples.md", gasket_linear, False),
     "patch-thesis": ("docs/examples.md", patch_thesis, False),
