@@ -112,6 +112,11 @@ scikit-fem.
 isotropic hardening none or up to 0.1 E; linear elements). A body that carries a material
 state is solved by Newton's method, and so the model by the Newton contact formulation
 (``vfem.contact.formulations.large``), whose equilibrium check 1 (K u) does not apply.
+**Bodies of revolution** (``--axisymmetric``, issue 42): the 2D models with both materials
+``plane = "axisymmetric"``, moved out from the axis (:func:`axisymmetric`), the checks' K u =
+f with an axisymmetric stiffness written here (:func:`_axisymmetric_elasticity`); a platen's
+force per full circle round the upper body's centre line.
+
 **Large kinematics** (``--large``): the same models with both bodies total Lagrangian (linear
 elements, the block elastic; with ``--plastic`` too, plastic), solved by that formulation too.
 Found on their first runs (2026-12-02): that formulation enforced contact at the compatibility
@@ -130,6 +135,7 @@ small kinematics does (docs/method.md §10: 1 and 0 wrong).
     vfem run /tmp/m17/random_2d-17.toml    # (add --set contact.method=lagrange for the baseline)
     python3 benchmarks/random_models.py --plastic --count-3d 6 --no-baseline  # plastic blocks
     python3 benchmarks/random_models.py --large --no-baseline    # large kinematics
+    python3 benchmarks/random_models.py --axisymmetric --count-3d 0 --no-baseline  # r-z
     python3 benchmarks/random_models.py --remedies   # then each stop again: the other
                                           # compatibility side, 4x the steps, large kinematics
 
