@@ -112,7 +112,7 @@ NOT_YET = {"friction": "friction is set for a model's contact: contact.friction 
                        "parameter: --set friction=0.3)",
            "self_contact": "a body's contact with itself is between two of its boundaries, "
                            "named as a pair's two sides: contact_pairs = [['ring:upper', "
-                           "'ring:lower']] (2D and r-z)"}
+                           "'ring:lower']]"}
 
 
 def _suggest(key: str, valid: list[str]) -> str:

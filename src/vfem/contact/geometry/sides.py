@@ -19,8 +19,8 @@ and the baselines, which refuse named sides) reads :meth:`ContactPairs.keys` and
 pair like any other to those that read sides: its two sides are two named boundaries of the
 body that share no facet (:func:`_check_own_sides`), so a node never meets its own facets; the
 invariants check the body against itself (:meth:`vfem.contact.invariants.check.InvariantCheck
-._own_sides_apart`). In 2D and r-z; a whole boundary that finds its own sides (single-surface
-contact) and 3D are not built yet.
+._own_sides_apart`), in 2D, r-z and 3D; a whole boundary that finds its own sides
+(single-surface contact) is not built yet.
 """
 
 from __future__ import annotations
@@ -214,10 +214,6 @@ def _check_own_sides(sides: list[Side], bodies, entry, where: str) -> None:
     facets that share a node with its own are left out of its candidates: the sides' common
     corner is no contact, :func:`~.pairing.facing`)."""
     body = bodies[sides[0].body]
-    if body.dim == 3:
-        raise InputError(f"{where} {list(entry)!r} names one body twice ({body.name!r}): a "
-                         "body's contact with itself is taken in 2D and in r-z as yet, not in "
-                         "3D")
     if any(s.boundaries is None for s in sides):
         raise InputError(f"{where} {list(entry)!r} names one body twice ({body.name!r}) "
                          "without its boundaries: a body's contact with itself is between two "

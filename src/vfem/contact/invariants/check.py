@@ -73,7 +73,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...executor import SERIAL
-from ..search import project_points
 from .check3d import SOLID
 from .kind import SurfaceKind
 from .measures import (
@@ -362,55 +361,26 @@ class InvariantCheck:
                          forces: list[np.ndarray]) -> None:
         """(b) between the two sides of a body in contact with itself (issue 42): no node of
         one side behind the other side's deformed facets deeper than the tolerance and the
-        faceting allowance, as between two bodies. A body's own polygon cannot say it (a
-        node lies on its own boundary, so on it, "inside"); so a node of side A is read
-        against side B's facets alone: behind them (along B's outward normal at its closest
-        point, or at a vertex between two of B's facets the sum of their normals), over B (a
-        node beyond B's ends is not: there the boundary turns away from B, to A or
-        elsewhere), and not a node of B itself (the sides' common corner). Every node of both
-        sides is asked, both ways: O(side) a step. Under small kinematics too the deformed
-        reading alone is judged (the linearised one of two bodies reads the other's
-        undeformed polygon, which here holds the node)."""
-        if self.kind is not PLANE:
-            raise NotImplementedError("a body's contact with itself is checked in 2D only")
+        faceting allowance, as between two bodies. A body's own boundary cannot say it (a
+        node lies on it, so "inside"); so a node of each side is read against the other
+        side's facets alone, behind them and over them (the kind's ``behind``:
+        :meth:`~vfem.contact.invariants.polygon._Polygon.behind`,
+        :meth:`~vfem.contact.invariants.check3d.Surface3.behind`), not a node of both (the
+        sides' common corner), both ways: O(side) a step. Under small kinematics too the
+        deformed reading alone is judged (the linearised one of two bodies reads the other's
+        undeformed boundary, which here holds the node)."""
         tol = self.penetration_tolerance + extra
         for i, facets_a, facets_b in self.own_sides:
             g = cur[i]
-            segments = g.b.segments
-            boundary = self.bodies[i].mesh.boundary_facets()
-            per = len(segments) // max(len(boundary), 1)  # 2: a quadratic facet's two chords
-            touched = _loaded_or_next(segments, forces[i])
-            for own, other in ((facets_a, facets_b), (facets_b, facets_a)):
-                mine = np.tile(np.isin(boundary, own), per)
-                theirs = segments[np.tile(np.isin(boundary, other), per)]
-                if not len(theirs) or not mine.any():
+            on_a, on_b = np.isin(g.b.facet_of, facets_a), np.isin(g.b.facet_of, facets_b)
+            touched = _loaded_or_next(g.b.segments, forces[i])
+            for own, other in ((on_a, on_b), (on_b, on_a)):
+                found = g.behind(own, other)
+                if found is None:
                     continue
-                nodes = np.setdiff1d(np.unique(segments[mine]), theirs)
-                a, b = g.x[theirs[:, 0]], g.x[theirs[:, 1]]
-                seg, t, dist, free = project_points(g.x[nodes], a, b, free=True)
-                d = b - a
-                length = np.maximum(np.linalg.norm(d, axis=1), 1e-300)
-                normal = np.column_stack([d[:, 1], -d[:, 0]]) / length[:, None]
-                # a vertex of B: the sum of its B facets' normals; an end of B: one facet
-                count = np.zeros(len(g.x))
-                vertex = np.zeros((len(g.x), 2))
-                for col in (0, 1):
-                    np.add.at(count, theirs[:, col], 1.0)
-                    np.add.at(vertex, theirs[:, col], normal)
-                at = np.where(t <= 0, theirs[seg, 0], theirs[seg, 1])
-                end = (t <= 0) | (t >= 1)
-                c = a[seg] + t[:, None] * d[seg]
-                inner = count[at] > 1  # a vertex between two of B's facets
-                direction = np.where((end & inner)[:, None], vertex[at], normal[seg])
-                behind = np.einsum("ij,ij->i", g.x[nodes] - c, direction) < 0
-                # over B: over a facet, at a vertex between two, or at B's end no further
-                # than its line's foot (to round-off)
-                over = ~end | inner | (np.abs(free - t) <= 1e-9)
-                hit = behind & over
-                if not hit.any():
-                    continue
-                node, depth = nodes[hit], dist[hit]
-                L = np.where(touched[theirs[seg[hit]]].any(axis=1), length[seg[hit]], 0.0)
+                node, depth, L, ends = found
+                # (the faceting allowance where the facet is in or next to contact, as (b)'s)
+                L = np.where(touched[ends].any(axis=1), L, 0.0)
                 alpha = np.minimum(g.turning_within(node, L), 0.5 * np.pi)
                 allowed = tol + np.minimum(0.5 * L * np.tan(0.5 * alpha),
                                            np.maximum(g.adjacent[node], 0.5 * L))
@@ -424,7 +394,7 @@ class InvariantCheck:
                     pos = g.x[node[k]]
                     out.where = {"body": self.bodies[i].name, "node": int(g.b.nodes[node[k]]),
                                  "into": self.bodies[i].name + " (its other side)",
-                                 **{c_: float(v) for c_, v in zip(("x", "y"), pos)},
+                                 **{c_: float(v) for c_, v in zip(("x", "y", "z"), pos)},
                                  "deformed_depth": float(depth[k]), "linearised_depth": None}
 
     def _may_enter(self, i: int, j: int, near: np.ndarray, cur: list, ref: list

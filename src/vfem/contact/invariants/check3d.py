@@ -80,6 +80,8 @@ class Boundary3:
     #: (nt,) bool: the triangle lies on one of the body's contact boundaries
     #: (``contact_boundaries``); None where it names none (every boundary may touch)
     contact: np.ndarray | None = None
+    #: (nt,) the mesh's boundary facet each triangle is part of: a pair's side reads its own
+    facet_of: np.ndarray | None = None
 
     @classmethod
     def of(cls, body: Body, symmetry: np.ndarray) -> Boundary3:
@@ -125,7 +127,7 @@ class Boundary3:
                    facets=local.reshape(fp.shape), mirror=mirror,
                    segments=lookup[sides].reshape(-1, 2), large=body.large,
                    corner_mid=None if corner_mid is None else lookup[corner_mid],
-                   contact=contact)
+                   contact=contact, facet_of=np.asarray(bf)[piece_of][owner])
 
     @cached_property
     def edges(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -267,6 +269,54 @@ class Surface3(CachedBoundary):
         direction = self.feature_normals(tri, lam, self.pseudonormals)
         return np.einsum("ij,ij->i", pts - c, direction) <= 1e-12 * np.maximum(
             self.sizes[tri], 1e-300), dist
+
+    def behind(self, own: np.ndarray, other: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """A body's side against its other side (self-contact, issue 42; the 2D reading's,
+        :meth:`~vfem.contact.invariants.polygon._Polygon.behind`): the nodes of the triangles
+        ``own`` (mask (nt,)), but those of ``other``, behind the triangles ``other`` and over
+        them — (nodes, depth, the closest facet's size, its triangle's nodes), None where there
+        are none. Behind: along the pseudonormal of the closest feature over ``other``'s
+        triangles alone (a face's normal, an edge's two, a vertex's angle-weighted sum). Over:
+        in a face, on an edge between two of ``other``'s triangles or at a vertex all of whose
+        triangles are ``other``'s — or, at ``other``'s border, with the node's foot on the
+        closest triangle's plane inside it (a node beyond the border is not over the side:
+        there the boundary turns away)."""
+        keep = np.flatnonzero(other)
+        if not len(keep) or not own.any():
+            return None
+        tri_all = self.b.triangles
+        nodes = np.setdiff1d(np.unique(tri_all[own]), tri_all[keep])
+        if not len(nodes):
+            return None
+        tri, lam, c, dist = self._closest(self.x[nodes], keep)
+        # the other side's interior features: edges of two of its triangles, vertices whose
+        # triangles are all its
+        half, count, opposite = self.b.edges
+        mine = np.zeros(count)
+        np.add.at(mine, half.reshape(-1, 3)[keep].ravel(), 1.0)
+        outside = np.zeros(len(self.x))
+        np.add.at(outside, tri_all[~other].ravel(), 1.0)
+        zero = lam <= FEATURE
+        n_zero = zero.sum(axis=1)
+        interior = n_zero == 0  # in the face
+        at = np.flatnonzero(n_zero == 1)  # on an edge
+        interior[at] = mine[opposite[tri[at], np.argmax(zero[at], axis=1)]] >= 2
+        at = np.flatnonzero(n_zero >= 2)  # at a vertex
+        corner = 3 - (zero[at] * np.arange(3)).sum(axis=1)
+        interior[at] = outside[tri_all[tri[at], corner]] == 0
+        direction = self.feature_normals(tri, lam, self._vertex_pseudonormals(keep))
+        # at the border: the foot on the closest triangle's plane inside it, read along its
+        # face normal
+        a, b, cc = (self.x[tri_all[tri, k]] for k in range(3))
+        foot = _barycentric(self.x[nodes], a, b, cc).min(axis=1) >= -FEATURE
+        border = ~interior & foot
+        direction[border] = self.unit_normals[tri[border]]
+        behind = np.einsum("ij,ij->i", self.x[nodes] - c, direction) < 0
+        hit = behind & (interior | foot)
+        if not hit.any():
+            return None
+        return nodes[hit], dist[hit], self.sizes[tri[hit]], tri_all[tri[hit]]
 
     def depth(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distance of ``pts`` to the surface triangles, the size of the closest one's facet

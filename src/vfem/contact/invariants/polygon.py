@@ -31,6 +31,8 @@ class _Boundary:
     facets: np.ndarray  # (nf, 2 or 3) local numbers of the facets (ends, midpoint), oriented
     mirror: np.ndarray  # (ns,) bool: the segment lies on a symmetry plane of the model
     large: bool  # the body is analysed under large kinematics
+    #: (ns,) the mesh's boundary facet each segment is (part of): a pair's side reads its own
+    facet_of: np.ndarray | None = None
 
     @classmethod
     def of(cls, body: Body) -> _Boundary:
@@ -47,16 +49,18 @@ class _Boundary:
             flip = np.einsum("ij,ij->i", normal, 0.5 * (a + b) - centroid) < 0
             fp[flip, :2] = fp[flip][:, 1::-1]
         mirror = np.isin(bf, symmetry_facets(body))
+        facet_of = np.asarray(bf)
         if fp.shape[1] == 3:  # quadratic: a facet is two chords through its midpoint
             segments = np.vstack([fp[:, [0, 2]], fp[:, [2, 1]]])
             mirror = np.concatenate([mirror, mirror])
+            facet_of = np.concatenate([facet_of, facet_of])
         else:
             segments = fp
         nodes, local = np.unique(segments, return_inverse=True)
         lookup = np.full(body.npoints, -1)
         lookup[nodes] = np.arange(len(nodes))
         return cls(nodes=nodes, segments=local.reshape(segments.shape), facets=lookup[fp],
-                   mirror=mirror, large=body.large)
+                   mirror=mirror, large=body.large, facet_of=facet_of)
 
 
 def symmetry_facets(body: Body) -> np.ndarray:
@@ -114,6 +118,40 @@ class _Polygon(CachedBoundary):
         direction = np.where(end[:, None], vertex_normal[at], n[seg])
         return np.einsum("ij,ij->i", pts - c, direction) <= 1e-12 * np.maximum(
             self.lengths[seg], 1e-300), dist
+
+    def behind(self, own: np.ndarray, other: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """A body's side against its other side (self-contact, issue 42): the nodes of the
+        segments ``own`` (mask (ns,)), but those of ``other``, that lie behind the segments
+        ``other`` and over them — (nodes, depth, the closest segment's length, its two
+        nodes), None where there are none. Behind: along the closest segment's outward
+        normal, or at a vertex between two of ``other``'s segments the sum of theirs. Over:
+        on a segment, at such a vertex, or at an end of ``other`` no further than its line's
+        foot (a node beyond the ends is not over it: there the boundary turns away)."""
+        theirs = self.b.segments[other]
+        if not len(theirs) or not own.any():
+            return None
+        nodes = np.setdiff1d(np.unique(self.b.segments[own]), theirs)
+        a, b = self.x[theirs[:, 0]], self.x[theirs[:, 1]]
+        seg, t, dist, free = project_points(self.x[nodes], a, b, free=True)
+        d = b - a
+        length = np.maximum(np.linalg.norm(d, axis=1), 1e-300)
+        normal = np.column_stack([d[:, 1], -d[:, 0]]) / length[:, None]
+        count = np.zeros(len(self.x))
+        vertex = np.zeros((len(self.x), 2))
+        for col in (0, 1):
+            np.add.at(count, theirs[:, col], 1.0)
+            np.add.at(vertex, theirs[:, col], normal)
+        at = np.where(t <= 0, theirs[seg, 0], theirs[seg, 1])
+        end = (t <= 0) | (t >= 1)
+        c = a[seg] + t[:, None] * d[seg]
+        inner = count[at] > 1  # a vertex between two of the other side's segments
+        direction = np.where((end & inner)[:, None], vertex[at], normal[seg])
+        behind = np.einsum("ij,ij->i", self.x[nodes] - c, direction) < 0
+        hit = behind & (~end | inner | (np.abs(free - t) <= 1e-9))
+        if not hit.any():
+            return None
+        return nodes[hit], dist[hit], length[seg[hit]], theirs[seg[hit]]
 
     def depth(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distance of ``pts`` to the surface segments, the length of the closest one and
