@@ -186,8 +186,9 @@ class BodyConfig:
             ``"updated"`` Lagrangian formulation (plane strain or 3D, linear elements; a
             plastic material at finite strain).
         law: under large kinematics, the hyperelastic law whose small-strain constants are the
-            material's: ``"saint-venant-kirchhoff"`` or ``"neo-hookean"`` (a plastic material
-            has its own law: Hencky elasticity in the logarithmic strain).
+            material's: ``"saint-venant-kirchhoff"``, ``"neo-hookean"`` (Ciarlet–Simo) or
+            ``"neo-hookean-isochoric"`` (CalculiX's and Abaqus's NEO HOOKE) (a plastic
+            material has its own law: Hencky elasticity in the logarithmic strain).
     """
 
     name: str

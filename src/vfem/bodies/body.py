@@ -47,8 +47,9 @@ class Body:
             or ``"updated"`` Lagrangian formulation (thesis Chapters 2-3; plane strain or 3D,
             linear elements; a plastic material at finite strain).
         law: under large kinematics, the hyperelastic law whose small-strain constants are the
-            material's: ``"saint-venant-kirchhoff"`` (default) or ``"neo-hookean"`` (a plastic
-            material has its own law: Hencky elasticity in the logarithmic strain).
+            material's: ``"saint-venant-kirchhoff"`` (default), ``"neo-hookean"``
+            (Ciarlet–Simo) or ``"neo-hookean-isochoric"`` (CalculiX's and Abaqus's NEO HOOKE)
+            (a plastic material has its own law: Hencky elasticity in the logarithmic strain).
 
     Points: the nodes of the elements. For linear elements they are the mesh vertices; quadratic
     elements add one point at the middle of each facet (numbered after the vertices, in facet
