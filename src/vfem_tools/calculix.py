@@ -10,7 +10,10 @@ CalculiX*):
   body; supports and prescribed displacements as ``*BOUNDARY``; a force-controlled platen as
   ``*EQUATION`` ties of its nodes' platen component to one reference node that carries the
   ``*CLOAD``; frictionless surface-to-surface penalty contact (``*CONTACT PAIR, TYPE=SURFACE TO
-  SURFACE``) between the bodies' contact candidate facets, the softer body the slave; a J2
+  SURFACE``) between the bodies' contact candidate facets, the softer body the slave (a
+  contact pair's side that names boundaries, ``"ring:outer"``, the surface of those boundaries'
+  element faces; a pair of two boundaries of one body, self-contact in 2D or r-z, a ``*CONTACT
+  PAIR`` of its two surfaces, the side named first the slave: ``Deck.pairs``); a J2
   plastic material (:class:`vfem.materials.J2Plastic`, isotropic hardening) as ``*PLASTIC``. With
   ``friction``, Coulomb friction (``*FRICTION``: mu and ccx's stick slope); with
   ``steps="curves"``, loads on load curves (prescribed displacements and a platen force with
@@ -111,6 +114,10 @@ class Deck:
     #: axisymmetric model (ccx expands CAX elements into a wedge of 2 degrees and reports the
     #: forces on it; vfem's, like the loads of both, are per full circle)
     force_scale: float = 1.0
+    #: every ``*CONTACT PAIR`` as (slave surface, master surface), in the deck's order: the two
+    #: bodies' pair first (if the model pairs them), then each pair of two sides of one body
+    #: (self-contact)
+    pairs: list[tuple[str, str]] = field(default_factory=list)
 
     def body(self, name: str) -> BodyDeck:
         return next(b for b in self.bodies if b.name == name)
@@ -126,6 +133,10 @@ def _check_supported(model, curves: bool = False) -> None:
     if len(model.bodies) != 2:
         raise InputError(f"CalculiX deck: the writer handles two bodies in contact, model "
                          f"{model.name!r} has {len(model.bodies)}")
+    if model.bodies[0].mesh.p.shape[0] == 3 and any(p.a.body == p.b.body
+                                                    for p in model.pairs()):
+        raise InputError(f"CalculiX deck: model {model.name!r} pairs two sides of one body "
+                         "in 3D (self-contact), which the writer does not translate")
     for b in model.bodies:
         if b.order != 1:
             raise InputError(f"CalculiX deck: body {b.name!r} must have linear elements (order "
@@ -283,6 +294,18 @@ def _tag(name: str) -> str:
     return re.sub(r"\W", "_", name.upper())
 
 
+def _side_surface(model, surfaces, side) -> tuple[str, np.ndarray]:
+    """A contact pair's side (:class:`vfem.contact.geometry.sides.Side`) as a ccx surface: its
+    name, ``S_<BODY>`` for a body's whole contact surface (its candidate facets),
+    ``S_<BODY>_<BOUNDARY>`` for named boundaries (their names joined by ``_``), and its facets
+    (indices into the body's mesh's facets)."""
+    body = model.bodies[side.body]
+    if side.boundaries is None:
+        return f"S_{_tag(body.name)}", np.asarray(surfaces[side.body].facet_ids)
+    name = f"S_{_tag(body.name)}_{_tag('_'.join(side.boundaries))}"
+    return name, np.asarray(side.mesh_facets(body))
+
+
 def _lines(values, per_line: int = 8) -> list[str]:
     values = list(values)
     return [", ".join(str(v) for v in values[i:i + per_line])
@@ -324,7 +347,13 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
         model: a two-body :class:`~vfem.model.Model` with linear elements (plane, axisymmetric
             or 3D; elastic bodies under small or large kinematics, plastic ones under small),
             supports, prescribed displacements and at most one platen (with amplitudes, i.e.
-            load curves, only with ``steps="curves"``).
+            load curves, only with ``steps="curves"``). Its contact pairs
+            (:meth:`~vfem.model.Model.pairs`) are written as ``*CONTACT PAIR`` of their sides'
+            surfaces (:func:`_side_surface`: a body's whole contact surface, or its named
+            boundaries): the two bodies' pair with the ``slave`` body's side the slave; a pair of
+            two sides of one body (self-contact, in 2D and r-z), the side the input names first
+            the slave and the second the master (ccx pairs two distinct surfaces of one body like
+            those of two bodies).
         path: the ``.inp`` file to write.
         slave: the slave body's name; default the one with the smaller Young's modulus.
         penalty: the contact stiffness (pressure per unit overclosure) of ccx's linear
@@ -383,7 +412,16 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     i_slave = names.index(slave)
     master = names[1 - i_slave]
     tags = {n: _tag(n) for n in names}
-    _, surfaces = model.contact_surfaces()
+    pairs, surfaces = model.contact_surfaces()
+    # every contact pair as (slave side, master side): the two bodies' first, then self pairs
+    contact_pairs = []
+    for p in pairs:
+        if p.a.body != p.b.body:
+            contact_pairs.insert(0, (p.a, p.b) if p.a.body == i_slave else (p.b, p.a))
+        else:
+            contact_pairs.append((p.a, p.b))
+    sides = {id(side): _side_surface(model, surfaces, side)
+             for pair in contact_pairs for side in pair}
     size = max(float(np.linalg.norm(np.ptp(b.mesh.p, axis=1))) for b in model.bodies)
     # large kinematics: every step NLGEOM (ccx's applies to the whole model; a small body in
     # it is then Saint Venant-Kirchhoff, which its small strains cannot tell from linear)
@@ -393,7 +431,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     out = ["*HEADING", f"vfem model {model.name!r} written by vfem_tools.calculix"]
     decks: list[BodyDeck] = []
     node_off = elem_off = 0
-    for b, s in zip(model.bodies, surfaces):
+    for ib, (b, s) in enumerate(zip(model.bodies, surfaces)):
         mesh, tag = b.mesh, tags[b.name]
         solid = mesh.p.shape[0] == 3
         if solid:
@@ -418,9 +456,15 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
             nodes = np.unique(mesh.facets[:, mesh.boundaries[name]]) + node_off + 1
             out.append(f"*NSET, NSET=B_{tag}_{_tag(name)}")
             out += _lines(nodes.tolist())
-        out.append(f"*SURFACE, NAME=S_{tag}, TYPE=ELEMENT")
-        out += [f"{elem_off + e + 1}, S{k}"
-                for e, k in (_faces3d if solid else _faces)(mesh, t, s.facet_ids)]
+        written = set()
+        for side in (side for pair in contact_pairs for side in pair):
+            surface, facets = sides[id(side)]
+            if side.body != ib or surface in written:
+                continue
+            written.add(surface)
+            out.append(f"*SURFACE, NAME={surface}, TYPE=ELEMENT")
+            out += [f"{elem_off + e + 1}, S{k}"
+                    for e, k in (_faces3d if solid else _faces)(mesh, t, facets)]
         # a plane element's thickness, 1 (an axisymmetric one's is ccx's 2 degrees, whatever
         # the line says: none is written)
         out += [f"*MATERIAL, NAME=M_{tag}", *_elastic(b), *_plastic(b),
@@ -465,8 +509,11 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
         if stick_slope is None:
             stick_slope = penalty if penalty is not None else 1e11
         out += ["*FRICTION", f"{_num(friction)}, {_num(stick_slope)}"]
-    out += ["*CONTACT PAIR, INTERACTION=CONTACT, TYPE=SURFACE TO SURFACE",
-            f"S_{tags[slave]}, S_{tags[master]}"]
+    deck_pairs = [(sides[id(a)][0], sides[id(b)][0]) for a, b in contact_pairs]
+    for a, b in deck_pairs:
+        out += ["*CONTACT PAIR, INTERACTION=CONTACT, TYPE=SURFACE TO SURFACE", f"{a}, {b}"]
+    prints = [line for a, b in deck_pairs
+              for line in (f"*CONTACT PRINT, SLAVE={a}, MASTER={b}", "CF")]
 
     factors = [float(f) for f in model.load_factors]
     stretches = _stretches(model) if curves else []
@@ -499,8 +546,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
                     f"*NODE PRINT, NSET=N_{tags[master]}", "U",
                     *(line for name in reaction_sets
                       for line in (f"*NODE PRINT, NSET={name}, TOTALS=ONLY", "RF")),
-                    f"*CONTACT PRINT, SLAVE=S_{tags[slave]}, MASTER=S_{tags[master]}", "CF",
-                    "*CONTACT FILE", "CSTR"]
+                    *prints, "*CONTACT FILE", "CSTR"]
         # every increment (ccx's default frequency): *TIME POINTS would pin the increments to
         # the load factors, but ccx 2.20 then stalls on an increment of length 0 after landing
         # on one (measured on the Cattaneo example); the increments are the model's steps
@@ -509,8 +555,7 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
                 f"*NODE PRINT, NSET=N_{tags[master]}", "U",
                 *(line for name in reaction_sets
                   for line in (f"*NODE PRINT, NSET={name}, TOTALS=ONLY", "RF")),
-                f"*CONTACT PRINT, SLAVE=S_{tags[slave]}, MASTER=S_{tags[master]}", "CF",
-                "*CONTACT FILE", "CSTR, CDIS"]
+                *prints, "*CONTACT FILE", "CSTR, CDIS"]
 
     previous = 0.0
     for k, (first, factor) in enumerate(plan):
@@ -536,7 +581,8 @@ def write_deck(model, path, *, slave: str | None = None, penalty: float | None =
     path.write_text("\n".join(out) + "\n", encoding="ascii")
     return Deck(path, model, decks, slave, master, ref, penalty, tension, approach,
                 [f for _, f in plan], friction, stick_slope if friction is not None else None,
-                [list(s) for s in stretches], reaction_sets, 180.0 if axisymmetric else 1.0)
+                [list(s) for s in stretches], reaction_sets, 180.0 if axisymmetric else 1.0,
+                deck_pairs)
 
 
 def _stretches(model) -> list[list[float]]:
@@ -607,10 +653,18 @@ def _contact_statistics(text: str) -> dict:
 
 
 def _contact_statistics_by_time(text: str) -> list[tuple[float, dict]]:
-    """Every "statistics for slave set" block of the ``.dat`` file, with its total time."""
+    """Every "statistics for slave set" block of the ``.dat`` file, with its total time; each
+    block's ``pair`` is its (slave surface, master surface)."""
     pieces = text.split(" statistics for slave set")[1:]
-    return [(_heading_time(p.splitlines()[0]), _statistics_block(p.splitlines()))
-            for p in pieces]
+    out = []
+    for p in pieces:
+        head = p.splitlines()[0]
+        stats = _statistics_block(p.splitlines())
+        names = re.match(r"\s*(\S+?),\s*master set\s+(\S+)", head)
+        if names:
+            stats["pair"] = (names.group(1), names.group(2))
+        out.append((_heading_time(head), stats))
+    return out
 
 
 def _statistics_block(body: list[str]) -> dict:
@@ -620,7 +674,8 @@ def _statistics_block(body: list[str]) -> dict:
         nums = None
         for j in range(i + 1, min(i + 4, len(body))):
             if body[j].strip():
-                nums = [float(v) for v in re.findall(_FLOAT, body[j])]
+                # (a pair without contact prints NaN for its normal and shear force)
+                nums = [float(v) for v in re.findall(_FLOAT + r"|[-+]?nan", body[j], re.I)]
                 break
         if line.strip().startswith("total surface force"):
             out["force"] = nums[:3]
@@ -792,8 +847,10 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
     along its component), ``reactions`` (set -> the total (fx, fy) of ``*NODE PRINT,
     TOTALS=ONLY``, ``steps="curves"`` or a large body) and ``contact_force`` (ccx's total
     surface force (fx, fy) on the slave), ``contact_normal_force`` and
-    ``contact_shear_force`` (its size) from ``*CONTACT PRINT, CF``; the forces of an
-    axisymmetric model per full circle (``Deck.force_scale``)."""
+    ``contact_shear_force`` (its size) from ``*CONTACT PRINT, CF`` (of the deck's first
+    contact pair, the two bodies'), ``pair_forces`` (every pair's, (slave surface, master
+    surface) -> its total surface force on the slave; a self-contact pair's too); the forces
+    of an axisymmetric model per full circle (``Deck.force_scale``)."""
     body = next(b for b in deck.model.bodies if b.name == deck.slave)
     bd = deck.body(deck.slave)
     nodes = np.unique(body.mesh.facets[:, bd.contact_facets])
@@ -842,8 +899,10 @@ def _history(deck: Deck, dat: str, contact: list) -> list[dict]:
             r = _at(blocks, total)
             if r is not None:
                 row["reactions"][name] = scale * r[0, :body.mesh.p.shape[0]]
-        stats = next((st for t, st in statistics
-                      if abs(t - total) <= 1e-6 * max(1.0, abs(total))), {})
+        now = [st for t, st in statistics if abs(t - total) <= 1e-6 * max(1.0, abs(total))]
+        stats = now[0] if now else {}  # the first pair's: the two bodies'
+        row["pair_forces"] = {st["pair"]: scale * np.asarray(st["force"][:body.mesh.p.shape[0]])
+                              for st in now if "pair" in st and "force" in st}
         if stats:
             row["contact_force"] = scale * np.asarray(
                 stats.get("force", [np.nan] * 3)[:body.mesh.p.shape[0]])
