@@ -191,10 +191,12 @@ def main(argv=None) -> int:
     ap.add_argument("--penalty", type=float, default=1e8, help="ccx's contact stiffness")
     ap.add_argument("--no-penalty-check", action="store_true",
                     help="skip ccx's second run at a tenth of the penalty")
-    ap.add_argument("--law", default="neo-hookean",
-                    choices=("neo-hookean", "saint-venant-kirchhoff"),
-                    help="the ring's law in both codes (Saint Venant-Kirchhoff: the same law in "
-                         "both, ccx's *ELASTIC under NLGEOM; it buckles past a travel of 0.9)")
+    ap.add_argument("--law", default="neo-hookean-isochoric",
+                    choices=("neo-hookean-isochoric", "neo-hookean", "saint-venant-kirchhoff"),
+                    help="the ring's law in vfem (default: the example's, CalculiX's NEO HOOKE, "
+                         "the same law in both codes; neo-hookean: vfem's Ciarlet-Simo form "
+                         "against ccx's NEO HOOKE; Saint Venant-Kirchhoff: ccx's *ELASTIC under "
+                         "NLGEOM, the same law; it buckles past a travel of 0.9)")
     ap.add_argument("--poissons-ratio", type=float, default=None, help="the ring's nu")
     ap.add_argument("--crush", type=float, default=None,
                     help="the plate's last travel over the outside diameter")
@@ -248,7 +250,7 @@ def main(argv=None) -> int:
             other = solve_ccx(args.penalty / 10.0, Path(tmp))[1]
     theirs = ccx_rows(ccx, deck, p)
     peak = max(abs(c["force"]) for c in theirs.values())
-    neo = args.law == "neo-hookean"
+    neo = args.law == "neo-hookean"  # (the two codes' laws differ: their first-order share)
 
     print(f"ring_crush example ({args.law}, nu {p.poissons_ratio:g}): "
           f"{sum(2 * b.npoints for b in model.bodies)} dofs, {len(model.load_factors)} steps, "

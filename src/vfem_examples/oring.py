@@ -73,6 +73,9 @@ class ORingParameters:
     #: plates: Lindley's setting, and the two-body model ``benchmarks/oring_calculix.py``
     #: writes for CalculiX)
     walls: bool = True
+    #: the ring's hyperelastic law: CalculiX's and Abaqus's NEO HOOKE by default (the same law
+    #: as benchmarks/oring_calculix.py's deck), or "neo-hookean" (Ciarlet–Simo)
+    law: str = "neo-hookean-isochoric"
 
 
 Parameters = ORingParameters
@@ -145,7 +148,7 @@ def config(p: ORingParameters | None = None) -> ModelConfig:
         material=LinearElastic(p.youngs_modulus, p.poissons_ratio, plane=plane),
         # the plane of symmetry (and the cord's vertical one)
         supports=(Support("bottom", ("y",)), *((Support("left", ("x",)),) if cord else ())),
-        contact_boundaries=("rim",), kinematics="total", law="neo-hookean")
+        contact_boundaries=("rim",), kinematics="total", law=p.law)
     # the lid spans the groove and a little more; the walls stop short of the lid's lowest
     # position (a twentieth of d below it), so that steel never meets steel
     lid = _steel("lid", rc - (0.0 if cord else 0.75 * w), 0.5 * d, (0.75 if cord else 1.5) * w,

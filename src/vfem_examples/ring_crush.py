@@ -54,6 +54,9 @@ class RingCrushParameters:
     radial: int = 6  # elements through the wall
     split: float = 60.0  # degrees: the bore's sides in self-contact lie beyond it
     plate_stiffness_ratio: float = 1000.0  # the plate's E over the ring's
+    #: the ring's hyperelastic law: CalculiX's and Abaqus's NEO HOOKE by default (the same law
+    #: as benchmarks/ring_crush_calculix.py's deck), or "neo-hookean" (Ciarlet–Simo)
+    law: str = "neo-hookean-isochoric"
 
 
 Parameters = RingCrushParameters
@@ -109,7 +112,7 @@ def config(p: RingCrushParameters | None = None) -> ModelConfig:
         material=LinearElastic(p.youngs_modulus, p.poissons_ratio),
         supports=(Support("top", ("x",)), Support("bottom", ("x",)), Support("foot", ("y",))),
         contact_boundaries=("inner_upper", "inner_lower", "outer"),
-        kinematics="total", law="neo-hookean")
+        kinematics="total", law=p.law)
     plate = BodyConfig(
         name="plate",
         mesh=MeshSpec(shape="block", parameters=as_parameters(

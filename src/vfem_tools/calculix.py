@@ -27,10 +27,10 @@ CalculiX*):
   reports its forces (RF, CF) on the wedge, which the readers multiply by 180
   (``Deck.force_scale``) to give vfem's, per full circle (its loads, like vfem's, are per full
   circle: ccx's manual, *Eight-node axisymmetric element*). A large-kinematics body (``kinematics
-  = "total"`` or ``"updated"``) puts NLGEOM on every step; its law ``"neo-hookean"`` is
-  written as ``*HYPERELASTIC, NEO HOOKE`` with the same small-strain constants (not the same
-  law at finite strain: :func:`_elastic`), Saint Venant-Kirchhoff as ``*ELASTIC`` (ccx's
-  under NLGEOM); the held boundaries' total reactions are then written at every increment.
+  = "total"`` or ``"updated"``) puts NLGEOM on every step; its law ``"neo-hookean-isochoric"``
+  is written as ``*HYPERELASTIC, NEO HOOKE`` (the same law), ``"neo-hookean"`` as the same card
+  with the same small-strain constants (not the same law at finite strain: :func:`_elastic`),
+  Saint Venant-Kirchhoff as ``*ELASTIC`` (ccx's under NLGEOM); the held boundaries' total reactions are then written at every increment.
 * :func:`run` runs ``ccx`` in a temporary folder, times it, and reads the results: ccx's own
   nodal contact pressure on the slave surface (CPRESS of ``*CONTACT FILE, CSTR``: "raw"), the
   total contact force ccx reports, and the slave body's nodal contact forces recomputed as
@@ -182,15 +182,16 @@ def _plastic(body) -> list[str]:
 def _elastic(body) -> list[str]:
     """The elastic law of a body's ``*MATERIAL``: ``*ELASTIC`` (E, nu), which under ``NLGEOM``
     ccx reads in the Green-Lagrange strain, i.e. Saint Venant-Kirchhoff, vfem's default law of a
-    large body; a large body with ``law = "neo-hookean"`` (:class:`vfem.materials.NeoHookean`)
-    as ``*HYPERELASTIC, NEO HOOKE`` with the same small-strain constants, ``C10 = mu / 2`` and
-    ``D1 = 2 / K`` (K = lambda + 2 mu / 3). The two neo-Hookean laws are not the same at finite
-    strain: vfem's is Ciarlet-Simo's, ``W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2``, ccx's
+    large body; a large body with ``law = "neo-hookean-isochoric"``
+    (:class:`vfem.materials.hyperelastic.IsochoricNeoHookean`) as ``*HYPERELASTIC, NEO HOOKE``
+    with ``C10 = mu / 2`` and ``D1 = 2 / K`` (K = lambda + 2 mu / 3): the same law. With ``law =
+    "neo-hookean"`` (:class:`vfem.materials.NeoHookean`) the same card and constants, which are
+    not the same law at finite strain: vfem's ``"neo-hookean"`` is Ciarlet-Simo's, ``W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2``, ccx's
     the split ``W = C10 (I1bar - 3) + (J - 1)^2 / D1`` (I1bar = J^(-2/3) I1); no form of ccx's
     ``*HYPERELASTIC`` or ``*HYPERFOAM`` equals vfem's (benchmarks/oring_calculix.py measures the
     difference at a material point)."""
     m = body.material
-    if body.large and body.law == "neo-hookean":
+    if body.large and body.law in ("neo-hookean", "neo-hookean-isochoric"):
         lam, mu = _lame3d(m.youngs_modulus, m.poissons_ratio)
         bulk = lam + 2.0 * mu / 3.0
         return ["*HYPERELASTIC, NEO HOOKE", f"{_num(mu / 2.0)}, {_num(2.0 / bulk)}"]
