@@ -4,14 +4,14 @@ same mesh) within 3 %; time ratio beside it").
 
 The model (default: the ``oring`` example, ``vfem_examples.oring``, without the groove's walls,
 which it does not touch; ``--model`` an input file of a ring and a lid): the upper half of an
-O-ring's cross-section (a half disk of radius 1 about r = 10, bilinear quadrilaterals,
-``kinematics = "total"``, ``law = "neo-hookean"``, E = 6, nu = 0.49, ``plane =
-"axisymmetric"``), its flat side on the plane of symmetry (held in y), pressed by a stiff
+O-ring's cross-section (a half disk of radius 1 about r = 10, bilinear quadrilaterals, ``kinematics
+= "total"``, ``law = "neo-hookean-isochoric"``: ccx's NEO HOOKE, the same law, E = 6, nu = 0.49,
+``plane = "axisymmetric"``), its flat side on the plane of symmetry (held in y), pressed by a stiff
 elastic lid (E = 2e5) moved down 0.3 (30 % compression of the section) in six steps, Coulomb
-friction 0.2 between lid and ring. vfem solves it (``vfem.solve``); ccx solves
-the deck :func:`vfem_tools.calculix.write_deck` makes of it (``steps="model"``: one ccx step
-per load factor): the same nodes and elements as CAX4, the ring ``*HYPERELASTIC, NEO HOOKE``,
-NLGEOM, surface-to-surface penalty contact (the ring the slave) with ccx's penalty friction.
+friction 0.2 between lid and ring. vfem solves it (``vfem.solve``); ccx solves the deck
+:func:`vfem_tools.calculix.write_deck` makes of it (``steps="model"``: one ccx step per load
+factor): the same nodes and elements as CAX4, the ring ``*HYPERELASTIC, NEO HOOKE``, NLGEOM,
+surface-to-surface penalty contact (the ring the slave) with ccx's penalty friction.
 
 Printed per load factor: the lid's displacement and the compression (over the ring's height),
 the lid's force (its held top's total reaction, y, per full circle: vfem's
@@ -49,13 +49,13 @@ many cutbacks in the first step) at penalties of 3e4, 1e5 and 1e6; a slope of 3e
 1e4 changes the force by under 0.01 %.
 
 Measured on the example's defaults without its walls (ccx 2.20, 3,460 dofs, h = d/40, six
-steps; 2 shared cores, 2026-12-03): the force differences (vfem - ccx)/ccx at 5, 10, ..., 30 %
-compression +0.48, -0.02, -0.30, -0.64, -0.93 and -1.28 % (ccx's law the stiffer, by 0.2 to
-1.8 % at a point: below); the contact width alike to 0.001 but at 15 % and 30 % (one node more
-in ccx's contact); the peak pressure -2.3 % at 5 %, then -0.5 to -1.6 %; penalty 1e5 against 1e6
-within 0.015 %; vfem 4.1 s, ccx 38.4 s (ratio 9.4). Earlier, on the coarser half model of the
-issue's first try (231 + 246 nodes, h = 0.1, ten steps): +2.9 % at 3 % (three nodes in
-contact), then within -0.9 ... +1.4 %, ccx 7 times vfem's time.
+steps; 2 shared cores, 2026-12-03), the same law in both codes: the force differences (vfem -
+ccx)/ccx at 5, 10, ..., 30 % compression +0.59, +0.23, +0.13, +0.02, +0.03 and +0.05 %; the
+contact width alike to 0.001 but at 15 % and 30 % (one node more in ccx's contact); the peak
+pressure -2.2 % at 5 % (three nodes in contact), then within 0.23 %; penalty 1e5 against 1e6
+within 0.015 %; vfem 4.5 s, ccx 27.6 s (ratio 6.1). With vfem's Ciarlet-Simo law instead (the
+example's ``law = "neo-hookean"``; ccx's NEO HOOKE is then not the same law): +0.48 ... -1.28 %,
+growing with the compression as the laws part (below).
 
     python3 benchmarks/oring_calculix.py
     python3 benchmarks/oring_calculix.py --model ring_and_lid.toml --keep /tmp/ccx_oring
