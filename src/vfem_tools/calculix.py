@@ -30,7 +30,8 @@ CalculiX*):
   = "total"`` or ``"updated"``) puts NLGEOM on every step; its law ``"neo-hookean-isochoric"``
   is written as ``*HYPERELASTIC, NEO HOOKE`` (the same law), ``"neo-hookean"`` as the same card
   with the same small-strain constants (not the same law at finite strain: :func:`_elastic`),
-  Saint Venant-Kirchhoff as ``*ELASTIC`` (ccx's under NLGEOM); the held boundaries' total reactions are then written at every increment.
+  Saint Venant-Kirchhoff as ``*ELASTIC`` (ccx's under NLGEOM); the held boundaries' total
+  reactions are then written at every increment.
 * :func:`run` runs ``ccx`` in a temporary folder, times it, and reads the results: ccx's own
   nodal contact pressure on the slave surface (CPRESS of ``*CONTACT FILE, CSTR``: "raw"), the
   total contact force ccx reports, and the slave body's nodal contact forces recomputed as
@@ -186,10 +187,11 @@ def _elastic(body) -> list[str]:
     (:class:`vfem.materials.hyperelastic.IsochoricNeoHookean`) as ``*HYPERELASTIC, NEO HOOKE``
     with ``C10 = mu / 2`` and ``D1 = 2 / K`` (K = lambda + 2 mu / 3): the same law. With ``law =
     "neo-hookean"`` (:class:`vfem.materials.NeoHookean`) the same card and constants, which are
-    not the same law at finite strain: vfem's ``"neo-hookean"`` is Ciarlet-Simo's, ``W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2``, ccx's
-    the split ``W = C10 (I1bar - 3) + (J - 1)^2 / D1`` (I1bar = J^(-2/3) I1); no form of ccx's
-    ``*HYPERELASTIC`` or ``*HYPERFOAM`` equals vfem's (benchmarks/oring_calculix.py measures the
-    difference at a material point)."""
+    not the same law at finite strain: vfem's ``"neo-hookean"`` is Ciarlet-Simo's, ``W = mu/2
+    (I1 - 3) - mu ln J + lambda/2 (ln J)^2``, ccx's the split ``W = C10 (I1bar - 3) + (J - 1)^2
+    / D1`` (I1bar = J^(-2/3) I1); no form of ccx's ``*HYPERELASTIC`` or ``*HYPERFOAM`` equals
+    the Ciarlet-Simo form (benchmarks/oring_calculix.py measures the difference at a material
+    point)."""
     m = body.material
     if body.large and body.law in ("neo-hookean", "neo-hookean-isochoric"):
         lam, mu = _lame3d(m.youngs_modulus, m.poissons_ratio)
