@@ -229,17 +229,11 @@ def main(argv=None) -> int:
         print(f"CalculiX ({args.ccx!r}) is not installed: vfem alone took {vfem_s:.1f} s")
         return 0
 
-    def solve_ccx(penalty: float, folder: Path, keep=None):
-        deck = calculix.write_deck(config.build(), folder / "oring.inp", steps="model",
-                                   penalty=penalty, friction=friction,
-                                   stick_slope=args.stick_slope)
-        return deck, calculix.run(deck, ccx=args.ccx, timeout=args.timeout, keep=keep)
-
     with tempfile.TemporaryDirectory() as tmp:
-        deck, ccx = solve_ccx(args.penalty, Path(tmp), args.keep)
-        other = None
-        if not args.no_penalty_check:
-            other = solve_ccx(args.penalty / 10.0, Path(tmp))[1]
+        deck, ccx, other = calculix.run_with_penalty_check(
+            config, Path(tmp) / "oring.inp", args.penalty, check=not args.no_penalty_check,
+            keep=args.keep, ccx=args.ccx, timeout=args.timeout, friction=friction,
+            stick_slope=args.stick_slope)
     ring = deck.slave
     ours = vfem_rows(result, ring, args.lid, deck.body(ring).contact_facets)
     theirs = ccx_rows(ccx, deck, args.lid)

@@ -233,16 +233,10 @@ def main(argv=None) -> int:
         print(f"CalculiX ({args.ccx!r}) is not installed: vfem alone took {vfem_s:.1f} s")
         return 0
 
-    def solve_ccx(penalty: float, folder: Path, keep=None):
-        deck = calculix.write_deck(config.build(), folder / "ring_crush.inp", steps="model",
-                                   penalty=penalty)
-        return deck, calculix.run(deck, ccx=args.ccx, timeout=args.timeout, keep=keep)
-
     with tempfile.TemporaryDirectory() as tmp:
-        deck, ccx = solve_ccx(args.penalty, Path(tmp), args.keep)
-        other = None
-        if not args.no_penalty_check:
-            other = solve_ccx(args.penalty / 10.0, Path(tmp))[1]
+        deck, ccx, other = calculix.run_with_penalty_check(
+            config, Path(tmp) / "ring_crush.inp", args.penalty, check=not args.no_penalty_check,
+            keep=args.keep, ccx=args.ccx, timeout=args.timeout)
     theirs = ccx_rows(ccx, deck, p)
     peak = max(abs(c["force"]) for c in theirs.values())
     neo = args.law == "neo-hookean"  # (the two codes' laws differ: their first-order share)

@@ -6,7 +6,6 @@ within 3 % at 10, 20 and 30 % compression (``benchmarks/oring_calculix.py``)."""
 from __future__ import annotations
 
 import dataclasses
-import shutil
 import sys
 from pathlib import Path
 
@@ -20,8 +19,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 import oring_calculix  # noqa: E402
 
-needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None,
-                               reason="CalculiX (ccx) is not installed")
+from test_calculix import blocks as cards  # noqa: E402
+from test_calculix import needs_ccx  # noqa: E402
 
 #: the upper half of an O-ring's section (radius 1 about r = 10, E = 6, nu = 0.49) on its plane
 #: of symmetry, pressed 0.3 (30 % of the section) by a stiff lid, friction 0.2
@@ -84,19 +83,6 @@ def config(load_factors=None):
         c = dataclasses.replace(c, steps=dataclasses.replace(c.steps,
                                                              load_factors=tuple(load_factors)))
     return c
-
-
-def cards(text: str) -> list[tuple[str, list[str]]]:
-    """(keyword line, data lines) of a deck, comments dropped."""
-    out = []
-    for line in text.splitlines():
-        if line.startswith("**"):
-            continue
-        if line.startswith("*"):
-            out.append((line.upper(), []))
-        elif out:
-            out[-1][1].append(line)
-    return out
 
 
 def test_a_neo_hookean_body_of_revolution_is_written_as_cax4_hyperelastic_nlgeom(tmp_path):

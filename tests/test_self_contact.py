@@ -28,32 +28,43 @@ P = 0.5
 STEPS = tuple(np.linspace(0.1, 1.0, 10))
 
 
-def u_mesh(half: bool = False) -> MeshQuad:
-    """A block H high with a slot GAP wide cut from x = BACK to its end at mid-height: a U on
-    its side, two arms T thick (``half``: its lower half, cut at y = H/2). Boundaries: the
-    ``back`` (x = 0), the arms' ends, the slot's two faces, the cut (``mid``)."""
-    xs = np.linspace(0.0, L, int(round(L / SIZE)) + 1)
-    ys = np.unique(np.r_[np.linspace(0.0, T, 10), np.linspace(T, T + GAP, 3),
-                         np.linspace(T + GAP, H, 10)])
+def slotted(mesh_cls, half: bool, *across):
+    """The U's mesh of ``mesh_cls`` on the grid of ``across`` (x, then z in 3D) by its
+    height's last coordinate, the slot's elements left out: a block H high, a slot GAP wide
+    cut from x = BACK to its end at mid-height, two arms T thick (``half``: its lower half,
+    cut at mid-height). Boundaries: the ``back`` (x = 0), the arms' ends, the slot's two
+    faces, the cut (``mid``); in 3D also ``front`` and ``rear``."""
+    up = np.unique(np.r_[np.linspace(0.0, T, 10 if mesh_cls is MeshQuad else 5),
+                         np.linspace(T, T + GAP, 3),
+                         np.linspace(T + GAP, H, 10 if mesh_cls is MeshQuad else 5)])
     if half:
-        ys = ys[ys <= 0.5 * H + 1e-12]
-    mesh = MeshQuad.init_tensor(xs, ys)
+        up = up[up <= 0.5 * H + 1e-12]
+    mesh = mesh_cls.init_tensor(*across, up)
+    z = mesh.p.shape[0] - 1  # the height's coordinate
     centre = mesh.p[:, mesh.t].mean(axis=1)
-    keep = ~((centre[0] > BACK) & (centre[1] > T) & (centre[1] < T + GAP))
+    keep = ~((centre[0] > BACK) & (centre[z] > T) & (centre[z] < T + GAP))
     t = mesh.t[:, keep]
     used = np.unique(t)
     number = np.full(mesh.p.shape[1], -1)
     number[used] = np.arange(len(used))
-    mesh = MeshQuad(mesh.p[:, used], number[t])
+    mesh = mesh_cls(mesh.p[:, used], number[t])
     tol = 1e-9
-    return named_boundaries(mesh, {
+    names = {
         "back": lambda x: x[0] < tol,
-        "upper_end": lambda x: (x[0] > L - tol) & (x[1] > T + 0.5 * GAP),
-        "lower_end": lambda x: (x[0] > L - tol) & (x[1] < T + 0.5 * GAP),
-        "slot_top": lambda x: (np.abs(x[1] - T - GAP) < tol) & (x[0] > BACK),
-        "slot_bottom": lambda x: (np.abs(x[1] - T) < tol) & (x[0] > BACK),
-        "mid": lambda x: (np.abs(x[1] - 0.5 * H) < tol) & (x[0] < BACK),
-    })
+        "upper_end": lambda x: (x[0] > L - tol) & (x[z] > T + 0.5 * GAP),
+        "lower_end": lambda x: (x[0] > L - tol) & (x[z] < T + 0.5 * GAP),
+        "slot_top": lambda x: (np.abs(x[z] - T - GAP) < tol) & (x[0] > BACK),
+        "slot_bottom": lambda x: (np.abs(x[z] - T) < tol) & (x[0] > BACK),
+        "mid": lambda x: (np.abs(x[z] - 0.5 * H) < tol) & (x[0] < BACK)}
+    if z == 2:
+        depth = float(across[1][-1])
+        names.update(front=lambda x: x[1] < tol, rear=lambda x: x[1] > depth - tol)
+    return named_boundaries(mesh, names)
+
+
+def u_mesh(half: bool = False) -> MeshQuad:
+    """The U on its side in quadrilaterals of SIZE (:func:`slotted`)."""
+    return slotted(MeshQuad, half, np.linspace(0.0, L, int(round(L / SIZE)) + 1))
 
 
 #: a U of revolution (``plane = "axisymmetric"``): moved out to r = 1 ... 5, a groove round a
@@ -228,28 +239,7 @@ def test_a_body_named_twice_needs_two_apart_sides(pair, words):
 def u_mesh_3d(half: bool = False) -> MeshHex:
     """:func:`u_mesh` extruded 0.4 deep along y in two elements (z up, elements of 0.2 along
     x): its faces ``front`` and ``rear`` (y = 0, 0.4) beside the 2D boundaries."""
-    xs, ys = np.linspace(0.0, L, 21), np.linspace(0.0, 0.4, 3)
-    zs = np.unique(np.r_[np.linspace(0.0, T, 5), np.linspace(T, T + GAP, 3),
-                         np.linspace(T + GAP, H, 5)])
-    if half:
-        zs = zs[zs <= 0.5 * H + 1e-12]
-    mesh = MeshHex.init_tensor(xs, ys, zs)
-    centre = mesh.p[:, mesh.t].mean(axis=1)
-    keep = ~((centre[0] > BACK) & (centre[2] > T) & (centre[2] < T + GAP))
-    t = mesh.t[:, keep]
-    used = np.unique(t)
-    number = np.full(mesh.p.shape[1], -1)
-    number[used] = np.arange(len(used))
-    mesh = MeshHex(mesh.p[:, used], number[t])
-    tol = 1e-9
-    return named_boundaries(mesh, {
-        "back": lambda x: x[0] < tol,
-        "upper_end": lambda x: (x[0] > L - tol) & (x[2] > T + 0.5 * GAP),
-        "lower_end": lambda x: (x[0] > L - tol) & (x[2] < T + 0.5 * GAP),
-        "slot_top": lambda x: (np.abs(x[2] - T - GAP) < tol) & (x[0] > BACK),
-        "slot_bottom": lambda x: (np.abs(x[2] - T) < tol) & (x[0] > BACK),
-        "mid": lambda x: (np.abs(x[2] - 0.5 * H) < tol) & (x[0] < BACK),
-        "front": lambda x: x[1] < tol, "rear": lambda x: x[1] > 0.4 - tol})
+    return slotted(MeshHex, half, np.linspace(0.0, L, 21), np.linspace(0.0, 0.4, 3))
 
 
 def test_a_u_closing_on_itself_in_3d_is_its_half_against_the_plane_of_symmetry():

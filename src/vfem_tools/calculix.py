@@ -934,6 +934,22 @@ def _solver(log: str) -> str:
     return found[-1].strip() if found else "unknown"
 
 
+def run_with_penalty_check(config, path: Path, penalty: float, *, check: bool = True,
+                           keep=None, ccx: str = "ccx", timeout: float = 600.0, **deck_options):
+    """Write ``config``'s model as a deck at ``path`` (:func:`write_deck`, ``steps="model"``,
+    ``penalty`` and ``deck_options``) and run it (:func:`run`); with ``check``, write and run it
+    again at a tenth of the penalty, the comparisons' check that the penalty does not decide the
+    answer. Returns (deck, results, results at a tenth of the penalty or None)."""
+    deck = write_deck(config.build(), path, steps="model", penalty=penalty, **deck_options)
+    results = run(deck, ccx=ccx, timeout=timeout, keep=keep)
+    other = None
+    if check:
+        tenth = write_deck(config.build(), path.with_name(f"{path.stem}_tenth{path.suffix}"),
+                           steps="model", penalty=penalty / 10.0, **deck_options)
+        other = run(tenth, ccx=ccx, timeout=timeout)
+    return deck, results, other
+
+
 def run(deck: Deck, ccx: str = "ccx", threads: int = 1, timeout: float = 600.0,
         p0: float | None = None, keep: str | Path | None = None) -> dict:
     """Run CalculiX on ``deck`` in a temporary folder and read its results.
