@@ -41,7 +41,7 @@ bore's top node is 1.4e-4 inside), +0.42 % at 1.50 (self-contact 18.19 against 1
 share of ccx's peak force at most 0.22 %. vfem's invariants passed at all 32 steps (its own
 reading of the bore's nodes, without the faceting allowance, 1.2e-5 inside at the last step;
 ccx's up to 1.4e-4). Penalty 1e7 against 1e8: within 0.34 %. Seconds: vfem 14.5, ccx 11.4 (ccx /
-vfem 0.8); ccx 297 iterations, vfem 142.
+vfem 0.8; another run 9.2 and 11.1, 1.2); ccx 297 iterations, vfem 142.
 
 With vfem's Ciarlet-Simo law instead (``--law neo-hookean``; ccx still NEO HOOKE: not the same
 law) the difference is the laws': +0.1 ... +0.5 % to a travel of 0.45, +1.7 % at 0.8, +2.2 % at
