@@ -1510,8 +1510,21 @@ def main(argv=None) -> int:
             ap.error(f"model ids look like 2d-17 or 3d-4, got {ident!r}")
         return draw(args.seed, int(dim), int(k))
 
+    def variant(models: list[dict]) -> list[dict]:
+        """The models as the flags make them (the dumped one too)."""
+        if args.axisymmetric:
+            models = [axisymmetric(p) for p in models if p["dim"] == 2]
+        if args.plastic:
+            models = [plastic(p) for p in models]
+        if args.large:
+            models = [large(p) for p in models]
+        return models
+
     if args.dump:
-        path = dump(parse(args.dump[0]), Path(args.dump[1]))
+        dumped = variant([parse(args.dump[0])])
+        if not dumped:
+            ap.error(f"{args.dump[0]} is a 3D model: --axisymmetric takes 2D models only")
+        path = dump(dumped[0], Path(args.dump[1]))
         print(f"wrote {path}: vfem run {path}")
         return 0
     if args.only:
@@ -1519,12 +1532,7 @@ def main(argv=None) -> int:
     else:
         models = ([draw(args.seed, 2, k) for k in range(args.count_2d)]
                   + [draw(args.seed, 3, k) for k in range(args.count_3d)])
-    if args.axisymmetric:
-        models = [axisymmetric(p) for p in models if p["dim"] == 2]
-    if args.plastic:
-        models = [plastic(p) for p in models]
-    if args.large:
-        models = [large(p) for p in models]
+    models = variant(models)
     tasks = []
     for p in models:  # each model's solves one after the other: its line comes when both are done
         tasks.append((p, "vfem"))
