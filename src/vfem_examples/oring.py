@@ -296,9 +296,8 @@ def figures(folder) -> list[Path]:
     left.plot([0.0, *c], [0.0, *(r["force_per_length"] for r in rows)], "o-", ms=4,
               label="vfem")
     cc = np.linspace(0.0, c.max(), 100)
-    left.plot(cc, [3.0 * E / (2.0 * (1.0 + s["parameters"]["poissons_ratio"])) * d
-                   * (1.25 * (x / 100) ** 1.5 + 50.0 * (x / 100) ** 6) for x in cc], "-",
-              label="Lindley (1966)")
+    run_p = ORingParameters(**s["parameters"])
+    left.plot(cc, [lindley(run_p, x / 100) for x in cc], "-", label="Lindley (1966)")
     left.set_xlabel("compression (% of d)")
     left.set_ylabel("lid force per unit circumference")
     left.legend(fontsize=8)

@@ -194,15 +194,10 @@ def _elastic(body) -> list[str]:
     point)."""
     m = body.material
     if body.large and body.law in ("neo-hookean", "neo-hookean-isochoric"):
-        lam, mu = _lame3d(m.youngs_modulus, m.poissons_ratio)
+        lam, mu = m.law(body.law, body.kinematics).lame()  # (the law's 3D constants)
         bulk = lam + 2.0 * mu / 3.0
         return ["*HYPERELASTIC, NEO HOOKE", f"{_num(mu / 2.0)}, {_num(2.0 / bulk)}"]
     return ["*ELASTIC", f"{_num(m.youngs_modulus)}, {_num(m.poissons_ratio)}"]
-
-
-def _lame3d(E: float, nu: float) -> tuple[float, float]:
-    """The 3D (= plane-strain, axisymmetric) Lamé constants (lambda, mu)."""
-    return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
 
 
 def _counter_clockwise(mesh) -> tuple[np.ndarray, int]:

@@ -209,10 +209,10 @@ def zone_mask(surface, facets: np.ndarray | None) -> np.ndarray:
 
 def _check_own_sides(sides: list[Side], bodies, entry, where: str) -> None:
     """Two sides of one body (self-contact, issue 42): each must name its boundaries, and
-    they must share no facet. A node never meets its own facets then, nor the surface next to
-    it along the boundary but across the line where the two sides meet (the other side's
-    facets that share a node with its own are left out of its candidates: the sides' common
-    corner is no contact, :func:`~.pairing.facing`)."""
+    they must share no facet, so a node never meets its own facets. Next to the line where the
+    two sides meet, the pairing reads only the other side's facets that face this one
+    (:func:`~.pairing.facing`: a straight boundary split in two pairs nothing), and the
+    invariants leave out a node of both sides (``docs/method.md`` §15)."""
     body = bodies[sides[0].body]
     if any(s.boundaries is None for s in sides):
         raise InputError(f"{where} {list(entry)!r} names one body twice ({body.name!r}) "

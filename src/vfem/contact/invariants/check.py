@@ -66,6 +66,7 @@ step and treats a violation as a failed step (:class:`vfem.errors.InvariantViola
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -265,8 +266,7 @@ class InvariantCheck:
         scale = float(np.linalg.norm(totals, axis=1).max(initial=0.0))
         # a body touching itself carries equal and opposite forces on its two sides, which its
         # own total does not show: each side's total counts as a body's would
-        for i, facets, _ in self.own_sides:
-            nodes = np.unique(self.bodies[i].facet_points(facets))
+        for i, nodes in self._own_side_nodes:
             scale = max(scale, float(np.linalg.norm(F[i][nodes].sum(axis=0))))
         out.force_balance = float(np.linalg.norm(resultant)) / scale if scale > 0 else 0.0
 
@@ -357,6 +357,19 @@ class InvariantCheck:
                      **{c: float(v) for c, v in zip(("x", "y", "z"), pos)},
                      "deformed_depth": deformed, "linearised_depth": linearised}
 
+    @functools.cached_property
+    def _own_side_nodes(self) -> list[tuple[int, np.ndarray]]:
+        """Per side of a body's own pair, (body, its nodes' point numbers): what (a) sums."""
+        return [(i, np.unique(self.bodies[i].facet_points(f)))
+                for i, a, b in self.own_sides for f in (a, b)]
+
+    @functools.cached_property
+    def _own_side_masks(self) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        """Per pair of a body's own sides, (body, its boundary's pieces on one side, on the
+        other): masks over the pieces (segments, triangles) that (b) reads, once."""
+        return [(i, np.isin(self.boundaries[i].facet_of, a),
+                 np.isin(self.boundaries[i].facet_of, b)) for i, a, b in self.own_sides]
+
     def _own_sides_apart(self, cur: list, out: Invariants, extra: float,
                          forces: list[np.ndarray]) -> None:
         """(b) between the two sides of a body in contact with itself (issue 42): no node of
@@ -370,9 +383,8 @@ class InvariantCheck:
         deformed reading alone is judged (the linearised one of two bodies reads the other's
         undeformed boundary, which here holds the node)."""
         tol = self.penetration_tolerance + extra
-        for i, facets_a, facets_b in self.own_sides:
+        for i, on_a, on_b in self._own_side_masks:
             g = cur[i]
-            on_a, on_b = np.isin(g.b.facet_of, facets_a), np.isin(g.b.facet_of, facets_b)
             touched = _loaded_or_next(g.b.segments, forces[i])
             for own, other in ((on_a, on_b), (on_b, on_a)):
                 found = g.behind(own, other)
