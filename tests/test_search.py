@@ -21,6 +21,22 @@ def test_projection_onto_segments():
     np.testing.assert_allclose(n[0], [0.0, -1.0])  # (t_y, -t_x)
 
 
+def test_near_ties_are_judged_against_the_nearest_not_by_bins():
+    """A point beside a corner, nearer to the side facet than to the bottom by less than the
+    tie tolerance (1e-9 of the longest segment), is a tie, which the facet facing the point
+    wins, wherever the point lies; fixed bins of the distance split such pairs whenever a bin's
+    edge fell between them (random model 2d-49: Newton cycled as a patch's facet came and
+    went). A difference well past the tolerance is no tie: the nearer facet wins."""
+    a = np.array([[0.0, 0.0], [0.0, 1.0]])  # the bottom (outward normal -y), the side (-x)
+    b = np.array([[1.0, 0.0], [0.0, 0.0]])
+    up = np.array([[0.0, 1.0]])  # the point's own surface faces up, at the bottom
+    for lead, winner in ((0.5e-9, 0), (10e-9, 1)):  # side nearer by this much (L = 1)
+        for x in np.linspace(0.3, 0.5, 201):
+            eps = np.sqrt(2.0 * x * lead)  # |corner - p| - x = lead, to first order
+            seg, _, dist = project_points(np.array([[-x, eps]]), a, b, up)
+            assert seg[0] == winner, (lead, x)
+
+
 def test_surface_orientation_and_rind_location():
     mesh = MeshTri.init_tensor(np.linspace(0, 1, 5), np.linspace(0, 1, 5)).with_boundaries(
         {"top": lambda x: x[1] > 1 - 1e-9, "bottom": lambda x: x[1] < 1e-9})

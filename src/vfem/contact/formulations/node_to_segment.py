@@ -218,11 +218,15 @@ def closest_master(slave: np.ndarray, node: np.ndarray, distance: np.ndarray,
     methods answer, but with the far body's corner pulling on nodes it does not touch.
     """
     key = slave.astype(np.int64) * (int(node.max(initial=0)) + 1) + node
-    level = np.floor(distance / tie) if tie > 0 else distance
-    order = np.lexsort((outside, level, key))
+    # tied with the node's nearest row (judged against it, not by fixed bins of the distance,
+    # which put two distances equal to round-off into neighbouring bins)
+    _, row = np.unique(key, return_inverse=True)
+    nearest = np.full(row.max(initial=-1) + 1, np.inf)
+    np.minimum.at(nearest, row, distance)
+    far = distance > nearest[row] + max(tie, 0.0)
+    order = np.lexsort((outside, far, key))
     first = np.r_[True, key[order][1:] != key[order][:-1]]
     best = np.maximum.accumulate(np.where(first, np.arange(len(order)), 0))
     keep = np.zeros(len(key), dtype=bool)
-    keep[order] = ((level[order] == level[order][best])
-                   & (outside[order] == outside[order][best]))
+    keep[order] = ~far[order] & (outside[order] == outside[order][best])
     return keep

@@ -42,9 +42,10 @@ outside a box's edge, equidistant from its two faces): with ``point_normals`` (t
 normal of the surface the point lies on) the facet whose outward normal at the closest point
 is most opposed to it wins (dot product rounded to 9 digits), so a point pairs with the face
 that faces it, as in 2D; then the facet the point lies over (``xi_free`` inside its reference
-domain, 1e-9); then the lowest facet number. Unlike 2D's fixed distance bins the tie is judged
-against each point's own nearest distance, so two equal distances never fall into different
-bins.
+domain, 1e-9); then the lowest facet number. The tie is judged against each point's own
+nearest distance (2D's :func:`~vfem.contact.search.closest.project_points` too, since issue
+42's random model 2d-49: its fixed distance bins put two distances closer than the tolerance
+into neighbouring bins), so two such distances are always tied.
 """
 
 from __future__ import annotations

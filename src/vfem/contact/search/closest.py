@@ -22,12 +22,13 @@ def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray,
     no farther than the nearest midpoint plus half the longest segment. The exact projection onto
     the candidates is vectorised.
 
-    **Ties** (a point equally far from two segments, e.g. closest to the vertex they share, to
-    1e-9 of the longest segment): with ``point_normals`` (the outward normal of the surface the
-    point lies on) the segment whose outward normal (``(t_y, -t_x)``) is most opposed to it wins,
-    so the point pairs with the facet that faces it; then the one whose segment the point lies
-    over (unclamped t inside [0, 1]); then the lowest segment number. The two nodes of a
-    symmetric model that lie over mirrored vertices so choose mirrored facets.
+    **Ties** (a point as near to a segment as to its nearest, to 1e-9 of the longest segment,
+    e.g. closest to the vertex two segments share; judged against the nearest, as in 3D): with
+    ``point_normals`` (the outward normal of the surface the point lies on) the segment whose
+    outward normal (``(t_y, -t_x)``) is most opposed to it wins, so the point pairs with the
+    facet that faces it; then the one whose segment the point lies over (unclamped t inside
+    [0, 1]); then the lowest segment number. The two nodes of a symmetric model that lie over
+    mirrored vertices so choose mirrored facets.
 
     Args:
         points: (m, 2) query points.
@@ -66,15 +67,24 @@ def project_points(points: np.ndarray, a: np.ndarray, b: np.ndarray,
     t = np.clip(tf, 0.0, 1.0)
     diff = points[pt] - (a[sg] + t[:, None] * d[sg])
     dist = np.sqrt(np.einsum("ij,ij->i", diff, diff))
-    # distances equal to 1e-9 of the longest segment are ties
-    level = np.floor(dist / (1e-9 * np.sqrt(L2.max()))) if len(dist) else dist
+    # distances within 1e-9 of the longest segment of the point's nearest are ties: judged
+    # against the nearest, not by fixed bins of the distance. Two distances closer than that
+    # fall into neighbouring bins wherever a bin's edge lies between them, so which was
+    # "nearer" changed as the point moved by 1e-9. Random model 2d-49 in r-z: the block's
+    # facets beside a soft punch's corner read that corner from just inside its bottom
+    # facet's strip (distances 2e-11 apart, ties by this rule); as the iterates moved, each
+    # facet read the side facet (not facing: out of the pair's patch) or the bottom (in),
+    # the nodal normal at the patch's end jumped with it and Newton cycled for good.
+    nearest = np.full(m, np.inf)
+    np.minimum.at(nearest, pt, dist)
+    tied = dist <= nearest[pt] + 1e-9 * np.sqrt(L2.max())
     facing = np.zeros(len(sg))
     if point_normals is not None:
         n = np.column_stack([d[sg, 1], -d[sg, 0]]) / np.sqrt(L2[sg])[:, None]
         facing = np.round(np.einsum("ij,ij->i", point_normals[pt], n), 9)
     outside = (tf < -1e-9) | (tf > 1 + 1e-9)
-    # per point, the candidate with the smallest distance, then the tie rules
-    order = np.lexsort((sg, outside, facing, level, pt))
+    # per point, a candidate tied with the nearest, by the tie rules
+    order = np.lexsort((sg, outside, facing, ~tied, pt))
     first = order[np.r_[0, np.flatnonzero(np.diff(pt[order])) + 1]]
     out = (sg[first], t[first], dist[first])
     return out + (tf[first],) if free else out
