@@ -11,20 +11,27 @@ shape's grid: elements a / N within 1.2 a of the axis and of the end, growing by
 distance up to 0.1 R), held radially on its top and pressed by a platen there, the axis a
 roller; the flat the 3D box's section, R wide and R deep (the ``block`` shape: 1.3 a / N within
 1.2 a of the axis and of the surface, growing by 0.3 up to 0.2 R), fixed on its bottom; the 3D
-example's contact settings and two load steps. ``--hemisphere``: the r-z model before it (the
-``axisymmetric_sphere`` example's, linear by default: the Hertz example's quarter disk as a
-hemisphere of R = 1 on a ``block`` flat R x R graded by 0.15 up to 0.1 R, one step), only
-alike to the 3D one.
+example's contact settings and two load steps. ``--hemisphere``: also the r-z model before it
+(the ``axisymmetric_sphere`` example's: the Hertz example's quarter disk as a hemisphere of
+R = 1 on a ``block`` flat R x R graded by 0.15 up to 0.1 R, one step), only alike to the 3D
+one. ``--order``: the r-z elements (linear by default, as the 3D example's hexahedra).
 
 Printed per N: each model's dofs, seconds, the sphere's peak nodal pressure against p0 =
 3P / 2 pi a^2 and its contact radius against Hertz's a (r-z: midway between the outermost
 sphere node in contact and the next one out along the surface; 3D: the example's own reading,
 the mean radius of the midpoints of the surface edges from a node in contact to one that is
-not), the differences 3D - r-z (in % of p0 and of a) and the time ratio.
+not), the differences 3D - r-z (in % of p0 and of a) and the time ratio. Both readings are
+of single nodes: the peak is the highest node, wherever the mesh puts it, and the edge lies
+within half a facet (a / 2N) of where the contact ends. ``--fit`` reads the whole zone
+instead: p0 and a of Hertz's ellipse p^2 = p0^2 (1 - r^2/a^2) fitted to the sphere's nodal
+pressures at 0 < r < 0.8 a.
 
     python3 benchmarks/sphere_rz.py --facets 6 8 12 16         # r-z only
     python3 benchmarks/sphere_rz.py --facets 6 8 12 --3d       # and the 3D example
-    python3 benchmarks/sphere_rz.py --facets 6 8 12 --3d --hemisphere   # the older r-z model
+    python3 benchmarks/sphere_rz.py --facets 6 8 12 --3d --hemisphere   # the older r-z model too
+    python3 benchmarks/sphere_rz.py --facets 6 8 12 --3d --fit          # fitted p0 and a
+    python3 benchmarks/sphere_rz.py --facets 6 8 12 --3d --nodes        # where the peaks are
+    python3 benchmarks/sphere_rz.py --facets 6 8 --3d --disk-flat       # 3D on a round flat
 """
 
 from __future__ import annotations
@@ -147,25 +154,58 @@ def axisymmetric(facets: int, order: int = 1, model: str = "section") -> dict:
     seconds = time.perf_counter() - t0
     r = result.steps[-1].bodies["sphere"]
     p0_fit, a_fit = fitted(result, a)
+    mesh = next(b for b in result.model.bodies if b.name == "sphere").mesh
+    nodes = np.unique(mesh.facets[:, mesh.boundaries["contact"]])
+    nodes = nodes[np.argsort(mesh.p[0, nodes])]  # the axis node first, then r = h
     return {"dofs": sum(b.ndofs for b in result.model.bodies), "seconds": seconds,
             "converged": result.converged, "p_max_error": float(r.contact_pressure.max() / p0 - 1),
             "a_error": edge(result) / a - 1, "p0_fit_error": p0_fit / p0 - 1,
-            "a_fit_error": a_fit / a - 1}
+            "a_fit_error": a_fit / a - 1,
+            "nodes": {"axis": r.contact_pressure[nodes[0]] / p0 - 1,
+                      "r = h": r.contact_pressure[nodes[1]] / p0 - 1}}
 
 
-def solid(facets: int) -> dict:
-    """The 3D sphere example with the sphere's facets a / ``facets``."""
+def disk_flat(config: ModelConfig, p: sphere.SphereParameters) -> ModelConfig:
+    """The 3D example with its flat's plan a quarter disk R in radius, not the box's square
+    (the ``cylinder`` shape, flat-ended, graded towards its top: within half its radius the
+    box's grid lines, node for node), R deep, fixed below: the r-z flat's solid of revolution."""
+    R, a = p.radius, sphere.theory(p)["a_theory"]
+    h, h_max = a / p.facets_per_radius, 0.1 * R * p.max_element_size
+    flat = next(b for b in config.bodies if b.name == "flat")
+    flat = dataclasses.replace(
+        flat, mesh=MeshSpec(shape="cylinder", parameters=as_parameters(
+            radius=sphere.FLAT_HALF_WIDTH * R, height=sphere.FLAT_DEPTH * R,
+            z0=-sphere.FLAT_DEPTH * R, h_contact=p.flat_size_ratio * h, h=2.0 * h_max,
+            growth=p.growth, plateau=sphere.PLATEAU * a, graded_end="top")),
+        supports=(Support("contact"), Support("left", ("x",)), Support("front", ("y",))))
+    return dataclasses.replace(config, bodies=tuple(flat if b.name == "flat" else b
+                                                    for b in config.bodies))
+
+
+def solid(facets: int, disk: bool = False) -> dict:
+    """The 3D sphere example with the sphere's facets a / ``facets`` (``disk``: on a flat
+    whose plan is a disk, :func:`disk_flat`)."""
     p = dataclasses.replace(sphere.SphereParameters(), facets_per_radius=facets)
+    config = sphere.config(p)
     t0 = time.perf_counter()
-    result = vfem.solve(sphere.config(p))
+    result = vfem.solve(disk_flat(config, p) if disk else config)
     seconds = time.perf_counter() - t0
     h = sphere.evaluate(result, p)
     a, p0 = h["a_theory"], h["p0_theory"]
     p0_fit, a_fit = fitted(result, a)
+    # the nodes on the axis, at (h, 0) (in the plane y = 0: r-z's node at r = h) and at (h, h)
+    mesh = next(b for b in result.model.bodies if b.name == "sphere").mesh
+    nodes = np.unique(mesh.facets[:, mesh.boundaries["contact"]])
+    x, y = mesh.p[0, nodes], mesh.p[1, nodes]
+    step = x[(y == 0.0) & (x > 0.0)].min()
+    pressure = result.steps[-1].bodies["sphere"].contact_pressure
+    at = lambda u, v: pressure[nodes[np.argmin(np.hypot(x - u, y - v))]] / p0 - 1  # noqa: E731
     return {"dofs": sum(b.ndofs for b in result.model.bodies), "seconds": seconds,
             "converged": result.converged, "p_max_error": h["sphere"]["p_max_error"],
             "a_error": h["sphere"]["a_estimate"] / a - 1, "p0_fit_error": p0_fit / p0 - 1,
-            "a_fit_error": a_fit / a - 1}
+            "a_fit_error": a_fit / a - 1,
+            "nodes": {"axis": at(0.0, 0.0), "(h, 0)": at(step, 0.0),
+                      "(h, h)": at(step, step)}}
 
 
 def main(argv=None) -> int:
@@ -176,6 +216,12 @@ def main(argv=None) -> int:
     ap.add_argument("--hemisphere", action="store_true",
                     help="the earlier r-z model too (a hemisphere on a flat disk), a row of its "
                          "own beside the section's, against the same 3D run")
+    ap.add_argument("--disk-flat", action="store_true",
+                    help="the 3D flat's plan a quarter disk R in radius (the cylinder shape), "
+                         "not the box's square: the r-z flat's solid of revolution")
+    ap.add_argument("--nodes", action="store_true",
+                    help="also the sphere's nodal pressures at the axis and the next node out "
+                         "(r-z: r = h; 3D: (h, 0) and (h, h)), in %% of p0")
     ap.add_argument("--fit", action="store_true",
                     help="p0 and a of Hertz's ellipse fitted to the nodal pressures (r < 0.8 a) "
                          "instead of the peak node and the contact's edge")
@@ -190,7 +236,7 @@ def main(argv=None) -> int:
              f" {'time ratio':>10}" if args.solid else ""))
     for n in args.facets:
         rows = [(m, axisymmetric(n, args.order, m)) for m in models]
-        s = solid(n) if args.solid else None
+        s = solid(n, args.disk_flat) if args.solid else None
         for model, rz in rows:
             line = (f"{n:>4} {model:>10} {rz['dofs']:>6} {rz['seconds']:>6.2f}"
                     f" {100 * rz[p_key]:>+6.2f}% {100 * rz[a_key]:>+6.2f}%")
@@ -204,6 +250,12 @@ def main(argv=None) -> int:
             if not rz["converged"]:
                 line += " (r-z not converged)"
             print(line, flush=True)
+            if args.nodes:
+                print(f"{'':>11} {model} nodes: " + ", ".join(
+                    f"{k} {100 * v:+.2f}%" for k, v in rz["nodes"].items()))
+        if args.nodes and s is not None:
+            print(f"{'':>11} 3D nodes: " + ", ".join(
+                f"{k} {100 * v:+.2f}%" for k, v in s["nodes"].items()))
     return 0
 
 
