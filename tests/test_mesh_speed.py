@@ -39,6 +39,8 @@ SMALL = {
     "gasket": dict(centre=(1.0, 2.0), opening="up", n_around=40, n_through=2),
     "rounded_punch": dict(x0=-1.0, y0=1.0, width=1.2, height=0.6, radius=1.0, nx=12, ny=4),
     "filleted_punch": dict(h_tangent=0.01, n_arc=5),
+    "cylinder_section": dict(radius=0.6, height=0.5, end_radius=1.0, h_contact=0.02, h=0.1,
+                             growth=0.3, plateau=0.1),
 }
 
 

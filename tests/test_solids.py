@@ -1,5 +1,5 @@
-"""Built-in 3D shapes (issue 21): the cylinder with a flat or spherical end, and the 3D
-stiffness assembly they are solved with."""
+"""Built-in 3D shapes (issue 21): the cylinder with a flat or spherical end (and its r-z
+section), and the 3D stiffness assembly they are solved with."""
 
 import math
 
@@ -18,7 +18,7 @@ from skfem.models.elasticity import linear_elasticity
 
 from vfem.bodies.assembly import cell_gradients, cell_mapping, elasticity_stiffness
 from vfem.mesh.checks import check_mesh
-from vfem.mesh.solids import box, cylinder
+from vfem.mesh.solids import box, cylinder, cylinder_section
 
 
 def volume(mesh) -> float:
@@ -157,3 +157,36 @@ def test_cylinder_with_a_grid_circle_under_a_punch_rim():
     assert z[-1] - z[-2] < 0.13 and z[1] - z[0] > 0.25  # graded towards the top
     with pytest.raises(ValueError, match="blend_from must lie between 0 and 0.58 circle_from"):
         cylinder(8.0, 1.0, h=1.0, circle_from=0.125)
+
+
+@pytest.mark.parametrize("kw", [
+    dict(end_radius=10.0, h_contact=1.008 / 8, h=1.0, growth=0.3, plateau=1.2 * 1.008),
+    dict(h_contact=0.2, h=1.0, graded_end="top", rings=(2.0,), grade_axis=False),
+], ids=["spherical_end", "flat_end_rings"])
+def test_cylinder_section_is_the_cylinders_plane_y0(kw):
+    """Issue 42: the r-z section of the sphere example's cylinder (sphere_rz's sphere) is,
+    node for node and element for element, the 3D quarter cylinder's face y = y0, r along x
+    and the axis along y; its boundaries are the 3D ones cut by that plane."""
+    x0, y0, z0 = 1.0, -2.0, 0.5
+    m3 = cylinder(6.0, 5.0, x0=x0, y0=y0, z0=z0, **kw)
+    m2 = cylinder_section(6.0, 5.0, x0=x0, y0=z0, **kw)
+    check_mesh(m2, "cylinder_section")
+    front = np.flatnonzero(np.abs(m3.p[1] - y0) < 1e-12)
+    p3 = m3.p[np.ix_([0, 2], front)]
+    assert p3.shape == m2.p.shape
+    assert np.abs(p3[:, np.lexsort(p3)] - m2.p[:, np.lexsort(m2.p)]).max() < 1e-12
+    # the 3D face's quadrilaterals are m2's elements: the same corners, by m2's numbering
+    number = np.full(m3.p.shape[1], -1)
+    number[front[np.lexsort(p3)]] = np.lexsort(m2.p)
+    faces = number[m3.facets[:, m3.boundaries["front"]]]
+    assert (faces >= 0).all()
+    assert (set(map(tuple, np.sort(faces, axis=0).T))
+            == set(map(tuple, np.sort(m2.t, axis=0).T)))
+    assert set(m2.boundaries) == {"contact", "top", "side", "left"}
+    for name in m2.boundaries:  # each named side: the 3D boundary's edges in the plane
+        ends = m2.p[:, np.unique(m2.facets[:, m2.boundaries[name]])]
+        cut = np.unique(m3.facets[:, m3.boundaries[name]])
+        cut = m3.p[np.ix_([0, 2], cut[np.abs(m3.p[1, cut] - y0) < 1e-12])]
+        assert np.abs(cut[:, np.lexsort(cut)] - ends[:, np.lexsort(ends)]).max() < 1e-12
+    with pytest.raises(ValueError, match="end_radius > radius"):
+        cylinder_section(6.0, 5.0, end_radius=5.0, h=1.0)

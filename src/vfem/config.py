@@ -54,6 +54,7 @@ SHAPES = {
     "annulus": shapes.annulus,
     "box": solids.box,
     "cylinder": solids.cylinder,
+    "cylinder_section": solids.cylinder_section,
     "ring": solids.ring,
 }
 #: The shapes of :data:`SHAPES` that make 3D meshes (tetrahedra, hexahedra).

@@ -5,7 +5,9 @@ a tensor grid of hexahedra (or of tetrahedra, six to a hexahedron), uniform or g
 given planes. The axes follow the 2D shapes with z up: ``left``/``right`` are the faces
 x = const, ``front``/``back`` the faces y = const (front: the smaller y, the side a viewer
 looking along +y sees), ``bottom``/``top`` the faces z = const. Each mesh comes with
-scikit-fem's facet topology already built (:mod:`vfem.mesh.topology`).
+scikit-fem's facet topology already built (:mod:`vfem.mesh.topology`). One 2D shape lives here
+too: :func:`cylinder_section`, the r-z section of :func:`cylinder` (a body of revolution meshed
+as the 3D cylinder is, node for node in its plane y = 0).
 """
 
 from __future__ import annotations
@@ -14,13 +16,13 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
-from skfem import MeshHex, MeshTet
+from skfem import MeshHex, MeshQuad, MeshTet
 
 from .parametric import check_count
-from .shapes import _grid_line, disk_map
+from .shapes import _counter_clockwise, _grid_line, disk_map
 from .topology import named_boundaries, share_topology, with_topology
 
-__all__ = ["box", "cylinder", "ring", "FACES"]
+__all__ = ["box", "cylinder", "cylinder_section", "ring", "FACES"]
 
 #: The named faces of :func:`box`: name -> (axis, end) (end 0: the face at the smaller
 #: coordinate).
@@ -119,8 +121,41 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     if half and quarter:
         raise ValueError("half models the part y >= y0 and quarter the part x >= x0, y >= y0: "
                          "give quarter = False with half")
+    across, up = _cylinder_lines(R, height, end_radius, 0.0 if quarter else -R, h_contact, h,
+                                 growth, plateau, blend_from, circle_from, graded_end, rings,
+                                 grade_axis)
+    along = (_cylinder_lines(R, height, end_radius, 0.0, h_contact, h, growth, plateau,
+                             blend_from, circle_from, graded_end, rings, grade_axis)[0]
+             if half else across)
+    check_count(float(len(across)) * len(along) * len(up), "cylinder")
+    mesh = (MeshTet if tetrahedra else MeshHex).init_tensor(across, along, up / height)
+    # names on the reference grid (u, v in [-1, 1] or [0, 1], w in [0, 1]), kept by the map
+    tol = 1e-9
+    ring = lambda p: np.maximum(np.abs(p[0]), np.abs(p[1]))  # noqa: E731
+    tests = {"contact": lambda p: p[2] < tol, "top": lambda p: p[2] > 1 - tol,
+             "side": lambda p: ring(p) > 1 - tol}
+    if quarter:
+        tests.update(left=lambda p: p[0] < tol, front=lambda p: p[1] < tol)
+    elif half:
+        tests.update(front=lambda p: p[1] < tol)
+    mesh = named_boundaries(mesh, tests)
+    u, v, w = mesh.p
+    x, y = disk_map(u, v, R, blend_from, circle_from)
+    z = _column_heights(np.hypot(x, y), w, up, R, height, end_radius, blend_from)
+    p = np.vstack([x + x0, y + y0, z + z0])
+    return share_topology(mesh, replace(mesh, doflocs=p))
+
+
+def _cylinder_lines(R: float, height: float, end_radius: float | None, start: float,
+                    h_contact: float | None, h: float | None, growth: float, plateau: float,
+                    blend_from: float, circle_from: float, graded_end: str,
+                    rings: Sequence[float], grade_axis: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The grid lines of :func:`cylinder` (and :func:`cylinder_section`), the parameters
+    checked: across the plan from ``start`` (-R, or 0 for a quarter) to R, over R, graded
+    towards the axis and the ``rings``; and the layers' heights from 0 to ``height``, graded
+    towards the ``graded_end``."""
     if not (R > 0 and height > 0):
-        raise ValueError(f"radius and height must be positive, got {radius}, {height}")
+        raise ValueError(f"radius and height must be positive, got {R}, {height}")
     if end_radius is not None:
         if not end_radius > 0:
             raise ValueError(f"end_radius must be positive, got {end_radius}")
@@ -143,28 +178,20 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
         raise ValueError("grade_axis = False grades towards the rings only: give rings")
     fine = (((0.0,) if grade_axis else ()) + tuple(float(r) for r in rings)
             + tuple(-float(r) for r in rings)) if h_contact is not None else ()
-    across = _grid_line(0.0 if quarter else -R, R, h, h_contact, growth, fine, plateau) / R
-    along = _grid_line(0.0, R, h, h_contact, growth, fine, plateau) / R if half else across
+    across = _grid_line(start, R, h, h_contact, growth, fine, plateau) / R
     # the layers graded towards the end only (the rings are radii, not heights)
     up = _grid_line(0.0, height, h, h_contact, growth, (0.0,) if h_contact is not None else (),
                     plateau)
     if graded_end == "top":
         up = height - up[::-1]
-    check_count(float(len(across)) * len(along) * len(up), "cylinder")
-    mesh = (MeshTet if tetrahedra else MeshHex).init_tensor(across, along, up / height)
-    # names on the reference grid (u, v in [-1, 1] or [0, 1], w in [0, 1]), kept by the map
-    tol = 1e-9
-    ring = lambda p: np.maximum(np.abs(p[0]), np.abs(p[1]))  # noqa: E731
-    tests = {"contact": lambda p: p[2] < tol, "top": lambda p: p[2] > 1 - tol,
-             "side": lambda p: ring(p) > 1 - tol}
-    if quarter:
-        tests.update(left=lambda p: p[0] < tol, front=lambda p: p[1] < tol)
-    elif half:
-        tests.update(front=lambda p: p[1] < tol)
-    mesh = named_boundaries(mesh, tests)
-    u, v, w = mesh.p
-    x, y = disk_map(u, v, R, blend_from, circle_from)
-    rr = np.hypot(x, y)
+    return across, up
+
+
+def _column_heights(rr: np.ndarray, w: np.ndarray, up: np.ndarray, R: float, height: float,
+                    end_radius: float | None, blend_from: float) -> np.ndarray:
+    """The heights above the end's lowest point of :func:`cylinder`'s nodes at plan radius
+    ``rr`` on the reference layer ``w`` (one of ``up / height``): each column stretched from
+    the end surface to the top plane."""
     bottom = (0.0 if end_radius is None
               else end_radius - np.sqrt(np.maximum(end_radius ** 2 - rr ** 2, 0.0)))
     # the layers: graded up from the end near the axis, turning into equal layers towards
@@ -173,9 +200,43 @@ def cylinder(radius: float = 1.0, height: float = 1.0, *, end_radius: float | No
     equal = layer / (len(up) - 1.0)
     gamma = (np.clip((rr / R - blend_from) / (1.0 - blend_from), 0.0, 1.0)
              if end_radius is not None else np.zeros_like(rr))
-    z = bottom + ((1.0 - gamma) * w + gamma * equal) * (height - bottom)
-    p = np.vstack([x + x0, y + y0, z + z0])
-    return share_topology(mesh, replace(mesh, doflocs=p))
+    return bottom + ((1.0 - gamma) * w + gamma * equal) * (height - bottom)
+
+
+def cylinder_section(radius: float = 1.0, height: float = 1.0, *,
+                     end_radius: float | None = None, x0: float = 0.0, y0: float = 0.0,
+                     h_contact: float | None = None, h: float | None = None,
+                     growth: float = 0.2, plateau: float = 0.0, blend_from: float = 0.5,
+                     graded_end: str = "bottom", rings: Sequence[float] = (),
+                     grade_axis: bool = True) -> MeshQuad:
+    """The r-z section of :func:`cylinder` (2D, for ``plane = "axisymmetric"``): the cylinder's
+    quarter model cut by its plane y = y0, node for node, with r along x from the axis
+    x = ``x0`` and the axis along y, its end's lowest point at (``x0``, ``y0``). The same
+    parameters make the same grid: the spacing ``h_contact`` within ``plateau`` of the axis
+    (across) and of the end (up), growing by ``growth`` per unit distance beyond, up to ``h``
+    (``rings``, ``grade_axis`` and ``graded_end`` as there); each column stretched from the
+    end (the arc of radius ``end_radius`` touching y = y0 at the axis, or flat) to the top,
+    its layers turning from graded to equal beyond ``blend_from`` times the radius. A body of
+    revolution so meshed has the 3D cylinder's elements in its symmetry planes (where the 3D
+    grid's plan is square, near the axis, the r-z one has no counterpart off those planes).
+
+    Named boundaries: ``contact`` (the end), ``top``, ``side`` (x = x0 + radius) and ``left``
+    (x = x0, the axis), as the 3D cylinder's boundaries cut by the plane.
+    """
+    R = float(radius)
+    across, up = _cylinder_lines(R, height, end_radius, 0.0, h_contact, h, growth, plateau,
+                                 blend_from, 1.0, graded_end, rings, grade_axis)
+    check_count(float(len(across)) * len(up), "cylinder_section")
+    grid = MeshQuad.init_tensor(across, up / height)
+    t = _counter_clockwise(grid.p, grid.t)  # init_tensor's quadrilaterals are clockwise
+    tol = 1e-9
+    mesh = named_boundaries(MeshQuad(grid.p, t), {
+        "contact": lambda p: p[1] < tol, "top": lambda p: p[1] > 1 - tol,
+        "side": lambda p: p[0] > 1 - tol, "left": lambda p: p[0] < tol})
+    u, w = mesh.p
+    # the plane y = 0 of the cylinder's plan (disk_map) is its line x = R u: r = R u
+    y = _column_heights(R * u, w, up, R, height, end_radius, blend_from)
+    return share_topology(mesh, replace(mesh, doflocs=np.vstack([x0 + R * u, y0 + y])))
 
 
 def ring(inner_radius: float = 1.0, outer_radius: float = 2.0, height: float = 1.0, *,
