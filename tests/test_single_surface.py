@@ -31,6 +31,7 @@ from test_self_contact import (
 )
 from vfem.bodies import Body, Support, Traction
 from vfem.cli import main
+from vfem.contact.geometry.own_sides import two_colours
 from vfem.errors import InputError
 from vfem.io.input import loads
 from vfem.materials import LinearElastic
@@ -93,6 +94,25 @@ def test_a_u_that_finds_its_own_sides_is_the_u_with_them_named(form):
         "u (side 1 of 2)" if form != "boundaries twice"
         else "u:slot_top,slot_bottom (side 1 of 2)")
     same_run(Analysis(closing_u()).run(), Analysis(model).run(), "u")
+
+
+@pytest.mark.parametrize("change", [{"order": 2}, {"kinematics": "total"}],
+                         ids=["quadratic", "finite strain"])
+def test_a_quadratic_or_finite_strain_u_that_finds_its_own_sides(change):
+    """The same with quadratic elements (3-node facets: the ray from each facet's midpoint
+    along its normal there), and at finite strain (total Lagrangian: the found sides'
+    zones re-paired at every iteration as named ones are): the slot's two faces, and the
+    named-sides run to 1e-10 (measured 0)."""
+    def u() -> Model:
+        model = closing_u()
+        for key, value in change.items():
+            setattr(model.bodies[0], key, value)
+        return model
+
+    model = single(u(), None)
+    mesh = model.bodies[0].mesh
+    assert found_sides(model) == (faces(mesh, "slot_bottom"), faces(mesh, "slot_top"))
+    same_run(Analysis(u()).run(), Analysis(model).run(), "u")
 
 
 def test_the_whole_free_surface_of_the_u_finds_the_slot():
@@ -226,6 +246,18 @@ def test_a_straight_boundary_finds_nothing(order, caplog):
 
 
 # -- refused ---------------------------------------------------------------------------------
+
+def test_runs_seeing_each_other_in_an_odd_cycle_have_no_two_sides():
+    """The colouring: runs seeing each other in a chain take alternate sides, the run with the
+    lowest facet number of each connected part side 1 (whatever the order of the links);
+    three runs each seeing the next have no two sides, and the clash is said."""
+    colour, clash = two_colours(4, np.array([0, 2]), np.array([1, 3]), np.array([7, 3, 5, 1]))
+    assert clash is None and colour.tolist() == [1, 0, 1, 0]
+    again, _ = two_colours(4, np.array([3, 1]), np.array([2, 0]), np.array([7, 3, 5, 1]))
+    assert again.tolist() == colour.tolist()
+    _, clash = two_colours(3, np.array([0, 1, 2]), np.array([1, 2, 0]), np.array([0, 1, 2]))
+    assert clash is not None and len(set(clash)) == 2
+
 
 def ring_mesh(inner: float = 0.7, outer: float = 1.0, around: int = 64,
               radial: int = 4) -> MeshQuad:

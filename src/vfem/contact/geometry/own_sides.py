@@ -116,7 +116,23 @@ def _split(body, facets: np.ndarray, where: str, names: tuple[str, ...] | None
     if own.any():
         _refuse(body, ids[seeing[label == rf[own][0]]], where, names,
                 "across one closed stretch (a round bore: each point faces the one opposite)")
-    links = sp.csr_array((np.ones(len(rf)), (rf, rg)), shape=(count, count))
+    colour, clash = two_colours(count, rf, rg, lowest)
+    if clash is not None:
+        _refuse(body, ids[seeing[np.isin(label, clash)]], where, names,
+                "in an odd cycle of parts, each facing the next")
+    side = colour[run[seeing]]
+    return np.sort(ids[seeing[side == 0]]), np.sort(ids[seeing[side == 1]])
+
+
+def two_colours(count: int, r: np.ndarray, s: np.ndarray, lowest: np.ndarray
+                ) -> tuple[np.ndarray, tuple[int, int] | None]:
+    """(count,) colours 0 and 1 of ``count`` runs such that runs ``r[k]`` and ``s[k]`` (which
+    see each other) differ, and None; or, where none exists (an odd cycle), the colours so far
+    and two runs of one colour that see each other. Breadth-first from the run with the
+    ``lowest`` mesh facet number of each connected part, coloured 0: the colours depend on
+    the facets' numbers, not on the order they are listed in."""
+    links = sp.csr_array((np.ones(len(r)), (r, s)), shape=(count, count))
+    links = (links + links.T).tocsr()
     colour = np.full(count, -1)
     for start in np.argsort(lowest, kind="stable"):
         if colour[start] >= 0:
@@ -124,16 +140,14 @@ def _split(body, facets: np.ndarray, where: str, names: tuple[str, ...] | None
         colour[start] = 0
         queue = deque([start])
         while queue:
-            r = queue.popleft()
-            for other in links.indices[links.indptr[r]:links.indptr[r + 1]]:
-                if colour[other] < 0:
-                    colour[other] = 1 - colour[r]
-                    queue.append(other)
-                elif colour[other] == colour[r]:
-                    _refuse(body, ids[seeing[np.isin(label, [r, other])]], where, names,
-                            "in an odd cycle of parts, each facing the next")
-    side = colour[run[seeing]]
-    return np.sort(ids[seeing[side == 0]]), np.sort(ids[seeing[side == 1]])
+            a = queue.popleft()
+            for b in links.indices[links.indptr[a]:links.indptr[a + 1]]:
+                if colour[b] < 0:
+                    colour[b] = 1 - colour[a]
+                    queue.append(b)
+                elif colour[b] == colour[a]:
+                    return colour, (int(a), int(b))
+    return colour, None
 
 
 def _refuse(body, ids: np.ndarray, where: str, names: tuple[str, ...] | None, how: str):

@@ -19,8 +19,10 @@ and the baselines, which refuse named sides) reads :meth:`ContactPairs.keys` and
 pair like any other to those that read sides: its two sides are two named boundaries of the
 body that share no facet (:func:`_check_own_sides`), so a node never meets its own facets; the
 invariants check the body against itself (:meth:`vfem.contact.invariants.check.InvariantCheck
-._own_sides_apart`), in 2D, r-z and 3D; a whole boundary that finds its own sides
-(single-surface contact) is not built yet.
+._own_sides_apart`), in 2D, r-z and 3D. A surface that finds its own two sides (single-surface
+contact: a body's ``self_contact``, or one side named twice, ``["ring:bore", "ring:bore"]``)
+is split once, at rest (:func:`~.own_sides.split`), into two sides that hold their facets
+(``Side.found``) and are read as named ones are.
 """
 
 from __future__ import annotations
