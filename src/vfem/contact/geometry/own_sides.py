@@ -52,7 +52,7 @@ def split(body, facets: np.ndarray, where: str, names: tuple[str, ...] | None = 
     the messages; ``names``: the boundaries the surface was named by (None: the body's whole
     contact surface), of which a refusal names those the offending facets lie on.
 
-    Kept on the body for its mesh and ``facets``: a model's pairs are read several times
+    Kept on the body for its mesh, order and ``facets``: a model's pairs are read several times
     (its check, its surfaces, the invariants), the split and its warning once.
 
     Raises:
@@ -60,7 +60,7 @@ def split(body, facets: np.ndarray, where: str, names: tuple[str, ...] | None = 
     """
     facets = np.unique(np.asarray(facets, dtype=np.int64))
     kept = body.__dict__.setdefault("_own_sides", {})
-    key = (id(body.mesh), facets.tobytes())
+    key = (id(body.mesh), body.order, facets.tobytes())
     if key not in kept:
         kept[key] = _split(body, facets, where, names)
     return kept[key]
