@@ -180,12 +180,12 @@ def test_output_locations_and_self_contact_are_one_message(tmp_path, capsys):
     model = tmp_path / "self.toml"
     text = (Path(__file__).parent.parent / "examples" / "punch" / "flat_punch.toml").read_text()
     model.write_text(text.replace('name = "flat_punch"',
-                                  'name = "flat_punch"\ncontact_pairs = [["block", "block"]]'))
+                                  'name = "flat_punch"\ncontact_pairs = [["block", "block:top"]]'))
     for command in (["check", str(model)], ["-q", "run", str(model), "--out",
                                             str(tmp_path / "out")]):
         assert main(command) == 2
         err = capsys.readouterr().err
-        assert "names one body twice" in err and "Traceback" not in err
+        assert "the two sides of body 'block' share" in err and "Traceback" not in err
 
 
 def test_file_system_errors_and_bugs_end_without_a_traceback(monkeypatch, tmp_path, capsys):

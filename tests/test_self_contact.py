@@ -223,13 +223,13 @@ def test_the_invariants_read_a_body_against_itself():
 
 
 @pytest.mark.parametrize(("pair", "words"), [
-    (("u", "u"), "names one body twice \\('u'\\) without its boundaries: a body's contact "
-                 "with itself is between two of its boundaries"),
+    (("u", "u:slot_top"), "share .* facets \\('u' is its whole contact surface\\)"),
     (("u:slot_top", "u:slot_top,slot_bottom"), "share .* facets .*'slot_top' is named on both"),
 ])
 def test_a_body_named_twice_needs_two_apart_sides(pair, words):
-    """A body paired with itself must name two of its boundaries, sharing no facet: said,
-    with the entry and the body."""
+    """A body paired with itself must name two different sides sharing no facet (or one side
+    twice: a surface that finds its own sides, tests/test_single_surface.py): said, with the
+    entry and the body."""
     model = closing_u()
     model.contact_pairs = (pair,)
     with pytest.raises(InputError, match=words):

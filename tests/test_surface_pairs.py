@@ -161,7 +161,7 @@ def test_a_stack_whose_middle_plate_names_its_top_and_bottom_is_the_stack_of_bod
     ('[["punch", "block:tpo"]]', "body 'block' has no boundary 'tpo'; its mesh's boundaries: "),
     ('[["punch", "blok:top"]]', "names unknown body 'blok:top'"),
     ('[["punch", "block:top"], ["block:left", "punch"]]', "are already paired"),
-    ('[["punch", "punch"]]', "names one body twice .'punch'. without its boundaries"),
+    ('[["punch", "punch:bottom"]]', "share .* facets .'punch' is its whole contact surface."),
     ('[["punch:bottom", "punch:bottom,left"]]', "the two sides of body 'punch' share"),
     ('[["punch", "block:top,"]]', "names an empty boundary"),
     ('[["punch", "block:bottom"]]', "boundary 'bottom' of body 'block' cannot touch: a "

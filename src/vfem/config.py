@@ -190,6 +190,11 @@ class BodyConfig:
             material's: ``"saint-venant-kirchhoff"``, ``"neo-hookean"`` (Ciarlet–Simo) or
             ``"neo-hookean-isochoric"`` (CalculiX's and Abaqus's NEO HOOKE) (a plastic
             material has its own law: Hencky elasticity in the logarithmic strain).
+        self_contact: whether its contact surface (``contact_boundaries``, or its whole free
+            surface) may touch itself (a slot closing, a seal folding): its two sides are
+            found at rest, where a ray along each facet's normal meets a facet facing it
+            (docs/method.md §15). A surface whose sides cannot be told apart at rest (a round
+            bore) is refused: name its two sides in ``contact_pairs`` instead.
     """
 
     name: str
@@ -203,6 +208,7 @@ class BodyConfig:
     contact_boundaries: tuple[str, ...] | None = None
     kinematics: str = "small"
     law: str = "saint-venant-kirchhoff"
+    self_contact: bool = False
 
     def build(self, base: Path | None = None) -> Body:
         try:
@@ -214,7 +220,8 @@ class BodyConfig:
         return Body(self.name, mesh, self.material, supports=self.supports,
                     prescribed=self.prescribed, tractions=self.tractions, platen=self.platen,
                     contact_boundaries=self.contact_boundaries, order=self.order,
-                    kinematics=self.kinematics, law=self.law)
+                    kinematics=self.kinematics, law=self.law,
+                    self_contact=self.self_contact)
 
 
 #: The most equal steps ``steps.count`` may ask for: each step is a contact solve, so more is a
@@ -304,7 +311,9 @@ class ModelConfig:
             A surface is a body's name (its whole contact surface), or its name, a colon and
             boundaries of its mesh separated by commas (``"block:top"``, ``"block:top,left"``):
             that pair reads those facets alone. Two bodies are paired once. Default: every
-            two bodies.
+            two bodies. A body with itself: two of its boundaries that share no facet
+            (``[["u:slot_top", "u:slot_bottom"]]``), or one surface named twice, which finds
+            its own two sides (``[["u", "u"]]``; as a body's ``self_contact``).
         output: what a run writes.
     """
 

@@ -110,8 +110,9 @@ NOT_YET = {"friction": "friction is set for a model's contact: contact.friction 
                        "coefficient, or [[contact.pairs]], in an input file (the paired "
                        "variant; of the built-in examples cattaneo and sliding have a friction "
                        "parameter: --set friction=0.3)",
-           "self_contact": "a body's contact with itself is between two of its boundaries, "
-                           "named as a pair's two sides: contact_pairs = [['ring:upper', "
+           "self_contact": "self_contact is a body's key in an input file ([[bodies]] "
+                           "self_contact = true: its surface finds its own two sides), or name "
+                           "the two sides as a pair: contact_pairs = [['ring:upper', "
                            "'ring:lower']]"}
 
 

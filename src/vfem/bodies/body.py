@@ -50,6 +50,9 @@ class Body:
             material's: ``"saint-venant-kirchhoff"`` (default), ``"neo-hookean"``
             (Ciarlet–Simo) or ``"neo-hookean-isochoric"`` (CalculiX's and Abaqus's NEO HOOKE)
             (a plastic material has its own law: Hencky elasticity in the logarithmic strain).
+        self_contact: whether its contact surface (``contact_boundaries``, or its whole free
+            surface) may touch itself: one self-contact pair of two sides found on the
+            undeformed geometry (:func:`vfem.contact.geometry.own_sides.split`).
 
     Points: the nodes of the elements. For linear elements they are the mesh vertices; quadratic
     elements add one point at the middle of each facet (numbered after the vertices, in facet
@@ -70,6 +73,7 @@ class Body:
     order: int = 1
     kinematics: str = "small"
     law: str = "saint-venant-kirchhoff"
+    self_contact: bool = False
 
     @property
     def dim(self) -> int:

@@ -51,6 +51,9 @@ def validate(body) -> None:
     if body.kinematics not in ("small", "total", "updated"):
         raise InputError(f"{where}: kinematics must be 'small', 'total' or 'updated', "
                          f"got {body.kinematics!r}")
+    if not isinstance(body.self_contact, bool):
+        raise InputError(f"{where}: self_contact must be true or false, got "
+                         f"{body.self_contact!r}")
     if body.law not in LAWS:
         names = " or ".join(repr(name) for name in LAWS)
         raise InputError(f"{where}: law must be {names}, got {body.law!r}")

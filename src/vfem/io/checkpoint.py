@@ -52,6 +52,8 @@ def fingerprint(model: Model) -> str:
                        b.law)).encode())
         if b.dim == 3:  # a default support (every component) apart from an explicit ("x", "y")
             h.update(repr([b.support_components(s) for s in b.supports]).encode())
+        if b.self_contact:  # (only where set: the checkpoints of before it still resume)
+            h.update(b"self_contact")
         for a in (b.mesh.p, b.mesh.t):
             h.update(np.ascontiguousarray(a).tobytes())
         for name in sorted(b.mesh.boundaries or {}):
@@ -88,6 +90,8 @@ def describe(model: Model) -> dict[str, str]:
         for name in ("material", "supports", "prescribed", "tractions", "platen",
                      "contact_boundaries", "order", "kinematics", "law"):
             _flatten(f"{key}.{name}", getattr(b, name), out)
+        if b.self_contact:
+            out[f"{key}.self_contact"] = "true"
         if b.dim == 3:  # the components a 3D support fixes: by default x, y and z
             for i, sup in enumerate(b.supports):
                 out[f"{key}.supports[{i}].components"] = _text(b.support_components(sup))

@@ -119,8 +119,9 @@ def check_capabilities(model) -> None:
         if len(one) == 1 and frozenset(one) not in pairs:  # a body's own sides
             raise InputError(f"model {model.name!r}: contact.pairs {list(pair.bodies)!r} names "
                              "one body twice, and contact_pairs pairs no sides of it with "
-                             "each other (a body's contact with itself is between two of its "
-                             "boundaries, named in contact_pairs as a pair's two sides)")
+                             "each other (a body's contact with itself is a pair of its two "
+                             "sides: two of its boundaries named in contact_pairs, one side "
+                             "named twice, or the body's self_contact = true)")
     # each pair's law and its parameters (the laws check their own), whether or not it acts
     laws = [(pair, friction_law(pair)) for pair in settings.pairs]
     if settings.frictional and (not caps.friction or (

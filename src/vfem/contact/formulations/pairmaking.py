@@ -103,9 +103,9 @@ def make_pair_sided(form, sides: SurfacePair, density_i: tuple[float, bool],
     elif abs(ci - cj) > 1e-9 * max(ci, cj):
         fine, coarse = (a, b) if ci > cj else (b, a)
     else:  # equal: a rule that does not depend on the order of the bodies (by name, then by
-        # the sides' boundaries; two sides alike of one body: the second)
-        fine, coarse = (a, b) if ((si.body.name, a.boundaries or ())
-                                  < (sj.body.name, b.boundaries or ())) else (b, a)
+        # the sides' boundaries; the two sides a surface found of itself: its side 1)
+        fine, coarse = (a, b) if ((si.body.name, a.boundaries or (), a.part)
+                                  < (sj.body.name, b.boundaries or (), b.part)) else (b, a)
     chosen = fine
     if form.settings.compatibility_side is not None:  # forced (for testing)
         names = (si.body.name, sj.body.name)

@@ -103,6 +103,14 @@ class ContactPair:
 #: shallow wedge, a chamfer up to 60 degrees) all do.
 FACING = 0.5
 
+
+def opposed(n: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """(k,) whether unit normals ``n`` and ``m`` ((k, dim)) face each other: at least 120
+    degrees apart (:data:`FACING`). What :func:`facing` asks of a facet and the other surface,
+    and the split of a surface that touches itself (:func:`~.own_sides.split`) of a facet and
+    what it sees."""
+    return np.einsum("ij,ij->i", n, m) <= -FACING
+
 #: A surface with an edge inside the contact zone (an end of its patch over the other surface)
 #: carries compatibility unless it gives way this many times less per unit length than the
 #: other: a node-free corner of the equilibrium side would otherwise indent the compatibility
@@ -142,7 +150,7 @@ def _facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray
     n = s.facet_normals(x)
     faces = np.zeros(len(s.facets), dtype=bool)
     for _, m, _ in read_facets(s, facets, x, so, xo, ozone, n[facets]):
-        faces[facets] |= np.einsum("ij,ij->i", n[facets], m) <= -FACING
+        faces[facets] |= opposed(n[facets], m)
     # and a facet over which a vertex of the other surface lies, facing it: a punch's corner
     # that has slid past the end of the face it pressed presses the block's facet beyond (left
     # out, the corner went into the block unheld: large kinematics, equal stiffness, 3e-3 deep)
@@ -151,8 +159,7 @@ def _facing(s: ContactSurface, x: np.ndarray, so: ContactSurface, xo: np.ndarray
     seg, _, dist, _, tf = s.closest(xo[verts], x, zone, vn)
     reach = 2.0 * (s.sizes[facets].max()
                    + (so.sizes.max() if ozone is None else so.sizes[ozone].max()))
-    over = (s.kind.strictly_inside(tf) & (dist < reach)
-            & (np.einsum("ij,ij->i", vn, n[seg]) <= -FACING))
+    over = s.kind.strictly_inside(tf) & (dist < reach) & opposed(vn, n[seg])
     faces[seg[over]] = True
     return np.flatnonzero(faces)
 
@@ -309,9 +316,12 @@ def ray_entry(s: ContactSurface, points: np.ndarray, directions: np.ndarray) -> 
 
 
 def ray_facet(s: ContactSurface, points: np.ndarray, directions: np.ndarray,
-              facets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+              facets: np.ndarray | None = None, skip: sp.csr_array | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`ray_entry` through the facets ``facets`` of ``s`` alone (all where None), and
-    the facet each ray enters by (-1 where it meets none).
+    the facet each ray enters by (-1 where it meets none). ``skip``: (rays, facets of ``s``)
+    true where that ray passes through that facet as if it were not there (a facet's own
+    neighbourhood, :func:`~.own_sides.split`); None: none.
 
     Each ray is first tested only against the pieces near its first :data:`RAY_REACH` piece
     radii (a k-d tree of the pieces' centres, queried at points along that segment): a piece
@@ -338,6 +348,8 @@ def ray_facet(s: ContactSurface, points: np.ndarray, directions: np.ndarray,
     if radius > 0 and len(pieces) > RAY_NEAR_FROM:
         ray, piece = _near_pieces(centre, radius, points, directions)
         t = _ray_hits(x, pieces[piece], outward[piece], points[ray], directions[ray], scale)
+        if skip is not None:
+            t = np.where(_skipped(skip, ray, facet[piece]), np.inf, t)
         reach = RAY_REACH * radius
         first = (t <= reach)  # (beyond it a piece not near the segment may come first)
         ray, piece, t = ray[first], piece[first], t[first]
@@ -355,11 +367,22 @@ def ray_facet(s: ContactSurface, points: np.ndarray, directions: np.ndarray,
         k = len(rows)
         t = _ray_hits(x, pieces, outward, points[rows], directions[rows], scale,
                       np.repeat(np.arange(k), len(pieces)), np.tile(every, k)).reshape(k, -1)
+        if skip is not None:
+            t = np.where(_skipped(skip, np.repeat(rows, len(pieces)),
+                                  np.tile(facet, k)).reshape(k, -1), np.inf, t)
         first = t.argmin(axis=1)
         best = t[np.arange(k), first]
         out[rows] = best
         which[rows] = np.where(np.isfinite(best), facet[first], -1)
     return out, which
+
+
+def _skipped(skip: sp.csr_array, ray: np.ndarray, facet: np.ndarray) -> np.ndarray:
+    """(k,) whether ``skip`` holds each (``ray``, ``facet``) pair: :func:`ray_facet`'s
+    facets a ray passes through."""
+    if not len(ray):
+        return np.zeros(0, dtype=bool)
+    return np.asarray(skip[ray, facet]).ravel() != 0
 
 
 #: piece radii along each ray within which :func:`ray_facet` looks for its entry among the

@@ -19,17 +19,20 @@ and the baselines, which refuse named sides) reads :meth:`ContactPairs.keys` and
 pair like any other to those that read sides: its two sides are two named boundaries of the
 body that share no facet (:func:`_check_own_sides`), so a node never meets its own facets; the
 invariants check the body against itself (:meth:`vfem.contact.invariants.check.InvariantCheck
-._own_sides_apart`), in 2D, r-z and 3D; a whole boundary that finds its own sides
-(single-surface contact) is not built yet.
+._own_sides_apart`), in 2D, r-z and 3D. A surface that finds its own two sides (single-surface
+contact: a body's ``self_contact``, or one side named twice, ``["ring:bore", "ring:bore"]``)
+is split once, at rest (:func:`~.own_sides.split`), into two sides that hold their facets
+(``Side.found``) and are read as named ones are.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ...errors import InputError
+from . import own_sides
 from .bodymesh import exterior_facets
 
 #: what separates a body's name from its boundaries' in a ``contact_pairs`` entry
@@ -43,31 +46,50 @@ class Side:
     or (None) on its whole contact surface. ``facets``: its **zone**, the facets of the body's
     contact surface it holds (indices into ``surface.facets``; :meth:`ContactPairs.on`), None
     for all of them. A side is itself and no other (compared by identity): the two sides of
-    one body in a self-contact pair are two sides."""
+    one body in a self-contact pair are two sides.
+
+    A side of a surface that found its own two sides (single-surface self-contact,
+    :func:`~.own_sides.split`) holds its mesh facets in ``found`` and which of the two it is
+    in ``part`` (1 or 2); ``boundaries`` then names the surface split (None: the body's whole
+    contact surface)."""
 
     body: int
     boundaries: tuple[str, ...] | None = None
     facets: np.ndarray | None = None
+    #: (k,) the mesh facets of a side found by a split (sorted); None: named by ``boundaries``
+    found: np.ndarray | None = None
+    #: 1 or 2: which side of a split surface; 0: a named side
+    part: int = 0
 
     def mesh_facets(self, body) -> np.ndarray | None:
         """(k,) the side's facets as indices into its ``body``'s mesh's facets, or None for
         all."""
+        if self.found is not None:
+            return self.found
         if self.boundaries is None:
             return None
         mesh = body.mesh
         return np.unique(np.concatenate([np.zeros(0, dtype=np.int64)] + [
             np.asarray(mesh.boundaries[b], dtype=np.int64) for b in self.boundaries]))
 
+    def zone(self, body) -> np.ndarray:
+        """(k,) the side's mesh facets, the body's whole contact surface's for None."""
+        facets = self.mesh_facets(body)
+        return exterior_facets(body) if facets is None else facets
+
     def text(self, bodies) -> str:
+        """The side as an input names it (``block:top``), a found side with which of its
+        surface's two it is (``ring:bore (side 1 of 2)``)."""
         name = bodies[self.body].name
-        return name if self.boundaries is None else (
+        named = name if self.boundaries is None else (
             f"{name}{SEPARATOR}{','.join(self.boundaries)}")
+        return f"{named} (side {self.part} of 2)" if self.part else named
 
     def on(self, surface) -> Side:
         """This side with its zone read on its body's contact ``surface``."""
         facets = self.mesh_facets(surface.body)
-        return Side(self.body, self.boundaries, None if facets is None else
-                    np.flatnonzero(np.isin(surface.facet_ids, facets)))
+        return replace(self, facets=None if facets is None else
+                       np.flatnonzero(np.isin(surface.facet_ids, facets)))
 
 
 @dataclass(frozen=True)
@@ -103,35 +125,57 @@ class ContactPairs:
 
     @classmethod
     def parse(cls, entries, bodies, where: str = "contact pair") -> ContactPairs:
-        """The pairs an input names (``contact_pairs``; None: :meth:`every`). A side is a body's
-        name, or its name, :data:`SEPARATOR` and boundary names separated by commas.
+        """The pairs an input names (``contact_pairs``; None: :meth:`every`), and a pair of
+        each body with ``self_contact`` with itself. A side is a body's name, or its name,
+        :data:`SEPARATOR` and boundary names separated by commas. An entry naming one side
+        twice (``["ring:bore", "ring:bore"]``, ``["u", "u"]``), or a body's
+        ``self_contact`` (its whole contact surface), is a surface that finds its own two
+        sides (:func:`~.own_sides.split`): the pair of those two, or none where it finds
+        nothing.
 
         Raises:
-            InputError: an unknown body or boundary (naming the entry and what there is), a
-                body named twice in one entry, or two entries for the same two bodies.
+            InputError: an unknown body or boundary (naming the entry and what there is), two
+                different sides of one body that share facets, two entries for the same two
+                bodies, a body with ``self_contact`` that an entry pairs with itself too, or a
+                surface whose two sides cannot be told apart (:func:`~.own_sides.split`).
         """
+        made: dict[tuple[int, int], SurfacePair | None] = {}
+        named: dict[tuple[int, int], list] = {}
         if entries is None:
-            return cls.every(len(bodies))
+            made = {p.bodies: p for p in cls.every(len(bodies)).pairs}
         names = {b.name: i for i, b in enumerate(bodies)}
-        made: dict[tuple[int, int], SurfacePair] = {}
-        for entry in entries:
+        for entry in entries or ():
             if len(entry) != 2:
                 raise InputError(f"{where} {list(entry)!r}: name two surfaces, e.g. "
                                  "['punch', 'block:top']")
             sides = [_side(text, names, bodies, entry, where) for text in entry]
-            if sides[0].body == sides[1].body:
-                _check_own_sides(sides, bodies, entry, where)
             key = tuple(sorted((sides[0].body, sides[1].body)))
-            if key in made:
-                first = made[key]
+            if key in named:
+                first = named[key]
                 raise InputError(
                     f"{where} {list(entry)!r}: bodies {bodies[key[0]].name!r} and "
-                    f"{bodies[key[1]].name!r} are already paired "
-                    f"({[first.a.text(bodies), first.b.text(bodies)]!r}); name all the "
+                    f"{bodies[key[1]].name!r} are already paired ({first!r}); name all the "
                     "boundaries of a side in one entry, separated by commas (e.g. "
                     f"'{bodies[key[1]].name}{SEPARATOR}top,left')")
-            made[key] = SurfacePair(*sides)
-        return cls(tuple(made.values()))
+            named[key] = list(entry)
+            if sides[0].body == sides[1].body and _check_own_sides(sides, bodies, entry,
+                                                                    where):
+                made[key] = _found(sides[0], bodies, f"{where} {list(entry)!r}")
+            else:
+                made[key] = SurfacePair(*sides)
+        for i, body in enumerate(bodies):
+            if getattr(body, "self_contact", False) is False:
+                continue
+            body.validate()  # (a self_contact that is not a boolean: said by the body)
+            if (i, i) in named:
+                raise InputError(f"{where} {named[(i, i)]!r} pairs body {body.name!r} with "
+                                 "itself, and the body has self_contact = true too: give one "
+                                 "(self_contact finds the two sides of its whole contact "
+                                 "surface; the entry names them, or one side to split)")
+            made[(i, i)] = _found(Side(i), bodies,
+                                  f"{where} of body {body.name!r} with itself "
+                                  "(self_contact = true)")
+        return cls(tuple(p for p in made.values() if p is not None))
 
     def keys(self) -> list[tuple[int, int]]:
         """(i, j), i <= j (equal: two sides of one body), of every pair, in order."""
@@ -207,25 +251,39 @@ def zone_mask(surface, facets: np.ndarray | None) -> np.ndarray:
     return mask
 
 
-def _check_own_sides(sides: list[Side], bodies, entry, where: str) -> None:
-    """Two sides of one body (self-contact, issue 42): each must name its boundaries, and
-    they must share no facet, so a node never meets its own facets. Next to the line where the
-    two sides meet, the pairing reads only the other side's facets that face this one
+def _check_own_sides(sides: list[Side], bodies, entry, where: str) -> bool:
+    """Two sides of one body (self-contact, issue 42): one side named twice (the same facets:
+    a surface that finds its own two sides, returns True), or two sides that share no facet,
+    so a node never meets its own facets (False). Next to the line where two named sides
+    meet, the pairing reads only the other side's facets that face this one
     (:func:`~.pairing.facing`: a straight boundary split in two pairs nothing), and the
     invariants leave out a node of both sides (``docs/method.md`` §15)."""
     body = bodies[sides[0].body]
-    if any(s.boundaries is None for s in sides):
-        raise InputError(f"{where} {list(entry)!r} names one body twice ({body.name!r}) "
-                         "without its boundaries: a body's contact with itself is between two "
-                         "of its boundaries, named as the pair's sides (e.g. "
-                         f"['{body.name}{SEPARATOR}upper', '{body.name}{SEPARATOR}lower'])")
-    a, b = (set(s.mesh_facets(body).tolist()) for s in sides)
+    a, b = (set(s.zone(body).tolist()) for s in sides)
+    if a == b:
+        return True
     if a & b:
-        shared = sorted(set(sides[0].boundaries) & set(sides[1].boundaries))
+        shared = sorted(set(sides[0].boundaries or ()) & set(sides[1].boundaries or ()))
+        whole = [s.text(bodies) for s in sides if s.boundaries is None]
         raise InputError(f"{where} {list(entry)!r}: the two sides of body {body.name!r} share "
                          f"{len(a & b)} facets" + (f" (boundary {shared[0]!r} is named on both)"
                                                    if shared else "")
-                         + "; a body's two sides in contact with each other must be apart")
+                         + (f" ({whole[0]!r} is its whole contact surface)" if whole else "")
+                         + "; a body's two sides in contact with each other must be apart (or "
+                         "name one side twice for a surface that finds its own two sides)")
+    return False
+
+
+def _found(side: Side, bodies, where: str) -> SurfacePair | None:
+    """The pair of the two sides the surface of ``side`` finds of itself
+    (:func:`~.own_sides.split`), None where it finds none."""
+    body = bodies[side.body]
+    body.validate()  # (the split reads its mesh, boundaries and section)
+    found = own_sides.split(body, side.zone(body), where, side.boundaries)
+    if found is None:
+        return None
+    return SurfacePair(*(Side(side.body, side.boundaries, found=f, part=k + 1)
+                         for k, f in enumerate(found)))
 
 
 def _side(text, names: dict, bodies, entry, where: str) -> Side:
