@@ -48,7 +48,7 @@ from vfem.bodies import Platen, Support
 from vfem.config import BodyConfig, Curve, MeshSpec, ModelConfig, Steps, as_parameters
 from vfem.contact.settings import ContactSettings
 from vfem.materials import LinearElastic
-from vfem_examples import hertz, sphere
+from vfem_examples import axisymmetric_sphere, hertz, sphere
 
 
 def section(facets: int, order: int = 1) -> tuple[ModelConfig, float, float]:
@@ -130,22 +130,6 @@ def edge(result, name: str = "sphere", boundary: str = "contact") -> float:
     return float(0.5 * (inside + beyond.min())) if beyond.size else float(inside)
 
 
-def fitted(result, a: float, name: str = "sphere", boundary: str = "contact"
-           ) -> tuple[float, float]:
-    """Hertz's ellipse fitted to the nodal pressures of ``boundary`` (the facets' end nodes)
-    at radii 0 < r < 0.8 a (``a``: Hertz's): p^2 = p0^2 (1 - r^2 / a^2) is linear in r^2, fitted
-    by least squares; its p0 and a. A reading of the whole zone, not of one node: the peak
-    node and the contact's edge are read to the mesh's nodes (the edge to half a facet)."""
-    body = next(b for b in result.model.bodies if b.name == name)
-    mesh = body.mesh
-    nodes = np.unique(mesh.facets[:, mesh.boundaries[boundary]])
-    r = np.linalg.norm(mesh.p[:-1, nodes], axis=0)  # from the axis (x = 0, or x = y = 0)
-    p = result.steps[-1].bodies[name].contact_pressure[nodes]
-    keep = (r > 1e-9 * a) & (r < 0.8 * a)
-    slope, p0_squared = np.polyfit(r[keep] ** 2, p[keep] ** 2, 1)
-    return float(np.sqrt(p0_squared)), float(np.sqrt(-p0_squared / slope))
-
-
 def axisymmetric(facets: int, order: int = 1, model: str = "section") -> dict:
     """The r-z sphere (``model``: "section" or "hemisphere"), its elements a / ``facets``."""
     config, a, p0 = (section if model == "section" else hemisphere)(facets, order)
@@ -153,7 +137,7 @@ def axisymmetric(facets: int, order: int = 1, model: str = "section") -> dict:
     result = vfem.solve(config)
     seconds = time.perf_counter() - t0
     r = result.steps[-1].bodies["sphere"]
-    p0_fit, a_fit = fitted(result, a)
+    p0_fit, a_fit = axisymmetric_sphere.hertz_fit(result, a)
     mesh = next(b for b in result.model.bodies if b.name == "sphere").mesh
     nodes = np.unique(mesh.facets[:, mesh.boundaries["contact"]])
     nodes = nodes[np.argsort(mesh.p[0, nodes])]  # the axis node first, then r = h
@@ -192,7 +176,7 @@ def solid(facets: int, disk: bool = False) -> dict:
     seconds = time.perf_counter() - t0
     h = sphere.evaluate(result, p)
     a, p0 = h["a_theory"], h["p0_theory"]
-    p0_fit, a_fit = fitted(result, a)
+    p0_fit, a_fit = axisymmetric_sphere.hertz_fit(result, a)
     # the nodes on the axis, at (h, 0) (in the plane y = 0: r-z's node at r = h) and at (h, h)
     mesh = next(b for b in result.model.bodies if b.name == "sphere").mesh
     nodes = np.unique(mesh.facets[:, mesh.boundaries["contact"]])
