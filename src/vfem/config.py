@@ -190,6 +190,11 @@ class BodyConfig:
             material's: ``"saint-venant-kirchhoff"``, ``"neo-hookean"`` (Ciarlet–Simo) or
             ``"neo-hookean-isochoric"`` (CalculiX's and Abaqus's NEO HOOKE) (a plastic
             material has its own law: Hencky elasticity in the logarithmic strain).
+        subdomains: 1 (default): the body's stiffness is factorized whole. K > 1: its elements
+            are split into K subdomains (METIS, balanced by element count) whose interface
+            problem is solved by BDDC, each subdomain factorized on its own: the same answers
+            to 1e-8 of the largest, for a body too large to factorize whole (issue 43; serial
+            for now). Linear bodies only: small kinematics, elastic material.
     """
 
     name: str
@@ -203,6 +208,7 @@ class BodyConfig:
     contact_boundaries: tuple[str, ...] | None = None
     kinematics: str = "small"
     law: str = "saint-venant-kirchhoff"
+    subdomains: int = 1
 
     def build(self, base: Path | None = None) -> Body:
         try:
@@ -214,7 +220,7 @@ class BodyConfig:
         return Body(self.name, mesh, self.material, supports=self.supports,
                     prescribed=self.prescribed, tractions=self.tractions, platen=self.platen,
                     contact_boundaries=self.contact_boundaries, order=self.order,
-                    kinematics=self.kinematics, law=self.law)
+                    kinematics=self.kinematics, law=self.law, subdomains=self.subdomains)
 
 
 #: The most equal steps ``steps.count`` may ask for: each step is a contact solve, so more is a
