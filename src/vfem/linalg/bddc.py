@@ -180,8 +180,12 @@ class BDDCSolve:
             trailing = np.asarray(trailing, dtype=int)
             E = np.zeros((n, len(trailing)))
             E[trailing, np.arange(len(trailing))] = 1.0
+            t1 = time.perf_counter()
             inv = self.solve(E)[trailing]
             self.trailing_inverse = 0.5 * (inv + inv.T)
+            log.info("%s: the flexibility on %d trailing dofs by block PCG in %.2f s (%d "
+                     "iterations)", what, len(trailing), time.perf_counter() - t1,
+                     self.iterations[-1])
 
     # -- the interface operator and its preconditioner --------------------------------------
 
