@@ -23,6 +23,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import vfem
+from vfem import linalg
 from vfem.bodies import Body, condensation
 from vfem.bodies.loads import Support, Traction
 from vfem.bodies.subdomains import (
@@ -32,7 +33,7 @@ from vfem.bodies.subdomains import (
     split_solve,
     subdomain_matrices,
 )
-from vfem.errors import InputError
+from vfem.errors import AnalysisError, InputError
 from vfem.io.input import load
 from vfem.materials import J2Plastic, LinearElastic
 from vfem.mesh.shapes import rectangle
@@ -148,6 +149,33 @@ def test_split_solve_equals_direct(dim, n, order, simplex, k):
     assert 0 < max(split.iterations) <= 60  # bounded: measured 8 to 35 on these meshes
 
 
+@pytest.mark.parametrize("backend", linalg.available())
+def test_split_solve_with_every_backend(backend):
+    """The subdomains' and the coarse factorizations by any installed backend: the same
+    answer; a one-column block comes back as a block."""
+    body = _body(3, 4, 1, False, 4)
+    f = body.f_load[body.free_dofs]
+    direct = spla.spsolve(body.K_ff, f)
+    split = split_solve(body, backend)
+    assert split.subdomains[0].A_II.name == backend
+    X = split.solve(f[:, None])
+    assert X.shape == (len(f), 1)
+    assert abs(X[:, 0] - direct).max() <= 1e-10 * abs(direct).max()
+
+
+def test_unconverged_interface_solve_stops(monkeypatch):
+    """Past its iteration limit the split solve raises, naming the body, instead of returning
+    an unconverged answer."""
+    from vfem.linalg import bddc
+
+    body = _body(2, 8, 1, False, 4)
+    split = split_solve(body)
+    monkeypatch.setattr(bddc, "MAX_ITERATIONS", 2)
+    with pytest.raises(AnalysisError, match=r"body 'box': the subdomains' interface problem "
+                                            r"did not converge in 2 iterations"):
+        split.solve(body.f_load[body.free_dofs])
+
+
 def test_island_subdomain_gets_primal_points():
     """A subdomain inside another (its cut touches neither the boundary nor a third
     subdomain) has no primal point by the rule; the completion gives it two, else its Neumann
@@ -160,6 +188,24 @@ def test_island_subdomain_gets_primal_points():
     direct = spla.spsolve(body.K_ff, f)
     split = split_solve(body)
     assert split.n_primal >= 4  # two points, two dofs each
+    assert abs(split.solve(f) - direct).max() <= 1e-10 * abs(direct).max()
+
+
+def test_cut_between_supports_needs_no_coarse_problem():
+    """A square held on its left and right sides, cut across between them: the cut's ends are
+    supported, so there is no free primal dof (an empty coarse problem), and each half is held
+    by its supports alone."""
+    mesh = rectangle(nx=8, ny=8)
+    body = Body("held", mesh, LinearElastic(1000.0, 0.3),
+                supports=(Support("left"), Support("right")),
+                tractions=(Traction("top", value=(0.0, -1.0)),), subdomains=2)
+    condensation.assemble(body)
+    upper = mesh.p[1, mesh.t].mean(axis=0) > 0.5
+    body._partition = (body.mesh, 2, upper.astype(int))
+    f = body.f_load[body.free_dofs]
+    direct = spla.spsolve(body.K_ff, f)
+    split = split_solve(body)
+    assert split.n_primal == 0
     assert abs(split.solve(f) - direct).max() <= 1e-10 * abs(direct).max()
 
 

@@ -100,8 +100,9 @@ class _Subdomain:
         self.nR = len(R)
         self.A_rr = _factor(A_i[R][:, R], backend, f"{what} (primal dofs held)")
         self.A_Pr = A_i[P][:, R].tocsr()
-        X = self.A_rr.solve(np.asarray(A_i[R][:, P].todense()))  # (A_rr)^-1 A_rΠ
-        X = X.reshape(len(R), len(P))
+        X = np.zeros((len(R), len(P)))  # (A_rr)^-1 A_rΠ
+        if len(P):
+            X[:] = self.A_rr.solve(np.asarray(A_i[R][:, P].todense())).reshape(X.shape)
         self.S_P = np.asarray(A_i[P][:, P].todense()) - self.A_Pr @ X
         self.S_P = 0.5 * (self.S_P + self.S_P.T)
         self.X_D = np.ascontiguousarray(X[self.dual_in_R])  # only its dual rows are read
