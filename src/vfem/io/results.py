@@ -450,13 +450,16 @@ def subdomain_summary(model: Model) -> dict:
     """``{"subdomains": {body: sizes}}`` for the bodies split into subdomains (issue 43): the
     count, each subdomain's elements and dofs, the interface's and the coarse problem's dofs
     (:func:`vfem.bodies.subdomains.split_solve`), and the PCG iterations of its solves (the
-    most, and the total); nothing when no body is split (a summary as before)."""
+    most, and how many solves: where this rank solved the body); nothing when no body is
+    split (a summary as before)."""
     out = {}
     for body in model.bodies:
         if body.subdomains > 1 and hasattr(body, "subdomain_sizes"):
-            its = getattr(getattr(body, "factor", None), "iterations", None) or [0]
-            out[body.name] = {**body.subdomain_sizes, "pcg_iterations_max": int(max(its)),
-                              "pcg_solves": len(its)}
+            factor = getattr(body, "factor", None)
+            factor = getattr(factor, "factor", factor)  # over MPI ranks: the owner's own
+            its = getattr(factor, "iterations", None)
+            out[body.name] = {**body.subdomain_sizes, **({
+                "pcg_iterations_max": int(max(its)), "pcg_solves": len(its)} if its else {})}
     return {"subdomains": out} if out else {}
 
 
