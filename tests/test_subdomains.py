@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from skfem import MeshHex2, MeshQuad2, MeshTet2, MeshTri2
 
 import vfem
 from vfem import linalg
@@ -147,6 +148,39 @@ def test_split_solve_equals_direct(dim, n, order, simplex, k):
     assert abs(split.trailing_inverse - inverse).max() <= 1e-10 * abs(inverse).max()
     assert np.array_equal(split.trailing_inverse, split.trailing_inverse.T)
     assert 0 < max(split.iterations) <= 60  # bounded: measured 8 to 35 on these meshes
+
+
+def _top_and_bottom(mesh):
+    """``mesh`` with its ``bottom`` and ``top`` boundaries named (its last coordinate 0, 1)."""
+    d = mesh.p.shape[0] - 1
+    return mesh.with_boundaries({"bottom": lambda x: x[d] < 1e-9,
+                                 "top": lambda x: x[d] > 1 - 1e-9})
+
+
+CURVED = {"tri2": lambda: MeshTri2.from_mesh(rectangle(nx=6, ny=6, triangles=True)),
+          "quad2": lambda: MeshQuad2.from_mesh(rectangle(nx=6, ny=6)),
+          "hex2": lambda: MeshHex2.from_mesh(box(nx=3, ny=3, nz=3)),
+          "tet2": lambda: MeshTet2.from_mesh(box(nx=3, ny=3, nz=3, tetrahedra=True))}
+
+
+@pytest.mark.parametrize("kind", [*CURVED, "axisymmetric"])
+def test_split_solve_on_quadratic_geometry_and_axisymmetric(kind):
+    """The meshes of quadratic geometry (their own nodes the points) and the axisymmetric
+    section (its own stiffness form, per full circle) split as the others do."""
+    if kind == "axisymmetric":
+        mesh = rectangle(x0=0.5, nx=8, ny=8)
+        material = LinearElastic(1000.0, 0.3, plane="axisymmetric")
+    else:
+        mesh = _top_and_bottom(CURVED[kind]())
+        material = LinearElastic(1000.0, 0.3)
+    value = (1.0, -0.5, 0.3)[: mesh.p.shape[0]]
+    body = Body("b", mesh, material, supports=(Support("bottom"),),
+                tractions=(Traction("top", value=value),), order=2, subdomains=4)
+    condensation.assemble(body)
+    f = body.f_load[body.free_dofs]
+    direct = spla.spsolve(body.K_ff, f)
+    x = split_solve(body).solve(f)
+    assert abs(x - direct).max() <= 1e-10 * abs(direct).max()
 
 
 @pytest.mark.parametrize("backend", linalg.available())
