@@ -48,10 +48,11 @@ log = logging.getLogger(__name__)
 
 #: PCG stops when every column's residual ``|g - S u_Γ|`` is at most this times ``|g|``. The
 #: interface error is then at most ``cond(S) * RTOL`` relative; cond(S) grows as the mesh
-#: size over the element size (about 1/h, not 1/h^2 as cond(A): a Schur complement), a few
-#: thousand at the sizes vfem solves, so 1e-12 keeps the displacements equal to a direct
-#: solve's to better than 1e-8 of the largest (measured: 1e-11 to 1e-13, tests/test_subdomains.py
-#: and benchmarks/subdomains.py), at a few more iterations than 1e-8 would take.
+#: size over the element size (about 1/h, not 1/h^2 as cond(A): a Schur complement; measured
+#: 218 to 2,270 on 2,000 to 8,000-dof squares and cubes, docs/scaling.md §4), so 1e-12 keeps
+#: the displacements equal to a direct solve's to better than 1e-8 of the largest (measured:
+#: 1e-14 to 1e-13, tests/test_subdomains.py and benchmarks/subdomains.py), at a few more
+#: iterations than 1e-8 would take.
 RTOL = 1e-12
 #: an iteration count no well-posed split problem reaches (measured: 8 to 40); beyond it the
 #: split solve stops with an AnalysisError instead of returning an unconverged answer
