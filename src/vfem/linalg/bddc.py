@@ -111,7 +111,8 @@ class _Subdomain:
     def schur(self, u: np.ndarray) -> np.ndarray:
         """(its interface dofs, k) ``S_i u`` for the global interface block ``u``."""
         uG = u[self.gG]
-        return self.A_GG @ uG - self.A_GI @ self.A_II.solve(self.A_IG @ uG)
+        y = self.A_II.solve(self.A_IG @ uG).reshape(len(self.I), uG.shape[1])
+        return self.A_GG @ uG - self.A_GI @ y  # (a backend may return one column as 1D)
 
 
 class BDDCSolve:
