@@ -98,6 +98,19 @@ def test_partition_covers_balances_and_repeats(kind, k):
         assert len(seen) == len(inside), f"subdomain {i} in pieces"
 
 
+def test_partition_is_the_same_in_a_fresh_process():
+    """METIS's seed is fixed: another interpreter (another run) gets the same partition."""
+    import subprocess
+    import sys
+
+    code = ("from vfem.bodies.subdomains import partition; from vfem.mesh.solids import box; "
+            "print(partition(box(nx=6, ny=6, nz=6, tetrahedra=True), 8).tolist())")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    here = partition(box(nx=6, ny=6, nz=6, tetrahedra=True), 8)
+    assert json.loads(out) == here.tolist()
+
+
 def test_element_graph_is_the_shared_facets():
     mesh = rectangle(nx=3, ny=2)
     xadj, adjncy = element_graph(mesh)
