@@ -195,6 +195,11 @@ class BodyConfig:
             found at rest, where a ray along each facet's normal meets a facet facing it
             (docs/method.md §15). A surface whose sides cannot be told apart at rest (a round
             bore) is refused: name its two sides in ``contact_pairs`` instead.
+        subdomains: 1 (default): the body's stiffness is factorized whole. K > 1: its elements
+            are split into K subdomains (METIS, balanced by element count) whose interface
+            problem is solved by BDDC, each subdomain factorized on its own: the same answers
+            to 1e-8 of the largest, for a body too large to factorize whole (issue 43; serial
+            for now). Linear bodies only: small kinematics, elastic material.
     """
 
     name: str
@@ -209,6 +214,7 @@ class BodyConfig:
     kinematics: str = "small"
     law: str = "saint-venant-kirchhoff"
     self_contact: bool = False
+    subdomains: int = 1
 
     def build(self, base: Path | None = None) -> Body:
         try:
@@ -221,7 +227,7 @@ class BodyConfig:
                     prescribed=self.prescribed, tractions=self.tractions, platen=self.platen,
                     contact_boundaries=self.contact_boundaries, order=self.order,
                     kinematics=self.kinematics, law=self.law,
-                    self_contact=self.self_contact)
+                    self_contact=self.self_contact, subdomains=self.subdomains)
 
 
 #: The most equal steps ``steps.count`` may ask for: each step is a contact solve, so more is a

@@ -68,8 +68,8 @@ def cell_gradients(mesh, element, mapping=None, chunk: int | None = None,
 
 
 def elasticity_stiffness(mesh, element, lam: float, mu: float, element_dofs=None,
-                         mapping=None, gradient_bound: np.ndarray | None = None
-                         ) -> csr_matrix:
+                         mapping=None, gradient_bound: np.ndarray | None = None,
+                         which: np.ndarray | None = None) -> csr_matrix:
     """The stiffness of isotropic linear elasticity (Lame's ``lam``, ``mu``) of ``mesh`` with
     the vector form of scalar ``element`` (scikit-fem's ``ElementVector``, its numbering:
     ``element_dofs``, (local dofs, elements), by default ``Dofs(mesh, ElementVector(element))``),
@@ -92,6 +92,10 @@ def elasticity_stiffness(mesh, element, lam: float, mu: float, element_dofs=None
     dim = mesh.dim()
     if element_dofs is None:
         element_dofs = Dofs(mesh, ElementVector(element)).element_dofs
+    n = int(element_dofs.max()) + 1 if element_dofs.size else 0
+    if which is not None:
+        which = np.asarray(which, dtype=int)
+        element_dofs = element_dofs[:, which]
     dofs = element_dofs  # (nloc, nelems)
     nnode, nel = dofs.shape[0] // dim, dofs.shape[1]
     first = dofs[::dim]  # each scalar function's component 0
@@ -100,7 +104,9 @@ def elasticity_stiffness(mesh, element, lam: float, mu: float, element_dofs=None
         raise AssertionError("unexpected vector dof order")  # a scikit-fem change: not input
     nloc = nnode * dim
     data = np.empty((nloc, nloc, nel))
-    for e, g, dx in cell_gradients(mesh, element, mapping):
+    for e, g, dx in cell_gradients(mesh, element, mapping, which=which):
+        if which is not None:  # element numbers -> their columns here
+            e = np.searchsorted(which, e)
         if gradient_bound is not None:
             gradient_bound[e] = gradient_sums(g)
         gw = g * dx  # the weights on one factor
@@ -111,7 +117,6 @@ def elasticity_stiffness(mesh, element, lam: float, mu: float, element_dofs=None
             block[:, c, :, c] += mu * dot
         block = block.reshape(nloc, nloc, -1)
         data[:, :, e] = 0.5 * (block + block.transpose(1, 0, 2))  # exactly symmetric
-    n = int(dofs.max()) + 1 if dofs.size else 0
     index = np.int32 if n < 2**31 else np.int64  # the indices' copies: half the bytes
     dofs = dofs.astype(index)
     rows = np.broadcast_to(dofs[:, None, :], data.shape).ravel()

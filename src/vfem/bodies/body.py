@@ -53,6 +53,10 @@ class Body:
         self_contact: whether its contact surface (``contact_boundaries``, or its whole free
             surface) may touch itself: one self-contact pair of two sides found on the
             undeformed geometry (:func:`vfem.contact.geometry.own_sides.split`).
+        subdomains: 1 (default) to factorize the body whole; K > 1 to split its elements into
+            K subdomains (METIS) glued on their interfaces and solved by BDDC
+            (:mod:`.subdomains`, issue 43): the same answers to 1e-8. Linear bodies only
+            (small kinematics, elastic).
 
     Points: the nodes of the elements. For linear elements they are the mesh vertices; quadratic
     elements add one point at the middle of each facet (numbered after the vertices, in facet
@@ -74,6 +78,7 @@ class Body:
     kinematics: str = "small"
     law: str = "saint-venant-kirchhoff"
     self_contact: bool = False
+    subdomains: int = 1
 
     @property
     def dim(self) -> int:

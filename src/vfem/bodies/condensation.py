@@ -98,6 +98,10 @@ def setup(body, backend: str | None = None, condensed_dofs: np.ndarray | None = 
 
     With ``condensed_dofs`` (the dofs contact follows), the factorization also yields the
     inverse stiffness among them (``condensed_flexibility``, supports kept: zero on fixed dofs).
+
+    A body with ``subdomains`` > 1 gets the split solve of :mod:`.subdomains` in place of the
+    factorization (BDDC, the same ``solve`` and ``trailing_inverse``); its flexibility among
+    the condensed dofs is then one PCG solve per condensed dof (a block of unit columns).
     """
     fixed = assemble(body) if assembled is None else assembled
     t1 = time.perf_counter()
@@ -109,8 +113,13 @@ def setup(body, backend: str | None = None, condensed_dofs: np.ndarray | None = 
         pos, free = free_positions(body, condensed_dofs)
         trailing = pos[free]
     t2 = time.perf_counter()
-    body.factor = factorize(K_ff, backend, trailing=trailing,
-                            groups=body.free_dofs // body.dim, what=f"body {body.name!r}")
+    if body.subdomains > 1:  # split into subdomains, solved by BDDC (issue 43)
+        from .subdomains import split_solve
+
+        body.factor = split_solve(body, backend, trailing=trailing)
+    else:
+        body.factor = factorize(K_ff, backend, trailing=trailing,
+                                groups=body.free_dofs // body.dim, what=f"body {body.name!r}")
     t3 = time.perf_counter()
     del K_ff  # the factorization has its own copy (a million-dof 3D model: 1 GB each)
     body.condensed_flexibility = None

@@ -98,8 +98,11 @@ class Section(Protocol):
         <vfem.bodies.Body.basis>`)."""
         ...
 
-    def stiffness(self, body, lam: float, mu: float) -> sp.csr_matrix:
-        """The body's small-strain stiffness for the Lamé constants (lam, mu)."""
+    def stiffness(self, body, lam: float, mu: float, elements: np.ndarray | None = None
+                  ) -> sp.csr_matrix:
+        """The body's small-strain stiffness for the Lamé constants (lam, mu); with
+        ``elements`` (sorted element numbers) only theirs, same size and numbering (a
+        subdomain's Neumann matrix, :mod:`vfem.bodies.subdomains`)."""
         ...
 
     def average_strain_operator(self, body) -> sp.csr_matrix:
@@ -121,6 +124,14 @@ class Section(Protocol):
     def contact_modulus(self, material) -> float:
         """The modulus of Hertz's E* for the material (E / (1 - nu^2), or E in plane stress)."""
         ...
+
+
+def _basis_on(body, elements: np.ndarray | None) -> Basis:
+    """A 2D body's vector basis: its own, or (``elements``) one on those elements alone, the
+    same element and quadrature (a subdomain's, :mod:`vfem.bodies.subdomains`)."""
+    if elements is None:
+        return body.basis
+    return Basis(body.mesh, ElementVector(body.element()), elements=np.asarray(elements))
 
 
 class _Plane:
@@ -146,8 +157,8 @@ class _Plane:
     def basis(self, body):
         return Basis(body.mesh, ElementVector(body.element()))
 
-    def stiffness(self, body, lam, mu):
-        return asm(linear_elasticity(lam, mu), body.basis).tocsr()
+    def stiffness(self, body, lam, mu, elements=None):
+        return asm(linear_elasticity(lam, mu), _basis_on(body, elements)).tocsr()
 
     def average_strain_operator(self, body):
         return plane_average_strain_operator(body)
@@ -224,7 +235,10 @@ class Solid:
         # 147 KB a hexahedron, is not kept (:attr:`Body.basis`)
         return None
 
-    def stiffness(self, body, lam, mu):
+    def stiffness(self, body, lam, mu, elements=None):
+        if elements is not None:  # a subdomain's share: no gradient bound kept
+            return elasticity_stiffness(body.mesh, body.element(), lam, mu,
+                                        body.dof_map.element_dofs, which=elements)
         # the strain screen's gradient bound from the assembly's own gradients (no pass of its
         # own: :func:`~vfem.bodies.stresses.strain_beyond`)
         bound = np.empty(body.mesh.nelements)
@@ -298,8 +312,8 @@ class Axisymmetric(_Plane):
         w = self.weight(np.moveaxis(at, 1, 0)) * wt[None] * L[:, None]  # (nf, q)
         return np.einsum("aq,bq,fq->fab", phi, phi, w)
 
-    def stiffness(self, body, lam, mu):
-        return asm(_axisymmetric_elasticity(lam, mu), body.basis).tocsr()
+    def stiffness(self, body, lam, mu, elements=None):
+        return asm(_axisymmetric_elasticity(lam, mu), _basis_on(body, elements)).tocsr()
 
     def average_strain_operator(self, body):
         return axisymmetric_average_strain_operator(body)

@@ -32,6 +32,24 @@ def _named_first(null: np.ndarray) -> np.ndarray:
     return np.vstack([named, vt[: len(null) - len(pure)]])
 
 
+def check_subdomains(body, where: str) -> None:
+    """``subdomains``: an integer >= 1, at most the elements; above 1 a linear body only (the
+    split solve stands in for the factorization of a constant stiffness, issue 43)."""
+    k = body.subdomains
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+        raise InputError(f"{where}: subdomains must be a whole number >= 1 (1: not split), "
+                         f"got {k!r}")
+    if k > 1 and body.iterates:
+        why = (f"large kinematics ({body.kinematics!r})" if body.large
+               else "a plastic material")
+        raise InputError(f"{where}: only a linear body can be split into subdomains (small "
+                         f"kinematics, elastic); this one has {why}: set subdomains = 1, "
+                         f"not {k}")
+    if k > body.mesh.nelements:
+        raise InputError(f"{where}: more subdomains ({k}) than elements "
+                         f"({body.mesh.nelements})")
+
+
 def validate(body) -> None:
     """Raise :class:`InputError` naming the body if its definition cannot be analysed."""
     where = f"body {body.name!r}"
@@ -57,6 +75,7 @@ def validate(body) -> None:
     if body.law not in LAWS:
         names = " or ".join(repr(name) for name in LAWS)
         raise InputError(f"{where}: law must be {names}, got {body.law!r}")
+    check_subdomains(body, where)
     section = section_of(body)  # refuses a plane given to a 3D body
     if body.large and (body.order != 1 or not section.takes_large):
         taken = [s.name for s in SECTIONS.values() if s.takes_large]

@@ -220,6 +220,10 @@ class ResultsWriter:
                             "reaction": pad(reaction)},
                 cell_data={_CELL_FIELD.get(k, k): [v] for k, v in stress.items()},
             )
+            if body.subdomains > 1:  # the split body's partition (issue 43)
+                from ..bodies.subdomains import body_partition
+
+                m.cell_data["subdomain"] = [body_partition(body).astype(np.int32)]
             # friction's fields (vfem.contact.formulations.friction)
             if r.contact_shear is not None:
                 m.point_data.update({
@@ -442,6 +446,23 @@ def mpi_ranks() -> dict:
     return {"mpi_ranks": size} if size > 1 else {}
 
 
+def subdomain_summary(model: Model) -> dict:
+    """``{"subdomains": {body: sizes}}`` for the bodies split into subdomains (issue 43): the
+    count, each subdomain's elements and dofs, the interface's and the coarse problem's dofs
+    (:func:`vfem.bodies.subdomains.split_solve`), and the PCG iterations of its solves (the
+    most, and how many solves: where this rank solved the body); nothing when no body is
+    split (a summary as before)."""
+    out = {}
+    for body in model.bodies:
+        if body.subdomains > 1 and hasattr(body, "subdomain_sizes"):
+            factor = getattr(body, "factor", None)
+            factor = getattr(factor, "factor", factor)  # over MPI ranks: the owner's own
+            its = getattr(factor, "iterations", None)
+            out[body.name] = {**body.subdomain_sizes, **({
+                "pcg_iterations_max": int(max(its)), "pcg_solves": len(its)} if its else {})}
+    return {"subdomains": out} if out else {}
+
+
 def finish_summary(out: Path, summary: dict) -> None:
     """Add the phase table of the run (:func:`vfem.result_types.phase_table`: seconds per
     phase, from its ``timings``) to ``summary``, log it (``vfem -v``) and write
@@ -596,7 +617,7 @@ def example_summary(name: str, result: AnalysisResult, parameters) -> dict:
            "dofs": int(sum(b.ndofs for b in result.model.bodies)),
            "parameters": dataclasses.asdict(parameters), "timings": result.timings,
            "linear_solver": result.backend, "contact_flexibility": result.flexibility,
-           **mpi_ranks(),
+           **mpi_ranks(), **subdomain_summary(result.model),
            "contact_settings": contact_settings(result.model)}
     out.update(friction_summary(result, out["steps"]))
     return out

@@ -27,6 +27,7 @@ from .results import (
     mpi_ranks,
     run_writing,
     step_record,
+    subdomain_summary,
     total,
     write_summary,
 )
@@ -86,6 +87,7 @@ def summarize(result: AnalysisResult, config: ModelConfig, source: str | None = 
         "linear_solver": result.backend,
         "contact_flexibility": result.flexibility,
         **mpi_ranks(),
+        **subdomain_summary(result.model),
         **friction,
     }
 
