@@ -28,6 +28,16 @@ P = 0.5
 STEPS = tuple(np.linspace(0.1, 1.0, 10))
 
 
+def kept_elements(mesh, keep: np.ndarray):
+    """``mesh`` (its class kept) with the elements where ``keep`` alone, its nodes renumbered
+    to those they use."""
+    t = mesh.t[:, keep]
+    used = np.unique(t)
+    number = np.full(mesh.p.shape[1], -1)
+    number[used] = np.arange(len(used))
+    return type(mesh)(mesh.p[:, used], number[t])
+
+
 def slotted(mesh_cls, half: bool, *across):
     """The U's mesh of ``mesh_cls`` on the grid of ``across`` (x, then z in 3D) by its
     height's last coordinate, the slot's elements left out: a block H high, a slot GAP wide
@@ -43,11 +53,7 @@ def slotted(mesh_cls, half: bool, *across):
     z = mesh.p.shape[0] - 1  # the height's coordinate
     centre = mesh.p[:, mesh.t].mean(axis=1)
     keep = ~((centre[0] > BACK) & (centre[z] > T) & (centre[z] < T + GAP))
-    t = mesh.t[:, keep]
-    used = np.unique(t)
-    number = np.full(mesh.p.shape[1], -1)
-    number[used] = np.arange(len(used))
-    mesh = mesh_cls(mesh.p[:, used], number[t])
+    mesh = kept_elements(mesh, keep)
     tol = 1e-9
     names = {
         "back": lambda x: x[0] < tol,

@@ -25,6 +25,7 @@ from test_self_contact import (
     P,
     T,
     closing_u,
+    kept_elements,
     material,
     u_mesh,
     u_mesh_3d,
@@ -169,11 +170,7 @@ def e_mesh() -> MeshQuad:
     x, y = mesh.p[:, mesh.t].mean(axis=1)
     slots = [(levels[1], levels[2]), (levels[3], levels[4])]
     keep = ~((x > BACK) & np.any([(y > a) & (y < b) for a, b in slots], axis=0))
-    t = mesh.t[:, keep]
-    used = np.unique(t)
-    number = np.full(mesh.p.shape[1], -1)
-    number[used] = np.arange(len(used))
-    mesh = MeshQuad(mesh.p[:, used], number[t])
+    mesh = kept_elements(mesh, keep)
     tol = 1e-9
 
     def at(level):
