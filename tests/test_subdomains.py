@@ -314,6 +314,9 @@ def test_partition_in_results(tmp_path):
     vtu = meshio.read(tmp_path / "plate1_step0001.vtu")
     assert np.array_equal(vtu.cell_data["subdomain"][0], body_partition(plate1))
     assert "subdomain" not in meshio.read(tmp_path / "plate0_step0001.vtu").cell_data
+    # the screen says the split was used, for the split body alone
+    split_lines = [line for line in runner.report(summary, tmp_path) if "subdomains" in line]
+    assert len(split_lines) == 1 and "'plate1' split into 4 subdomains" in split_lines[0]
 
 
 # -- input ----------------------------------------------------------------------------------------

@@ -286,7 +286,26 @@ def report(s: dict, out: Path) -> list[str]:
                             "files")
     if line:
         lines.append("  " + line)
+    lines.extend("  " + line for line in subdomain_lines(s))
     return lines
+
+
+def subdomain_lines(s: dict) -> list[str]:
+    """A line per body split into subdomains (``summary.json``'s ``subdomains``, issue 43):
+    how it was split and what its BDDC solves took, so a user sees the split was used and
+    what it cost (the partition itself is the VTU cell field ``subdomain``)."""
+    out = []
+    for name, d in (s.get("subdomains") or {}).items():
+        dofs = d.get("dofs") or []
+        sizes = f" ({min(dofs)} to {max(dofs)} dofs each)" if dofs else ""
+        its = d.get("pcg_iterations_max")
+        solves = d.get("pcg_solves")
+        cost = (f", {solves} solve{'' if solves == 1 else 's'} of at most {its} BDDC iterations"
+                if its is not None and solves else "")
+        out.append(f"{name!r} split into {d['count']} subdomains{sizes}, interface "
+                   f"{d['interface_dofs']} dofs, coarse {d['primal_dofs']}{cost}; the partition "
+                   "is the VTU cell field 'subdomain'")
+    return out
 
 
 #: A frictional work within this fraction of the external work is round-off: shown as 0.
