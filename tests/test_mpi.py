@@ -105,14 +105,15 @@ def test_the_ranks_launcher_runs_the_same_command(tmp_path):
 
 
 @pytest.mark.slow
-def killed_and_resumed(tmp_path: Path, args: list[str], steps: int) -> tuple[Path, Path]:
-    """``vfem run ARGS`` whole in one process, and over two ranks killed (SIGKILL) after its
-    third checkpoint of ``steps`` and resumed over two ranks: the two results folders."""
+def killed_and_resumed(tmp_path: Path, args: list[str], steps: int, ranks: int = 2
+                       ) -> tuple[Path, Path]:
+    """``vfem run ARGS`` whole in one process, and over ``ranks`` ranks killed (SIGKILL) after
+    its third checkpoint of ``steps`` and resumed over as many: the two results folders."""
     whole = tmp_path / "whole"
     assert vfem(["run", *args, "--out", str(whole)]).returncode == 0
     out = tmp_path / "killed"
     command, env = parallel.launch_command(
-        MPIEXEC, 2, [sys.executable, "-m", "vfem", "run", *args, "--out", str(out)])
+        MPIEXEC, ranks, [sys.executable, "-m", "vfem", "run", *args, "--out", str(out)])
     proc = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, start_new_session=True)
     deadline = time.time() + 300
@@ -125,7 +126,7 @@ def killed_and_resumed(tmp_path: Path, args: list[str], steps: int) -> tuple[Pat
     proc.wait()
     steps_before = len(list(out.glob("**/checkpoint/step*.npz")))
     assert 1 <= steps_before < steps
-    done = vfem(["run", *args, "--resume", str(out)], ranks=2)
+    done = vfem(["run", *args, "--resume", str(out)], ranks=ranks)
     assert done.returncode == 0, done.stderr + done.stdout
     return whole, out
 
@@ -137,6 +138,23 @@ def test_resume_after_a_kill_under_mpi_is_the_uninterrupted_run(tmp_path):
     same_results(whole, out)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["converged"] and len(summary["steps"]) == 8
+
+
+@pytest.mark.slow
+def test_a_split_body_killed_under_four_ranks_resumes_as_the_uninterrupted_run(tmp_path):
+    """Issue 43's acceptance, as far as its serial core goes: the stack with its middle plate
+    split into four subdomains (BDDC), run whole in one process, and under ``mpiexec -n 4``
+    (oversubscribed here) killed after its third checkpoint and resumed: every VTU field the
+    uninterrupted run's to 1e-10 of its largest (the split body on one rank: the subdomains
+    are not yet spread over the ranks)."""
+    stack = str(Path(__file__).parent.parent / "examples" / "stack.toml")
+    args = [stack, "--set", "bodies.plate1.subdomains=4", "--set", "steps.count=8",
+            "--no-figures"]
+    whole, out = killed_and_resumed(tmp_path, args, 8, ranks=4)
+    assert same_results(whole, out) >= 8
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["converged"] and len(summary["steps"]) == 8
+    assert summary["subdomains"]["plate1"]["count"] == 4
 
 
 def test_two_plates_on_two_ranks_give_the_serial_answers(tmp_path):
